@@ -1,0 +1,73 @@
+// Atomic replace through write-temp, fsync, rename, fsync-directory.
+#include "picksight/common/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace picksight {
+namespace {
+std::string errnoText(const std::string& what, const std::string& path) {
+  return what + " " + path + ": " + std::strerror(errno);
+}
+
+// Closes the descriptor on every path out of writeFileAtomically.
+struct FdGuard {
+  int fd;
+  ~FdGuard() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+}  // namespace
+
+Result<void> writeFileAtomically(const std::string& path, const std::string& content) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  {
+    FdGuard file{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644)};
+    if (file.fd < 0) return makeError(errno, errnoText("cannot create", tmp));
+    const char* p = content.data();
+    size_t left = content.size();
+    while (left > 0) {
+      ssize_t n = ::write(file.fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        Error e = makeError(errno, errnoText("cannot write", tmp));
+        ::unlink(tmp.c_str());
+        return e;
+      }
+      p += n;
+      left -= static_cast<size_t>(n);
+    }
+    if (::fsync(file.fd) != 0) {
+      Error e = makeError(errno, errnoText("cannot sync", tmp));
+      ::unlink(tmp.c_str());
+      return e;
+    }
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    Error e = makeError(errno, errnoText("cannot rename over", path));
+    ::unlink(tmp.c_str());
+    return e;
+  }
+  // The rename itself is only durable once the directory entry is on disk.
+  const size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  FdGuard dir_fd{::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC)};
+  if (dir_fd.fd >= 0) ::fsync(dir_fd.fd);
+  return {};
+}
+
+Result<std::string> readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(ENOENT, "cannot open " + path);
+  std::ostringstream out;
+  out << in.rdbuf();
+  if (in.bad()) return makeError(EIO, "cannot read " + path);
+  return out.str();
+}
+
+}  // namespace picksight

@@ -1,0 +1,43 @@
+// Control client. A REQ socket that timed out is stuck waiting for its reply,
+// so on timeout the socket is dropped and a new one connected.
+#include "picksight/transport/control_client.hpp"
+
+namespace picksight {
+
+ControlClient::ControlClient(zmq::context_t& context, std::string endpoint,
+                             std::chrono::milliseconds timeout)
+    : context_(context), endpoint_(std::move(endpoint)), timeout_(timeout) {
+  reconnect();
+}
+
+void ControlClient::reconnect() {
+  socket_ = std::make_unique<zmq::socket_t>(context_, zmq::socket_type::req);
+  socket_->set(zmq::sockopt::linger, 0);
+  socket_->connect(endpoint_);
+}
+
+Result<proto::ControlReply> ControlClient::call(const proto::ControlRequest& request) {
+  const std::string bytes = request.SerializeAsString();
+  socket_->send(zmq::buffer(bytes), zmq::send_flags::none);
+  zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
+  if (zmq::poll(&item, 1, timeout_) == 0) {
+    reconnect();
+    return makeError(kControlTimeout, "video server at " + endpoint_ + " did not answer within " +
+                                          std::to_string(timeout_.count()) + " ms");
+  }
+  zmq::message_t reply_bytes;
+  if (!socket_->recv(reply_bytes)) {
+    reconnect();
+    return makeError(kControlTimeout, "no reply from " + endpoint_);
+  }
+  proto::ControlReply reply;
+  if (!reply.ParseFromArray(reply_bytes.data(), static_cast<int>(reply_bytes.size()))) {
+    return makeError(proto::Error::INTERNAL, "malformed reply from " + endpoint_);
+  }
+  if (reply.has_error() && reply.error().code() != proto::Error::OK) {
+    return makeError(reply.error().code(), reply.error().text());
+  }
+  return reply;
+}
+
+}  // namespace picksight

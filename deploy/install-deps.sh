@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs every build, run and test dependency of PickSight from Debian 12's
+# own packages. Idempotent: when everything is present it only checks and
+# returns, without touching the network.
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  build-essential cmake pkg-config git clang clang-format
+  # core libraries
+  libopencv-dev libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
+  libyaml-cpp-dev libeigen3-dev
+  # camera drivers: GigE/USB3 Vision (and the fake camera used by tests), V4L2
+  libaravis-dev aravis-tools aravis-tools-cli libv4l-dev
+  # tests
+  catch2
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: missing packages (${missing[*]}); run as root" >&2
+  exit 1
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: done"

@@ -1,0 +1,516 @@
+// picksight-cam against a real ZeroMQ REP socket: what it sends for each
+// command, what it prints for people and scripts, and its exit codes.
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <zmq.hpp>
+
+#include "cam_cli.hpp"
+#include "picksight.pb.h"
+
+namespace {
+
+using picksight::cam::runCamCli;
+namespace proto = picksight::proto;
+
+// Generous: a loaded CI machine must never turn a passing test into a timeout.
+const std::string kTimeoutMs = "10000";
+
+// A control socket served by its own thread (which owns the socket), answering
+// every request with the same canned reply and recording what it received.
+class FakeServer {
+ public:
+  FakeServer(zmq::context_t& context, proto::ControlReply reply)
+      : context_(context), reply_(std::move(reply)) {
+    thread_ = std::thread([this] { serve(); });
+    endpoint_ = bound_.get_future().get();
+  }
+  ~FakeServer() { stop(); }
+  FakeServer(const FakeServer&) = delete;
+  FakeServer& operator=(const FakeServer&) = delete;
+
+  const std::string& endpoint() const { return endpoint_; }
+
+  // Stops the thread and returns the requests it received, in order. The
+  // vector is only read after the join, so it needs no mutex.
+  std::vector<proto::ControlRequest> stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    return requests_;
+  }
+  // Valid after stop(): empty unless the server thread failed.
+  const std::string& failure() const { return failure_; }
+
+ private:
+  void serve() {
+    bool bound = false;
+    try {
+      zmq::socket_t socket(context_, zmq::socket_type::rep);
+      socket.set(zmq::sockopt::linger, 0);
+      socket.bind("tcp://127.0.0.1:*");
+      bound_.set_value(socket.get(zmq::sockopt::last_endpoint));
+      bound = true;
+      const std::string reply_bytes = reply_.SerializeAsString();
+      while (!stop_) {
+        zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+        if (zmq::poll(&item, 1, std::chrono::milliseconds(20)) == 0) continue;
+        zmq::message_t message;
+        if (!socket.recv(message)) continue;
+        proto::ControlRequest request;
+        if (!request.ParseFromArray(message.data(), static_cast<int>(message.size()))) {
+          failure_ += "unparsable request; ";
+        }
+        requests_.push_back(request);
+        socket.send(zmq::buffer(reply_bytes), zmq::send_flags::none);
+      }
+    } catch (const std::exception& e) {
+      failure_ += e.what();
+      if (!bound) bound_.set_value("server failed: " + failure_);
+    }
+  }
+
+  zmq::context_t& context_;
+  const proto::ControlReply reply_;
+  std::promise<std::string> bound_;
+  std::string endpoint_;
+  std::atomic<bool> stop_{false};
+  std::vector<proto::ControlRequest> requests_;  // server thread only until stop()
+  std::string failure_;                          // server thread only until stop()
+  std::thread thread_;
+};
+
+struct Run {
+  int code;
+  std::string out;
+  std::string err;
+};
+
+Run runCli(zmq::context_t& context, const std::vector<std::string>& args) {
+  std::ostringstream out;
+  std::ostringstream err;
+  const int code = runCamCli(args, out, err, context);
+  return {code, out.str(), err.str()};
+}
+
+// Runs `args` against `server`, as a user would with --control.
+Run runAt(zmq::context_t& context, const FakeServer& server, std::vector<std::string> args) {
+  args.insert(args.begin(), {"--control", server.endpoint(), "--timeout", kTimeoutMs});
+  return runCli(context, args);
+}
+
+proto::ControlReply okReply() {
+  proto::ControlReply reply;
+  reply.mutable_error()->set_code(proto::Error::OK);
+  return reply;
+}
+
+// Expects exactly one request, and returns it.
+proto::ControlRequest onlyRequest(FakeServer& server) {
+  const std::vector<proto::ControlRequest> requests = server.stop();
+  INFO("server failure: " << server.failure());
+  REQUIRE(server.failure().empty());
+  REQUIRE(requests.size() == 1);
+  return requests.front();
+}
+
+// A port nothing listens on: bound once to get it from the kernel, then freed.
+std::string unusedEndpoint(zmq::context_t& context) {
+  zmq::socket_t socket(context, zmq::socket_type::rep);
+  socket.set(zmq::sockopt::linger, 0);
+  socket.bind("tcp://127.0.0.1:*");
+  return socket.get(zmq::sockopt::last_endpoint);
+}
+
+}  // namespace
+
+TEST_CASE("list prints an aligned table, or JSON", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply = okReply();
+  auto* cameras = reply.mutable_list_cameras();
+  auto* cam0 = cameras->add_cameras();
+  cam0->set_name("cam0");
+  cam0->set_source("synthetic:");
+  cam0->set_state("streaming");
+  cam0->set_mode(proto::FREERUN);
+  auto* left = cameras->add_cameras();
+  left->set_name("conveyor-left");
+  left->set_source("aravis:Basler-12345");
+  left->set_state("reconnecting");
+  left->set_mode(proto::TRIGGER);
+  FakeServer server(context, reply);
+
+  SECTION("text") {
+    const Run run = runAt(context, server, {"list"});
+    CHECK(run.code == 0);
+    CHECK(run.err.empty());
+    CHECK(run.out ==
+          "NAME           SOURCE               STATE         MODE\n"
+          "cam0           synthetic:           streaming     freerun\n"
+          "conveyor-left  aravis:Basler-12345  reconnecting  trigger\n");
+  }
+  SECTION("JSON, with the option after the command") {
+    const Run run = runAt(context, server, {"list", "--json"});
+    CHECK(run.code == 0);
+    CHECK(run.out == R"({"cameras":[{"name":"cam0","source":"synthetic:","state":"streaming",)"
+                     R"("mode":"freerun"},{"name":"conveyor-left","source":"aravis:Basler-12345",)"
+                     R"("state":"reconnecting","mode":"trigger"}]})"
+                     "\n");
+  }
+  CHECK(onlyRequest(server).request_case() == proto::ControlRequest::kListCameras);
+}
+
+TEST_CASE("list of a server without cameras", "[cam]") {
+  zmq::context_t context;
+  // The list part left out entirely: proto3 cannot tell it from an empty list.
+  FakeServer server(context, okReply());
+  CHECK(runAt(context, server, {"list"}).out == "no cameras\n");
+  CHECK(runAt(context, server, {"--json", "list"}).out == "{\"cameras\":[]}\n");
+}
+
+TEST_CASE("info prints key: value lines, or JSON with escaped strings", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply = okReply();
+  auto* d = reply.mutable_describe_camera();
+  d->mutable_summary()->set_name("cam0");
+  d->mutable_summary()->set_source("aravis:Basler-12345");
+  d->mutable_summary()->set_state("streaming");
+  d->mutable_summary()->set_mode(proto::TRIGGER);
+  d->set_vendor("Basler");
+  d->set_model("acA1920-40gm \"rev\\2\"");
+  d->set_serial("12345");
+  d->set_sensor_width(1920);
+  d->set_sensor_height(1200);
+  d->mutable_roi()->set_x(100);
+  d->mutable_roi()->set_y(50);
+  d->mutable_roi()->set_width(800);
+  d->mutable_roi()->set_height(600);
+  d->set_output_width(400);
+  d->set_output_height(300);
+  d->set_pixel_format(proto::MONO8);
+  d->set_fps(40.0);
+  d->add_source_formats("Mono8");
+  d->add_source_formats("Mono12");
+  FakeServer server(context, reply);
+
+  SECTION("text") {
+    const Run run = runAt(context, server, {"info", "cam0"});
+    CHECK(run.code == 0);
+    CHECK(run.out ==
+          "camera:         cam0\n"
+          "source:         aravis:Basler-12345\n"
+          "state:          streaming\n"
+          "mode:           trigger\n"
+          "vendor:         Basler\n"
+          "model:          acA1920-40gm \"rev\\2\"\n"
+          "serial:         12345\n"
+          "sensor:         1920x1200\n"
+          "roi:            x=100 y=50 width=800 height=600\n"
+          "output:         400x300\n"
+          "pixel format:   mono8\n"
+          "fps:            40.0\n"
+          "source formats: Mono8, Mono12\n");
+  }
+  SECTION("JSON") {
+    const Run run = runAt(context, server, {"--json", "info", "cam0"});
+    CHECK(run.code == 0);
+    CHECK(run.out == R"({"name":"cam0","source":"aravis:Basler-12345","state":"streaming",)"
+                     R"("mode":"trigger","vendor":"Basler","model":"acA1920-40gm \"rev\\2\"",)"
+                     R"("serial":"12345","sensor_width":1920,"sensor_height":1200,)"
+                     R"("roi":{"x":100,"y":50,"width":800,"height":600},"output_width":400,)"
+                     R"("output_height":300,"pixel_format":"mono8","fps":40,)"
+                     R"("source_formats":["Mono8","Mono12"]})"
+                     "\n");
+  }
+  const proto::ControlRequest request = onlyRequest(server);
+  REQUIRE(request.request_case() == proto::ControlRequest::kDescribeCamera);
+  CHECK(request.describe_camera().camera() == "cam0");
+}
+
+TEST_CASE("roi sends the rectangle and confirms it", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  SECTION("text") {
+    const Run run = runAt(context, server, {"roi", "cam0", "10", "20", "300", "200"});
+    CHECK(run.code == 0);
+    CHECK(run.err.empty());
+    CHECK(run.out == "cam0: ROI set to x=10 y=20 width=300 height=200\n");
+  }
+  SECTION("JSON") {
+    const Run run = runAt(context, server, {"--json", "roi", "cam0", "10", "20", "300", "200"});
+    CHECK(run.code == 0);
+    CHECK(run.out == R"({"ok":true,"camera":"cam0","roi":{"x":10,"y":20,"width":300,"height":200}})"
+                     "\n");
+  }
+  const proto::ControlRequest request = onlyRequest(server);
+  REQUIRE(request.request_case() == proto::ControlRequest::kSetRoi);
+  CHECK(request.set_roi().camera() == "cam0");
+  CHECK(request.set_roi().roi().x() == 10);
+  CHECK(request.set_roi().roi().y() == 20);
+  CHECK(request.set_roi().roi().width() == 300);
+  CHECK(request.set_roi().roi().height() == 200);
+}
+
+TEST_CASE("size sends a target size or a scale", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  SECTION("target size") {
+    const Run run = runAt(context, server, {"size", "cam0", "640", "480"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "cam0: output size set to 640x480\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetSize);
+    CHECK(request.set_size().camera() == "cam0");
+    CHECK(request.set_size().width() == 640);
+    CHECK(request.set_size().height() == 480);
+    CHECK(request.set_size().scale() == 0.0);
+  }
+  SECTION("scale") {
+    const Run run = runAt(context, server, {"size", "cam0", "--scale", "0.5"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "cam0: output scale set to 0.5\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetSize);
+    CHECK(request.set_size().width() == 0);
+    CHECK(request.set_size().height() == 0);
+    CHECK(request.set_size().scale() == 0.5);
+  }
+  SECTION("scale, JSON") {
+    const Run run = runAt(context, server, {"--json", "size", "cam0", "--scale", "0.25"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "{\"ok\":true,\"camera\":\"cam0\",\"scale\":0.25}\n");
+  }
+}
+
+TEST_CASE("mode and format send the enum values", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  SECTION("free-run with a frame rate") {
+    const Run run = runAt(context, server, {"mode", "cam0", "freerun", "15"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "cam0: mode set to freerun at 15 fps\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetMode);
+    CHECK(request.set_mode().mode() == proto::FREERUN);
+    CHECK(request.set_mode().fps() == 15.0);
+  }
+  SECTION("trigger, frame rate left unchanged, JSON") {
+    const Run run = runAt(context, server, {"--json", "mode", "cam0", "trigger"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "{\"ok\":true,\"camera\":\"cam0\",\"mode\":\"trigger\"}\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetMode);
+    CHECK(request.set_mode().mode() == proto::TRIGGER);
+    CHECK(request.set_mode().fps() == 0.0);
+  }
+  SECTION("format") {
+    const Run run = runAt(context, server, {"format", "cam0", "bgr8"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "cam0: pixel format set to bgr8\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetFormat);
+    CHECK(request.set_format().camera() == "cam0");
+    CHECK(request.set_format().pixel_format() == proto::BGR8);
+  }
+}
+
+TEST_CASE("trigger prints the sequence number the frame will carry", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply = okReply();
+  reply.mutable_trigger()->set_sequence(4242);
+  SECTION("trigger mode") {
+    reply.mutable_trigger()->set_triggered(true);
+    FakeServer server(context, reply);
+    const Run text = runAt(context, server, {"trigger", "cam0"});
+    CHECK(text.code == 0);
+    CHECK(text.out == "cam0: triggered, the frame will carry sequence 4242\n");
+    const Run json = runAt(context, server, {"--json", "trigger", "cam0"});
+    CHECK(json.code == 0);
+    CHECK(json.out == "{\"camera\":\"cam0\",\"sequence\":4242,\"triggered\":true}\n");
+    const std::vector<proto::ControlRequest> requests = server.stop();
+    REQUIRE(requests.size() == 2);
+    REQUIRE(requests[0].request_case() == proto::ControlRequest::kTrigger);
+    CHECK(requests[0].trigger().camera() == "cam0");
+  }
+  SECTION("free-run: says the frame is not a dedicated one") {
+    reply.mutable_trigger()->set_triggered(false);
+    FakeServer server(context, reply);
+    const Run run = runAt(context, server, {"trigger", "cam0"});
+    CHECK(run.code == 0);
+    CHECK(run.out ==
+          "cam0: camera is in free-run, the first frame after the request will carry "
+          "sequence 4242\n");
+  }
+}
+
+TEST_CASE("trigger with a reply that lacks the sequence number is an error", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  const Run run = runAt(context, server, {"trigger", "cam0"});
+  CHECK(run.code == 1);
+  CHECK(run.out.empty());
+  CHECK_THAT(run.err, Catch::Contains("unexpected reply: no trigger sequence number"));
+}
+
+TEST_CASE("stats prints an aligned table with right-aligned numbers, or JSON", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply = okReply();
+  reply.mutable_statistics()->set_subscribers(3);
+  auto* s = reply.mutable_statistics()->add_cameras();
+  s->set_camera("cam0");
+  s->set_frames_acquired(1200);
+  s->set_frames_published(1198);
+  s->set_frames_dropped(2);
+  s->set_acquisition_errors(0);
+  s->set_reconnects(1);
+  s->set_fps(29.97);
+  s->set_last_sequence(1199);
+  FakeServer server(context, reply);
+
+  SECTION("all cameras, text") {
+    const Run run = runAt(context, server, {"stats"});
+    CHECK(run.code == 0);
+    CHECK(run.out ==
+          "CAMERA  ACQUIRED  PUBLISHED  DROPPED  ERRORS  RECONNECTS   FPS  LAST SEQ\n"
+          "cam0        1200       1198        2       0           1  30.0      1199\n"
+          "subscribers: 3\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kStatistics);
+    CHECK(request.statistics().camera().empty());
+  }
+  SECTION("one camera, JSON") {
+    const Run run = runAt(context, server, {"--json", "stats", "cam0"});
+    CHECK(run.code == 0);
+    CHECK(run.out == R"({"subscribers":3,"cameras":[{"camera":"cam0","frames_acquired":1200,)"
+                     R"("frames_published":1198,"frames_dropped":2,"acquisition_errors":0,)"
+                     R"("reconnects":1,"fps":29.97,"last_sequence":1199}]})"
+                     "\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kStatistics);
+    CHECK(request.statistics().camera() == "cam0");
+  }
+}
+
+TEST_CASE("usage errors exit 2 with a message and contact no server", "[cam]") {
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"roi", "cam0", "abc", "20", "300", "200"},
+       "roi: X must be a non-negative integer, got 'abc'"},
+      {{"roi", "cam0", "10", "-5", "300", "200"},
+       "roi: Y must be a non-negative integer, got '-5'"},
+      {{"roi", "cam0", "10", "20", "1.5", "200"},
+       "roi: W must be a non-negative integer, got '1.5'"},
+      {{"roi", "cam0", "10", "20", "300", "99999999999"}, "roi: H is too large, got '99999999999'"},
+      {{"roi", "cam0", "10", "20", "300"},
+       "roi: missing arguments; usage: picksight-cam roi CAM X Y W H"},
+      {{"info"}, "info: missing arguments"},
+      {{"info", "cam0", "cam1"}, "info: too many arguments (unexpected 'cam1')"},
+      {{"info", ""}, "info: CAM must not be empty"},
+      {{"list", "extra"}, "list: too many arguments (unexpected 'extra')"},
+      {{"size", "cam0", "640"}, "size: missing arguments"},
+      {{"size", "cam0", "640", "x480"}, "size: H must be a non-negative integer, got 'x480'"},
+      {{"size", "cam0", "--scale", "0"}, "size: S must be a positive number, got '0'"},
+      // A decimal comma is what a German locale would accept.
+      {{"size", "cam0", "--scale", "1,5"}, "size: S must be a positive number, got '1,5'"},
+      {{"mode", "cam0", "burst"}, "mode: mode must be 'freerun' or 'trigger', got 'burst'"},
+      {{"mode", "cam0", "freerun", "fast"}, "mode: FPS must be a positive number, got 'fast'"},
+      {{"mode", "cam0", "freerun", "15", "x"}, "mode: too many arguments (unexpected 'x')"},
+      {{"format", "cam0", "rgb8"}, "format: format must be 'mono8' or 'bgr8', got 'rgb8'"},
+      {{"trigger"}, "trigger: missing arguments; usage: picksight-cam trigger CAM"},
+      {{"stats", "cam0", "cam1"}, "stats: too many arguments (unexpected 'cam1')"},
+      {{"frobnicate", "cam0"}, "unknown command 'frobnicate'"},
+      {{}, "missing command"},
+      {{"--verbose", "list"}, "unknown option '--verbose'"},
+      {{"--timeout", "soon", "list"}, "--timeout: MS must be a positive integer, got 'soon'"},
+      {{"--timeout", "0", "list"}, "--timeout: MS must be a positive integer, got '0'"},
+      {{"list", "--control"}, "--control: missing value"},
+  };
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  for (const Case& c : cases) {
+    std::string joined;
+    for (const std::string& arg : c.args) joined += " '" + arg + "'";
+    INFO("args:" << joined);
+    const Run run = runAt(context, server, c.args);
+    CHECK(run.code == 2);
+    CHECK(run.out.empty());
+    CHECK_THAT(run.err, Catch::StartsWith("picksight-cam: " + c.message));
+  }
+  // runCamCli waits for a reply to whatever it sends, so anything sent has
+  // been received by the time the loop ends.
+  CHECK(server.stop().empty());
+  CHECK(server.failure().empty());
+}
+
+TEST_CASE("a malformed endpoint is a usage error", "[cam]") {
+  zmq::context_t context;
+  const Run run = runCli(context, {"--control", "not-an-endpoint", "list"});
+  CHECK(run.code == 2);
+  CHECK_THAT(run.err, Catch::Contains("invalid endpoint 'not-an-endpoint'"));
+}
+
+TEST_CASE("--help prints the usage on stdout", "[cam]") {
+  zmq::context_t context;
+  const Run run = runCli(context, {"list", "--help"});
+  CHECK(run.code == 0);
+  CHECK(run.err.empty());
+  CHECK_THAT(run.out, Catch::StartsWith("usage: picksight-cam [--control ENDPOINT]"));
+  CHECK_THAT(run.out, Catch::Contains("size CAM --scale S"));
+}
+
+TEST_CASE("a server error exits 1 with the server's text and code", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply;
+  reply.mutable_error()->set_code(proto::Error::UNKNOWN_CAMERA);
+  reply.mutable_error()->set_text("unknown camera 'cam9'");
+  FakeServer server(context, reply);
+  const Run run = runAt(context, server, {"roi", "cam9", "0", "0", "64", "64"});
+  CHECK(run.code == 1);
+  CHECK(run.out.empty());
+  CHECK(run.err ==
+        "picksight-cam: roi: unknown camera 'cam9' (server error UNKNOWN_CAMERA, code 2)\n");
+  CHECK(onlyRequest(server).set_roi().camera() == "cam9");
+}
+
+TEST_CASE("no server: exit 3 naming the endpoint and the timeout", "[cam]") {
+  zmq::context_t context;
+  const std::string endpoint = unusedEndpoint(context);
+  const Run run = runCli(context, {"--control", endpoint, "--timeout", "200", "info", "cam0"});
+  CHECK(run.code == 3);
+  CHECK(run.out.empty());
+  CHECK(run.err == "picksight-cam: no answer from " + endpoint +
+                       " within 200 ms: is picksight-video-server running?\n");
+}
+
+TEST_CASE("JSON strings are escaped", "[cam]") {
+  using picksight::cam::escapeJson;
+  CHECK(escapeJson("plain") == "plain");
+  CHECK(escapeJson("a\"b\\c") == "a\\\"b\\\\c");
+  CHECK(escapeJson("line\nnext\ttab\r") == "line\\nnext\\ttab\\r");
+  CHECK(escapeJson(std::string("\x01\x1f", 2)) == "\\u0001\\u001f");
+  CHECK(escapeJson(std::string("nul\0x", 5)) == "nul\\u0000x");
+  CHECK(escapeJson("caf\xc3\xa9") == "caf\xc3\xa9");  // UTF-8 passes through
+}
+
+TEST_CASE("JsonWriter places commas and writes numbers JSON can read", "[cam]") {
+  picksight::cam::JsonWriter json;
+  json.beginObject();
+  json.key("a").beginArray().uinteger(1).real(2.5).boolean(false).string("x").endArray();
+  json.key("empty").beginObject().endObject();
+  json.key("nan").real(std::numeric_limits<double>::quiet_NaN());
+  json.key("big").uinteger(std::numeric_limits<std::uint64_t>::max());
+  json.key("k\"ey").beginArray().beginObject().endObject().beginObject().endObject().endArray();
+  json.endObject();
+  CHECK(json.str() == R"({"a":[1,2.5,false,"x"],"empty":{},"nan":null,"big":18446744073709551615,)"
+                      R"("k\"ey":[{},{}]})");
+}

@@ -1,0 +1,115 @@
+// Pins atomic file replacement: create, replace, no temporary left behind,
+// clean errors for impossible writes and missing files.
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <set>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "picksight/common/atomic_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh directory under the system temp dir, removed with its content.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "picksight-common-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+std::set<std::string> namesIn(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+}  // namespace
+
+TEST_CASE("writeFileAtomically creates a file with the exact bytes", "[common]") {
+  TempDir dir;
+  const std::string path = (dir.path() / "points.txt").string();
+  const std::string content("line 1\nbinary \0 byte\r\nlast", 26);
+  REQUIRE(picksight::writeFileAtomically(path, content));
+  auto read = picksight::readFile(path);
+  REQUIRE(read);
+  CHECK(*read == content);
+}
+
+TEST_CASE("writeFileAtomically replaces an existing file", "[common]") {
+  TempDir dir;
+  const std::string path = (dir.path() / "model.yaml").string();
+  REQUIRE(picksight::writeFileAtomically(path, "old content that is rather long\n"));
+  REQUIRE(picksight::writeFileAtomically(path, "new\n"));
+  auto read = picksight::readFile(path);
+  REQUIRE(read);
+  CHECK(*read == "new\n");
+  REQUIRE(picksight::writeFileAtomically(path, ""));
+  read = picksight::readFile(path);
+  REQUIRE(read);
+  CHECK(read->empty());
+}
+
+TEST_CASE("writeFileAtomically leaves no temporary file behind", "[common]") {
+  TempDir dir;
+  const std::string path = (dir.path() / "calib.yaml").string();
+  for (int i = 0; i < 3; ++i) {
+    REQUIRE(picksight::writeFileAtomically(path, "version " + std::to_string(i) + "\n"));
+  }
+  CHECK(namesIn(dir.path()) == std::set<std::string>{"calib.yaml"});
+}
+
+TEST_CASE("writeFileAtomically into a missing directory is an error, not a crash",
+          "[common]") {
+  TempDir dir;
+  const fs::path missing = dir.path() / "no_such_dir";
+  const std::string path = (missing / "file.txt").string();
+  auto written = picksight::writeFileAtomically(path, "content");
+  REQUIRE_FALSE(written);
+  CHECK(written.error().code != 0);
+  CHECK_THAT(written.error().message, Catch::Contains("no_such_dir"));
+  CHECK_FALSE(fs::exists(missing));
+  CHECK(namesIn(dir.path()).empty());
+}
+
+TEST_CASE("writeFileAtomically over a directory fails and removes its temporary", "[common]") {
+  TempDir dir;
+  const fs::path target = dir.path() / "occupied";
+  fs::create_directory(target);
+  auto written = picksight::writeFileAtomically(target.string(), "content");
+  REQUIRE_FALSE(written);
+  CHECK_FALSE(written.error().message.empty());
+  CHECK(fs::is_directory(target));
+  CHECK(namesIn(dir.path()) == std::set<std::string>{"occupied"});
+}
+
+TEST_CASE("readFile of a missing file is an error naming the file", "[common]") {
+  TempDir dir;
+  const std::string path = (dir.path() / "absent.txt").string();
+  auto read = picksight::readFile(path);
+  REQUIRE_FALSE(read);
+  CHECK(read.error().code != 0);
+  CHECK_THAT(read.error().message, Catch::Contains("absent.txt"));
+}
+
+TEST_CASE("readFile of a directory is an error", "[common]") {
+  TempDir dir;
+  auto read = picksight::readFile(dir.path().string());
+  CHECK_FALSE(read);
+}

@@ -1,0 +1,214 @@
+// Pins the frame wire format: header/payload consistency, the zero-copy image
+// view, and a FrameSubscriber that returns only well-formed frames of exactly
+// its camera and counts the malformed ones.
+#include <chrono>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <zmq.hpp>
+
+#include "picksight/transport/frame_message.hpp"
+
+using namespace std::chrono_literals;
+namespace proto = picksight::proto;
+using picksight::FrameSubscriber;
+using picksight::ReceivedFrame;
+
+namespace {
+
+constexpr auto kTimeout = 10000ms;
+// Sequence numbers of the probe frames that wait for the subscription to reach
+// the publisher; the frames under test use small numbers.
+constexpr uint64_t kProbeBase = 1000000;
+
+proto::FrameHeader monoHeader(const std::string& camera, uint64_t sequence, uint32_t width,
+                              uint32_t height, uint32_t stride) {
+  proto::FrameHeader h;
+  h.set_camera(camera);
+  h.set_sequence(sequence);
+  h.set_width(width);
+  h.set_height(height);
+  h.set_stride(stride);
+  h.set_pixel_format(proto::MONO8);
+  h.set_scale_x(1);
+  h.set_scale_y(1);
+  return h;
+}
+
+// Pixel bytes whose value encodes their offset.
+std::string pattern(size_t size) {
+  std::string bytes(size, '\0');
+  for (size_t i = 0; i < size; ++i) bytes[i] = static_cast<char>(i * 7 + 1);
+  return bytes;
+}
+
+void sendParts(zmq::socket_t& pub, const std::vector<std::string>& parts) {
+  for (size_t i = 0; i < parts.size(); ++i) {
+    pub.send(zmq::buffer(parts[i]),
+             i + 1 < parts.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+  }
+}
+
+void sendFrame(zmq::socket_t& pub, const std::string& topic, const proto::FrameHeader& header,
+               const std::string& pixels) {
+  sendParts(pub, {topic, header.SerializeAsString(), pixels});
+}
+
+// Sends probe frames until the subscriber receives one, so that everything
+// sent afterwards reaches it (PUB drops messages for unknown subscriptions).
+void waitForSubscription(zmq::socket_t& pub, FrameSubscriber& sub, const std::string& topic) {
+  for (uint64_t i = 0; i < 100; ++i) {
+    sendFrame(pub, topic, monoHeader(topic, kProbeBase + i, 2, 2, 2), pattern(4));
+    if (sub.receive(100ms)) return;
+  }
+  FAIL("the subscription never reached the publisher");
+}
+
+// The next frame that is not a probe.
+std::optional<ReceivedFrame> receiveNonProbe(FrameSubscriber& sub) {
+  for (;;) {
+    auto frame = sub.receive(kTimeout);
+    if (!frame || frame->header.sequence() < kProbeBase) return frame;
+  }
+}
+
+}  // namespace
+
+TEST_CASE("bytesPerPixel knows mono8 and bgr8 only", "[common]") {
+  CHECK(picksight::bytesPerPixel(proto::MONO8) == 1);
+  CHECK(picksight::bytesPerPixel(proto::BGR8) == 3);
+  CHECK(picksight::bytesPerPixel(proto::PIXEL_FORMAT_UNSPECIFIED) == 0);
+}
+
+TEST_CASE("frameIsConsistent checks format, sizes, stride and payload length", "[common]") {
+  using picksight::frameIsConsistent;
+  const auto h = monoHeader("cam", 1, 4, 3, 4);
+  CHECK(frameIsConsistent(h, 12));
+  CHECK(frameIsConsistent(h, 20));  // trailing bytes are harmless
+  CHECK_FALSE(frameIsConsistent(h, 11));
+  CHECK_FALSE(frameIsConsistent(h, 0));
+  auto padded = monoHeader("cam", 1, 4, 3, 8);
+  CHECK(frameIsConsistent(padded, 24));
+  CHECK_FALSE(frameIsConsistent(padded, 12));
+  auto narrow = monoHeader("cam", 1, 4, 3, 3);  // stride below width
+  CHECK_FALSE(frameIsConsistent(narrow, 100));
+  auto bgr = monoHeader("cam", 1, 4, 3, 12);
+  bgr.set_pixel_format(proto::BGR8);
+  CHECK(frameIsConsistent(bgr, 36));
+  bgr.set_stride(11);  // 4 pixels of 3 bytes do not fit in 11
+  CHECK_FALSE(frameIsConsistent(bgr, 100));
+  auto unknown = h;
+  unknown.set_pixel_format(proto::PIXEL_FORMAT_UNSPECIFIED);
+  CHECK_FALSE(frameIsConsistent(unknown, 12));
+  auto empty = monoHeader("cam", 1, 0, 3, 4);
+  CHECK_FALSE(frameIsConsistent(empty, 12));
+  auto flat = monoHeader("cam", 1, 4, 0, 4);
+  CHECK_FALSE(frameIsConsistent(flat, 12));
+}
+
+TEST_CASE("ReceivedFrame image is a view on the pixel bytes with the stride", "[common]") {
+  ReceivedFrame frame;
+  frame.header = monoHeader("cam", 1, 3, 2, 4);
+  const std::string bytes = pattern(8);
+  frame.pixels = zmq::message_t(bytes.data(), bytes.size());
+  const cv::Mat image = frame.image();
+  REQUIRE(image.type() == CV_8UC1);
+  REQUIRE(image.cols == 3);
+  REQUIRE(image.rows == 2);
+  CHECK(image.step[0] == 4);
+  CHECK(image.data == frame.pixels.data());
+  CHECK(image.at<uint8_t>(1, 2) == static_cast<uint8_t>(bytes[1 * 4 + 2]));
+
+  ReceivedFrame colour;
+  colour.header = monoHeader("cam", 1, 2, 2, 6);
+  colour.header.set_pixel_format(proto::BGR8);
+  const std::string bgr = pattern(12);
+  colour.pixels = zmq::message_t(bgr.data(), bgr.size());
+  const cv::Mat c = colour.image();
+  REQUIRE(c.type() == CV_8UC3);
+  CHECK(c.at<cv::Vec3b>(1, 1)[2] == static_cast<uint8_t>(bgr[6 + 3 + 2]));
+}
+
+TEST_CASE("FrameSubscriber returns only well-formed frames of its camera", "[common]") {
+  zmq::context_t context;
+  zmq::socket_t pub(context, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  pub.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = pub.get(zmq::sockopt::last_endpoint);
+  REQUIRE(endpoint.rfind("tcp://127.0.0.1:", 0) == 0);
+
+  // A deep queue: this test checks filtering, not loss under load.
+  FrameSubscriber sub(context, endpoint, "cam1", 64);
+  waitForSubscription(pub, sub, "cam1");
+  const uint64_t malformed_before = sub.malformedMessages();
+  CHECK(malformed_before == 0);
+
+  const auto good = monoHeader("cam1", 1, 5, 4, 6);
+  const std::string good_pixels = pattern(24);
+  // Malformed: two parts only.
+  sendParts(pub, {"cam1", good.SerializeAsString()});
+  // Malformed: a header that is not a FrameHeader.
+  sendParts(pub, {"cam1", std::string("\xff\xff\xff\xff", 4), good_pixels});
+  // Malformed: payload shorter than stride * height.
+  sendFrame(pub, "cam1", good, good_pixels.substr(0, 23));
+  // Malformed: a header with no pixel format.
+  auto no_format = good;
+  no_format.set_pixel_format(proto::PIXEL_FORMAT_UNSPECIFIED);
+  sendFrame(pub, "cam1", no_format, good_pixels);
+  // Malformed: four parts.
+  sendParts(pub, {"cam1", good.SerializeAsString(), good_pixels, "extra"});
+  // Well-formed, but for another camera whose name starts with ours.
+  sendFrame(pub, "cam10", monoHeader("cam10", 7, 5, 4, 6), good_pixels);
+  // The one valid frame, then another camera again, then an end marker.
+  sendFrame(pub, "cam1", good, good_pixels);
+  sendFrame(pub, "cam10", monoHeader("cam10", 8, 5, 4, 6), good_pixels);
+  sendFrame(pub, "cam1", monoHeader("cam1", 2, 2, 2, 2), pattern(4));
+
+  auto frame = receiveNonProbe(sub);
+  REQUIRE(frame);
+  CHECK(frame->header.camera() == "cam1");
+  CHECK(frame->header.sequence() == 1);
+  CHECK(frame->header.width() == 5);
+  CHECK(frame->header.height() == 4);
+  CHECK(frame->received_ns > 0);
+  REQUIRE(frame->pixels.size() == good_pixels.size());
+  CHECK(std::memcmp(frame->pixels.data(), good_pixels.data(), good_pixels.size()) == 0);
+  CHECK(frame->image().at<uint8_t>(3, 4) == static_cast<uint8_t>(good_pixels[3 * 6 + 4]));
+
+  auto marker = receiveNonProbe(sub);
+  REQUIRE(marker);
+  CHECK(marker->header.camera() == "cam1");
+  CHECK(marker->header.sequence() == 2);
+  CHECK(sub.malformedMessages() - malformed_before == 5);
+  CHECK_FALSE(sub.receive(50ms));
+}
+
+TEST_CASE("FrameSubscriber with an empty camera name receives every camera", "[common]") {
+  zmq::context_t context;
+  zmq::socket_t pub(context, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  pub.bind("tcp://127.0.0.1:*");
+  FrameSubscriber sub(context, pub.get(zmq::sockopt::last_endpoint), "", 64);
+  waitForSubscription(pub, sub, "cam1");
+  sendFrame(pub, "cam1", monoHeader("cam1", 1, 2, 2, 2), pattern(4));
+  sendFrame(pub, "cam10", monoHeader("cam10", 2, 2, 2, 2), pattern(4));
+  sendFrame(pub, "other", monoHeader("other", 3, 2, 2, 2), pattern(4));
+  for (const char* camera : {"cam1", "cam10", "other"}) {
+    auto frame = receiveNonProbe(sub);
+    REQUIRE(frame);
+    CHECK(frame->header.camera() == camera);
+  }
+  CHECK(sub.malformedMessages() == 0);
+}
+
+TEST_CASE("FrameSubscriber receive times out with nothing published", "[common]") {
+  zmq::context_t context;
+  zmq::socket_t pub(context, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  pub.bind("tcp://127.0.0.1:*");
+  FrameSubscriber sub(context, pub.get(zmq::sockopt::last_endpoint), "cam1");
+  CHECK_FALSE(sub.receive(50ms));
+  CHECK(sub.malformedMessages() == 0);
+}

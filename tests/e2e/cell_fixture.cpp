@@ -1,0 +1,95 @@
+// End-to-end cell fixture (see cell_fixture.hpp).
+#include "cell_fixture.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+
+#include "picksight/common/text.hpp"
+
+namespace picksight::e2e {
+using namespace std::chrono_literals;
+
+std::string binPath(const std::string& name) { return std::string(PICKSIGHT_BIN_DIR) + "/" + name; }
+
+VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
+  std::vector<std::string> argv = {binPath("picksight-video-server"), "--frames", "tcp://127.0.0.1:*",
+                                   "--control", "tcp://127.0.0.1:*"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  process = std::make_unique<Subprocess>(argv);
+  auto f = process->waitForLine("frames ", 10s);
+  REQUIRE(f);
+  auto c = process->waitForLine("control ", 10s);
+  REQUIRE(c);
+  frames = *f;
+  control = *c;
+}
+
+VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string& camera) {
+  char dir[] = "/tmp/picksight-e2e-XXXXXX";
+  REQUIRE(::mkdtemp(dir) != nullptr);
+  data_dir = dir;
+  process = std::make_unique<Subprocess>(std::vector<std::string>{
+      binPath("picksight-vision"), "--frames", server.frames, "--control", server.control, "--camera",
+      camera, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
+  auto port = process->waitForLine("robot ", 10s);
+  REQUIRE(port);
+  auto value = parseInt(*port);
+  REQUIRE(value);
+  robot_port = static_cast<uint16_t>(*value);
+  REQUIRE(process->waitForLine("ready", 10s));
+}
+
+VisionProcess::~VisionProcess() {
+  process.reset();
+  std::error_code ignored;
+  std::filesystem::remove_all(data_dir, ignored);
+}
+
+LineClient VisionProcess::connect() const {
+  auto c = LineClient::connect("127.0.0.1", robot_port, 5s);
+  REQUIRE(c);
+  return std::move(*c);
+}
+
+CommandResult run(const std::vector<std::string>& argv) {
+  Subprocess p(argv);
+  CommandResult r;
+  while (auto line = p.readLine(10s)) r.out += *line + "\n";
+  auto status = p.wait(10s);
+  REQUIRE(status);
+  r.exit_code = WIFEXITED(*status) ? WEXITSTATUS(*status) : -1;
+  return r;
+}
+
+std::optional<ReceivedFrame> receiveUntil(FrameSubscriber& subscriber,
+                                          const std::function<bool(const ReceivedFrame&)>& accept,
+                                          int tries) {
+  for (int i = 0; i < tries; ++i) {
+    auto f = subscriber.receive(2s);
+    if (f && accept(*f)) return f;
+  }
+  return std::nullopt;
+}
+
+std::vector<Pose> parseLocateReply(const std::string& reply) {
+  const auto words = splitFields(reply, " ");
+  REQUIRE(words.size() >= 2);
+  REQUIRE(words[0] == "OK");
+  const auto n = parseInt(words[1]);
+  REQUIRE(n);
+  REQUIRE(words.size() == 2 + 3 * static_cast<size_t>(*n));
+  std::vector<Pose> poses;
+  for (size_t i = 2; i < words.size(); i += 3) {
+    auto x = parseDouble(words[i]);
+    auto y = parseDouble(words[i + 1]);
+    auto rz = parseDouble(words[i + 2]);
+    REQUIRE((x && y && rz));
+    poses.push_back({*x, *y, *rz});
+  }
+  return poses;
+}
+
+}  // namespace picksight::e2e

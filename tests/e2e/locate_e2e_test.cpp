@@ -1,0 +1,137 @@
+// LOCATE end to end: synthetic camera -> video server -> ZeroMQ -> vision
+// app -> TCP robot client, against the scene's ground truth.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "cell_fixture.hpp"
+#include "picksight/common/angles.hpp"
+#include "picksight/common/clock.hpp"
+#include "picksight/common/text.hpp"
+
+using namespace picksight;
+using namespace picksight::e2e;
+using namespace std::chrono_literals;
+
+namespace {
+// "OK cam seq host_ns width height triggered" from FRAME.
+struct UsedFrame {
+  uint64_t sequence = 0;
+  uint64_t host_ns = 0;
+  bool triggered = false;
+};
+
+UsedFrame usedFrame(LineClient& robot) {
+  auto reply = robot.request("FRAME", 5s);
+  REQUIRE(reply);
+  const auto w = splitFields(*reply, " ");
+  REQUIRE(w.size() == 7);
+  REQUIRE(w[0] == "OK");
+  UsedFrame f;
+  f.sequence = static_cast<uint64_t>(parseInt(w[2]).value_or(0));
+  f.host_ns = static_cast<uint64_t>(parseInt(w[3]).value_or(0));
+  f.triggered = w[6] == "1";
+  return f;
+}
+}  // namespace
+
+TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
+  // A new layout on every trigger, so each request sees a different scene.
+  VideoServerProcess server({"--source", "cam0=synthetic:width=1280,height=960,parts=8,seed=11,scene_every=1",
+                             "--mode", "trigger"});
+  VisionProcess vision(server);
+  zmq::context_t context;
+  FrameSubscriber watcher(context, server.frames, "cam0", 16);
+  std::this_thread::sleep_for(300ms);  // the subscription must reach the server first
+  auto robot = vision.connect();
+
+  double worst_position = 0;
+  double worst_angle = 0;
+  int parts_checked = 0;
+  for (int request = 0; request < 4; ++request) {
+    auto reply = robot.request("LOCATE 1", 10s);
+    REQUIRE(reply);
+    INFO("reply: " << *reply);
+    const auto poses = parseLocateReply(*reply);
+    const UsedFrame used = usedFrame(robot);
+    auto frame = receiveUntil(watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == used.sequence; });
+    REQUIRE(frame);
+    const auto& truth = frame->header.truth();
+    REQUIRE(truth.size() == 8);
+    CHECK(poses.size() == static_cast<size_t>(truth.size()));
+    for (const auto& t : truth) {
+      double best = std::numeric_limits<double>::max();
+      const Pose* match = nullptr;
+      for (const auto& p : poses) {
+        const double d = std::hypot(p.x - t.x(), p.y - t.y());
+        if (d < best) {
+          best = d;
+          match = &p;
+        }
+      }
+      REQUIRE(match);
+      INFO(t.type() << " at " << t.x() << ", " << t.y() << " angle " << t.angle_deg());
+      // Replies carry 3 decimals: 0.0005 of rounding on top of the error.
+      CHECK(best < 0.1);
+      const double angle_error = angleDiffDeg(match->rz, t.angle_deg(), t.symmetry_deg());
+      CHECK(angle_error < 0.5);
+      worst_position = std::max(worst_position, best);
+      worst_angle = std::max(worst_angle, angle_error);
+      ++parts_checked;
+    }
+  }
+  WARN("worst position error " << worst_position << " px, worst angle error " << worst_angle << " deg over "
+                               << parts_checked << " parts");
+}
+
+TEST_CASE("a malformed robot line gets ERROR and the connection goes on", "[e2e][locate]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=3", "--mode", "trigger"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  for (const std::string& bad :
+       std::vector<std::string>{"LOCATE", "LOCATE x", "FLY 1 2", std::string("\x01\x02\xff", 3), ""}) {
+    auto reply = robot.request(bad, 5s);
+    REQUIRE(reply);
+    CHECK(reply->rfind("ERROR ", 0) == 0);
+  }
+  auto reply = robot.request("locate,1", 10s);
+  REQUIRE(reply);
+  CHECK(parseLocateReply(*reply).size() == 3);
+  CHECK(*robot.request("PING", 5s) == "OK");
+}
+
+TEST_CASE("the frame used after a trigger was produced after the request", "[e2e][locate]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  uint64_t last_sequence = 0;
+  for (int i = 0; i < 3; ++i) {
+    const uint64_t before = realtimeNs();
+    auto reply = robot.request("LOCATE 1", 10s);
+    REQUIRE(reply);
+    REQUIRE(reply->rfind("OK ", 0) == 0);
+    const UsedFrame used = usedFrame(robot);
+    CHECK(used.triggered);
+    CHECK(used.host_ns > before);
+    CHECK(used.sequence > last_sequence);
+    last_sequence = used.sequence;
+  }
+}
+
+TEST_CASE("in free-run LOCATE waits for a frame taken after the request", "[e2e][locate]") {
+  // A slow camera: the newest frame is usually older than the request.
+  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=2", "--fps", "4"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  for (int i = 0; i < 3; ++i) {
+    const uint64_t before = realtimeNs();
+    auto reply = robot.request("LOCATE 1", 10s);
+    REQUIRE(reply);
+    REQUIRE(reply->rfind("OK ", 0) == 0);
+    const UsedFrame used = usedFrame(robot);
+    CHECK_FALSE(used.triggered);
+    CHECK(used.host_ns > before);
+  }
+}

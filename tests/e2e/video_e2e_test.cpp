@@ -1,0 +1,136 @@
+// Video server end to end: frames to several subscribers, ROI and resize at
+// run time through picksight-cam, software trigger.
+#include <catch2/catch.hpp>
+
+#include <opencv2/imgproc.hpp>
+#include <thread>
+
+#include "cell_fixture.hpp"
+#include "picksight/common/clock.hpp"
+#include "picksight/common/text.hpp"
+
+using namespace picksight;
+using namespace picksight::e2e;
+using namespace std::chrono_literals;
+
+namespace {
+CommandResult cam(const VideoServerProcess& server, std::vector<std::string> args) {
+  std::vector<std::string> argv = {binPath("picksight-cam"), "--control", server.control};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return run(argv);
+}
+}  // namespace
+
+TEST_CASE("ROI and resize change both the pixels and the header", "[e2e][video]") {
+  // Noise-free, so two frames of the scene are identical pixel for pixel.
+  VideoServerProcess server({"--source", "cam0=synthetic:width=800,height=600,parts=5,noise=0", "--fps", "20"});
+  zmq::context_t context;
+  FrameSubscriber sub(context, server.frames, "cam0", 4);
+  auto full = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 800; });
+  REQUIRE(full);
+  CHECK(full->header.roi_x() == 0);
+  CHECK(full->header.scale_x() == 1.0);
+  const cv::Mat sensor = full->image().clone();
+
+  REQUIRE(cam(server, {"roi", "cam0", "100", "50", "400", "300"}).exit_code == 0);
+  auto cropped = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 400; });
+  REQUIRE(cropped);
+  CHECK(cropped->header.height() == 300);
+  CHECK(cropped->header.roi_x() == 100);
+  CHECK(cropped->header.roi_y() == 50);
+  CHECK(cropped->header.scale_x() == 1.0);
+  CHECK(cv::countNonZero(cropped->image() != sensor(cv::Rect(100, 50, 400, 300))) == 0);
+
+  REQUIRE(cam(server, {"size", "cam0", "200", "150"}).exit_code == 0);
+  auto resized = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 200; });
+  REQUIRE(resized);
+  CHECK(resized->header.height() == 150);
+  CHECK(resized->header.roi_x() == 100);
+  CHECK(resized->header.scale_x() == Approx(0.5));
+  CHECK(resized->header.scale_y() == Approx(0.5));
+  cv::Mat expected;
+  cv::resize(sensor(cv::Rect(100, 50, 400, 300)), expected, cv::Size(200, 150), 0, 0, cv::INTER_AREA);
+  CHECK(cv::norm(resized->image(), expected, cv::NORM_INF) <= 1);
+
+  // Out of range is refused with the reason, and changes nothing.
+  const auto refused = cam(server, {"roi", "cam0", "700", "0", "400", "300"});
+  CHECK(refused.exit_code == 1);
+  auto still = receiveUntil(sub, [](const ReceivedFrame&) { return true; });
+  REQUIRE(still);
+  CHECK(still->header.width() == 200);
+}
+
+TEST_CASE("two subscribers receive the same sequence numbers", "[e2e][video]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=4", "--fps", "25"});
+  zmq::context_t context;
+  FrameSubscriber a(context, server.frames, "cam0", 16);
+  FrameSubscriber b(context, server.frames, "cam0", 16);
+  // Both are connected once both have seen a frame; from the next sequence on
+  // they must see the very same ones.
+  auto first_a = a.receive(5s);
+  auto first_b = b.receive(5s);
+  REQUIRE(first_a);
+  REQUIRE(first_b);
+  const uint64_t start = std::max(first_a->header.sequence(), first_b->header.sequence()) + 1;
+  auto collect = [&](FrameSubscriber& s) {
+    std::vector<uint64_t> seqs;
+    while (seqs.size() < 20) {
+      auto f = s.receive(5s);
+      if (!f) break;
+      if (f->header.sequence() >= start) seqs.push_back(f->header.sequence());
+    }
+    return seqs;
+  };
+  const auto seqs_a = collect(a);
+  const auto seqs_b = collect(b);
+  REQUIRE(seqs_a.size() == 20);
+  CHECK(seqs_a == seqs_b);
+  for (size_t i = 1; i < seqs_a.size(); ++i) CHECK(seqs_a[i] == seqs_a[i - 1] + 1);
+}
+
+TEST_CASE("a software trigger's frame carries the sequence its reply named", "[e2e][video]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
+  zmq::context_t context;
+  FrameSubscriber sub(context, server.frames, "cam0", 4);
+  std::this_thread::sleep_for(300ms);
+  // No trigger, no frame.
+  CHECK_FALSE(sub.receive(500ms));
+  for (int i = 0; i < 3; ++i) {
+    const uint64_t before = realtimeNs();
+    const auto reply = cam(server, {"--json", "trigger", "cam0"});
+    REQUIRE(reply.exit_code == 0);
+    const size_t at = reply.out.find("\"sequence\":");
+    REQUIRE(at != std::string::npos);
+    const auto seq = parseInt(reply.out.substr(at + 11, reply.out.find_first_of(",}", at) - at - 11));
+    REQUIRE(seq);
+    auto frame = sub.receive(5s);
+    REQUIRE(frame);
+    CHECK(static_cast<long long>(frame->header.sequence()) == *seq);
+    CHECK(frame->header.triggered());
+    CHECK(frame->header.host_timestamp_ns() > before);
+  }
+}
+
+TEST_CASE("picksight-cam reports cameras and refuses unknown ones", "[e2e][video]") {
+  VideoServerProcess server({"--source", "top=synthetic:width=640,height=480", "--source",
+                             "side=synthetic:width=320,height=240,seed=2"});
+  const auto list = cam(server, {"list"});
+  CHECK(list.exit_code == 0);
+  CHECK(list.out.find("top") != std::string::npos);
+  CHECK(list.out.find("side") != std::string::npos);
+  const auto info = cam(server, {"info", "side"});
+  CHECK(info.exit_code == 0);
+  CHECK(info.out.find("320") != std::string::npos);
+  CHECK(cam(server, {"info", "front"}).exit_code == 1);
+  CHECK(cam(server, {"roi", "top", "x", "0", "10", "10"}).exit_code == 2);
+  CHECK(cam(server, {"stats"}).exit_code == 0);
+}
+
+TEST_CASE("bad video server options fail at start with the option named", "[e2e][video]") {
+  auto r = run({binPath("picksight-video-server"), "--fps", "fast"});
+  CHECK(r.exit_code == 2);
+  r = run({binPath("picksight-video-server"), "--source", "cam0=synthetic:parts=lots"});
+  CHECK(r.exit_code == 1);
+  r = run({binPath("picksight-video-server"), "--source", "cam0=webcam:0"});
+  CHECK(r.exit_code == 1);
+}

@@ -1,0 +1,297 @@
+// Pins a camera's acquisition: one frame per trigger with the ticket's
+// sequence, none without, increasing sequences in free-run, tickets after
+// every published frame, output settings applied from the next frame, and
+// retries of a source that is not there yet.
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "picksight/video_server/camera.hpp"
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+using picksight::video::AcquisitionMode;
+using picksight::video::Camera;
+using picksight::video::CameraConfig;
+using picksight::video::OutputSettings;
+using picksight::video::PublishedFrame;
+
+namespace {
+
+// Generous: only a broken camera takes this long.
+constexpr auto kTimeout = 10s;
+const std::string kSource = "synthetic:width=160,height=120,parts=2,size=30,seed=3";
+
+// Collects published frames; tests wait on it.
+class CollectingSink : public picksight::video::FrameSink {
+ public:
+  void publish(PublishedFrame frame) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      frames_.push_back(std::move(frame));
+    }
+    changed_.notify_all();
+  }
+
+  std::vector<PublishedFrame> frames() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return frames_;
+  }
+  size_t count() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return frames_.size();
+  }
+  // Waits until `done(frames)` holds; false on timeout.
+  bool waitUntil(const std::function<bool(const std::vector<PublishedFrame>&)>& done,
+                 std::chrono::milliseconds timeout = kTimeout) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return changed_.wait_for(lock, timeout, [&] { return done(frames_); });
+  }
+  bool waitForCount(size_t n) {
+    return waitUntil([n](const std::vector<PublishedFrame>& f) { return f.size() >= n; });
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<PublishedFrame> frames_;
+};
+
+CameraConfig config(AcquisitionMode mode, double fps = 10, const std::string& uri = kSource) {
+  CameraConfig c;
+  c.name = "cam1";
+  c.uri = uri;
+  c.mode = mode;
+  c.fps = fps;
+  return c;
+}
+
+std::unique_ptr<Camera> makeCamera(const CameraConfig& c, CollectingSink& sink) {
+  auto source = picksight::video::makeSource(c.uri);
+  REQUIRE(source);
+  return std::make_unique<Camera>(c, std::move(*source), sink);
+}
+
+bool waitForState(const Camera& camera, const std::string& state) {
+  const auto deadline = std::chrono::steady_clock::now() + kTimeout;
+  while (camera.status().state != state) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+  return true;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "picksight-camera-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+uint64_t maxSequence(const std::vector<PublishedFrame>& frames) {
+  uint64_t m = 0;
+  for (const auto& f : frames) m = std::max(m, f.sequence);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("Camera in trigger mode publishes nothing without a trigger", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kTrigger), sink);
+  camera->start();
+  REQUIRE(waitForState(*camera, "streaming"));
+  // Absence, not speed: a camera that acquired on its own would have done so.
+  std::this_thread::sleep_for(300ms);
+  CHECK(sink.count() == 0);
+  CHECK(camera->status().frames_acquired == 0);
+}
+
+TEST_CASE("Camera trigger tickets are consecutive and each gives exactly one frame",
+          "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kTrigger), sink);
+  camera->start();
+  REQUIRE(waitForState(*camera, "streaming"));
+
+  std::vector<uint64_t> tickets;
+  for (int i = 0; i < 5; ++i) {
+    const auto t = camera->trigger();
+    CHECK(t.triggered);
+    tickets.push_back(t.sequence);
+  }
+  for (size_t i = 1; i < tickets.size(); ++i) CHECK(tickets[i] == tickets[i - 1] + 1);
+
+  REQUIRE(sink.waitForCount(tickets.size()));
+  std::this_thread::sleep_for(300ms);  // no extra frame may follow
+  const auto frames = sink.frames();
+  REQUIRE(frames.size() == tickets.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    CHECK(frames[i].sequence == tickets[i]);
+    CHECK(frames[i].triggered);
+    CHECK(frames[i].camera == "cam1");
+    CHECK(frames[i].output.image.size() == cv::Size(160, 120));
+    CHECK(frames[i].truth.size() == 2);
+    CHECK(frames[i].host_timestamp_ns > 0);
+  }
+
+  // A later trigger continues the numbering.
+  const auto next = camera->trigger();
+  CHECK(next.sequence == tickets.back() + 1);
+  REQUIRE(sink.waitForCount(tickets.size() + 1));
+  CHECK(sink.frames().back().sequence == next.sequence);
+  CHECK(camera->status().frames_acquired == tickets.size() + 1);
+  CHECK(camera->status().last_sequence == next.sequence);
+}
+
+TEST_CASE("Camera in free-run publishes increasing sequences untriggered", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 50), sink);
+  camera->start();
+  REQUIRE(sink.waitForCount(5));
+  camera->stop();
+  const auto frames = sink.frames();
+  for (size_t i = 1; i < frames.size(); ++i) CHECK(frames[i].sequence > frames[i - 1].sequence);
+  for (const auto& f : frames) CHECK_FALSE(f.triggered);
+  CHECK(camera->status().state == "stopped");
+}
+
+TEST_CASE("Camera free-run trigger ticket follows every published frame", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 50), sink);
+  camera->start();
+  REQUIRE(sink.waitForCount(3));
+  for (int i = 0; i < 3; ++i) {
+    const uint64_t published = maxSequence(sink.frames());
+    const auto ticket = camera->trigger();
+    CHECK_FALSE(ticket.triggered);
+    CHECK(ticket.sequence > published);
+    // ... and a frame with that sequence does come.
+    CHECK(sink.waitUntil([&](const std::vector<PublishedFrame>& f) {
+      return maxSequence(f) >= ticket.sequence;
+    }));
+  }
+}
+
+TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kTrigger), sink);
+  camera->start();
+  REQUIRE(waitForState(*camera, "streaming"));
+  camera->trigger();
+  REQUIRE(sink.waitForCount(1));
+  CHECK(sink.frames()[0].output.image.size() == cv::Size(160, 120));
+  CHECK(sink.frames()[0].output.roi_offset == cv::Point(0, 0));
+
+  OutputSettings roi;
+  roi.roi = cv::Rect(10, 20, 64, 48);
+  REQUIRE(camera->setOutput(roi));
+  CHECK(camera->output().roi == roi.roi);
+  camera->trigger();
+  REQUIRE(sink.waitForCount(2));
+  const auto cropped = sink.frames()[1];
+  CHECK(cropped.output.image.size() == cv::Size(64, 48));
+  CHECK(cropped.output.roi_offset == cv::Point(10, 20));
+
+  OutputSettings scaled = roi;
+  scaled.scale = 0.5;
+  scaled.format = picksight::video::OutputFormat::kBgr8;
+  REQUIRE(camera->setOutput(scaled));
+  camera->trigger();
+  REQUIRE(sink.waitForCount(3));
+  const auto small = sink.frames()[2];
+  CHECK(small.output.image.size() == cv::Size(32, 24));
+  CHECK(small.output.image.type() == CV_8UC3);
+  CHECK(small.output.scale_x == 0.5);
+  // Ground truth stays in sensor pixels.
+  CHECK(small.truth.size() == 2);
+}
+
+TEST_CASE("Camera setOutput rejects a ROI beyond the sensor once open", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kTrigger), sink);
+  camera->start();
+  REQUIRE(waitForState(*camera, "streaming"));
+  OutputSettings beyond;
+  beyond.roi = cv::Rect(100, 100, 100, 100);
+  auto r = camera->setOutput(beyond);
+  REQUIRE_FALSE(r);
+  CHECK_THAT(r.error().message, Catch::Contains("160x120"));
+  CHECK(camera->output().roi.empty());
+  CHECK(camera->status().info.sensor_width == 160);
+}
+
+TEST_CASE("Camera setMode switches between free-run and trigger", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 50), sink);
+  camera->start();
+  REQUIRE(sink.waitForCount(2));
+
+  REQUIRE(camera->setMode(AcquisitionMode::kTrigger, 0));
+  CHECK(camera->status().mode == AcquisitionMode::kTrigger);
+  CHECK(camera->status().fps_setting == 50);  // fps 0 leaves it unchanged
+  // A frame whose grab had begun may still arrive; after that, silence.
+  std::this_thread::sleep_for(300ms);
+  const size_t settled = sink.count();
+  std::this_thread::sleep_for(300ms);
+  CHECK(sink.count() == settled);
+
+  const auto ticket = camera->trigger();
+  CHECK(ticket.triggered);
+  REQUIRE(sink.waitForCount(settled + 1));
+  CHECK(sink.frames().back().sequence == ticket.sequence);
+  CHECK(sink.frames().back().triggered);
+
+  REQUIRE(camera->setMode(AcquisitionMode::kFreeRun, 40));
+  CHECK(camera->status().fps_setting == 40);
+  REQUIRE(sink.waitForCount(settled + 4));
+  CHECK_FALSE(sink.frames().back().triggered);
+
+  CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, -1));
+  CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, 5000));
+}
+
+TEST_CASE("Camera retries a source that is missing and streams once it appears",
+          "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 20, "file:" + path), sink);
+  camera->start();
+  REQUIRE(waitForState(*camera, "reconnecting"));
+  CHECK_THAT(camera->status().last_error, Catch::Contains(path));
+  CHECK(sink.count() == 0);
+
+  REQUIRE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
+  CHECK(sink.waitForCount(1));
+  CHECK(camera->status().state == "streaming");
+  camera->stop();
+  const auto frames = sink.frames();
+  REQUIRE_FALSE(frames.empty());
+  CHECK(frames[0].output.image.size() == cv::Size(40, 30));
+  CHECK(frames[0].output.image.at<uint8_t>(0, 0) == 99);
+}

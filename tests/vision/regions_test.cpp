@@ -1,0 +1,159 @@
+// Region features against values computed by hand or in closed form.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "picksight/common/angles.hpp"
+#include "picksight/vision/regions.hpp"
+
+using picksight::angleDiffDeg;
+using picksight::vision::findRegions;
+using picksight::vision::Region;
+
+namespace {
+// An L shape (long leg 120, short leg 70, thickness 30) turned by `deg`
+// about (200, 200), optionally mirrored: drawn 8x larger and averaged down,
+// as a camera sees it (edge pixels partly covered). `truth` gets the centroid
+// and angle of what was drawn, from the moments of the 8x drawing.
+struct Drawn {
+  cv::Mat grey;  // a dark part (50) on a light background (220)
+  cv::Point2d centroid;
+  double axis_deg = 0;  // axis of least inertia, modulo 180
+};
+
+Drawn drawL(double deg, bool mirrored) {
+  constexpr int kSuper = 8;
+  const std::vector<cv::Point2d> local = {{0, 0}, {120, 0}, {120, 30}, {30, 30}, {30, 70}, {0, 70}};
+  const double a = deg * M_PI / 180.0;
+  std::vector<cv::Point> pts;
+  for (auto p : local) {
+    p -= cv::Point2d(45, 25);
+    if (mirrored) p.y = -p.y;
+    const double x = 200 + p.x * std::cos(a) - p.y * std::sin(a);
+    const double y = 200 + p.x * std::sin(a) + p.y * std::cos(a);
+    // Pixel centres at integers at both scales: u = (x + 0.5) * S - 0.5.
+    pts.emplace_back(static_cast<int>(std::lround(((x + 0.5) * kSuper - 0.5) * 256)),
+                     static_cast<int>(std::lround(((y + 0.5) * kSuper - 0.5) * 256)));
+  }
+  cv::Mat big(400 * kSuper, 400 * kSuper, CV_8UC1, cv::Scalar(0));
+  cv::fillPoly(big, std::vector<std::vector<cv::Point>>{pts}, cv::Scalar(255), cv::LINE_8, 8);
+  Drawn d;
+  cv::Mat coverage;
+  cv::resize(big, coverage, cv::Size(400, 400), 0, 0, cv::INTER_AREA);
+  coverage.convertTo(d.grey, CV_8U, -170.0 / 255.0, 220.0);
+  const cv::Moments m = cv::moments(big, true);
+  d.centroid = cv::Point2d((m.m10 / m.m00 + 0.5) / kSuper - 0.5, (m.m01 / m.m00 + 0.5) / kSuper - 0.5);
+  d.axis_deg = 0.5 * std::atan2(2 * m.mu11, m.mu20 - m.mu02) * 180.0 / M_PI;
+  return d;
+}
+
+std::vector<Region> regionsOf(const Drawn& d, bool use_grey) {
+  return findRegions(d.grey < 135, {}, use_grey ? d.grey : cv::Mat());
+}
+}  // namespace
+
+TEST_CASE("rectangle moments match the closed form", "[vision][regions]") {
+  cv::Mat img(100, 100, CV_8UC1, cv::Scalar(0));
+  img(cv::Rect(10, 20, 50, 20)).setTo(255);
+  const auto regions = findRegions(img);
+  REQUIRE(regions.size() == 1);
+  const Region& r = regions[0];
+  CHECK(r.area == 1000);
+  CHECK(r.centroid.x == Approx(34.5));
+  CHECK(r.centroid.y == Approx(29.5));
+  // sum over a run of n pixels of (k - mean)^2 = n (n^2 - 1) / 12
+  CHECK(r.moments.mu20 == Approx(20 * 50 * (50 * 50 - 1) / 12.0));
+  CHECK(r.moments.mu02 == Approx(50 * 20 * (20 * 20 - 1) / 12.0));
+  CHECK(r.moments.mu11 == Approx(0).margin(1e-6));
+  CHECK(r.holes == 0);
+  CHECK(r.bbox == cv::Rect(10, 20, 50, 20));
+  // The long axis is x; a rectangle's direction along it is ambiguous.
+  CHECK(angleDiffDeg(r.angle_deg, 0, 180) < 1e-9);
+}
+
+TEST_CASE("holes are counted and regions come largest first", "[vision][regions]") {
+  cv::Mat img(300, 300, CV_8UC1, cv::Scalar(0));
+  cv::circle(img, {80, 80}, 50, cv::Scalar(255), cv::FILLED);
+  cv::circle(img, {70, 80}, 10, cv::Scalar(0), cv::FILLED);
+  cv::circle(img, {100, 80}, 8, cv::Scalar(0), cv::FILLED);
+  cv::rectangle(img, cv::Rect(200, 200, 30, 30), cv::Scalar(255), cv::FILLED);
+  const auto regions = findRegions(img);
+  REQUIRE(regions.size() == 2);
+  CHECK(regions[0].holes == 2);
+  CHECK(regions[0].hole_boundaries.size() == 2);
+  CHECK(regions[1].holes == 0);
+  CHECK(regions[0].area > regions[1].area);
+  // A disc's area, less its holes, within the rasterization error.
+  CHECK(regions[0].area == Approx(M_PI * (2500 - 100 - 64)).epsilon(0.02));
+}
+
+TEST_CASE("a disc has no elongation; a bar has a lot", "[vision][regions]") {
+  cv::Mat img(300, 300, CV_8UC1, cv::Scalar(0));
+  cv::circle(img, {80, 80}, 60, cv::Scalar(255), cv::FILLED);
+  cv::rectangle(img, cv::Rect(180, 50, 20, 200), cv::Scalar(255), cv::FILLED);
+  const auto regions = findRegions(img);
+  REQUIRE(regions.size() == 2);
+  const Region& disc = regions[0].bbox.x < 150 ? regions[0] : regions[1];
+  const Region& bar = regions[0].bbox.x < 150 ? regions[1] : regions[0];
+  CHECK(disc.elongation < 0.01);
+  CHECK(bar.elongation > 0.95);
+  CHECK(angleDiffDeg(bar.angle_deg, 90, 180) < 1e-6);
+}
+
+TEST_CASE("small regions and regions cut by the border are left out", "[vision][regions]") {
+  cv::Mat img(200, 200, CV_8UC1, cv::Scalar(0));
+  img(cv::Rect(0, 50, 40, 40)).setTo(255);     // touches the left edge
+  img(cv::Rect(100, 100, 5, 5)).setTo(255);    // 25 px: noise
+  img(cv::Rect(120, 20, 30, 30)).setTo(255);   // a part
+  auto regions = findRegions(img);
+  REQUIRE(regions.size() == 1);
+  CHECK(regions[0].bbox == cv::Rect(120, 20, 30, 30));
+  picksight::vision::RegionOptions keep;
+  keep.keep_border_regions = true;
+  keep.min_area = 10;
+  regions = findRegions(img, keep);
+  REQUIRE(regions.size() == 3);
+  CHECK(regions[0].touches_border);
+}
+
+TEST_CASE("an L shape's angle follows its rotation over the full turn", "[vision][regions]") {
+  const auto base = regionsOf(drawL(0, false), true);
+  REQUIRE(base.size() == 1);
+  for (double deg = 0; deg < 360; deg += 17.5) {
+    const Drawn d = drawL(deg, false);
+    const auto turned = regionsOf(d, true);
+    REQUIRE(turned.size() == 1);
+    INFO("rotation " << deg);
+    CHECK(angleDiffDeg(turned[0].angle_deg, base[0].angle_deg + deg) < 0.1);
+    CHECK(angleDiffDeg(turned[0].angle_deg, d.axis_deg, 180) < 0.1);
+    CHECK(turned[0].centroid.x == Approx(d.centroid.x).margin(0.02));
+    CHECK(turned[0].centroid.y == Approx(d.centroid.y).margin(0.02));
+  }
+}
+
+TEST_CASE("grey-level moments beat binary ones on diagonal edges", "[vision][regions]") {
+  // At 45 degrees every edge pixel of a side has the same coverage, so the
+  // binary cut errs the same way all along the side.
+  const Drawn d = drawL(315, false);
+  const auto grey = regionsOf(d, true);
+  const auto binary = regionsOf(d, false);
+  REQUIRE(grey.size() == 1);
+  REQUIRE(binary.size() == 1);
+  const double grey_error = cv::norm(grey[0].centroid - d.centroid);
+  const double binary_error = cv::norm(binary[0].centroid - d.centroid);
+  CHECK(grey_error < 0.02);
+  CHECK(binary_error > 5 * grey_error);
+}
+
+TEST_CASE("a mirrored L shape turns the other way", "[vision][regions]") {
+  const auto base = regionsOf(drawL(0, false), true);
+  REQUIRE(base.size() == 1);
+  for (double deg = 0; deg < 360; deg += 45) {
+    const auto mirrored = regionsOf(drawL(deg, true), true);
+    REQUIRE(mirrored.size() == 1);
+    INFO("rotation " << deg);
+    // Mirroring about the x axis maps an angle t to -t, then the turn adds.
+    CHECK(angleDiffDeg(mirrored[0].angle_deg, -base[0].angle_deg + deg) < 0.1);
+  }
+}

@@ -1,0 +1,119 @@
+// A camera of the video server: owns one source and its acquisition thread,
+// applies the output settings, and hands finished frames to a FrameSink.
+//
+// Threading: the acquisition thread is the only caller of the source. All
+// public methods are safe from any thread (the control thread calls them).
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "picksight/video_server/frame_pipeline.hpp"
+#include "picksight/video_server/source.hpp"
+
+namespace picksight::video {
+
+enum class AcquisitionMode { kFreeRun, kTrigger };
+
+struct CameraConfig {
+  std::string name;
+  std::string uri;
+  OutputSettings output;
+  AcquisitionMode mode = AcquisitionMode::kFreeRun;
+  double fps = 10;
+};
+
+// A frame ready to publish.
+struct PublishedFrame {
+  std::string camera;
+  uint64_t sequence = 0;
+  uint64_t device_timestamp_ns = 0;
+  uint64_t host_timestamp_ns = 0;
+  bool triggered = false;
+  OutputFrame output;
+  std::vector<TruthPart> truth;
+};
+
+// Where a camera's frames go. publish() must not block: the acquisition thread
+// calls it and a slow consumer must never slow the camera.
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  virtual void publish(PublishedFrame frame) = 0;
+};
+
+struct TriggerTicket {
+  uint64_t sequence = 0;  // the frame to wait for (or any later one)
+  bool triggered = false;  // false in free-run: no frame was forced
+};
+
+struct CameraStatus {
+  std::string name;
+  std::string uri;
+  std::string state;  // "opening", "streaming", "reconnecting", "failed", "stopped"
+  std::string last_error;
+  AcquisitionMode mode = AcquisitionMode::kFreeRun;
+  double fps_setting = 0;
+  double fps_measured = 0;
+  SourceInfo info;
+  OutputSettings output;
+  uint64_t frames_acquired = 0;
+  uint64_t acquisition_errors = 0;
+  uint64_t reconnects = 0;
+  uint64_t last_sequence = 0;
+};
+
+class Camera {
+ public:
+  Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& sink);
+  ~Camera();
+  Camera(const Camera&) = delete;
+  Camera& operator=(const Camera&) = delete;
+
+  void start();
+  void stop();
+
+  const std::string& name() const { return config_.name; }
+  CameraStatus status() const;
+
+  // Output settings take effect from the next frame; validated against the
+  // sensor size once the source has been opened.
+  Result<void> setOutput(const OutputSettings& output);
+  OutputSettings output() const;
+  Result<void> setMode(AcquisitionMode mode, double fps);
+
+  // In trigger mode queues one frame and returns its sequence number. In
+  // free-run returns the first sequence number acquired after this call.
+  TriggerTicket trigger();
+
+ private:
+  void run();
+  bool ensureOpen(std::unique_lock<std::mutex>& lock);
+  void waitBackoff(std::unique_lock<std::mutex>& lock);
+
+  const CameraConfig config_;
+  const std::unique_ptr<Source> source_;  // acquisition thread only
+  FrameSink& sink_;
+  std::thread thread_;
+
+  mutable std::mutex mutex_;  // guards everything below
+  std::condition_variable wake_;
+  bool stop_ = false;
+  bool open_ = false;
+  bool ever_opened_ = false;
+  std::chrono::milliseconds backoff_{100};
+  OutputSettings output_;
+  AcquisitionMode mode_;
+  double fps_;
+  uint64_t next_sequence_ = 1;
+  uint64_t pending_triggers_ = 0;
+  CameraStatus status_;
+};
+
+}  // namespace picksight::video

@@ -1,0 +1,34 @@
+// The per-camera output transform: region of interest, resize and output
+// pixel format, applied to every sensor frame before it is published.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "picksight/common/result.hpp"
+
+namespace picksight::video {
+
+enum class OutputFormat { kMono8, kBgr8 };
+
+struct OutputSettings {
+  cv::Rect roi;           // in sensor pixels; empty = full sensor
+  cv::Size size;          // output size; empty = ROI size (or scaled)
+  double scale = 0;       // used when `size` is empty; 0 = 1
+  OutputFormat format = OutputFormat::kMono8;
+};
+
+struct OutputFrame {
+  cv::Mat image;  // continuous, owned
+  cv::Point roi_offset;
+  double scale_x = 1;  // output pixels per sensor pixel
+  double scale_y = 1;
+};
+
+// Checks settings against a sensor size; the error names what is wrong.
+Result<void> validateOutputSettings(const OutputSettings& settings, cv::Size sensor);
+
+// Applies the settings to a sensor frame (CV_8UC1 or CV_8UC3 BGR). Settings
+// that do not fit this frame (a sensor that changed size) are clamped.
+OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings);
+
+}  // namespace picksight::video

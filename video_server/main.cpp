@@ -1,0 +1,46 @@
+// picksight-video-server: parses options, starts the server, prints the bound
+// endpoints, runs until SIGINT/SIGTERM.
+#include <csignal>
+#include <iostream>
+
+#include "picksight/common/log.hpp"
+#include "picksight/video_server/video_server.hpp"
+
+int main(int argc, char** argv) {
+  using namespace picksight;
+  setLogPrefix("video-server");
+  bool help = false;
+  auto config = video::parseServerArgs(std::vector<std::string>(argv + 1, argv + argc), &help);
+  if (help) {
+    std::cout << video::serverUsage();
+    return 0;
+  }
+  if (!config) {
+    std::cerr << "picksight-video-server: " << config.error().message << "\n\n" << video::serverUsage();
+    return 2;
+  }
+  // Block the stop signals in every thread; the main thread waits for them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+  try {
+    video::VideoServer server(*config);
+    server.start();
+    // Machine-readable lines: tests and scripts bind port 0 and read these.
+    std::cout << "frames " << server.framesEndpoint() << "\n"
+              << "control " << server.controlEndpoint() << "\n"
+              << "ready" << std::endl;
+    for (const auto& c : config->cameras) logInfo("camera ", c.name, " = ", c.uri);
+    int sig = 0;
+    sigwait(&signals, &sig);
+    logInfo("stopping on signal ", sig);
+    server.stop();
+  } catch (const std::exception& e) {
+    std::cerr << "picksight-video-server: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,80 @@
+// File camera source.
+#include "file_source.hpp"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace picksight::video {
+namespace {
+// Any depth/channel layout imread gives, to 8-bit mono or BGR.
+cv::Mat toEightBit(const cv::Mat& in) {
+  cv::Mat eight;
+  if (in.depth() == CV_16U) {
+    in.convertTo(eight, CV_8U, 1.0 / 257.0);
+  } else if (in.depth() != CV_8U) {
+    cv::normalize(in, eight, 0, 255, cv::NORM_MINMAX, CV_8U);
+  } else {
+    eight = in;
+  }
+  if (eight.channels() == 4) {
+    cv::Mat bgr;
+    cv::cvtColor(eight, bgr, cv::COLOR_BGRA2BGR);
+    return bgr;
+  }
+  return eight;
+}
+}  // namespace
+
+FileSource::FileSource(std::string path) : path_(std::move(path)) {}
+
+Result<void> FileSource::open() { return refresh(); }
+
+void FileSource::close() { image_.release(); inode_ = 0; size_ = -1; }
+
+SourceInfo FileSource::info() const {
+  SourceInfo i;
+  i.vendor = "PickSight";
+  i.model = "file";
+  i.serial = path_;
+  i.sensor_width = image_.cols;
+  i.sensor_height = image_.rows;
+  i.formats = {image_.channels() == 3 ? "BGR8" : "Mono8"};
+  return i;
+}
+
+Result<void> FileSource::refresh() {
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) != 0) {
+    if (!image_.empty()) return {};  // keep serving the last image while the file is being replaced
+    return makeError(kSourceUnavailable, "file:" + path_ + ": " + std::strerror(errno));
+  }
+  if (!image_.empty() && st.st_ino == inode_ && st.st_size == size_ &&
+      st.st_mtim.tv_sec == mtime_.tv_sec && st.st_mtim.tv_nsec == mtime_.tv_nsec) {
+    return {};
+  }
+  cv::Mat loaded = cv::imread(path_, cv::IMREAD_UNCHANGED);
+  if (loaded.empty()) {
+    // A half-written file reads as garbage: keep the previous image and try
+    // again on the next frame.
+    if (!image_.empty()) return {};
+    return makeError(kSourceUnavailable, "file:" + path_ + ": not a readable image");
+  }
+  image_ = toEightBit(loaded);
+  inode_ = st.st_ino;
+  size_ = st.st_size;
+  mtime_ = st.st_mtim;
+  return {};
+}
+
+Result<SourceFrame> FileSource::grab(std::chrono::milliseconds /*timeout*/) {
+  if (auto r = refresh(); !r) return r.error();
+  SourceFrame frame;
+  frame.image = image_;  // shared, read-only: the pipeline copies or converts it
+  return frame;
+}
+
+}  // namespace picksight::video

@@ -1,0 +1,105 @@
+// Synthetic scenes with exact ground truth: dark anti-aliased parts on a
+// light, unevenly lit, noisy background. Used by the synthetic camera source
+// (the embedded default), by tests and by benchmarks.
+//
+// Conventions: pixel centres at integer coordinates (pixel (u, v) covers
+// [u-0.5, u+0.5] x [v-0.5, v+0.5]); image axes x right, y down; angles in
+// degrees, a part frame point (px, py) lands at
+//   (x + px cos a - py sin a, y + px sin a + py cos a).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace picksight::synthetic {
+
+// A part's silhouette in its own frame: loops[0] is the outer boundary, the
+// others are holes. Canonical frame: the area centroid is the origin, the axis
+// of least second moment is +x, and +x points to the side where the part
+// reaches farther from the centroid along that axis (SPEC section 3).
+struct Shape {
+  std::vector<std::vector<cv::Point2d>> loops;
+};
+
+struct PartTruth {
+  std::string type;
+  double x = 0;  // area centroid, pixels
+  double y = 0;
+  double angle_deg = 0;       // [0, 360)
+  double symmetry_deg = 360;  // 360 directed, 180 axis only, 0 isotropic
+  double area_px = 0;         // exact polygon area
+};
+
+struct SceneOptions {
+  int width = 1280;
+  int height = 960;
+  int parts = 8;
+  uint64_t seed = 1;
+  // Part types to draw from (empty = all of partTypes()).
+  std::vector<std::string> types;
+  // Size of a part's longest side in pixels (scaled so `parts` fit when needed).
+  double part_size = 120;
+  double noise_sigma = 3.0;       // grey levels, Gaussian
+  bool uneven_light = true;       // smooth illumination gradient and vignetting
+  double background_level = 200;  // grey level of the lit background
+  double part_level = 45;         // grey level of a part
+};
+
+// The part types the generator knows: "rectangle", "l_shape", "l_shape_mirror",
+// "disc_holes", "gear".
+const std::vector<std::string>& partTypes();
+
+// The canonical silhouette of a part type whose longest side is `size` pixels.
+// Throws std::invalid_argument for an unknown type.
+Shape partShape(const std::string& type, double size);
+
+// Symmetry of the inertia-based angle for a shape (see PartTruth::symmetry_deg).
+double angleSymmetryDeg(const Shape& shape);
+
+// Exact area of a shape (outer minus holes).
+double shapeArea(const Shape& shape);
+
+// Area, centroid and central second moments of a shape (outer minus holes),
+// exact for its polygons whatever the winding of each loop. Image axes.
+struct ShapeMoments {
+  double area = 0;
+  double cx = 0;
+  double cy = 0;
+  double mu20 = 0;  // sum (x - cx)^2 dA
+  double mu11 = 0;  // sum (x - cx)(y - cy) dA
+  double mu02 = 0;  // sum (y - cy)^2 dA
+};
+ShapeMoments shapeMoments(const Shape& shape);
+
+// A shape moved from its own frame to image pixels with the pose convention
+// above (centroid at (x, y), rotated by angle_deg).
+Shape placedShape(const Shape& shape, double x, double y, double angle_deg);
+
+class SceneRenderer {
+ public:
+  // Lays out the parts (random non-overlapping positions and angles drawn
+  // from the seed) and renders the clean image once.
+  explicit SceneRenderer(SceneOptions options);
+
+  const SceneOptions& options() const { return options_; }
+  const std::vector<PartTruth>& truth() const { return truth_; }
+  // Noise-free CV_8UC1 image.
+  const cv::Mat& clean() const { return clean_; }
+  // The clean image plus sensor noise that differs per frame index and is
+  // reproducible for a given (seed, index). Cheap: no re-rendering.
+  cv::Mat render(uint64_t frame_index) const;
+  // The same frame written into `out` (reallocated only when its size or type
+  // differ), so a caller with pooled buffers renders without allocating.
+  void renderInto(uint64_t frame_index, cv::Mat& out) const;
+
+ private:
+  SceneOptions options_;
+  std::vector<PartTruth> truth_;
+  cv::Mat clean_;
+  std::vector<cv::Mat> noise_bank_;  // CV_16SC1 noise fields reused across frames
+};
+
+}  // namespace picksight::synthetic

@@ -1,0 +1,86 @@
+// ROI, resize and pixel format for published frames.
+#include "picksight/video_server/frame_pipeline.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <string>
+
+namespace picksight::video {
+namespace {
+// Output sizes beyond this are a typing error, not a camera.
+constexpr int kMaxOutputSide = 16384;
+
+cv::Rect effectiveRoi(const OutputSettings& s, cv::Size sensor) {
+  if (s.roi.empty()) return cv::Rect(0, 0, sensor.width, sensor.height);
+  return s.roi & cv::Rect(0, 0, sensor.width, sensor.height);
+}
+
+cv::Size outputSize(const OutputSettings& s, cv::Size roi) {
+  if (!s.size.empty()) return s.size;
+  if (s.scale > 0 && s.scale != 1.0) {
+    return cv::Size(std::max(1, static_cast<int>(std::lround(roi.width * s.scale))),
+                    std::max(1, static_cast<int>(std::lround(roi.height * s.scale))));
+  }
+  return roi;
+}
+}  // namespace
+
+Result<void> validateOutputSettings(const OutputSettings& s, cv::Size sensor) {
+  if (!s.roi.empty()) {
+    if (s.roi.x < 0 || s.roi.y < 0 || s.roi.width <= 0 || s.roi.height <= 0) {
+      return makeError(1, "roi must have a non-negative offset and a positive size");
+    }
+    if (sensor.area() > 0 && (s.roi.x + s.roi.width > sensor.width ||
+                              s.roi.y + s.roi.height > sensor.height)) {
+      return makeError(1, "roi " + std::to_string(s.roi.x) + "," + std::to_string(s.roi.y) + " " +
+                              std::to_string(s.roi.width) + "x" + std::to_string(s.roi.height) +
+                              " exceeds the sensor " + std::to_string(sensor.width) + "x" +
+                              std::to_string(sensor.height));
+    }
+  }
+  if ((s.size.width == 0) != (s.size.height == 0)) {
+    return makeError(1, "size needs both a width and a height");
+  }
+  if (s.size.width < 0 || s.size.height < 0 || s.size.width > kMaxOutputSide ||
+      s.size.height > kMaxOutputSide) {
+    return makeError(1, "size must be between 1 and " + std::to_string(kMaxOutputSide));
+  }
+  if (s.scale < 0 || s.scale > 16) return makeError(1, "scale must be in (0, 16]");
+  return {};
+}
+
+OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings) {
+  OutputFrame out;
+  cv::Rect roi = effectiveRoi(settings, sensor.size());
+  if (roi.empty()) roi = cv::Rect(0, 0, sensor.cols, sensor.rows);
+  const cv::Size size = outputSize(settings, roi.size());
+  out.roi_offset = roi.tl();
+  out.scale_x = static_cast<double>(size.width) / roi.width;
+  out.scale_y = static_cast<double>(size.height) / roi.height;
+
+  cv::Mat view = sensor(roi);
+  cv::Mat sized;
+  if (size == roi.size()) {
+    sized = view;
+  } else {
+    // INTER_AREA when shrinking keeps the centroid of every blob where it was;
+    // linear when enlarging.
+    const int interp = size.area() < roi.area() ? cv::INTER_AREA : cv::INTER_LINEAR;
+    cv::resize(view, sized, size, 0, 0, interp);
+  }
+  const bool want_mono = settings.format == OutputFormat::kMono8;
+  if (want_mono && sized.channels() == 3) {
+    cv::cvtColor(sized, out.image, cv::COLOR_BGR2GRAY);
+  } else if (!want_mono && sized.channels() == 1) {
+    cv::cvtColor(sized, out.image, cv::COLOR_GRAY2BGR);
+  } else if (sized.data == sensor.data || !sized.isContinuous() || sized.datastart == sensor.datastart) {
+    // Never publish the source's own buffer: it is reused for the next frame.
+    out.image = sized.clone();
+  } else {
+    out.image = sized;
+  }
+  return out;
+}
+
+}  // namespace picksight::video

@@ -1,0 +1,25 @@
+// Binarization of a grey image into part (255) and background (0) pixels.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace picksight::vision {
+
+enum class Polarity { kDarkOnLight, kLightOnDark };
+enum class ThresholdMethod { kAdaptive, kOtsu, kFixed };
+
+struct BinarizeOptions {
+  ThresholdMethod method = ThresholdMethod::kAdaptive;
+  Polarity polarity = Polarity::kDarkOnLight;
+  int fixed_threshold = 128;  // kFixed: grey level separating part and background
+  // kAdaptive: size in pixels of the window over which the illumination is
+  // estimated. It must exceed the width of the largest part, or that part's
+  // middle is taken for background and the part breaks apart. 0 = a sixth of
+  // the smaller image side.
+  int adaptive_window = 0;
+};
+
+// Returns a CV_8UC1 mask, 255 on parts. `grey` is CV_8UC1.
+cv::Mat binarize(const cv::Mat& grey, const BinarizeOptions& options);
+
+}  // namespace picksight::vision
