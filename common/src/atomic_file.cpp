@@ -2,6 +2,7 @@
 #include "picksight/common/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -62,6 +63,11 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& con
 }
 
 Result<std::string> readFile(const std::string& path) {
+  // An ifstream opens a directory and reads it as an empty file.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    return makeError(EISDIR, "cannot read " + path + ": is a directory");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return makeError(ENOENT, "cannot open " + path);
   std::ostringstream out;

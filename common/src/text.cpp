@@ -7,10 +7,19 @@
 #include <cstdio>
 
 namespace picksight {
+namespace {
+// from_chars takes no '+': drop one. False for "+-3", which from_chars would
+// otherwise read as -3.
+bool dropPlusSign(std::string_view& text) {
+  if (text.empty() || text.front() != '+') return true;
+  text.remove_prefix(1);
+  return text.empty() || text.front() != '-';
+}
+}  // namespace
 
 std::optional<double> parseDouble(std::string_view text) {
   if (text.empty()) return std::nullopt;
-  if (text.front() == '+') text.remove_prefix(1);
+  if (!dropPlusSign(text)) return std::nullopt;
   double value = 0;
   auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(value)) {
@@ -21,7 +30,7 @@ std::optional<double> parseDouble(std::string_view text) {
 
 std::optional<long long> parseInt(std::string_view text) {
   if (text.empty()) return std::nullopt;
-  if (text.front() == '+') text.remove_prefix(1);
+  if (!dropPlusSign(text)) return std::nullopt;
   long long value = 0;
   auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec != std::errc() || ptr != text.data() + text.size()) return std::nullopt;

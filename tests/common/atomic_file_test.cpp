@@ -2,8 +2,8 @@
 // clean errors for impossible writes and missing files.
 #include <cstdlib>
 #include <filesystem>
-#include <stdexcept>
 #include <set>
+#include <stdexcept>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -75,8 +75,7 @@ TEST_CASE("writeFileAtomically leaves no temporary file behind", "[common]") {
   CHECK(namesIn(dir.path()) == std::set<std::string>{"calib.yaml"});
 }
 
-TEST_CASE("writeFileAtomically into a missing directory is an error, not a crash",
-          "[common]") {
+TEST_CASE("writeFileAtomically into a missing directory is an error, not a crash", "[common]") {
   TempDir dir;
   const fs::path missing = dir.path() / "no_such_dir";
   const std::string path = (missing / "file.txt").string();

@@ -69,8 +69,7 @@ TEST_CASE("ControlClient returns the reply of a server that answers OK", "[commo
   CHECK(reply->list_cameras().cameras(0).name() == "cam0");
 }
 
-TEST_CASE("ControlClient turns a server error into an Error with its code and text",
-          "[common]") {
+TEST_CASE("ControlClient turns a server error into an Error with its code and text", "[common]") {
   zmq::context_t context;
   std::string endpoint;
   zmq::socket_t rep = boundRep(context, &endpoint);
@@ -98,8 +97,7 @@ TEST_CASE("ControlClient reports a malformed reply as INTERNAL", "[common]") {
   CHECK(reply.error().code == proto::Error::INTERNAL);
 }
 
-TEST_CASE("ControlClient times out on a silent server and works again afterwards",
-          "[common]") {
+TEST_CASE("ControlClient times out on a silent server and works again afterwards", "[common]") {
   zmq::context_t context;
   std::string endpoint;
   zmq::socket_t rep = boundRep(context, &endpoint);

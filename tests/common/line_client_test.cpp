@@ -76,7 +76,8 @@ class TestServer {
         while (readable(fd)) {
           const ssize_t n = ::recv(fd, buf, sizeof(buf), 0);
           if (n <= 0) break;
-          if (behaviour_ == Behaviour::kEcho) (void)::send(fd, buf, static_cast<size_t>(n), MSG_NOSIGNAL);
+          if (behaviour_ == Behaviour::kEcho)
+            (void)::send(fd, buf, static_cast<size_t>(n), MSG_NOSIGNAL);
         }
       }
       ::close(fd);

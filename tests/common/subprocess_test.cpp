@@ -17,6 +17,16 @@ using picksight::Subprocess;
 
 namespace {
 constexpr auto kTimeout = 10000ms;
+
+// Polls running(), which reaps the child, until it has exited by itself.
+bool waitForExit(Subprocess& child) {
+  const auto deadline = std::chrono::steady_clock::now() + kTimeout;
+  while (child.running()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+  return true;
+}
 }  // namespace
 
 TEST_CASE("Subprocess reads the lines of /bin/echo, then EOF", "[common]") {
@@ -24,6 +34,8 @@ TEST_CASE("Subprocess reads the lines of /bin/echo, then EOF", "[common]") {
   CHECK(echo.pid() > 0);
   CHECK(echo.readLine(kTimeout) == std::optional<std::string>("hello world"));
   CHECK(echo.readLine(kTimeout) == std::nullopt);
+  // EOF comes before the exit: wait for it, or terminate() would kill it.
+  REQUIRE(waitForExit(echo));
   const int status = echo.terminate();
   REQUIRE(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
@@ -39,11 +51,8 @@ TEST_CASE("Subprocess waitForLine skips to the line with the prefix", "[common]"
 
 TEST_CASE("Subprocess keeps the exit status of a child that ended by itself", "[common]") {
   Subprocess sh({"/bin/sh", "-c", "exit 3"});
-  const auto deadline = std::chrono::steady_clock::now() + kTimeout;
-  while (sh.running() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(10ms);
-  }
-  REQUIRE_FALSE(sh.running());
+  REQUIRE(waitForExit(sh));
+  CHECK_FALSE(sh.running());
   const int status = sh.terminate();
   REQUIRE(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 3);

@@ -78,9 +78,9 @@ TEST_CASE("parseDouble accepts plain decimals with an optional sign", "[common]"
 }
 
 TEST_CASE("parseDouble rejects anything that is not a whole finite number", "[common]") {
-  for (const char* bad : {"1,5", "abc", "", "1.5x", "nan", "NaN", "inf", "-inf", "infinity", "+",
-                          "-", ".", " 1.5", "1.5 ", "1.5\n", "+-3", "++3", "-+3", "1e999",
-                          "0x10", "1..5", "1.5.2"}) {
+  for (const char* bad : {"1,5",      "abc", "",      "1.5x", "nan",  "NaN",  "inf",   "-inf",
+                          "infinity", "+",   "-",     ".",    " 1.5", "1.5 ", "1.5\n", "+-3",
+                          "++3",      "-+3", "1e999", "0x10", "1..5", "1.5.2"}) {
     INFO("input '" << bad << "'");
     CHECK(parseDouble(bad) == std::nullopt);
   }
@@ -92,8 +92,8 @@ TEST_CASE("parseInt accepts signed integers and rejects the rest", "[common]") {
   CHECK(parseInt("+3").value_or(0) == 3);
   CHECK(parseInt("0").value_or(1) == 0);
   CHECK(parseInt("9223372036854775807").value_or(0) == 9223372036854775807LL);
-  for (const char* bad : {"1.5", "1,5", "abc", "", "3x", "+", "-", " 3", "3 ", "+-3", "++3",
-                          "nan", "inf", "99999999999999999999", "0x10"}) {
+  for (const char* bad : {"1.5", "1,5", "abc", "", "3x", "+", "-", " 3", "3 ", "+-3", "++3", "nan",
+                          "inf", "99999999999999999999", "0x10"}) {
     INFO("input '" << bad << "'");
     CHECK(parseInt(bad) == std::nullopt);
   }

@@ -190,9 +190,8 @@ TEST_CASE("Camera free-run trigger ticket follows every published frame", "[vide
     CHECK_FALSE(ticket.triggered);
     CHECK(ticket.sequence > published);
     // ... and a frame with that sequence does come.
-    CHECK(sink.waitUntil([&](const std::vector<PublishedFrame>& f) {
-      return maxSequence(f) >= ticket.sequence;
-    }));
+    CHECK(sink.waitUntil(
+        [&](const std::vector<PublishedFrame>& f) { return maxSequence(f) >= ticket.sequence; }));
   }
 }
 
@@ -274,8 +273,7 @@ TEST_CASE("Camera setMode switches between free-run and trigger", "[video_server
   CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, 5000));
 }
 
-TEST_CASE("Camera retries a source that is missing and streams once it appears",
-          "[video_server]") {
+TEST_CASE("Camera retries a source that is missing and streams once it appears", "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");
 

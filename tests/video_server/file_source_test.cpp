@@ -1,14 +1,14 @@
 // Pins the file camera: serves the image on every grab, picks up a new image
 // renamed over the path (even with equal size and mtime), keeps the last good
 // image while the file is missing or half-written, and fails cleanly.
-#include <sys/stat.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <stdexcept>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 #include <catch2/catch.hpp>
@@ -157,8 +157,7 @@ TEST_CASE("FileSource picks up a renamed image of equal size and mtime (new inod
   CHECK(sameImage(grabImage(*source), sceneImage(2)));
 }
 
-TEST_CASE("FileSource of a missing file is kSourceUnavailable naming the path",
-          "[video_server]") {
+TEST_CASE("FileSource of a missing file is kSourceUnavailable naming the path", "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("absent.png");
   auto source = fileSource(path);

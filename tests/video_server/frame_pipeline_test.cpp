@@ -33,7 +33,8 @@ cv::Mat positionImage(int width, int height) {
 cv::Mat monoGradient(int width, int height) {
   cv::Mat image(height, width, CV_8UC1);
   for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) image.at<uint8_t>(y, x) = static_cast<uint8_t>((x + 3 * y) % 256);
+    for (int x = 0; x < width; ++x)
+      image.at<uint8_t>(y, x) = static_cast<uint8_t>((x + 3 * y) % 256);
   }
   return image;
 }
@@ -70,7 +71,8 @@ TEST_CASE("applyOutputSettings crops the ROI with the pixels at their sensor pos
   int wrong = 0;
   for (int v = 0; v < out.image.rows; ++v) {
     for (int u = 0; u < out.image.cols; ++u) {
-      if (out.image.at<cv::Vec3b>(v, u) != cv::Vec3b(static_cast<uint8_t>(10 + u), static_cast<uint8_t>(5 + v), 77)) {
+      if (out.image.at<cv::Vec3b>(v, u) !=
+          cv::Vec3b(static_cast<uint8_t>(10 + u), static_cast<uint8_t>(5 + v), 77)) {
         ++wrong;
       }
     }
@@ -230,7 +232,8 @@ TEST_CASE("applyOutputSettings never returns the input buffer", "[video_server]"
       {"mono full-width rows", &mono, full_rows},
       {"mono crop", &mono, crop},
       {"bgr kept bgr", &bgr, bgr_out},
-      {"bgr full-width rows kept bgr", &bgr, [&] {
+      {"bgr full-width rows kept bgr", &bgr,
+       [&] {
          OutputSettings s = full_rows;
          s.format = OutputFormat::kBgr8;
          return s;
@@ -283,6 +286,8 @@ TEST_CASE("validateOutputSettings rejects a ROI whose end overflows int", "[vide
   CHECK_FALSE(validateOutputSettings(s, cv::Size(640, 480)));
   s.roi = cv::Rect(0, 2000000000, 10, 2000000000);
   CHECK_FALSE(validateOutputSettings(s, cv::Size(640, 480)));
+  // Also before the sensor size is known: cv::Rect arithmetic would overflow.
+  CHECK_FALSE(validateOutputSettings(s, cv::Size()));
 }
 
 TEST_CASE("validateOutputSettings rejects half sizes and negative values", "[video_server]") {

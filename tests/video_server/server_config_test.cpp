@@ -2,8 +2,8 @@
 // and YAML files whose errors name the file and the key path.
 #include <cstdlib>
 #include <filesystem>
-#include <stdexcept>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -105,8 +105,8 @@ TEST_CASE("parseServerArgs --help sets the flag", "[video_server]") {
 
 TEST_CASE("parseServerArgs --source NAME=URI repeated, with --mode and --fps", "[video_server]") {
   auto config = parseServerArgs({"--source", "top=synthetic:parts=3", "--mode", "trigger",
-                                 "--source", "side=file:/data/a=b.png", "--fps", "25.5",
-                                 "--frames", "tcp://127.0.0.1:*", "--control", "ipc:///tmp/c"},
+                                 "--source", "side=file:/data/a=b.png", "--fps", "25.5", "--frames",
+                                 "tcp://127.0.0.1:*", "--control", "ipc:///tmp/c"},
                                 nullptr);
   REQUIRE(config);
   REQUIRE(config->cameras.size() == 2);
@@ -165,8 +165,7 @@ TEST_CASE("loadServerConfig reads endpoints and cameras with their output", "[vi
   CHECK(config->cameras[2].output.scale == 0.5);
 }
 
-TEST_CASE("parseServerArgs --config loads the file, and --frames overrides it",
-          "[video_server]") {
+TEST_CASE("parseServerArgs --config loads the file, and --frames overrides it", "[video_server]") {
   TempDir dir;
   const std::string path = dir.write("server.yaml", kTwoCameras);
   auto config = parseServerArgs({"--config", path, "--frames", "tcp://127.0.0.1:*"}, nullptr);
@@ -211,7 +210,8 @@ TEST_CASE("loadServerConfig errors name the key path", "[video_server]") {
                        "  - {name: a, source: 'synthetic:'}\n"
                        "  - {name: b}\n"),
              Catch::Contains("cameras[1].source"));
-  CHECK_THAT(yamlError("cameras:\n  - {source: 'synthetic:'}\n"), Catch::Contains("cameras[0].name"));
+  CHECK_THAT(yamlError("cameras:\n  - {source: 'synthetic:'}\n"),
+             Catch::Contains("cameras[0].name"));
   CHECK_THAT(yamlError("cameras:\n  - just a string\n"), Catch::Contains("cameras[0]"));
   CHECK_THAT(yamlError("cameras: {name: a}\n"), Catch::Contains("cameras"));
   CHECK_THAT(yamlError("cameras:\n"

@@ -42,8 +42,10 @@ TEST_CASE("makeSource synthetic: errors name the key and what it must be", "[vid
   CHECK_THAT(badConfigMessage("synthetic:width=10"), Catch::StartsWith("synthetic: width must be"));
   CHECK_THAT(badConfigMessage("synthetic:width=320,height=1.5"),
              Catch::StartsWith("synthetic: height must be"));
-  CHECK_THAT(badConfigMessage("synthetic:noise=loud"), Catch::StartsWith("synthetic: noise must be"));
-  CHECK_THAT(badConfigMessage("synthetic:light=dim"), Catch::StartsWith("synthetic: light must be"));
+  CHECK_THAT(badConfigMessage("synthetic:noise=loud"),
+             Catch::StartsWith("synthetic: noise must be"));
+  CHECK_THAT(badConfigMessage("synthetic:light=dim"),
+             Catch::StartsWith("synthetic: light must be"));
   CHECK_THAT(badConfigMessage("synthetic:types=rectangle+blob"),
              Catch::StartsWith("synthetic: types must be") && Catch::Contains("rectangle"));
   CHECK_THAT(badConfigMessage("synthetic:colour=red"), Catch::Contains("unknown key 'colour'"));

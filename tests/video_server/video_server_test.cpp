@@ -350,8 +350,7 @@ TEST_CASE("VideoServer answers a real ControlClient on its bound endpoint", "[vi
   CHECK(client.call(list));
 }
 
-TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers",
-          "[video_server]") {
+TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", "[video_server]") {
   VideoServer server(testConfig());
   server.start();
   zmq::context_t context;

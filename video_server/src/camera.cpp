@@ -1,13 +1,14 @@
 // Camera acquisition loop: open with back-off, pace or wait for triggers,
-// grab, apply output settings, hand over.
+// grab, standardize and apply output settings, hand over.
 //
 // The synthetic and file sources render or read on demand, so this thread is
-// their acquisition thread. Drivers with their own delivery thread (Aravis)
-// only hand buffers to grab(); the conversion work happens here, never on
-// the driver's thread.
+// their acquisition thread. Streaming drivers (Aravis, V4L2) receive buffers
+// on their own thread or in the kernel and only hand them to grab(); the
+// conversion work happens here, never on the driver's thread.
 #include "picksight/video_server/camera.hpp"
 
 #include <algorithm>
+#include <future>
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/log.hpp"
@@ -15,7 +16,10 @@
 namespace picksight::video {
 namespace {
 constexpr std::chrono::milliseconds kMaxBackoff{5000};
-constexpr std::chrono::milliseconds kGrabTimeout{1000};
+// Streaming sources are polled in short slices so feature commands and stop
+// requests are served promptly even when no frame comes.
+constexpr std::chrono::milliseconds kGrabSlice{200};
+constexpr std::chrono::milliseconds kCommandTimeout{5000};
 }  // namespace
 
 Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& sink)
@@ -47,9 +51,10 @@ void Camera::stop() {
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (open_) source_->close();
-  open_ = false;
+  std::unique_lock<std::mutex> lock(mutex_);
+  closeSource(lock);
+  // Commands queued after the thread ended still get an answer.
+  runCommands(lock);
   status_.state = "stopped";
 }
 
@@ -59,6 +64,7 @@ CameraStatus Camera::status() const {
   s.mode = mode_;
   s.fps_setting = fps_;
   s.output = output_;
+  s.open_requested = open_requested_;
   return s;
 }
 
@@ -82,9 +88,19 @@ Result<void> Camera::setMode(AcquisitionMode mode, double fps) {
     mode_ = mode;
     if (fps > 0) fps_ = fps;
     if (mode == AcquisitionMode::kFreeRun) pending_triggers_ = 0;
+    reconfigure_ = true;
   }
   wake_.notify_all();
   return {};
+}
+
+void Camera::setOpen(bool open) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_requested_ = open;
+    if (!open) pending_triggers_ = 0;
+  }
+  wake_.notify_all();
 }
 
 TriggerTicket Camera::trigger() {
@@ -105,9 +121,80 @@ TriggerTicket Camera::trigger() {
   return ticket;
 }
 
+std::optional<PublishedFrame> Camera::waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const auto ready = [&] { return last_frame_ && last_frame_->sequence >= sequence; };
+  frame_published_.wait_for(lock, timeout, ready);
+  if (!ready()) return std::nullopt;
+  return last_frame_;
+}
+
+template <typename T>
+Result<T> Camera::onAcquisitionThread(std::function<Result<T>(Source&, bool open)> fn) {
+  auto promise = std::make_shared<std::promise<Result<T>>>();
+  auto future = promise->get_future();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // open_ is read on the acquisition thread when the command runs.
+    commands_.push_back([this, fn, promise] { promise->set_value(fn(*source_, open_)); });
+    if (!thread_.joinable()) {
+      // No acquisition thread: nobody else touches the source.
+      Command command = std::move(commands_.back());
+      commands_.pop_back();
+      command();
+      return future.get();
+    }
+  }
+  wake_.notify_all();
+  if (future.wait_for(kCommandTimeout) != std::future_status::ready) {
+    return makeError(kSourceTimeout, "camera " + config_.name + " is busy: no answer within 5 s");
+  }
+  return future.get();
+}
+
+Result<std::vector<Feature>> Camera::features() {
+  return onAcquisitionThread<std::vector<Feature>>([](Source& s, bool open) -> Result<std::vector<Feature>> {
+    if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+    return s.features();
+  });
+}
+
+Result<Feature> Camera::feature(const std::string& name) {
+  return onAcquisitionThread<Feature>([name](Source& s, bool open) -> Result<Feature> {
+    if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+    return s.feature(name);
+  });
+}
+
+Result<Feature> Camera::setFeature(const std::string& name, const std::string& value) {
+  return onAcquisitionThread<Feature>([name, value](Source& s, bool open) -> Result<Feature> {
+    if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+    if (auto ok = s.setFeature(name, value); !ok) return ok.error();
+    return s.feature(name);
+  });
+}
+
+void Camera::runCommands(std::unique_lock<std::mutex>& lock) {
+  while (!commands_.empty()) {
+    Command command = std::move(commands_.front());
+    commands_.pop_front();
+    lock.unlock();
+    command();
+    lock.lock();
+  }
+}
+
 void Camera::waitBackoff(std::unique_lock<std::mutex>& lock) {
-  wake_.wait_for(lock, backoff_, [this] { return stop_; });
+  wake_.wait_for(lock, backoff_, [this] { return stop_ || !commands_.empty() || !open_requested_; });
   backoff_ = std::min(backoff_ * 2, kMaxBackoff);
+}
+
+void Camera::closeSource(std::unique_lock<std::mutex>& lock) {
+  if (!open_) return;
+  open_ = false;
+  lock.unlock();
+  source_->close();
+  lock.lock();
 }
 
 bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
@@ -132,6 +219,7 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
   }
   ever_opened_ = true;
   open_ = true;
+  reconfigure_ = true;
   backoff_ = std::chrono::milliseconds(100);
   status_.info = info;
   status_.state = "streaming";
@@ -145,29 +233,52 @@ void Camera::run() {
   uint64_t last_frame_ns = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
+    runCommands(lock);
+    if (!open_requested_) {
+      closeSource(lock);
+      status_.state = "closed";
+      wake_.wait(lock, [this] { return stop_ || open_requested_ || !commands_.empty(); });
+      continue;
+    }
     if (!ensureOpen(lock)) continue;
 
-    // Wait for the next frame's turn: a trigger, or the free-run period.
+    if (reconfigure_) {
+      reconfigure_ = false;
+      const AcquisitionMode mode = mode_;
+      const double fps = fps_;
+      lock.unlock();
+      const Result<void> configured = source_->configureAcquisition(mode, fps);
+      lock.lock();
+      if (!configured) {
+        status_.last_error = configured.error().message;
+        logWarning("camera ", config_.name, ": ", configured.error().message);
+      }
+      next_due = Clock::now();
+    }
+    const bool streams = source_->streams();
+
+    // Wait for the next frame's turn: a trigger, or the free-run period
+    // (sources that stream pace themselves).
     bool triggered = false;
     if (mode_ == AcquisitionMode::kTrigger) {
       wake_.wait(lock, [this] {
-        return stop_ || pending_triggers_ > 0 || mode_ != AcquisitionMode::kTrigger;
+        return stop_ || pending_triggers_ > 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
+               !open_requested_ || !commands_.empty();
       });
-      if (stop_ || mode_ != AcquisitionMode::kTrigger) continue;
-      triggered = true;
-      --pending_triggers_;
-    } else {
-      const auto period = std::chrono::duration_cast<Clock::duration>(
-          std::chrono::duration<double>(1.0 / std::max(fps_, 1e-3)));
-      const AcquisitionMode mode = mode_;
-      const double fps = fps_;
-      wake_.wait_until(lock, next_due,
-                       [&] { return stop_ || mode_ != mode || fps_ != fps; });
-      if (stop_ || mode_ != mode) continue;
-      if (fps_ != fps) {
-        next_due = Clock::now();
+      if (stop_ || pending_triggers_ == 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
+          !open_requested_) {
         continue;
       }
+      triggered = true;
+      --pending_triggers_;
+    } else if (!streams) {
+      const auto period = std::chrono::duration_cast<Clock::duration>(
+          std::chrono::duration<double>(1.0 / std::max(fps_, 1e-3)));
+      wake_.wait_until(lock, next_due, [&] {
+        return stop_ || reconfigure_ || mode_ != AcquisitionMode::kFreeRun || !open_requested_ ||
+               !commands_.empty();
+      });
+      if (Clock::now() < next_due) continue;  // woken for something else
       // Behind by more than a period (a slow grab): restart the cadence
       // rather than bursting to catch up.
       next_due = std::max(next_due + period, Clock::now());
@@ -176,22 +287,32 @@ void Camera::run() {
     const OutputSettings output = output_;
     lock.unlock();
 
-    Result<SourceFrame> grabbed = source_->grab(kGrabTimeout);
+    Result<void> asked = triggered ? source_->softwareTrigger() : Result<void>();
+    Result<SourceFrame> grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
+                                        : Result<SourceFrame>(asked.error());
     const uint64_t host_ns = realtimeNs();
+    Result<OutputFrame> out = grabbed ? applyOutputSettings(*grabbed, output) : Result<OutputFrame>(grabbed.error());
 
-    if (!grabbed) {
+    if (!out) {
       lock.lock();
-      ++status_.acquisition_errors;
-      status_.last_error = grabbed.error().message;
+      // The sequence number was not used: give it back so a gap means a lost frame.
+      if (next_sequence_ == sequence + 1) next_sequence_ = sequence;
       if (triggered) ++pending_triggers_;  // the trigger is still owed a frame
-      if (grabbed.error().code != kSourceTimeout) {
-        logWarning("camera ", config_.name, ": ", grabbed.error().message);
-        lock.unlock();
-        source_->close();
-        lock.lock();
-        open_ = false;
+      if (out.error().code == kSourceTimeout) {
+        // A streaming camera with nothing to deliver yet; not an error.
+        if (triggered) ++status_.acquisition_errors;
+        continue;
+      }
+      ++status_.acquisition_errors;
+      status_.last_error = out.error().message;
+      if (out.error().code == kSourceUnavailable) {
+        logWarning("camera ", config_.name, ": ", out.error().message);
+        closeSource(lock);
         status_.state = "reconnecting";
         waitBackoff(lock);
+      } else {
+        // A bad frame (a corrupt buffer): drop it and go on.
+        logWarning("camera ", config_.name, ": frame dropped: ", out.error().message);
       }
       continue;
     }
@@ -202,21 +323,23 @@ void Camera::run() {
     frame.device_timestamp_ns = grabbed->device_timestamp_ns;
     frame.host_timestamp_ns = host_ns;
     frame.triggered = triggered;
-    frame.output = applyOutputSettings(grabbed->image, output);
+    frame.output = std::move(*out);
     frame.truth = std::move(grabbed->truth);
+    PublishedFrame kept = frame;
     sink_.publish(std::move(frame));
 
     lock.lock();
+    last_frame_ = std::move(kept);
     ++status_.frames_acquired;
     status_.last_sequence = sequence;
     if (last_frame_ns != 0) {
       // Exponential average of the instantaneous rate: smooth, and follows a
       // rate change within a few frames.
       const double rate = 1e9 / static_cast<double>(std::max<uint64_t>(1, host_ns - last_frame_ns));
-      status_.fps_measured =
-          status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
+      status_.fps_measured = status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
     }
     last_frame_ns = host_ns;
+    frame_published_.notify_all();
   }
 }
 

@@ -1,9 +1,13 @@
 // ROI, resize and pixel format for published frames.
 #include "picksight/video_server/frame_pipeline.hpp"
 
+#include "picksight/video_server/pixel_format.hpp"
+
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <string>
 
 namespace picksight::video {
@@ -27,12 +31,17 @@ cv::Size outputSize(const OutputSettings& s, cv::Size roi) {
 }  // namespace
 
 Result<void> validateOutputSettings(const OutputSettings& s, cv::Size sensor) {
-  if (!s.roi.empty()) {
+  // Only the all-zero ROI means the full sensor: one with a zero or negative
+  // side (a uint32 from a control request that did not fit an int) is an error.
+  if (s.roi != cv::Rect()) {
     if (s.roi.x < 0 || s.roi.y < 0 || s.roi.width <= 0 || s.roi.height <= 0) {
       return makeError(1, "roi must have a non-negative offset and a positive size");
     }
-    if (sensor.area() > 0 && (s.roi.x + s.roi.width > sensor.width ||
-                              s.roi.y + s.roi.height > sensor.height)) {
+    // In 64 bits: x + width may overflow an int, and cv::Rect arithmetic with it.
+    const int64_t right = int64_t{s.roi.x} + s.roi.width;
+    const int64_t bottom = int64_t{s.roi.y} + s.roi.height;
+    if (right > std::numeric_limits<int>::max() || bottom > std::numeric_limits<int>::max() ||
+        (sensor.area() > 0 && (right > sensor.width || bottom > sensor.height))) {
       return makeError(1, "roi " + std::to_string(s.roi.x) + "," + std::to_string(s.roi.y) + " " +
                               std::to_string(s.roi.width) + "x" + std::to_string(s.roi.height) +
                               " exceeds the sensor " + std::to_string(sensor.width) + "x" +
@@ -74,13 +83,20 @@ OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& set
     cv::cvtColor(sized, out.image, cv::COLOR_BGR2GRAY);
   } else if (!want_mono && sized.channels() == 1) {
     cv::cvtColor(sized, out.image, cv::COLOR_GRAY2BGR);
-  } else if (sized.data == sensor.data || !sized.isContinuous() || sized.datastart == sensor.datastart) {
-    // Never publish the source's own buffer: it is reused for the next frame.
+  } else if (sized.datastart == sensor.datastart || !sized.isContinuous()) {
+    // Never publish the source's own buffer (it is reused for the next
+    // frame), and publish only continuous images (sent as one block).
     out.image = sized.clone();
   } else {
     out.image = sized;
   }
   return out;
+}
+
+Result<OutputFrame> applyOutputSettings(const SourceFrame& frame, const OutputSettings& settings) {
+  auto standard = toOutputFormat(frame.image, frame.layout, settings.format);
+  if (!standard) return standard.error();
+  return applyOutputSettings(*standard, settings);
 }
 
 }  // namespace picksight::video

@@ -17,7 +17,9 @@ std::atomic<int> g_monitor_id{0};
 // sent the pixels; the cv::Mat keeps the buffer alive until then.
 void releaseMat(void* /*data*/, void* hint) { delete static_cast<cv::Mat*>(hint); }
 
-proto::FrameHeader makeHeader(const PublishedFrame& f) {
+}  // namespace
+
+proto::FrameHeader frameHeaderOf(const PublishedFrame& f) {
   proto::FrameHeader h;
   h.set_camera(f.camera);
   h.set_sequence(f.sequence);
@@ -44,7 +46,6 @@ proto::FrameHeader makeHeader(const PublishedFrame& f) {
   }
   return h;
 }
-}  // namespace
 
 FramePublisher::FramePublisher(zmq::context_t& context, const std::string& endpoint,
                                size_t queue_limit, int subscriber_queue)
@@ -102,7 +103,7 @@ PublisherCounters FramePublisher::counters(const std::string& camera) const {
 }
 
 void FramePublisher::send(PublishedFrame& frame) {
-  const std::string header = makeHeader(frame).SerializeAsString();
+  const std::string header = frameHeaderOf(frame).SerializeAsString();
   cv::Mat* owner = new cv::Mat(frame.output.image);
   zmq::message_t pixels(owner->data, owner->total() * owner->elemSize(), releaseMat, owner);
   // PUB never blocks: a subscriber whose pipe is full simply misses the message.

@@ -53,7 +53,9 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
   CameraConfig c;
   static const std::set<std::string> kKeys = {"name", "source", "mode", "fps", "format", "roi", "size", "scale"};
   for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
+    // as<std::string>() throws on a key that is a list or a map.
+    if (!kv.first.IsScalar()) return makeError(kConfigError, where + ": keys must be plain names");
+    const std::string key = kv.first.Scalar();
     if (!kKeys.count(key)) return makeError(kConfigError, where + "." + key + ": unknown key");
   }
   if (!node["name"] || !node["name"].IsScalar() || node["name"].Scalar().empty()) {
@@ -119,7 +121,8 @@ Result<ServerConfig> loadServerConfig(const std::string& path) {
   ServerConfig config;
   if (!root.IsMap()) return makeError(kConfigError, path + ": must be a YAML map");
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) return makeError(kConfigError, path + ": keys must be plain names");
+    const std::string key = kv.first.Scalar();
     if (key != "frames" && key != "control" && key != "cameras") {
       return makeError(kConfigError, path + ": " + key + ": unknown key (known: frames, control, cameras)");
     }

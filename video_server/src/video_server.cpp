@@ -16,6 +16,34 @@ proto::ControlReply errorReply(proto::Error::Code code, const std::string& text)
   return reply;
 }
 
+constexpr std::chrono::milliseconds kSnapTimeout{3000};
+
+// Source error codes to the wire's.
+proto::ControlReply sourceErrorReply(const Error& e) {
+  switch (e.code) {
+    case kSourceUnknownFeature: return errorReply(proto::Error::UNKNOWN_FEATURE, e.message);
+    case kSourceBadValue: return errorReply(proto::Error::OUT_OF_RANGE, e.message);
+    case kSourceUnavailable: return errorReply(proto::Error::CAMERA_UNAVAILABLE, e.message);
+    case kSourceTimeout: return errorReply(proto::Error::TIMEOUT, e.message);
+    case kSourceNotSupported: return errorReply(proto::Error::NOT_SUPPORTED, e.message);
+    default: return errorReply(proto::Error::INTERNAL, e.message);
+  }
+}
+
+void fillFeature(const Feature& f, proto::Feature* out) {
+  out->set_name(f.name);
+  out->set_type(static_cast<proto::FeatureType>(static_cast<int>(f.type) + 1));
+  out->set_value(f.value);
+  out->set_has_range(f.has_range);
+  out->set_min(f.min);
+  out->set_max(f.max);
+  out->set_increment(f.increment);
+  for (const auto& c : f.choices) out->add_choices(c);
+  out->set_unit(f.unit);
+  out->set_description(f.description);
+  out->set_writable(f.writable);
+}
+
 void fillSummary(const CameraStatus& s, proto::CameraSummary* out) {
   out->set_name(s.name);
   out->set_source(s.uri);
@@ -25,14 +53,24 @@ void fillSummary(const CameraStatus& s, proto::CameraSummary* out) {
 }  // namespace
 
 VideoServer::VideoServer(const ServerConfig& config) {
-  publisher_ = std::make_unique<FramePublisher>(context_, config.frames_endpoint);
+  // zmq::error_t alone ("Address already in use") would not say which endpoint.
+  try {
+    publisher_ = std::make_unique<FramePublisher>(context_, config.frames_endpoint);
+  } catch (const zmq::error_t& e) {
+    throw std::runtime_error("frames endpoint " + config.frames_endpoint + ": " + e.what());
+  }
   for (const auto& c : config.cameras) {
     auto source = makeSource(c.uri);
     if (!source) throw std::runtime_error("camera " + c.name + ": " + source.error().message);
     cameras_.push_back(std::make_unique<Camera>(c, std::move(*source), *publisher_));
   }
-  control_ = std::make_unique<ControlServer>(
-      context_, config.control_endpoint, [this](const proto::ControlRequest& r) { return handle(r); });
+  try {
+    control_ = std::make_unique<ControlServer>(
+        context_, config.control_endpoint,
+        [this](const proto::ControlRequest& r) { return handle(r); });
+  } catch (const zmq::error_t& e) {
+    throw std::runtime_error("control endpoint " + config.control_endpoint + ": " + e.what());
+  }
 }
 
 VideoServer::~VideoServer() { stop(); }
@@ -97,6 +135,12 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
     case R::kSetMode: name = request.set_mode().camera(); break;
     case R::kSetFormat: name = request.set_format().camera(); break;
     case R::kTrigger: name = request.trigger().camera(); break;
+    case R::kListFeatures: name = request.list_features().camera(); break;
+    case R::kGetFeature: name = request.get_feature().camera(); break;
+    case R::kSetFeature: name = request.set_feature().camera(); break;
+    case R::kOpenStream: name = request.open_stream().camera(); break;
+    case R::kCloseStream: name = request.close_stream().camera(); break;
+    case R::kSnap: name = request.snap().camera(); break;
     default: return errorReply(proto::Error::NOT_SUPPORTED, "request not supported by this server");
   }
   Camera* camera = find(name);
@@ -172,6 +216,48 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
       const TriggerTicket t = camera->trigger();
       reply.mutable_trigger()->set_sequence(t.sequence);
       reply.mutable_trigger()->set_triggered(t.triggered);
+      return reply;
+    }
+    case R::kListFeatures: {
+      auto features = camera->features();
+      if (!features) return sourceErrorReply(features.error());
+      auto* list = reply.mutable_list_features();
+      for (const auto& f : *features) fillFeature(f, list->add_features());
+      return reply;
+    }
+    case R::kGetFeature: {
+      auto f = camera->feature(request.get_feature().name());
+      if (!f) return sourceErrorReply(f.error());
+      fillFeature(*f, reply.mutable_feature()->mutable_feature());
+      return reply;
+    }
+    case R::kSetFeature: {
+      const auto& set = request.set_feature();
+      auto f = camera->setFeature(set.name(), set.value());
+      if (!f) return sourceErrorReply(f.error());
+      fillFeature(*f, reply.mutable_feature()->mutable_feature());
+      return reply;
+    }
+    case R::kOpenStream:
+      camera->setOpen(true);
+      return reply;
+    case R::kCloseStream:
+      camera->setOpen(false);
+      return reply;
+    case R::kSnap: {
+      if (!camera->status().open_requested) {
+        return errorReply(proto::Error::CAMERA_UNAVAILABLE, "camera '" + name + "' is closed");
+      }
+      const TriggerTicket t = camera->trigger();
+      auto frame = camera->waitForFrame(t.sequence, kSnapTimeout);
+      if (!frame) {
+        return errorReply(proto::Error::TIMEOUT, "no frame from camera '" + name + "' within " +
+                                                     std::to_string(kSnapTimeout.count()) + " ms");
+      }
+      auto* snap = reply.mutable_snap();
+      *snap->mutable_header() = frameHeaderOf(*frame);
+      const cv::Mat& img = frame->output.image;
+      snap->set_pixels(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize());
       return reply;
     }
     default:

@@ -1,53 +1,21 @@
-// Robot protocol commands.
+// Robot protocol core commands.
 #include "picksight/vision_app/robot_protocol.hpp"
-
-#include <algorithm>
 
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
 namespace {
 constexpr const char* kVersion = "0.1.0";
-constexpr const char* kHelp =
-    "OK commands: PING | LOCATE <type> | FRAME | VERSION | HELP (see docs/PROTOCOL.md)";
-
-// Keeps a reply one line of printable text whatever a request contained.
-std::string printable(std::string_view text, size_t limit = 40) {
-  std::string out;
-  for (char c : text.substr(0, limit)) {
-    out += (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f) ? c : '?';
-  }
-  if (text.size() > limit) out += "...";
-  return out;
-}
 }  // namespace
 
-std::string errorReply(int code, const std::string& text) {
-  return "ERROR " + std::to_string(code) + " " + text;
-}
-
-std::optional<Request> parseRequest(std::string_view line) {
-  const auto fields = splitFields(line, " \t,");
-  if (fields.empty()) return std::nullopt;
-  Request r;
-  r.command = toUpper(fields[0]);
-  for (size_t i = 1; i < fields.size(); ++i) r.args.emplace_back(fields[i]);
-  return r;
-}
-
-std::string RobotProtocol::handle(std::string_view line) {
-  const auto request = parseRequest(line);
-  if (!request) return errorReply(kEmptyRequest, "empty request");
-  const std::string& c = request->command;
-  if (c == "PING") {
-    if (!request->args.empty()) return errorReply(kBadArguments, "PING takes no arguments");
-    return "OK";
-  }
-  if (c == "LOCATE") return locate(*request);
-  if (c == "FRAME") return frame(*request);
-  if (c == "VERSION") return std::string("OK ") + kVersion;
-  if (c == "HELP") return kHelp;
-  return errorReply(kUnknownCommand, "unknown command '" + printable(c) + "' (try HELP)");
+RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
+  table_.add("PING", "PING", [](const Request& r) {
+    return r.args.empty() ? std::string("OK") : errorReply(kBadArguments, "PING takes no arguments");
+  });
+  table_.add("VERSION", "VERSION", [](const Request&) { return std::string("OK ") + kVersion; });
+  table_.add("HELP", "HELP", [this](const Request&) { return table_.help(); });
+  table_.add("LOCATE", "LOCATE <type>", [this](const Request& r) { return locate(r); });
+  table_.add("FRAME", "FRAME", [this](const Request& r) { return frame(r); });
 }
 
 std::string RobotProtocol::locate(const Request& request) {

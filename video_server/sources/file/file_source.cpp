@@ -74,6 +74,7 @@ Result<SourceFrame> FileSource::grab(std::chrono::milliseconds /*timeout*/) {
   if (auto r = refresh(); !r) return r.error();
   SourceFrame frame;
   frame.image = image_;  // shared, read-only: the pipeline copies or converts it
+  frame.layout = image_.channels() == 3 ? PixelLayout::kBGR8 : PixelLayout::kMono8;
   return frame;
 }
 

@@ -8,8 +8,11 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -18,8 +21,6 @@
 #include "picksight/video_server/source.hpp"
 
 namespace picksight::video {
-
-enum class AcquisitionMode { kFreeRun, kTrigger };
 
 struct CameraConfig {
   std::string name;
@@ -56,8 +57,11 @@ struct TriggerTicket {
 struct CameraStatus {
   std::string name;
   std::string uri;
-  std::string state;  // "opening", "streaming", "reconnecting", "failed", "stopped"
+  // "opening", "streaming", "reconnecting", "closed" (stream closed on
+  // request, device released), "stopped" (thread not running)
+  std::string state;
   std::string last_error;
+  bool open_requested = true;
   AcquisitionMode mode = AcquisitionMode::kFreeRun;
   double fps_setting = 0;
   double fps_measured = 0;
@@ -92,10 +96,31 @@ class Camera {
   // free-run returns the first sequence number acquired after this call.
   TriggerTicket trigger();
 
+  // Opens or closes the stream. A closed camera releases its device (another
+  // program may use it) and keeps its settings.
+  void setOpen(bool open);
+
+  // The last published frame with a sequence of at least `sequence`, waiting
+  // up to `timeout` for it; nullopt on timeout.
+  std::optional<PublishedFrame> waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout);
+
+  // Feature access runs on the acquisition thread, between grabs, so the
+  // source is only ever called from one thread.
+  Result<std::vector<Feature>> features();
+  Result<Feature> feature(const std::string& name);
+  Result<Feature> setFeature(const std::string& name, const std::string& value);
+
  private:
+  using Command = std::function<void()>;
+
   void run();
   bool ensureOpen(std::unique_lock<std::mutex>& lock);
+  void closeSource(std::unique_lock<std::mutex>& lock);
   void waitBackoff(std::unique_lock<std::mutex>& lock);
+  void runCommands(std::unique_lock<std::mutex>& lock);
+  // Runs `fn` on the acquisition thread and waits for it.
+  template <typename T>
+  Result<T> onAcquisitionThread(std::function<Result<T>(Source&, bool open)> fn);
 
   const CameraConfig config_;
   const std::unique_ptr<Source> source_;  // acquisition thread only
@@ -104,8 +129,13 @@ class Camera {
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable wake_;
+  std::condition_variable frame_published_;
   bool stop_ = false;
   bool open_ = false;
+  bool open_requested_ = true;
+  bool reconfigure_ = true;  // acquisition settings changed since the source last heard
+  std::deque<Command> commands_;
+  std::optional<PublishedFrame> last_frame_;
   bool ever_opened_ = false;
   std::chrono::milliseconds backoff_{100};
   OutputSettings output_;

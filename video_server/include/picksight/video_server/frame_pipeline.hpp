@@ -8,6 +8,8 @@
 
 namespace picksight::video {
 
+struct SourceFrame;
+
 enum class OutputFormat { kMono8, kBgr8 };
 
 struct OutputSettings {
@@ -28,7 +30,11 @@ struct OutputFrame {
 Result<void> validateOutputSettings(const OutputSettings& settings, cv::Size sensor);
 
 // Applies the settings to a sensor frame (CV_8UC1 or CV_8UC3 BGR). Settings
-// that do not fit this frame (a sensor that changed size) are clamped.
+// that do not fit this frame (a sensor that changed size) are clamped. The
+// output never shares memory with `sensor`.
 OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings);
+
+// The same for a frame in any source layout: standardized first.
+Result<OutputFrame> applyOutputSettings(const SourceFrame& frame, const OutputSettings& settings);
 
 }  // namespace picksight::video

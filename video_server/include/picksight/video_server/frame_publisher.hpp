@@ -18,9 +18,13 @@
 
 #include <zmq.hpp>
 
+#include "picksight.pb.h"
 #include "picksight/video_server/camera.hpp"
 
 namespace picksight::video {
+
+// The wire header of a frame.
+proto::FrameHeader frameHeaderOf(const PublishedFrame& frame);
 
 struct PublisherCounters {
   uint64_t published = 0;

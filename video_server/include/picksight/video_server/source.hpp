@@ -18,6 +18,46 @@
 
 namespace picksight::video {
 
+enum class AcquisitionMode { kFreeRun, kTrigger };
+
+// How a source's frame bytes are laid out. Mono10/12/16 arrive unpacked in
+// 16-bit words (CV_16UC1), YUYV/UYVY as CV_8UC2, MJPEG as one row of bytes
+// (CV_8UC1, 1 x size); the rest as their OpenCV 8-bit equivalents.
+enum class PixelLayout {
+  kMono8,
+  kMono10,
+  kMono12,
+  kMono16,
+  kBayerRG8,
+  kBayerGR8,
+  kBayerBG8,
+  kBayerGB8,
+  kRGB8,
+  kBGR8,
+  kYUYV,
+  kUYVY,
+  kMJPEG,
+};
+
+const char* pixelLayoutName(PixelLayout layout);
+
+// A camera setting by name: GenICam features for Aravis, controls for V4L2.
+enum class FeatureType { kInteger, kFloat, kEnumeration, kBoolean, kString, kCommand };
+
+struct Feature {
+  std::string name;
+  FeatureType type = FeatureType::kString;
+  std::string value;  // current value as text; empty for commands
+  bool has_range = false;
+  double min = 0;
+  double max = 0;
+  double increment = 0;  // 0 = any
+  std::vector<std::string> choices;  // enumerations
+  std::string unit;
+  std::string description;
+  bool writable = true;
+};
+
 // Ground truth of one part in a frame, in sensor pixels (synthetic sources).
 struct TruthPart {
   std::string type;
@@ -29,9 +69,11 @@ struct TruthPart {
 };
 
 struct SourceFrame {
-  // CV_8UC1 (mono) or CV_8UC3 (BGR) at sensor resolution. May share memory
-  // with the source's own cache: consumers must not write into it.
+  // The frame at sensor resolution, laid out as `layout` says. May share
+  // memory with the source's own buffers: consumers must not write into it,
+  // and must not keep it past the next grab() unless they copied it.
   cv::Mat image;
+  PixelLayout layout = PixelLayout::kMono8;
   uint64_t device_timestamp_ns = 0;  // 0 when the device gives none
   std::vector<TruthPart> truth;
 };
@@ -50,6 +92,9 @@ enum SourceError : int {
   kSourceTimeout = 1,      // no frame in time; try again
   kSourceUnavailable = 2,  // device gone or not openable; reopen with back-off
   kSourceBadConfig = 3,    // the source string is wrong; retrying will not help
+  kSourceUnknownFeature = 4,
+  kSourceBadValue = 5,     // feature value out of range or of the wrong type
+  kSourceNotSupported = 6,
 };
 
 class Source {
@@ -62,8 +107,29 @@ class Source {
   // Valid after a successful open().
   virtual SourceInfo info() const = 0;
   // Produces one frame. Sources that render or read on demand (synthetic,
-  // file) make it now; the caller paces them.
+  // file) make it now; the caller paces them. Streaming sources return the
+  // next frame the device delivers, or kSourceTimeout.
   virtual Result<SourceFrame> grab(std::chrono::milliseconds timeout) = 0;
+
+  // --- Acquisition. Defaults suit on-demand sources.
+  // True when the device delivers frames at its own pace once configured
+  // (a camera); the Camera then does not pace free-run itself.
+  virtual bool streams() const { return false; }
+  // Called after open() and whenever the mode or rate changes. A streaming
+  // source sets its trigger mode (software) and frame rate here.
+  virtual Result<void> configureAcquisition(AcquisitionMode /*mode*/, double /*fps*/) { return {}; }
+  // In trigger mode, asks the device for one frame; grab() then returns it.
+  virtual Result<void> softwareTrigger() { return {}; }
+
+  // --- Features by name. Values travel as text and are checked by type and
+  // range; errors name the feature and, for a range, the range.
+  virtual std::vector<Feature> features() { return {}; }
+  virtual Result<Feature> feature(const std::string& name) {
+    return makeError(kSourceUnknownFeature, "unknown feature '" + name + "'");
+  }
+  virtual Result<void> setFeature(const std::string& name, const std::string& /*value*/) {
+    return makeError(kSourceUnknownFeature, "unknown feature '" + name + "'");
+  }
 };
 
 // Builds a source from its string ("synthetic:", "synthetic:?width=..",

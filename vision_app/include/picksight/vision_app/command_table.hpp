@@ -1,0 +1,59 @@
+// The robot protocol's command table: each feature of the vision app
+// registers its command words with their usage and handler, so commands live
+// beside the code they drive and HELP lists them all.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace picksight::app {
+
+// Protocol error codes shared by every command (ERROR <code> <text>).
+enum ProtocolError : int {
+  kUnknownCommand = 10,
+  kBadArguments = 11,
+  kRequestTooLong = 12,      // sent by RobotServer
+  kTooManyConnections = 13,  // sent by RobotServer
+  kEmptyRequest = 14,
+  kInternalError = 99,
+};
+
+// A parsed request: the command word upper-cased and its arguments, split
+// on spaces, tabs or commas.
+struct Request {
+  std::string command;
+  std::vector<std::string> args;
+};
+
+// Nullopt for an empty or blank line.
+std::optional<Request> parseRequest(std::string_view line);
+
+std::string errorReply(int code, const std::string& text);
+// Up to `limit` characters of client text, safe to echo in a reply line.
+std::string printable(std::string_view text, size_t limit = 40);
+
+class CommandTable {
+ public:
+  // Returns the whole reply line (without line end).
+  using Handler = std::function<std::string(const Request&)>;
+
+  // Registers (or replaces) a command word, upper case.
+  void add(const std::string& word, const std::string& usage, Handler handler);
+  // Parses and runs one request line. Thread-safe once set up.
+  std::string dispatch(std::string_view line) const;
+  // "OK" and every usage, separated by " | ".
+  std::string help() const;
+
+ private:
+  struct Entry {
+    std::string usage;
+    Handler handler;
+  };
+  std::map<std::string, Entry> commands_;
+};
+
+}  // namespace picksight::app
