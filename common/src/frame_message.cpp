@@ -74,6 +74,13 @@ std::optional<ReceivedFrame> FrameSubscriber::receive(std::chrono::milliseconds 
       continue;
     }
     frame.received_ns = monotonicNs();
+    ++received_;
+    const uint64_t seq = frame.header.sequence();
+    auto [last, first] = last_sequence_.try_emplace(frame.header.camera(), seq);
+    if (!first) {
+      if (seq > last->second + 1) lost_ += seq - last->second - 1;
+      last->second = seq;
+    }
     return frame;
   }
 }

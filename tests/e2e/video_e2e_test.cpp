@@ -134,3 +134,34 @@ TEST_CASE("bad video server options fail at start with the option named", "[e2e]
   r = run({binPath("picksight-video-server"), "--source", "cam0=webcam:0"});
   CHECK(r.exit_code == 1);
 }
+
+TEST_CASE("a stalled subscriber loses frames on its own side only", "[e2e][video]") {
+  // Full-HD frames fill a stalled reader's queues within a second.
+  VideoServerProcess server({"--source", "cam0=synthetic:width=1920,height=1080,parts=4", "--fps", "15"});
+  zmq::context_t context;
+  FrameSubscriber stalled(context, server.frames, "cam0", 2);
+  // A deep queue: on a loaded machine the reader may pause, but must not lose.
+  FrameSubscriber reader(context, server.frames, "cam0", 64);
+  REQUIRE(stalled.receive(5s));
+  REQUIRE(reader.receive(5s));
+  // The stalled subscriber now reads nothing while the other one reads 90
+  // frames (6 s): its own queues overflow, the reader must not see a gap.
+  const uint64_t lost_before = reader.framesLost();
+  int received = 0;
+  while (received < 90) {
+    auto f = reader.receive(5s);
+    REQUIRE(f);
+    ++received;
+  }
+  CHECK(reader.framesLost() == lost_before);
+  // The stalled one resumes and finds its own loss, and frames still come.
+  uint64_t stalled_lost = 0;
+  for (int i = 0; i < 30 && stalled_lost == 0; ++i) {
+    REQUIRE(stalled.receive(5s));
+    stalled_lost = stalled.framesLost();
+  }
+  CHECK(stalled_lost > 0);
+  const auto stats = cam(server, {"--json", "stats"});
+  CHECK(stats.exit_code == 0);
+  CHECK(stats.out.find("\"subscribers\":2") != std::string::npos);
+}

@@ -83,13 +83,18 @@ std::unique_ptr<Camera> makeCamera(const CameraConfig& c, CollectingSink& sink) 
   return std::make_unique<Camera>(c, std::move(*source), sink);
 }
 
-bool waitForState(const Camera& camera, const std::string& state) {
+bool waitForStatus(const Camera& camera,
+                   const std::function<bool(const picksight::video::CameraStatus&)>& done) {
   const auto deadline = std::chrono::steady_clock::now() + kTimeout;
-  while (camera.status().state != state) {
+  while (!done(camera.status())) {
     if (std::chrono::steady_clock::now() > deadline) return false;
     std::this_thread::sleep_for(5ms);
   }
   return true;
+}
+
+bool waitForState(const Camera& camera, const std::string& state) {
+  return waitForStatus(camera, [&](const auto& s) { return s.state == state; });
 }
 
 class TempDir {
@@ -163,6 +168,10 @@ TEST_CASE("Camera trigger tickets are consecutive and each gives exactly one fra
   CHECK(next.sequence == tickets.back() + 1);
   REQUIRE(sink.waitForCount(tickets.size() + 1));
   CHECK(sink.frames().back().sequence == next.sequence);
+  // The status is updated beside the hand-over to the sink, not before it.
+  REQUIRE(waitForStatus(*camera, [&](const picksight::video::CameraStatus& s) {
+    return s.frames_acquired >= tickets.size() + 1;
+  }));
   CHECK(camera->status().frames_acquired == tickets.size() + 1);
   CHECK(camera->status().last_sequence == next.sequence);
 }

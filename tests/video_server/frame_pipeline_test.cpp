@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/video_server/frame_pipeline.hpp"
+#include "picksight/video_server/source.hpp"
 
 using Catch::Detail::Approx;
 using picksight::video::applyOutputSettings;
@@ -249,6 +250,22 @@ TEST_CASE("applyOutputSettings never returns the input buffer", "[video_server]"
     CHECK_FALSE(aliases(out.image, input));
     CHECK(out.image.isContinuous());
     CHECK(out.image.u != input.u);
+  }
+}
+
+TEST_CASE("applyOutputSettings of a source frame never returns the source's buffer",
+          "[video_server]") {
+  picksight::video::SourceFrame frame;
+  frame.image = monoGradient(64, 48);
+  frame.layout = picksight::video::PixelLayout::kMono8;
+  OutputSettings full_rows;
+  full_rows.roi = cv::Rect(0, 8, 64, 20);
+  for (const OutputSettings& s : {OutputSettings{}, full_rows}) {
+    auto out = applyOutputSettings(frame, s);
+    REQUIRE(out);
+    CHECK_FALSE(aliases(out->image, frame.image));
+    CHECK(out->image.isContinuous());
+    CHECK(out->image.at<uint8_t>(0, 5) == frame.image.at<uint8_t>(s.roi.y, 5));
   }
 }
 

@@ -294,7 +294,7 @@ TEST_CASE("VideoServer handle statistics counts each camera's frames", "[video_s
     REQUIRE(reply.error().code() == proto::Error::OK);
     REQUIRE(reply.statistics().cameras_size() == 1);
     cam1 = reply.statistics().cameras(0);
-    if (cam1.frames_published() >= 3) break;
+    if (cam1.frames_published() >= 3 && cam1.frames_acquired() >= 3) break;
     std::this_thread::sleep_for(5ms);
   } while (std::chrono::steady_clock::now() < deadline);
   CHECK(cam1.camera() == "cam1");

@@ -71,7 +71,7 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& where, cv::Vec3d* plane) {
 // side of a part more than the other and pull its centroid by a tenth of a
 // pixel under a few percent of light gradient.
 bool greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, const cv::Rect& bbox,
-                 cv::Moments* moments, cv::Point2d* centroid) {
+                 cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin) {
   const cv::Rect box = (bbox + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, grey.cols, grey.rows);
   const cv::Mat own = labels(box) == label;
   const cv::Mat free = labels(box) == 0;
@@ -119,6 +119,8 @@ bool greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, const cv
   if (m.m00 <= 0) return false;
   *moments = m;
   *centroid = cv::Point2d(box.x + m.m10 / m.m00, box.y + m.m01 / m.m00);
+  *weights = coverage;
+  *origin = box.tl();
   return true;
 }
 }  // namespace
@@ -167,8 +169,12 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
     }
     r.holes = static_cast<int>(r.hole_boundaries.size());
 
-    if (!grey.empty() && greyMoments(grey, labels, label, bbox, &r.moments, &r.centroid)) {
+    if (!grey.empty() &&
+        greyMoments(grey, labels, label, bbox, &r.moments, &r.centroid, &r.coverage, &r.coverage_origin)) {
       r.area = r.moments.m00;
+    } else {
+      inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
+      r.coverage_origin = bbox.tl();
     }
     r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
     const cv::Moments& rm = r.moments;

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -47,12 +48,20 @@ class FrameSubscriber {
   std::optional<ReceivedFrame> receive(std::chrono::milliseconds timeout);
 
   uint64_t malformedMessages() const { return malformed_; }
+  // Frames this subscriber missed: gaps in each camera's sequence numbers
+  // (a slow reader's own losses, or frames the camera lost). A sequence that
+  // goes back (a restarted server) starts counting afresh.
+  uint64_t framesLost() const { return lost_; }
+  uint64_t framesReceived() const { return received_; }
   zmq::socket_t& socket() { return socket_; }
 
  private:
   zmq::socket_t socket_;
   std::string camera_;
   uint64_t malformed_ = 0;
+  uint64_t lost_ = 0;
+  uint64_t received_ = 0;
+  std::map<std::string, uint64_t> last_sequence_;  // per camera
 };
 
 }  // namespace picksight

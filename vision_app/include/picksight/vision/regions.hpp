@@ -26,6 +26,12 @@ struct Region {
   cv::Moments moments;
   std::vector<cv::Point> outer;  // outer boundary, image coordinates
   std::vector<std::vector<cv::Point>> hole_boundaries;
+  // The weight of every pixel in the moments (CV_32F, 0..1: grey-level
+  // coverage, or 1 inside the mask without a grey image), over a box whose
+  // top-left pixel is `coverage_origin`. Kept so that higher-order features
+  // (complex moments for the rotation of symmetric parts) need no second pass.
+  cv::Mat coverage;
+  cv::Point coverage_origin;
 };
 
 struct RegionOptions {
