@@ -202,7 +202,14 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
   lock.unlock();
   Result<void> opened = source_->open();
   SourceInfo info;
-  if (opened) info = source_->info();
+  if (opened) {
+    for (const auto& [name, value] : config_.features) {
+      if (auto set = source_->setFeature(name, value); !set) {
+        logWarning("camera ", config_.name, ": feature ", name, " = ", value, ": ", set.error().message);
+      }
+    }
+    info = source_->info();
+  }
   lock.lock();
   if (!opened) {
     status_.state = "reconnecting";

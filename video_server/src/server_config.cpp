@@ -51,7 +51,8 @@ Result<std::vector<int>> intList(const YAML::Node& node, size_t n) {
 Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& where) {
   if (!node.IsMap()) return makeError(kConfigError, where + ": must be a map");
   CameraConfig c;
-  static const std::set<std::string> kKeys = {"name", "source", "mode", "fps", "format", "roi", "size", "scale"};
+  static const std::set<std::string> kKeys = {"name", "source", "mode", "fps", "format",
+                                              "roi", "size", "scale", "features"};
   for (const auto& kv : node) {
     // as<std::string>() throws on a key that is a list or a map.
     if (!kv.first.IsScalar()) return makeError(kConfigError, where + ": keys must be plain names");
@@ -95,6 +96,18 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
     auto s = parseDouble(node["scale"].Scalar());
     if (!s || *s <= 0 || *s > 16) return makeError(kConfigError, where + ".scale: must be a number in (0, 16]");
     c.output.scale = *s;
+  }
+  if (node["features"]) {
+    if (!node["features"].IsMap()) {
+      return makeError(kConfigError, where + ".features: must be a map of feature names to values");
+    }
+    for (const auto& kv : node["features"]) {
+      const std::string key = kv.first.as<std::string>();
+      if (!kv.second.IsScalar()) {
+        return makeError(kConfigError, where + ".features." + key + ": must be a single value");
+      }
+      c.features.emplace_back(key, kv.second.Scalar());
+    }
   }
   if (auto ok = validateOutputSettings(c.output, cv::Size()); !ok) {
     return makeError(kConfigError, where + ": " + ok.error().message);

@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "picksight/video_server/frame_pipeline.hpp"
@@ -28,6 +29,9 @@ struct CameraConfig {
   OutputSettings output;
   AcquisitionMode mode = AcquisitionMode::kFreeRun;
   double fps = 10;
+  // Feature values applied, in order, every time the device is (re)opened:
+  // a camera that was power-cycled has forgotten them.
+  std::vector<std::pair<std::string, std::string>> features;
 };
 
 // A frame ready to publish.
