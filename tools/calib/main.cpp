@@ -1,0 +1,91 @@
+// picksight-calib: robot-camera calibration offline, from a CSV of point
+// pairs (robot_x,robot_y,vision_x,vision_y, vision in mm). Prints the
+// transform, the RMS and every point's residual.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "picksight/calibration/robot_camera.hpp"
+#include "picksight/common/text.hpp"
+
+namespace {
+using namespace picksight;
+
+int usage() {
+  std::cerr << "usage: picksight-calib --csv FILE [--method best|geometric|lsq]\n"
+               "  FILE: a header line, then robot_x,robot_y,vision_x,vision_y per point (mm)\n";
+  return 2;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string path;
+  calibration::Method method = calibration::Method::kBest;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--csv" && i + 1 < argc) {
+      path = argv[++i];
+    } else if (a == "--method" && i + 1 < argc) {
+      const std::string m = argv[++i];
+      if (m == "geometric") method = calibration::Method::kGeometric;
+      else if (m == "lsq") method = calibration::Method::kLeastSquares;
+      else if (m == "best") method = calibration::Method::kBest;
+      else return usage();
+    } else {
+      return usage();
+    }
+  }
+  if (path.empty()) return usage();
+  std::ifstream in(path);
+  if (!in) {
+    std::cerr << "picksight-calib: cannot read " << path << "\n";
+    return 1;
+  }
+  std::vector<calibration::PointPair> points;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto fields = splitFields(line, ",; \t");
+    if (fields.empty() || line[0] == '#') continue;
+    if (number == 1 && !parseDouble(fields[0])) continue;  // the header
+    if (fields.size() != 4) {
+      std::cerr << "picksight-calib: " << path << ":" << number << ": expected 4 numbers, got " << fields.size()
+                << "\n";
+      return 1;
+    }
+    double v[4];
+    for (int k = 0; k < 4; ++k) {
+      auto d = parseDouble(fields[static_cast<size_t>(k)]);
+      if (!d) {
+        std::cerr << "picksight-calib: " << path << ":" << number << ": '" << std::string(fields[static_cast<size_t>(k)])
+                  << "' is not a number\n";
+        return 1;
+      }
+      v[k] = *d;
+    }
+    points.push_back({{v[2], v[3]}, {v[0], v[1]}});
+  }
+  auto result = calibration::calibrate(points, method);
+  if (!result) {
+    std::cerr << "picksight-calib: " << result.error().message << "\n";
+    return 1;
+  }
+  const auto& t = result->transform;
+  std::printf("method %s\n", calibration::methodName(result->method));
+  std::printf("dx %s\ndy %s\nrz %s\n", formatFixed(t.dx, 4).c_str(), formatFixed(t.dy, 4).c_str(),
+              formatFixed(t.rz_deg, 4).c_str());
+  std::printf("mirrored %s\n", t.mirrored ? "yes" : "no");
+  std::printf("rms %s\ninliers %d of %zu\n", formatFixed(result->rms, 4).c_str(), result->inliers, points.size());
+  std::printf("%5s %10s %10s %10s %10s %9s %9s %9s %s\n", "point", "robot_x", "robot_y", "vision_x", "vision_y",
+              "err_x", "err_y", "err", "");
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto& r = result->residuals[i];
+    std::printf("%5zu %10.3f %10.3f %10.3f %10.3f %9.4f %9.4f %9.4f %s\n", i + 1, points[i].robot.x,
+                points[i].robot.y, points[i].vision.x, points[i].vision.y, r.dx, r.dy, r.distance,
+                r.inlier ? "" : "outlier");
+  }
+  return 0;
+}
