@@ -1,0 +1,168 @@
+// Calibration persistence in YAML, written atomically. Every change is
+// applied to a copy, saved, and only then kept: memory never says what the
+// disk does not.
+#include "picksight/calibration/calibration_store.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <sys/stat.h>
+
+#include "picksight/common/atomic_file.hpp"
+
+namespace picksight::calibration {
+namespace {
+constexpr int kFormatVersion = 1;
+
+double number(const YAML::Node& node, const char* key) {
+  if (!node[key]) throw std::runtime_error(std::string("missing ") + key);
+  return node[key].as<double>();
+}
+}  // namespace
+
+CalibrationStore::CalibrationStore(std::string path) : path_(std::move(path)) {}
+
+std::string CalibrationStore::serialize() const {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "format_version" << YAML::Value << kFormatVersion;
+  out << YAML::Key << "next_id" << YAML::Value << next_id_;
+  out << YAML::Key << "points" << YAML::Value << YAML::BeginSeq;
+  for (const auto& [id, p] : points_) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << id << YAML::Key << "vision_x"
+        << YAML::Value << p.vision.x << YAML::Key << "vision_y" << YAML::Value << p.vision.y << YAML::Key
+        << "robot_x" << YAML::Value << p.robot.x << YAML::Key << "robot_y" << YAML::Value << p.robot.y
+        << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  if (transform_) {
+    const auto& t = transform_->transform;
+    out << YAML::Key << "transform" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "dx" << YAML::Value << t.dx << YAML::Key << "dy" << YAML::Value << t.dy;
+    out << YAML::Key << "rz_deg" << YAML::Value << t.rz_deg << YAML::Key << "mirrored" << YAML::Value << t.mirrored;
+    out << YAML::Key << "method" << YAML::Value << methodName(transform_->method);
+    out << YAML::Key << "rms" << YAML::Value << transform_->rms;
+    out << YAML::Key << "inliers" << YAML::Value << transform_->inliers;
+    out << YAML::EndMap;
+  }
+  if (scale_) {
+    out << YAML::Key << "scale" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "mm_per_px_x" << YAML::Value << scale_->mm_per_px_x;
+    out << YAML::Key << "mm_per_px_y" << YAML::Value << scale_->mm_per_px_y;
+    out << YAML::Key << "skew_deg" << YAML::Value << scale_->skew_deg;
+    out << YAML::EndMap;
+  }
+  if (lens_) {
+    out << YAML::Key << "lens" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "image_width" << YAML::Value << lens_->image_size.width;
+    out << YAML::Key << "image_height" << YAML::Value << lens_->image_size.height;
+    out << YAML::Key << "camera_matrix" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int i = 0; i < 9; ++i) out << lens_->camera_matrix(i / 3, i % 3);
+    out << YAML::EndSeq;
+    out << YAML::Key << "distortion" << YAML::Value << YAML::Flow << lens_->distortion;
+    out << YAML::Key << "rms_reprojection_px" << YAML::Value << lens_->rms_reprojection_px;
+    out << YAML::Key << "views" << YAML::Value << lens_->views;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+Result<void> CalibrationStore::save() { return writeFileAtomically(path_, serialize()); }
+
+Result<void> CalibrationStore::load() {
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) != 0) return {};  // nothing stored yet
+  CalibrationStore loaded(path_);
+  try {
+    const YAML::Node root = YAML::LoadFile(path_);
+    if (!root.IsMap()) throw std::runtime_error("not a YAML map");
+    if (!root["format_version"] || root["format_version"].as<int>() != kFormatVersion) {
+      throw std::runtime_error("format_version must be " + std::to_string(kFormatVersion));
+    }
+    loaded.next_id_ = root["next_id"] ? root["next_id"].as<int>() : 1;
+    for (const auto& p : root["points"]) {
+      const int id = p["id"].as<int>();
+      if (id <= 0 || loaded.points_.count(id)) throw std::runtime_error("bad or repeated point id " + std::to_string(id));
+      loaded.points_[id] = PointPair{{number(p, "vision_x"), number(p, "vision_y")},
+                                     {number(p, "robot_x"), number(p, "robot_y")}};
+      loaded.next_id_ = std::max(loaded.next_id_, id + 1);
+    }
+    if (const auto t = root["transform"]) {
+      CalibrationResult r;
+      r.transform = RigidTransform{number(t, "dx"), number(t, "dy"), number(t, "rz_deg"),
+                                   t["mirrored"] && t["mirrored"].as<bool>()};
+      const std::string method = t["method"] ? t["method"].as<std::string>() : "lsq";
+      r.method = method == "geometric" ? Method::kGeometric : Method::kLeastSquares;
+      r.rms = number(t, "rms");
+      r.inliers = t["inliers"] ? t["inliers"].as<int>() : 0;
+      loaded.transform_ = r;
+    }
+    if (const auto s = root["scale"]) {
+      PixelScale scale{number(s, "mm_per_px_x"), number(s, "mm_per_px_y"), s["skew_deg"] ? number(s, "skew_deg") : 0};
+      if (!(scale.mm_per_px_x > 0) || !(scale.mm_per_px_y > 0)) throw std::runtime_error("scale must be positive");
+      loaded.scale_ = scale;
+    }
+    if (const auto l = root["lens"]) {
+      LensModel lens;
+      lens.image_size = cv::Size(l["image_width"].as<int>(), l["image_height"].as<int>());
+      const auto k = l["camera_matrix"].as<std::vector<double>>();
+      if (k.size() != 9) throw std::runtime_error("lens camera_matrix must have 9 values");
+      for (int i = 0; i < 9; ++i) lens.camera_matrix(i / 3, i % 3) = k[static_cast<size_t>(i)];
+      lens.distortion = l["distortion"].as<std::vector<double>>();
+      if (lens.distortion.size() < 4) throw std::runtime_error("lens distortion needs at least 4 values");
+      lens.rms_reprojection_px = number(l, "rms_reprojection_px");
+      lens.views = l["views"] ? l["views"].as<int>() : 0;
+      loaded.lens_ = lens;
+    }
+  } catch (const std::exception& e) {
+    return makeError(EINVAL, path_ + ": " + e.what());
+  }
+  *this = std::move(loaded);
+  return {};
+}
+
+Result<int> CalibrationStore::addPoint(const PointPair& pair) {
+  CalibrationStore next = *this;
+  const int id = next.next_id_++;
+  next.points_[id] = pair;
+  if (auto ok = next.save(); !ok) return ok.error();
+  *this = std::move(next);
+  return id;
+}
+
+Result<void> CalibrationStore::deletePoint(int id) {
+  if (!points_.count(id)) return makeError(ENOENT, "no point with id " + std::to_string(id));
+  CalibrationStore next = *this;
+  next.points_.erase(id);
+  if (auto ok = next.save(); !ok) return ok;
+  *this = std::move(next);
+  return {};
+}
+
+Result<void> CalibrationStore::setTransform(const CalibrationResult& result) {
+  CalibrationStore next = *this;
+  next.transform_ = result;
+  if (auto ok = next.save(); !ok) return ok;
+  *this = std::move(next);
+  return {};
+}
+
+Result<void> CalibrationStore::setScale(const PixelScale& scale) {
+  CalibrationStore next = *this;
+  next.scale_ = scale;
+  if (auto ok = next.save(); !ok) return ok;
+  *this = std::move(next);
+  return {};
+}
+
+Result<void> CalibrationStore::setLens(const LensModel& lens) {
+  CalibrationStore next = *this;
+  next.lens_ = lens;
+  if (auto ok = next.save(); !ok) return ok;
+  *this = std::move(next);
+  return {};
+}
+
+}  // namespace picksight::calibration

@@ -1,0 +1,109 @@
+// Calibration persistence: survives a reload, ids never reused, damaged
+// files refused with the file named, and a failed write changes nothing.
+#include <catch2/catch.hpp>
+
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "picksight/calibration/calibration_store.hpp"
+#include "picksight/calibration/vision_frame.hpp"
+
+using namespace picksight::calibration;
+namespace fs = std::filesystem;
+
+namespace {
+struct TempDir {
+  TempDir() {
+    char name[] = "/tmp/picksight-store-XXXXXX";
+    path = ::mkdtemp(name);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string path;
+};
+}  // namespace
+
+TEST_CASE("calibration points, transform, scale and lens survive a reload", "[calibration][store]") {
+  TempDir dir;
+  const std::string file = dir.path + "/calibration.yaml";
+  {
+    CalibrationStore store(file);
+    REQUIRE(store.load());
+    CHECK(*store.addPoint({{1.5, -2.25}, {300.125, 40}}) == 1);
+    CHECK(*store.addPoint({{10, 20}, {310, 60}}) == 2);
+    CHECK(*store.addPoint({{30, 5}, {330, 45}}) == 3);
+    REQUIRE(store.deletePoint(2));
+    CalibrationResult r;
+    r.transform = RigidTransform{300.1234567891, 41.5, -12.25, false};
+    r.rms = 0.0123;
+    r.inliers = 2;
+    REQUIRE(store.setTransform(r));
+    REQUIRE(store.setScale({0.2512345678, 0.25, 0.1}));
+    LensModel lens;
+    lens.image_size = cv::Size(640, 480);
+    lens.camera_matrix = cv::Matx33d(536, 0, 342, 0, 536, 235, 0, 0, 1);
+    lens.distortion = {-0.26, -0.04, 0.0018, -0.0003, 0.24};
+    lens.rms_reprojection_px = 0.41;
+    REQUIRE(store.setLens(lens));
+  }
+  CalibrationStore again(file);
+  REQUIRE(again.load());
+  REQUIRE(again.points().size() == 2);
+  CHECK(again.points().at(1).robot.x == 300.125);
+  CHECK(again.points().at(3).vision.y == 5);
+  CHECK_FALSE(again.points().count(2));
+  REQUIRE(again.transform());
+  CHECK(again.transform()->transform.dx == 300.1234567891);
+  CHECK(again.transform()->transform.rz_deg == -12.25);
+  REQUIRE(again.scale());
+  CHECK(again.scale()->mm_per_px_x == 0.2512345678);
+  REQUIRE(again.lens());
+  CHECK(again.lens()->distortion[4] == 0.24);
+  // Ids are never reused, even after a delete and a restart.
+  CHECK(*again.addPoint({{0, 0}, {0, 0}}) == 4);
+  CHECK_FALSE(again.deletePoint(2));
+  CHECK(again.deletePoint(2).error().message.find("2") != std::string::npos);
+}
+
+TEST_CASE("a damaged calibration file is refused, named, and left alone", "[calibration][store]") {
+  TempDir dir;
+  const std::string file = dir.path + "/calibration.yaml";
+  std::ofstream(file) << "format_version: 1\npoints:\n  - {id: 1, vision_x: 1}\n";
+  CalibrationStore store(file);
+  auto r = store.load();
+  REQUIRE_FALSE(r);
+  CHECK(r.error().message.find(file) != std::string::npos);
+  CHECK(store.points().empty());
+  std::ofstream(file) << "format_version: 7\n";
+  CHECK_FALSE(store.load());
+  std::ofstream(file) << "{{{{ not yaml";
+  CHECK_FALSE(store.load());
+}
+
+TEST_CASE("a failed write keeps memory and disk as they were", "[calibration][store]") {
+  TempDir dir;
+  const std::string sub = dir.path + "/data";
+  fs::create_directory(sub);
+  CalibrationStore store(sub + "/calibration.yaml");
+  REQUIRE(store.addPoint({{1, 1}, {2, 2}}));
+  // The directory vanishes (a disk unmounted): the write fails cleanly.
+  fs::remove_all(sub);
+  CHECK_FALSE(store.addPoint({{3, 3}, {4, 4}}));
+  CHECK(store.points().size() == 1);
+  CHECK_FALSE(store.deletePoint(1));
+  CHECK(store.points().size() == 1);
+}
+
+TEST_CASE("the vision frame flips y so that a camera looking down is right-handed", "[calibration][frame]") {
+  VisionFrame frame(PixelScale{0.5, 0.25, 0});
+  const cv::Point2d mm = frame.toMm({100, 40});
+  CHECK(mm.x == 50);
+  CHECK(mm.y == -10);
+  CHECK(frame.toPixels(mm).x == Approx(100));
+  CHECK(frame.toPixels(mm).y == Approx(40));
+  // 30 degrees clockwise on screen is 30 degrees clockwise seen from above:
+  // -30, that is 330, counter-clockwise.
+  CHECK(VisionFrame::angleToVision(30) == Approx(330));
+  CHECK(VisionFrame::angleToImage(VisionFrame::angleToVision(123)) == Approx(123));
+}
