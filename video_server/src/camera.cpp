@@ -332,11 +332,10 @@ void Camera::run() {
     frame.triggered = triggered;
     frame.output = std::move(*out);
     frame.truth = std::move(grabbed->truth);
-    PublishedFrame kept = frame;
-    sink_.publish(std::move(frame));
-
+    // Statistics first, then the hand-over: a subscriber must never hold a
+    // frame that `stats` does not count yet.
     lock.lock();
-    last_frame_ = std::move(kept);
+    last_frame_ = frame;
     ++status_.frames_acquired;
     status_.last_sequence = sequence;
     if (last_frame_ns != 0) {
@@ -346,6 +345,9 @@ void Camera::run() {
       status_.fps_measured = status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
     }
     last_frame_ns = host_ns;
+    lock.unlock();
+    sink_.publish(std::move(frame));
+    lock.lock();
     frame_published_.notify_all();
   }
 }
