@@ -2,6 +2,9 @@
 // command, what it prints for people and scripts, and its exit codes.
 #include <atomic>
 #include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
 #include <future>
 #include <limits>
 #include <sstream>
@@ -11,6 +14,8 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
 
 #include "cam_cli.hpp"
@@ -26,10 +31,13 @@ const std::string kTimeoutMs = "10000";
 
 // A control socket served by its own thread (which owns the socket), answering
 // every request with the same canned reply and recording what it received.
+// `delay` holds each reply back, as the real server does while it waits for a
+// frame to snap.
 class FakeServer {
  public:
-  FakeServer(zmq::context_t& context, proto::ControlReply reply)
-      : context_(context), reply_(std::move(reply)) {
+  FakeServer(zmq::context_t& context, proto::ControlReply reply,
+             std::chrono::milliseconds delay = std::chrono::milliseconds(0))
+      : context_(context), reply_(std::move(reply)), delay_(delay) {
     thread_ = std::thread([this] { serve(); });
     endpoint_ = bound_.get_future().get();
   }
@@ -69,6 +77,7 @@ class FakeServer {
           failure_ += "unparsable request; ";
         }
         requests_.push_back(request);
+        std::this_thread::sleep_for(delay_);
         socket.send(zmq::buffer(reply_bytes), zmq::send_flags::none);
       }
     } catch (const std::exception& e) {
@@ -79,6 +88,7 @@ class FakeServer {
 
   zmq::context_t& context_;
   const proto::ControlReply reply_;
+  const std::chrono::milliseconds delay_;
   std::promise<std::string> bound_;
   std::string endpoint_;
   std::atomic<bool> stop_{false};
@@ -127,6 +137,107 @@ std::string unusedEndpoint(zmq::context_t& context) {
   socket.set(zmq::sockopt::linger, 0);
   socket.bind("tcp://127.0.0.1:*");
   return socket.get(zmq::sockopt::last_endpoint);
+}
+
+// A fresh directory for the files a test writes, removed with everything in it.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "cam_test.XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Value of channel `c` of pixel (x, y) in the frames the tests snap: varied
+// enough that a swapped channel, row or column shows.
+std::uint8_t pixelValue(int x, int y, int c) {
+  return static_cast<std::uint8_t>((x * 37 + y * 11 + c * 101 + 5) % 256);
+}
+
+// A snap reply whose rows are `stride` bytes apart; the padding after each row
+// is 0xEE, so that a writer that ignored the stride would put it in the image.
+proto::ControlReply snapReply(int width, int height, int channels, int stride) {
+  proto::ControlReply reply = okReply();
+  auto* h = reply.mutable_snap()->mutable_header();
+  h->set_camera("cam0");
+  h->set_sequence(77);
+  h->set_width(static_cast<std::uint32_t>(width));
+  h->set_height(static_cast<std::uint32_t>(height));
+  h->set_stride(static_cast<std::uint32_t>(stride));
+  h->set_pixel_format(channels == 3 ? proto::BGR8 : proto::MONO8);
+  std::string pixels(static_cast<size_t>(stride) * static_cast<size_t>(height), '\xEE');
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < channels; ++c) {
+        pixels[static_cast<size_t>(y * stride + x * channels + c)] =
+            static_cast<char>(pixelValue(x, y, c));
+      }
+    }
+  }
+  reply.mutable_snap()->set_pixels(pixels);
+  return reply;
+}
+
+// The image snapReply() describes, built pixel by pixel.
+cv::Mat expectedImage(int width, int height, int channels) {
+  cv::Mat image(height, width, channels == 3 ? CV_8UC3 : CV_8UC1);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < channels; ++c)
+        image.ptr<std::uint8_t>(y)[x * channels + c] = pixelValue(x, y, c);
+    }
+  }
+  return image;
+}
+
+proto::Feature exposureFeature() {
+  proto::Feature f;
+  f.set_name("ExposureTimeAbs");
+  f.set_type(proto::FLOAT);
+  f.set_value("20000");
+  f.set_has_range(true);
+  f.set_min(10);
+  f.set_max(1000000);
+  f.set_unit("us");
+  f.set_description("Exposure time");
+  f.set_writable(true);
+  return f;
+}
+
+proto::Feature triggerModeFeature() {
+  proto::Feature f;
+  f.set_name("TriggerMode");
+  f.set_type(proto::ENUMERATION);
+  f.set_value("Off");
+  f.add_choices("Off");
+  f.add_choices("On");
+  f.set_writable(true);
+  return f;
+}
+
+proto::ControlReply featureReply(const proto::Feature& feature) {
+  proto::ControlReply reply = okReply();
+  *reply.mutable_feature()->mutable_feature() = feature;
+  return reply;
+}
+
+proto::ControlReply errorReply(proto::Error::Code code, const std::string& text) {
+  proto::ControlReply reply;
+  reply.mutable_error()->set_code(code);
+  reply.mutable_error()->set_text(text);
+  return reply;
 }
 
 }  // namespace
@@ -434,6 +545,20 @@ TEST_CASE("usage errors exit 2 with a message and contact no server", "[cam]") {
       {{"--timeout", "soon", "list"}, "--timeout: MS must be a positive integer, got 'soon'"},
       {{"--timeout", "0", "list"}, "--timeout: MS must be a positive integer, got '0'"},
       {{"list", "--control"}, "--control: missing value"},
+      {{"features"}, "features: missing arguments; usage: picksight-cam features CAM"},
+      {{"features", "cam0", "Gain"}, "features: too many arguments (unexpected 'Gain')"},
+      {{"get", "cam0"}, "get: missing arguments; usage: picksight-cam get CAM FEATURE"},
+      {{"get", "cam0", ""}, "get: FEATURE must not be empty"},
+      {{"set", "cam0", "GainRaw"},
+       "set: missing arguments; usage: picksight-cam set CAM FEATURE VALUE"},
+      {{"set", "", "GainRaw", "3"}, "set: CAM must not be empty"},
+      {{"set", "cam0", "GainRaw", "3", "4"}, "set: too many arguments (unexpected '4')"},
+      {{"open"}, "open: missing arguments; usage: picksight-cam open CAM"},
+      {{"close", "cam0", "now"}, "close: too many arguments (unexpected 'now')"},
+      {{"snap", "cam0"}, "snap: missing arguments; usage: picksight-cam snap CAM FILE"},
+      {{"snap", "cam0", ""}, "snap: FILE must not be empty"},
+      {{"snap", "cam0", "frame.xyz"}, "snap: no image writer for 'frame.xyz'"},
+      {{"snap", "cam0", "frame"}, "snap: no image writer for 'frame'"},
   };
   zmq::context_t context;
   FakeServer server(context, okReply());
@@ -466,6 +591,12 @@ TEST_CASE("--help prints the usage on stdout", "[cam]") {
   CHECK(run.err.empty());
   CHECK_THAT(run.out, Catch::StartsWith("usage: picksight-cam [--control ENDPOINT]"));
   CHECK_THAT(run.out, Catch::Contains("size CAM --scale S"));
+  CHECK_THAT(run.out, Catch::Contains("features CAM"));
+  CHECK_THAT(run.out, Catch::Contains("get CAM FEATURE"));
+  CHECK_THAT(run.out, Catch::Contains("set CAM FEATURE VALUE"));
+  CHECK_THAT(run.out, Catch::Contains("open CAM"));
+  CHECK_THAT(run.out, Catch::Contains("close CAM"));
+  CHECK_THAT(run.out, Catch::Contains("snap CAM FILE"));
 }
 
 TEST_CASE("a server error exits 1 with the server's text and code", "[cam]") {
@@ -513,4 +644,368 @@ TEST_CASE("JsonWriter places commas and writes numbers JSON can read", "[cam]") 
   json.endObject();
   CHECK(json.str() == R"({"a":[1,2.5,false,"x"],"empty":{},"nan":null,"big":18446744073709551615,)"
                       R"("k\"ey":[{},{}]})");
+}
+
+TEST_CASE("features prints names, types, values, ranges, units and access", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply = okReply();
+  auto* list = reply.mutable_list_features();
+  *list->add_features() = exposureFeature();
+  auto* gain = list->add_features();
+  gain->set_name("GainRaw");
+  gain->set_type(proto::INTEGER);
+  gain->set_value("0");
+  gain->set_has_range(true);
+  gain->set_max(10);
+  gain->set_increment(1);
+  gain->set_writable(true);
+  *list->add_features() = triggerModeFeature();
+  // GenICam float ranges often end at the largest double.
+  auto* rate = list->add_features();
+  rate->set_name("AcquisitionFrameRate");
+  rate->set_type(proto::FLOAT);
+  rate->set_value("25.5");
+  rate->set_has_range(true);
+  rate->set_min(0.1);
+  rate->set_max(std::numeric_limits<double>::max());
+  rate->set_unit("Hz");
+  rate->set_writable(true);
+  auto* model = list->add_features();
+  model->set_name("DeviceModelName");
+  model->set_type(proto::STRING);
+  model->set_value("GV01");
+  auto* software = list->add_features();
+  software->set_name("TriggerSoftware");
+  software->set_type(proto::COMMAND);
+  software->set_writable(true);
+  FakeServer server(context, reply);
+
+  const Run run = runAt(context, server, {"features", "cam0"});
+  CHECK(run.code == 0);
+  CHECK(run.err.empty());
+  CHECK(run.out ==
+        "NAME                  TYPE         VALUE  RANGE                         UNIT  WRITABLE\n"
+        "ExposureTimeAbs       float        20000  10..1000000                   us    yes\n"
+        "GainRaw               integer      0      0..10, step 1                       yes\n"
+        "TriggerMode           enumeration  Off    Off|On                              yes\n"
+        "AcquisitionFrameRate  float        25.5   0.1..1.7976931348623157e+308  Hz    yes\n"
+        "DeviceModelName       string       GV01                                       no\n"
+        "TriggerSoftware       command                                                 yes\n");
+  const proto::ControlRequest request = onlyRequest(server);
+  REQUIRE(request.request_case() == proto::ControlRequest::kListFeatures);
+  CHECK(request.list_features().camera() == "cam0");
+}
+
+TEST_CASE("features as JSON: every field of every feature", "[cam]") {
+  zmq::context_t context;
+  proto::ControlReply reply = okReply();
+  *reply.mutable_list_features()->add_features() = exposureFeature();
+  *reply.mutable_list_features()->add_features() = triggerModeFeature();
+  FakeServer server(context, reply);
+  const Run run = runAt(context, server, {"--json", "features", "cam0"});
+  CHECK(run.code == 0);
+  CHECK(run.out == R"({"camera":"cam0","features":[{"name":"ExposureTimeAbs","type":"float",)"
+                   R"("value":"20000","has_range":true,"min":10,"max":1e+06,"increment":0,)"
+                   R"("choices":[],"unit":"us","description":"Exposure time","writable":true},)"
+                   R"({"name":"TriggerMode","type":"enumeration","value":"Off","has_range":false,)"
+                   R"("min":0,"max":0,"increment":0,"choices":["Off","On"],"unit":"",)"
+                   R"("description":"","writable":true}]})"
+                   "\n");
+}
+
+TEST_CASE("features of a camera without any", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  CHECK(runAt(context, server, {"features", "cam0"}).out == "cam0: no features\n");
+  CHECK(runAt(context, server, {"--json", "features", "cam0"}).out ==
+        "{\"camera\":\"cam0\",\"features\":[]}\n");
+}
+
+TEST_CASE("get prints the bare value, or the whole feature as JSON", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, featureReply(exposureFeature()));
+  SECTION("text") {
+    const Run run = runAt(context, server, {"get", "cam0", "ExposureTimeAbs"});
+    CHECK(run.code == 0);
+    CHECK(run.err.empty());
+    CHECK(run.out == "20000\n");
+  }
+  SECTION("JSON") {
+    const Run run = runAt(context, server, {"--json", "get", "cam0", "ExposureTimeAbs"});
+    CHECK(run.code == 0);
+    CHECK(run.out == R"({"name":"ExposureTimeAbs","type":"float","value":"20000",)"
+                     R"("has_range":true,"min":10,"max":1e+06,"increment":0,"choices":[],)"
+                     R"("unit":"us","description":"Exposure time","writable":true})"
+                     "\n");
+  }
+  const proto::ControlRequest request = onlyRequest(server);
+  REQUIRE(request.request_case() == proto::ControlRequest::kGetFeature);
+  CHECK(request.get_feature().camera() == "cam0");
+  CHECK(request.get_feature().name() == "ExposureTimeAbs");
+}
+
+TEST_CASE("set sends the value as typed and prints the value read back", "[cam]") {
+  zmq::context_t context;
+  SECTION("text, with the unit") {
+    FakeServer server(context, featureReply(exposureFeature()));
+    const Run run = runAt(context, server, {"set", "cam0", "ExposureTimeAbs", "20000"});
+    CHECK(run.code == 0);
+    CHECK(run.err.empty());
+    CHECK(run.out == "ExposureTimeAbs = 20000 us\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetFeature);
+    CHECK(request.set_feature().camera() == "cam0");
+    CHECK(request.set_feature().name() == "ExposureTimeAbs");
+    CHECK(request.set_feature().value() == "20000");
+  }
+  SECTION("a camera that rounded the value: says what was asked") {
+    FakeServer server(context, featureReply(exposureFeature()));
+    const Run run = runAt(context, server, {"set", "cam0", "ExposureTimeAbs", "19999.5"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "ExposureTimeAbs = 20000 us (requested 19999.5)\n");
+  }
+  SECTION("the same number written differently is not a rounding") {
+    FakeServer server(context, featureReply(exposureFeature()));
+    const Run run = runAt(context, server, {"set", "cam0", "ExposureTimeAbs", "20000.0"});
+    CHECK(run.out == "ExposureTimeAbs = 20000 us\n");
+  }
+  SECTION("a negative value is a value, not an option") {
+    proto::Feature offset;
+    offset.set_name("BlackLevel");
+    offset.set_type(proto::INTEGER);
+    offset.set_value("-5");
+    FakeServer server(context, featureReply(offset));
+    const Run run = runAt(context, server, {"set", "cam0", "BlackLevel", "-5"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "BlackLevel = -5\n");
+    CHECK(onlyRequest(server).set_feature().value() == "-5");
+  }
+  SECTION("an empty string value") {
+    proto::Feature user;
+    user.set_name("DeviceUserID");
+    user.set_type(proto::STRING);
+    FakeServer server(context, featureReply(user));
+    const Run run = runAt(context, server, {"set", "cam0", "DeviceUserID", ""});
+    CHECK(run.code == 0);
+    CHECK(run.out == "DeviceUserID = \n");
+    const proto::ControlRequest request = onlyRequest(server);
+    CHECK(request.set_feature().value().empty());
+  }
+  SECTION("JSON") {
+    FakeServer server(context, featureReply(exposureFeature()));
+    const Run run = runAt(context, server, {"set", "cam0", "ExposureTimeAbs", "20000", "--json"});
+    CHECK(run.code == 0);
+    CHECK_THAT(run.out, Catch::StartsWith(R"({"name":"ExposureTimeAbs","type":"float",)"
+                                          R"("value":"20000",)"));
+  }
+}
+
+TEST_CASE("feature errors exit 1 with the server's text", "[cam]") {
+  struct Case {
+    std::vector<std::string> args;
+    proto::Error::Code code;
+    std::string text;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {{"get", "cam0", "Exposure"},
+       proto::Error::UNKNOWN_FEATURE,
+       "unknown feature 'Exposure'",
+       "picksight-cam: get: unknown feature 'Exposure' (server error UNKNOWN_FEATURE, code 7)\n"},
+      {{"set", "cam0", "GainRaw", "99"},
+       proto::Error::OUT_OF_RANGE,
+       "GainRaw: 99 is out of range 0..10",
+       "picksight-cam: set: GainRaw: 99 is out of range 0..10 (server error OUT_OF_RANGE, "
+       "code 3)\n"},
+      {{"set", "cam0", "GainRaw", "3"},
+       proto::Error::CAMERA_UNAVAILABLE,
+       "camera 'cam0' is disconnected",
+       "picksight-cam: set: camera 'cam0' is disconnected (server error CAMERA_UNAVAILABLE, "
+       "code 5)\n"},
+      {{"features", "cam0"},
+       proto::Error::CAMERA_UNAVAILABLE,
+       "camera 'cam0' is disconnected",
+       "picksight-cam: features: camera 'cam0' is disconnected (server error CAMERA_UNAVAILABLE, "
+       "code 5)\n"},
+  };
+  zmq::context_t context;
+  for (const Case& c : cases) {
+    INFO("command: " << c.args[0] << ", error: " << c.text);
+    FakeServer server(context, errorReply(c.code, c.text));
+    const Run run = runAt(context, server, c.args);
+    CHECK(run.code == 1);
+    CHECK(run.out.empty());
+    CHECK(run.err == c.expected);
+  }
+}
+
+TEST_CASE("get and set with a reply that lacks the feature are errors", "[cam]") {
+  zmq::context_t context;
+  FakeServer server(context, okReply());
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"get", "cam0", "GainRaw"},
+        std::vector<std::string>{"set", "cam0", "GainRaw", "3"}}) {
+    INFO("command: " << args[0]);
+    const Run run = runAt(context, server, args);
+    CHECK(run.code == 1);
+    CHECK(run.out.empty());
+    CHECK_THAT(run.err, Catch::Contains("unexpected reply: no feature"));
+  }
+}
+
+TEST_CASE("open and close send the camera and confirm", "[cam]") {
+  struct Case {
+    std::string command;
+    proto::ControlRequest::RequestCase request_case;
+    std::string text;
+    std::string json;
+  };
+  const std::vector<Case> cases = {
+      {"open", proto::ControlRequest::kOpenStream, "cam0: stream opened\n",
+       "{\"ok\":true,\"camera\":\"cam0\",\"open\":true}\n"},
+      {"close", proto::ControlRequest::kCloseStream, "cam0: stream closed, device released\n",
+       "{\"ok\":true,\"camera\":\"cam0\",\"open\":false}\n"},
+  };
+  zmq::context_t context;
+  for (const Case& c : cases) {
+    INFO("command: " << c.command);
+    FakeServer server(context, okReply());
+    const Run text = runAt(context, server, {c.command, "cam0"});
+    CHECK(text.code == 0);
+    CHECK(text.out == c.text);
+    const Run json = runAt(context, server, {"--json", c.command, "cam0"});
+    CHECK(json.code == 0);
+    CHECK(json.out == c.json);
+    const std::vector<proto::ControlRequest> requests = server.stop();
+    REQUIRE(requests.size() == 2);
+    REQUIRE(requests[0].request_case() == c.request_case);
+    CHECK((c.request_case == proto::ControlRequest::kOpenStream
+               ? requests[0].open_stream().camera()
+               : requests[0].close_stream().camera()) == "cam0");
+  }
+}
+
+TEST_CASE("snap saves the frame with its exact pixels, honouring the stride", "[cam]") {
+  struct Case {
+    const char* name;
+    int width, height, channels, stride;
+    const char* format;
+  };
+  // Odd sizes and strides past the row: rows must be cut at the width.
+  const Case c = GENERATE(Case{"mono8, packed rows", 5, 3, 1, 5, "mono8"},
+                          Case{"mono8, padded rows", 5, 3, 1, 8, "mono8"},
+                          Case{"bgr8, packed rows", 4, 3, 3, 12, "bgr8"},
+                          Case{"bgr8, padded rows", 4, 3, 3, 17, "bgr8"});
+  INFO(c.name);
+  zmq::context_t context;
+  TempDir dir;
+  const std::string file = dir.file("frame.png");
+  FakeServer server(context, snapReply(c.width, c.height, c.channels, c.stride));
+
+  const Run run = runAt(context, server, {"snap", "cam0", file});
+  CHECK(run.code == 0);
+  CHECK(run.err.empty());
+  CHECK(run.out == "saved " + std::to_string(c.width) + "x" + std::to_string(c.height) + " " +
+                       c.format + " frame #77 to " + file + "\n");
+  const cv::Mat read = cv::imread(file, cv::IMREAD_UNCHANGED);
+  const cv::Mat expected = expectedImage(c.width, c.height, c.channels);
+  REQUIRE(read.type() == expected.type());
+  REQUIRE(read.size() == expected.size());
+  CHECK(cv::norm(read, expected, cv::NORM_INF) == 0);
+  const proto::ControlRequest request = onlyRequest(server);
+  REQUIRE(request.request_case() == proto::ControlRequest::kSnap);
+  CHECK(request.snap().camera() == "cam0");
+}
+
+TEST_CASE("snap as JSON describes the saved frame", "[cam]") {
+  zmq::context_t context;
+  TempDir dir;
+  const std::string file = dir.file("frame.png");
+  proto::ControlReply reply = snapReply(4, 2, 1, 4);
+  reply.mutable_snap()->mutable_header()->set_triggered(true);
+  reply.mutable_snap()->mutable_header()->set_host_timestamp_ns(1700000000123456789);
+  FakeServer server(context, reply);
+  const Run run = runAt(context, server, {"--json", "snap", "cam0", file});
+  CHECK(run.code == 0);
+  CHECK(run.out == R"({"camera":"cam0","file":")" + file +
+                       R"(","sequence":77,"width":4,"height":2,"pixel_format":"mono8",)"
+                       R"("triggered":true,"device_timestamp_ns":0,)"
+                       R"("host_timestamp_ns":1700000000123456789})"
+                       "\n");
+  CHECK(cv::imread(file, cv::IMREAD_UNCHANGED).size() == cv::Size(4, 2));
+}
+
+TEST_CASE("snap refuses a frame whose payload does not match its header", "[cam]") {
+  zmq::context_t context;
+  TempDir dir;
+  const std::string file = dir.file("frame.png");
+  // The last row of a padded frame is padded too: one byte short is short.
+  proto::ControlReply reply = snapReply(5, 3, 1, 8);
+  reply.mutable_snap()->mutable_pixels()->pop_back();
+  FakeServer server(context, reply);
+  const Run run = runAt(context, server, {"snap", "cam0", file});
+  CHECK(run.code == 1);
+  CHECK(run.out.empty());
+  CHECK(run.err ==
+        "picksight-cam: snap: inconsistent frame: 5x3 mono8 with stride 8 needs 24 bytes of "
+        "pixels, got 23 from " +
+            server.endpoint() + "\n");
+  CHECK_FALSE(std::filesystem::exists(file));
+}
+
+TEST_CASE("snap with a stride shorter than a row is refused", "[cam]") {
+  zmq::context_t context;
+  TempDir dir;
+  const std::string file = dir.file("frame.png");
+  proto::ControlReply reply = snapReply(4, 3, 3, 12);
+  reply.mutable_snap()->mutable_header()->set_stride(4);  // as if mono8
+  FakeServer server(context, reply);
+  const Run run = runAt(context, server, {"snap", "cam0", file});
+  CHECK(run.code == 1);
+  CHECK_THAT(run.err, Catch::Contains("inconsistent frame: 4x3 bgr8 with stride 4"));
+  CHECK_FALSE(std::filesystem::exists(file));
+}
+
+TEST_CASE("snap into a directory that does not exist exits 1 naming the file", "[cam]") {
+  zmq::context_t context;
+  TempDir dir;
+  const std::string file = dir.file("missing/frame.png");
+  FakeServer server(context, snapReply(5, 3, 1, 5));
+  const Run run = runAt(context, server, {"snap", "cam0", file});
+  CHECK(run.code == 1);
+  CHECK(run.out.empty());
+  CHECK_THAT(run.err, Catch::StartsWith("picksight-cam: snap: could not save '" + file + "': "));
+  // The server did nothing wrong.
+  CHECK_THAT(run.err, !Catch::Contains(server.endpoint()));
+}
+
+TEST_CASE("snap: a server error exits 1 and writes nothing", "[cam]") {
+  zmq::context_t context;
+  TempDir dir;
+  const std::string file = dir.file("frame.png");
+  FakeServer server(
+      context, errorReply(proto::Error::TIMEOUT, "no frame from camera 'cam0' within 3000 ms"));
+  const Run run = runAt(context, server, {"snap", "cam0", file});
+  CHECK(run.code == 1);
+  CHECK(run.err ==
+        "picksight-cam: snap: no frame from camera 'cam0' within 3000 ms (server error TIMEOUT, "
+        "code 8)\n");
+  CHECK_FALSE(std::filesystem::exists(file));
+}
+
+TEST_CASE("snap waits longer than --timeout for the server to take the frame", "[cam]") {
+  zmq::context_t context;
+  TempDir dir;
+  // The reply comes after 300 ms; --timeout 50 alone would give up before it.
+  FakeServer server(context, snapReply(5, 3, 1, 5), std::chrono::milliseconds(300));
+  const std::vector<std::string> options = {"--control", server.endpoint(), "--timeout", "50"};
+  auto with = [&](std::vector<std::string> args) {
+    args.insert(args.begin(), options.begin(), options.end());
+    return args;
+  };
+  // The same delay makes any other command time out: the test can fail.
+  CHECK(runCli(context, with({"get", "cam0", "GainRaw"})).code == 3);
+  const Run run = runCli(context, with({"snap", "cam0", dir.file("frame.png")}));
+  CHECK(run.code == 0);
+  CHECK(run.err.empty());
 }

@@ -13,8 +13,12 @@
 #include <sstream>
 #include <utility>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "picksight/common/text.hpp"
 #include "picksight/transport/control_client.hpp"
+#include "picksight/transport/frame_message.hpp"
 
 namespace picksight::cam {
 
@@ -32,6 +36,28 @@ std::string formatShortest(double value) {
   if (ec != std::errc()) return "nan";
   return std::string(buf, ptr);
 }
+
+// Like formatShortest, but without exponents for the numbers people type:
+// an exposure range reads "100..1000000", not "100..1e+06". Exponents stay
+// for the extremes (GenICam float ranges often end at DBL_MAX).
+std::string formatReadable(double value) {
+  const double magnitude = std::fabs(value);
+  if (magnitude != 0 && (magnitude < 1e-6 || magnitude >= 1e15)) return formatShortest(value);
+  char buf[64];
+  auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::fixed);
+  if (ec != std::errc()) return formatShortest(value);
+  return std::string(buf, ptr);
+}
+
+// Codes of the errors that printReply returns; both exit with
+// kExitServerError, but only a reply the CLI cannot use is the server's fault,
+// and only then does the message name the server.
+constexpr int kBadReply = 1;
+constexpr int kSaveFailed = 2;
+
+// Index of FILE in "snap CAM FILE": the request has no field for it, so the
+// command words carry it to the code that writes the frame.
+constexpr size_t kSnapFileArg = 2;
 
 // ------------------------------------------------------------- argument parsing
 
@@ -59,9 +85,16 @@ Result<double> parsePositive(std::string_view command, std::string_view name,
   return *value;
 }
 
-Result<std::string> parseCamera(std::string_view command, const std::string& text) {
-  if (text.empty()) return usageError(std::string(command) + ": CAM must not be empty");
+Result<std::string> parseWord(std::string_view command, std::string_view name,
+                              const std::string& text) {
+  if (text.empty()) {
+    return usageError(std::string(command) + ": " + std::string(name) + " must not be empty");
+  }
   return text;
+}
+
+Result<std::string> parseCamera(std::string_view command, const std::string& text) {
+  return parseWord(command, "CAM", text);
 }
 
 // Checks the argument count of `command`; `synopsis` is its usage line.
@@ -73,6 +106,14 @@ Result<void> checkCount(const std::vector<std::string>& command, size_t min_args
   if (n > max_args) what += " (unexpected '" + command[max_args + 1] + "')";
   return usageError(command[0] + ": " + what + "; usage: " + kProgram + " " +
                     std::string(synopsis));
+}
+
+// The camera of a command whose synopsis starts "COMMAND CAM", after checking
+// the argument count.
+Result<std::string> cameraOf(const std::vector<std::string>& command, size_t min_args,
+                             size_t max_args, std::string_view synopsis) {
+  if (auto ok = checkCount(command, min_args, max_args, synopsis); !ok) return ok.error();
+  return parseCamera(command[0], command[1]);
 }
 
 Result<proto::ControlRequest> buildRoi(const std::vector<std::string>& c) {
@@ -159,6 +200,79 @@ Result<proto::ControlRequest> buildFormat(const std::vector<std::string>& c) {
   return request;
 }
 
+// A command whose one argument is the camera: they differ only in the
+// request they fill.
+struct CameraCommand {
+  std::string_view name;
+  std::string_view synopsis;
+  void (*fill)(proto::ControlRequest& request, const std::string& camera);
+};
+
+const CameraCommand* findCameraCommand(std::string_view name) {
+  static const CameraCommand kCommands[] = {
+      {"info", "info CAM",
+       [](proto::ControlRequest& r, const std::string& c) {
+         r.mutable_describe_camera()->set_camera(c);
+       }},
+      {"trigger", "trigger CAM",
+       [](proto::ControlRequest& r, const std::string& c) { r.mutable_trigger()->set_camera(c); }},
+      {"features", "features CAM",
+       [](proto::ControlRequest& r, const std::string& c) {
+         r.mutable_list_features()->set_camera(c);
+       }},
+      {"open", "open CAM",
+       [](proto::ControlRequest& r, const std::string& c) {
+         r.mutable_open_stream()->set_camera(c);
+       }},
+      {"close", "close CAM",
+       [](proto::ControlRequest& r, const std::string& c) {
+         r.mutable_close_stream()->set_camera(c);
+       }},
+  };
+  for (const CameraCommand& command : kCommands) {
+    if (command.name == name) return &command;
+  }
+  return nullptr;
+}
+
+// "get CAM FEATURE" and "set CAM FEATURE VALUE".
+Result<proto::ControlRequest> buildFeature(const std::vector<std::string>& c) {
+  const bool set = c[0] == "set";
+  auto camera =
+      cameraOf(c, set ? 3 : 2, set ? 3 : 2, set ? "set CAM FEATURE VALUE" : "get CAM FEATURE");
+  if (!camera) return camera.error();
+  auto feature = parseWord(c[0], "FEATURE", c[2]);
+  if (!feature) return feature.error();
+  proto::ControlRequest request;
+  if (!set) {
+    request.mutable_get_feature()->set_camera(*camera);
+    request.mutable_get_feature()->set_name(*feature);
+    return request;
+  }
+  // An empty VALUE stays allowed: it is a legitimate value of a string feature.
+  auto* set_feature = request.mutable_set_feature();
+  set_feature->set_camera(*camera);
+  set_feature->set_name(*feature);
+  set_feature->set_value(c[3]);
+  return request;
+}
+
+Result<proto::ControlRequest> buildSnap(const std::vector<std::string>& c) {
+  auto camera = cameraOf(c, 2, 2, "snap CAM FILE");
+  if (!camera) return camera.error();
+  const std::string& file = c[kSnapFileArg];
+  if (auto ok = parseWord(c[0], "FILE", file); !ok) return ok.error();
+  // Checked before asking: a snap in trigger mode takes a frame that the
+  // vision apps receive too, which should not happen for a file never written.
+  if (!cv::haveImageWriter(file)) {
+    return usageError("snap: no image writer for '" + file +
+                      "'; the extension names the format (.png, .jpg, .tiff, .bmp)");
+  }
+  proto::ControlRequest request;
+  request.mutable_snap()->set_camera(*camera);
+  return request;
+}
+
 // ------------------------------------------------------------------- output
 
 const char* modeName(proto::AcquisitionMode mode) {
@@ -178,6 +292,25 @@ const char* formatName(proto::PixelFormat format) {
       return "mono8";
     case proto::BGR8:
       return "bgr8";
+    default:
+      return "unspecified";
+  }
+}
+
+const char* featureTypeName(proto::FeatureType type) {
+  switch (type) {
+    case proto::INTEGER:
+      return "integer";
+    case proto::FLOAT:
+      return "float";
+    case proto::ENUMERATION:
+      return "enumeration";
+    case proto::BOOLEAN:
+      return "boolean";
+    case proto::STRING:
+      return "string";
+    case proto::COMMAND:
+      return "command";
     default:
       return "unspecified";
   }
@@ -238,6 +371,131 @@ void writeRoi(JsonWriter& json, const proto::Roi& roi) {
   json.key("x").uinteger(roi.x()).key("y").uinteger(roi.y());
   json.key("width").uinteger(roi.width()).key("height").uinteger(roi.height());
   json.endObject();
+}
+
+// "min..max, step S" for numeric features, "A|B|C" for enumerations.
+std::string rangeText(const proto::Feature& f) {
+  std::string text;
+  if (f.has_range()) {
+    text = formatReadable(f.min()) + ".." + formatReadable(f.max());
+    if (f.increment() > 0) text += ", step " + formatReadable(f.increment());
+  }
+  for (const auto& choice : f.choices()) text += (text.empty() ? "" : "|") + choice;
+  return text;
+}
+
+// The feature as on the wire: scripts get the same fields whatever the type.
+void writeFeature(JsonWriter& json, const proto::Feature& f) {
+  json.beginObject();
+  json.key("name").string(f.name()).key("type").string(featureTypeName(f.type()));
+  json.key("value").string(f.value()).key("has_range").boolean(f.has_range());
+  json.key("min").real(f.min()).key("max").real(f.max()).key("increment").real(f.increment());
+  json.key("choices").beginArray();
+  for (const auto& choice : f.choices()) json.string(choice);
+  json.endArray();
+  json.key("unit").string(f.unit()).key("description").string(f.description());
+  json.key("writable").boolean(f.writable());
+  json.endObject();
+}
+
+void printFeatures(const std::string& camera, const proto::ListFeaturesReply& reply, bool as_json,
+                   std::ostream& out) {
+  if (as_json) {
+    JsonWriter json;
+    json.beginObject().key("camera").string(camera).key("features").beginArray();
+    for (const auto& f : reply.features()) writeFeature(json, f);
+    json.endArray().endObject();
+    out << json.str() << '\n';
+    return;
+  }
+  if (reply.features().empty()) {
+    out << camera << ": no features\n";
+    return;
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& f : reply.features()) {
+    rows.push_back({f.name(), featureTypeName(f.type()), f.value(), rangeText(f), f.unit(),
+                    f.writable() ? "yes" : "no"});
+  }
+  printTable(out,
+             {{"NAME", false},
+              {"TYPE", false},
+              {"VALUE", false},
+              {"RANGE", false},
+              {"UNIT", false},
+              {"WRITABLE", false}},
+             rows);
+}
+
+// The reply to get (the bare value, for $(...) in shell scripts) or to set
+// (the value read back, which is what the camera took).
+void printFeature(const proto::ControlRequest& request, const proto::Feature& f, bool as_json,
+                  std::ostream& out) {
+  if (as_json) {
+    JsonWriter json;
+    writeFeature(json, f);
+    out << json.str() << '\n';
+    return;
+  }
+  if (!request.has_set_feature()) {
+    out << f.value() << '\n';
+    return;
+  }
+  out << f.name() << " = " << f.value();
+  if (!f.unit().empty()) out << ' ' << f.unit();
+  // Cameras round to their increment or clamp without saying so: point it out
+  // when the number read back is not the one asked for.
+  const std::string& asked = request.set_feature().value();
+  if (f.type() == proto::INTEGER || f.type() == proto::FLOAT) {
+    const std::optional<double> wanted = parseDouble(asked);
+    const std::optional<double> got = parseDouble(f.value());
+    if (wanted && got && *wanted != *got) out << " (requested " << asked << ')';
+  }
+  out << '\n';
+}
+
+// Writes the snapped frame to `file` in the format its extension names.
+Result<void> saveSnap(const std::string& camera, const proto::SnapReply& snap,
+                      const std::string& file, bool as_json, std::ostream& out) {
+  const proto::FrameHeader& h = snap.header();
+  if (!frameIsConsistent(h, snap.pixels().size())) {
+    return makeError(kBadReply,
+                     "inconsistent frame: " + std::to_string(h.width()) + "x" +
+                         std::to_string(h.height()) + " " + formatName(h.pixel_format()) +
+                         " with stride " + std::to_string(h.stride()) + " needs " +
+                         std::to_string(std::uint64_t{h.stride()} * h.height()) +
+                         " bytes of pixels, got " + std::to_string(snap.pixels().size()));
+  }
+  // Decoded as a subscriber decodes a published frame, so that the file holds
+  // what a vision app would have seen. The copy is one frame, once.
+  ReceivedFrame frame;
+  frame.header = h;
+  frame.pixels = zmq::message_t(snap.pixels().data(), snap.pixels().size());
+  bool written = false;
+  std::string reason = "cannot write the file (does its directory exist, is it writable?)";
+  try {
+    written = cv::imwrite(file, frame.image());
+  } catch (const cv::Exception& e) {
+    reason = e.err;  // what() adds OpenCV's source path and line
+  }
+  if (!written) return makeError(kSaveFailed, "could not save '" + file + "': " + reason);
+
+  if (as_json) {
+    JsonWriter json;
+    json.beginObject().key("camera").string(camera).key("file").string(file);
+    json.key("sequence").uinteger(h.sequence());
+    json.key("width").uinteger(h.width()).key("height").uinteger(h.height());
+    json.key("pixel_format").string(formatName(h.pixel_format()));
+    json.key("triggered").boolean(h.triggered());
+    json.key("device_timestamp_ns").uinteger(h.device_timestamp_ns());
+    json.key("host_timestamp_ns").uinteger(h.host_timestamp_ns());
+    json.endObject();
+    out << json.str() << '\n';
+    return {};
+  }
+  out << "saved " << h.width() << 'x' << h.height() << ' ' << formatName(h.pixel_format())
+      << " frame #" << h.sequence() << " to " << file << '\n';
+  return {};
 }
 
 void printList(const proto::ListCamerasReply& reply, bool as_json, std::ostream& out) {
@@ -412,6 +670,14 @@ void printSetConfirmation(const proto::ControlRequest& request, bool as_json, st
       text << r.camera() << ": pixel format set to " << formatName(r.pixel_format());
       break;
     }
+    case proto::ControlRequest::kOpenStream:
+      json.key("camera").string(request.open_stream().camera()).key("open").boolean(true);
+      text << request.open_stream().camera() << ": stream opened";
+      break;
+    case proto::ControlRequest::kCloseStream:
+      json.key("camera").string(request.close_stream().camera()).key("open").boolean(false);
+      text << request.close_stream().camera() << ": stream closed, device released";
+      break;
     default:
       break;
   }
@@ -419,12 +685,14 @@ void printSetConfirmation(const proto::ControlRequest& request, bool as_json, st
   out << (as_json ? json.str() : text.str()) << '\n';
 }
 
-// Prints the reply to `request`; an error when the reply lacks the part the
-// request asks for (a server speaking another protocol version).
+// Prints the reply to `request` (and saves a snap); an error when the reply
+// lacks the part the request asks for (a server speaking another protocol
+// version) or the snap cannot be saved.
 Result<void> printReply(const proto::ControlRequest& request, const proto::ControlReply& reply,
-                        bool as_json, std::ostream& out) {
+                        const CamOptions& options, std::ostream& out) {
+  const bool as_json = options.json;
   auto missing = [](const char* what) {
-    return makeError(kExitServerError, std::string("unexpected reply: no ") + what);
+    return makeError(kBadReply, std::string("unexpected reply: no ") + what);
   };
   switch (request.request_case()) {
     // An empty list is a legitimate answer, and reading an absent proto3
@@ -444,6 +712,18 @@ Result<void> printReply(const proto::ControlRequest& request, const proto::Contr
       if (!reply.has_trigger()) return missing("trigger sequence number");
       printTrigger(request.trigger().camera(), reply.trigger(), as_json, out);
       return {};
+    case proto::ControlRequest::kListFeatures:
+      printFeatures(request.list_features().camera(), reply.list_features(), as_json, out);
+      return {};
+    case proto::ControlRequest::kGetFeature:
+    case proto::ControlRequest::kSetFeature:
+      if (!reply.feature().has_feature()) return missing("feature");
+      printFeature(request, reply.feature().feature(), as_json, out);
+      return {};
+    case proto::ControlRequest::kSnap:
+      if (!reply.has_snap()) return missing("frame");
+      return saveSnap(request.snap().camera(), reply.snap(), options.command[kSnapFileArg], as_json,
+                      out);
     default:
       printSetConfirmation(request, as_json, out);
       return {};
@@ -600,6 +880,13 @@ std::string usageText() {
          "  format CAM mono8|bgr8           output pixel format\n"
          "  trigger CAM                     acquire one frame; prints its sequence number\n"
          "  stats [CAM]                     frames, drops, errors, reconnects, fps\n"
+         "  features CAM                    the camera's features: types, values, ranges\n"
+         "  get CAM FEATURE                 a feature's current value\n"
+         "  set CAM FEATURE VALUE           set a feature; prints the value the camera took\n"
+         "  open CAM                        open the stream (takes the device)\n"
+         "  close CAM                       close the stream and release the device\n"
+         "  snap CAM FILE                   save the next frame; the extension of FILE\n"
+         "                                  names the format (.png, .jpg, .tiff, ...)\n"
          "\n"
          "options:\n"
          "  --control ENDPOINT  the server's control socket (default " +
@@ -607,6 +894,9 @@ std::string usageText() {
          ")\n"
          "  --timeout MS        how long to wait for an answer (default " +
          std::to_string(kDefaultTimeout.count()) +
+         ";\n"
+         "                      snap waits at least " +
+         std::to_string(kSnapMinTimeout.count()) +
          ")\n"
          "  --json              print one JSON object on stdout, for scripts\n"
          "  -h, --help          print this help\n"
@@ -662,11 +952,10 @@ Result<proto::ControlRequest> buildRequest(const std::vector<std::string>& comma
   if (name == "list") {
     if (auto ok = checkCount(command, 0, 0, "list"); !ok) return ok.error();
     request.mutable_list_cameras();
-  } else if (name == "info") {
-    if (auto ok = checkCount(command, 1, 1, "info CAM"); !ok) return ok.error();
-    auto camera = parseCamera(name, command[1]);
+  } else if (const CameraCommand* camera_command = findCameraCommand(name)) {
+    auto camera = cameraOf(command, 1, 1, camera_command->synopsis);
     if (!camera) return camera.error();
-    request.mutable_describe_camera()->set_camera(*camera);
+    camera_command->fill(request, *camera);
   } else if (name == "roi") {
     return buildRoi(command);
   } else if (name == "size") {
@@ -675,11 +964,10 @@ Result<proto::ControlRequest> buildRequest(const std::vector<std::string>& comma
     return buildMode(command);
   } else if (name == "format") {
     return buildFormat(command);
-  } else if (name == "trigger") {
-    if (auto ok = checkCount(command, 1, 1, "trigger CAM"); !ok) return ok.error();
-    auto camera = parseCamera(name, command[1]);
-    if (!camera) return camera.error();
-    request.mutable_trigger()->set_camera(*camera);
+  } else if (name == "get" || name == "set") {
+    return buildFeature(command);
+  } else if (name == "snap") {
+    return buildSnap(command);
   } else if (name == "stats") {
     if (auto ok = checkCount(command, 0, 1, "stats [CAM]"); !ok) return ok.error();
     auto* stats = request.mutable_statistics();
@@ -712,10 +1000,12 @@ int runCamCli(const std::vector<std::string>& args, std::ostream& out, std::ostr
     return kExitUsage;
   }
   const std::string& command = options->command[0];
+  const std::chrono::milliseconds timeout =
+      request->has_snap() ? std::max(options->timeout, kSnapMinTimeout) : options->timeout;
 
   std::optional<ControlClient> client;
   try {
-    client.emplace(ctx, options->endpoint, options->timeout);
+    client.emplace(ctx, options->endpoint, timeout);
   } catch (const zmq::error_t& e) {
     // connect() rejects malformed endpoints: the user's typo, not the server.
     err << kProgram << ": invalid endpoint '" << options->endpoint << "': " << e.what() << '\n';
@@ -732,8 +1022,8 @@ int runCamCli(const std::vector<std::string>& args, std::ostream& out, std::ostr
   if (!*reply) {
     const Error& error = reply->error();
     if (error.code == kControlTimeout) {
-      err << kProgram << ": no answer from " << options->endpoint << " within "
-          << options->timeout.count() << " ms: is picksight-video-server running?\n";
+      err << kProgram << ": no answer from " << options->endpoint << " within " << timeout.count()
+          << " ms: is picksight-video-server running?\n";
       return kExitTimeout;
     }
     err << kProgram << ": " << command << ": " << error.message << " (server error "
@@ -742,9 +1032,10 @@ int runCamCli(const std::vector<std::string>& args, std::ostream& out, std::ostr
   }
 
   std::ostringstream text;  // nothing on `out` unless the whole reply printed
-  if (auto printed = printReply(*request, reply->value(), options->json, text); !printed) {
-    err << kProgram << ": " << command << ": " << printed.error().message << " from "
-        << options->endpoint << '\n';
+  if (auto printed = printReply(*request, reply->value(), *options, text); !printed) {
+    err << kProgram << ": " << command << ": " << printed.error().message;
+    if (printed.error().code == kBadReply) err << " from " << options->endpoint;
+    err << '\n';
     return kExitServerError;
   }
   out << text.str();

@@ -24,6 +24,9 @@ constexpr int kExitTimeout = 3;      // the server did not answer in time
 
 constexpr const char* kDefaultEndpoint = "tcp://127.0.0.1:5556";
 constexpr std::chrono::milliseconds kDefaultTimeout{2000};
+// Least time a snap waits for its answer: the server itself waits for the
+// next frame (up to 3 s) before it replies, so the usual timeout is too short.
+constexpr std::chrono::milliseconds kSnapMinTimeout{5000};
 
 struct CamOptions {
   std::string endpoint = kDefaultEndpoint;
