@@ -1,4 +1,5 @@
-// picksight-vision: subscribes to one camera, serves robot controllers.
+// picksight-vision: subscribes to one camera, serves robot controllers; or,
+// with a subcommand (learn, locate, blobs), works on image files.
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -8,6 +9,9 @@
 
 #include "picksight/common/log.hpp"
 #include "picksight/vision_app/app_options.hpp"
+#include "picksight/vision_app/model_commands.hpp"
+#include "picksight/vision_app/model_library.hpp"
+#include "picksight/vision_app/offline_commands.hpp"
 #include "picksight/vision_app/robot_protocol.hpp"
 #include "picksight/vision_app/robot_server.hpp"
 #include "picksight/vision_app/vision_service.hpp"
@@ -15,10 +19,12 @@
 int main(int argc, char** argv) {
   using namespace picksight;
   setLogPrefix("vision");
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  if (app::isOfflineCommand(args)) return app::runOfflineCommand(args, std::cout, std::cerr);
   bool help = false;
-  auto options = app::parseAppArgs(std::vector<std::string>(argv + 1, argv + argc), &help);
+  auto options = app::parseAppArgs(args, &help);
   if (help) {
-    std::cout << app::appUsage();
+    std::cout << app::appUsage() << "\n" << app::offlineUsage();
     return 0;
   }
   if (!options) {
@@ -26,7 +32,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (::mkdir(options->data_dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    std::cerr << "picksight-vision: --data-dir " << options->data_dir << ": " << std::strerror(errno) << "\n";
+    std::cerr << "picksight-vision: --data-dir " << options->data_dir << ": "
+              << std::strerror(errno) << "\n";
     return 2;
   }
   sigset_t signals;
@@ -36,16 +43,23 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
   try {
+    app::ModelLibrary models(options->data_dir + "/models");
+    // A bad model file costs that model, never the start.
+    for (const auto& problem : models.load()) logError("model rejected: ", problem);
+    logInfo(models.snapshot()->size(), " part models from ", models.directory());
     zmq::context_t context;
     app::VisionService vision(context, options->frames_endpoint, options->control_endpoint,
-                              options->camera, options->vision);
+                              options->camera, options->vision, &models);
     app::RobotProtocol protocol(vision);
+    app::addModelCommands(protocol.table(), vision);
     app::RobotServer robots(options->robot,
                             [&protocol](std::string_view line) { return protocol.handle(line); });
     vision.start();
     robots.start();
-    std::cout << "robot " << robots.port() << "\n" << "ready" << std::endl;
-    logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ", robots.port());
+    std::cout << "robot " << robots.port() << "\n"
+              << "ready" << std::endl;
+    logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ",
+            robots.port());
     int sig = 0;
     sigwait(&signals, &sig);
     logInfo("stopping on signal ", sig);

@@ -34,7 +34,7 @@ TEST_CASE("angleDiffDeg with period 90 and period 0", "[common]") {
   CHECK(angleDiffDeg(17, 300, 0) == 0.0);
 }
 
-TEST_CASE("normalizeDeg maps into [0, 360)", "[common]") {
+TEST_CASE("normalizeDeg maps into 0 up to but excluding 360", "[common]") {
   CHECK(normalizeDeg(0) == 0.0);
   CHECK(normalizeDeg(360) == 0.0);
   CHECK(normalizeDeg(-30) == Approx(330));

@@ -39,7 +39,8 @@ UsedFrame usedFrame(LineClient& robot) {
 
 TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
   // A new layout on every trigger, so each request sees a different scene.
-  VideoServerProcess server({"--source", "cam0=synthetic:width=1280,height=960,parts=8,seed=11,scene_every=1",
+  VideoServerProcess server({"--source",
+                             "cam0=synthetic:width=1280,height=960,parts=8,seed=11,scene_every=1",
                              "--mode", "trigger"});
   VisionProcess vision(server);
   zmq::context_t context;
@@ -56,7 +57,8 @@ TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
     INFO("reply: " << *reply);
     const auto poses = parseLocateReply(*reply);
     const UsedFrame used = usedFrame(robot);
-    auto frame = receiveUntil(watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == used.sequence; });
+    auto frame = receiveUntil(
+        watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == used.sequence; });
     REQUIRE(frame);
     const auto& truth = frame->header.truth();
     REQUIRE(truth.size() == 8);
@@ -82,16 +84,17 @@ TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
       ++parts_checked;
     }
   }
-  WARN("worst position error " << worst_position << " px, worst angle error " << worst_angle << " deg over "
-                               << parts_checked << " parts");
+  WARN("worst position error " << worst_position << " px, worst angle error " << worst_angle
+                               << " deg over " << parts_checked << " parts");
 }
 
 TEST_CASE("a malformed robot line gets ERROR and the connection goes on", "[e2e][locate]") {
-  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=3", "--mode", "trigger"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=3", "--mode", "trigger"});
   VisionProcess vision(server);
   auto robot = vision.connect();
-  for (const std::string& bad :
-       std::vector<std::string>{"LOCATE", "LOCATE x", "FLY 1 2", std::string("\x01\x02\xff", 3), ""}) {
+  for (const std::string& bad : std::vector<std::string>{"LOCATE", "LOCATE x", "FLY 1 2",
+                                                         std::string("\x01\x02\xff", 3), ""}) {
     auto reply = robot.request(bad, 5s);
     REQUIRE(reply);
     CHECK(reply->rfind("ERROR ", 0) == 0);
@@ -103,7 +106,8 @@ TEST_CASE("a malformed robot line gets ERROR and the connection goes on", "[e2e]
 }
 
 TEST_CASE("the frame used after a trigger was produced after the request", "[e2e][locate]") {
-  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
   VisionProcess vision(server);
   auto robot = vision.connect();
   uint64_t last_sequence = 0;
@@ -122,7 +126,8 @@ TEST_CASE("the frame used after a trigger was produced after the request", "[e2e
 
 TEST_CASE("in free-run LOCATE waits for a frame taken after the request", "[e2e][locate]") {
   // A slow camera: the newest frame is usually older than the request.
-  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=2", "--fps", "4"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=2", "--fps", "4"});
   VisionProcess vision(server);
   auto robot = vision.connect();
   for (int i = 0; i < 3; ++i) {
@@ -134,4 +139,79 @@ TEST_CASE("in free-run LOCATE waits for a frame taken after the request", "[e2e]
     CHECK_FALSE(used.triggered);
     CHECK(used.host_ns > before);
   }
+}
+
+TEST_CASE("LEARN a part, then LOCATE finds it turned from the trained pose",
+          "[e2e][locate][models]") {
+  // One L per frame, in a new pose on every trigger.
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,scene_every=1",
+       "--mode", "trigger"});
+  VisionProcess vision(server);
+  zmq::context_t context;
+  FrameSubscriber watcher(context, server.frames, "cam0", 16);
+  std::this_thread::sleep_for(300ms);
+  auto robot = vision.connect();
+  const auto truthOf = [&](uint64_t sequence) {
+    auto frame = receiveUntil(
+        watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == sequence; });
+    REQUIRE(frame);
+    REQUIRE(frame->header.truth().size() == 1);
+    return frame->header.truth(0);
+  };
+
+  CHECK(*robot.request("MODELS", 5s) == "OK 0");
+  auto reply = robot.request("LEARN 1 bracket", 10s);
+  REQUIRE(reply);
+  INFO("LEARN reply: " << *reply);
+  REQUIRE(reply->rfind("OK 1 bracket ", 0) == 0);
+  const auto trained = truthOf(usedFrame(robot).sequence);
+  reply = robot.request("MODELS", 5s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("OK 1 1 bracket ", 0) == 0);
+
+  for (int i = 0; i < 3; ++i) {
+    reply = robot.request("LOCATE 1", 10s);
+    REQUIRE(reply);
+    INFO("LOCATE reply: " << *reply);
+    const auto poses = parseLocateReply(*reply);
+    const auto truth = truthOf(usedFrame(robot).sequence);
+    REQUIRE(poses.size() == 1);
+    CHECK(std::hypot(poses[0].x - truth.x(), poses[0].y - truth.y()) < 0.1);
+    CHECK(angleDiffDeg(poses[0].rz, truth.angle_deg() - trained.angle_deg()) < 0.3);
+  }
+  // Another type is not trained: refused, no frame taken.
+  reply = robot.request("LOCATE 2", 5s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("ERROR 32 ", 0) == 0);
+
+  reply = robot.request("BLOBS", 10s);
+  REQUIRE(reply);
+  const auto fields = splitFields(*reply, " ");
+  REQUIRE(fields.size() == 2 + 19);
+  CHECK(fields[1] == "1");
+
+  CHECK(*robot.request("FORGET 1", 5s) == "OK");
+  CHECK(*robot.request("MODELS", 5s) == "OK 0");
+  reply = robot.request("LOCATE 1", 10s);
+  REQUIRE(reply);
+  CHECK(parseLocateReply(*reply).size() == 1);  // no models: every region again
+}
+
+TEST_CASE("LEARN refuses a frame with no part or several", "[e2e][locate][models]") {
+  VideoServerProcess several(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=3", "--mode", "trigger"});
+  VisionProcess vision(several);
+  auto robot = vision.connect();
+  auto reply = robot.request("LEARN 4", 10s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("ERROR 31 ", 0) == 0);
+  VideoServerProcess none(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=0", "--mode", "trigger"});
+  VisionProcess vision_none(none);
+  auto robot_none = vision_none.connect();
+  reply = robot_none.request("LEARN 4", 10s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("ERROR 30 ", 0) == 0);
+  CHECK(*robot_none.request("MODELS", 5s) == "OK 0");
 }

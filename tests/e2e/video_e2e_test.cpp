@@ -2,7 +2,9 @@
 // run time through picksight-cam, software trigger.
 #include <catch2/catch.hpp>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <filesystem>
 #include <thread>
 
 #include "cell_fixture.hpp"
@@ -164,4 +166,32 @@ TEST_CASE("a stalled subscriber loses frames on its own side only", "[e2e][video
   const auto stats = cam(server, {"--json", "stats"});
   CHECK(stats.exit_code == 0);
   CHECK(stats.out.find("\"subscribers\":2") != std::string::npos);
+}
+
+TEST_CASE("snap saves the next frame; close releases the camera and open resumes it", "[e2e][video]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=3,noise=0", "--fps", "20"});
+  char dir[] = "/tmp/picksight-snap-XXXXXX";
+  REQUIRE(::mkdtemp(dir));
+  const std::string file = std::string(dir) + "/frame.png";
+  REQUIRE(cam(server, {"snap", "cam0", file}).exit_code == 0);
+  const cv::Mat saved = cv::imread(file, cv::IMREAD_UNCHANGED);
+  REQUIRE_FALSE(saved.empty());
+  CHECK(saved.cols == 640);
+  CHECK(saved.rows == 480);
+  CHECK(saved.channels() == 1);
+
+  zmq::context_t context;
+  FrameSubscriber sub(context, server.frames, "cam0", 4);
+  REQUIRE(sub.receive(5s));
+  REQUIRE(cam(server, {"close", "cam0"}).exit_code == 0);
+  // Frames already on their way may still arrive; then nothing.
+  while (sub.receive(500ms)) {
+  }
+  CHECK(cam(server, {"list"}).out.find("closed") != std::string::npos);
+  CHECK(cam(server, {"snap", "cam0", file}).exit_code == 1);
+  REQUIRE(cam(server, {"open", "cam0"}).exit_code == 0);
+  auto resumed = sub.receive(5s);
+  REQUIRE(resumed);
+  CHECK(cam(server, {"list"}).out.find("streaming") != std::string::npos);
+  std::filesystem::remove_all(dir);
 }

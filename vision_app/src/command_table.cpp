@@ -9,10 +9,17 @@ std::string errorReply(int code, const std::string& text) {
   return "ERROR " + std::to_string(code) + " " + text;
 }
 
+std::optional<int> parseType(std::string_view text) {
+  const auto type = parseInt(text);
+  if (!type || *type < 0 || *type > 9999) return std::nullopt;
+  return static_cast<int>(*type);
+}
+
 std::string printable(std::string_view text, size_t limit) {
   std::string out;
   for (char c : text.substr(0, limit)) {
-    out += (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f) ? c : '?';
+    out +=
+        (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f) ? c : '?';
   }
   if (text.size() > limit) out += "...";
   return out;
@@ -36,7 +43,8 @@ std::string CommandTable::dispatch(std::string_view line) const {
   if (!request) return errorReply(kEmptyRequest, "empty request");
   const auto it = commands_.find(request->command);
   if (it == commands_.end()) {
-    return errorReply(kUnknownCommand, "unknown command '" + printable(request->command) + "' (try HELP)");
+    return errorReply(kUnknownCommand,
+                      "unknown command '" + printable(request->command) + "' (try HELP)");
   }
   return it->second.handler(*request);
 }

@@ -72,7 +72,8 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& where, cv::Vec3d* plane) {
 // pixel under a few percent of light gradient.
 bool greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, const cv::Rect& bbox,
                  cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin) {
-  const cv::Rect box = (bbox + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, grey.cols, grey.rows);
+  const cv::Rect box =
+      (bbox + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, grey.cols, grey.rows);
   const cv::Mat own = labels(box) == label;
   const cv::Mat free = labels(box) == 0;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
@@ -91,7 +92,8 @@ bool greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, const cv
   cv::Mat background(box.size(), CV_32F);
   for (int y = 0; y < box.height; ++y) {
     float* b = background.ptr<float>(y);
-    for (int x = 0; x < box.width; ++x) b[x] = static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
+    for (int x = 0; x < box.width; ++x)
+      b[x] = static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
   }
   cv::Mat level;
   grey(box).convertTo(level, CV_32F);
@@ -137,9 +139,11 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   for (int label = 1; label < count; ++label) {
     const int area = stats.at<int>(label, cv::CC_STAT_AREA);
     if (area < options.min_area) continue;
-    const cv::Rect bbox(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-                        stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    const bool border = bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+    const cv::Rect bbox(
+        stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
+        stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    const bool border =
+        bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
     if (border && !options.keep_border_regions) continue;
 
     Region r;
@@ -169,8 +173,8 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
     }
     r.holes = static_cast<int>(r.hole_boundaries.size());
 
-    if (!grey.empty() &&
-        greyMoments(grey, labels, label, bbox, &r.moments, &r.centroid, &r.coverage, &r.coverage_origin)) {
+    if (!grey.empty() && greyMoments(grey, labels, label, bbox, &r.moments, &r.centroid,
+                                     &r.coverage, &r.coverage_origin)) {
       r.area = r.moments.m00;
     } else {
       inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
@@ -178,7 +182,8 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
     }
     r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
     const cv::Moments& rm = r.moments;
-    const double common = std::sqrt((rm.mu20 - rm.mu02) * (rm.mu20 - rm.mu02) + 4 * rm.mu11 * rm.mu11);
+    const double common =
+        std::sqrt((rm.mu20 - rm.mu02) * (rm.mu20 - rm.mu02) + 4 * rm.mu11 * rm.mu11);
     const double major = rm.mu20 + rm.mu02 + common;
     const double minor = rm.mu20 + rm.mu02 - common;
     r.elongation = major > 0 ? 1.0 - minor / major : 0;

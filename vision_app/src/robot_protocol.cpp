@@ -10,7 +10,8 @@ constexpr const char* kVersion = "0.1.0";
 
 RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
   table_.add("PING", "PING", [](const Request& r) {
-    return r.args.empty() ? std::string("OK") : errorReply(kBadArguments, "PING takes no arguments");
+    return r.args.empty() ? std::string("OK")
+                          : errorReply(kBadArguments, "PING takes no arguments");
   });
   table_.add("VERSION", "VERSION", [](const Request&) { return std::string("OK ") + kVersion; });
   table_.add("HELP", "HELP", [this](const Request&) { return table_.help(); });
@@ -20,12 +21,12 @@ RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
 
 std::string RobotProtocol::locate(const Request& request) {
   if (request.args.size() != 1) return errorReply(kBadArguments, "usage: LOCATE <type>");
-  const auto type = parseInt(request.args[0]);
-  if (!type || *type < 0 || *type > 9999) {
+  const auto type = parseType(request.args[0]);
+  if (!type) {
     return errorReply(kBadArguments, "LOCATE: type must be an integer in [0, 9999], got '" +
                                          printable(request.args[0]) + "'");
   }
-  auto outcome = vision_.locate();
+  auto outcome = vision_.locate(*type);
   if (!outcome) return errorReply(outcome.error().code, outcome.error().message);
   std::string reply = "OK " + std::to_string(outcome->parts.size());
   for (const auto& p : outcome->parts) {

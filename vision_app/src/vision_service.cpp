@@ -1,50 +1,113 @@
-// Vision service: fresh frame, then blob location.
+// Vision service: fresh frame, then recognition (or blob location) in
+// sensor pixels; training and blob features on the same frames.
 #include "picksight/vision_app/vision_service.hpp"
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "picksight/common/clock.hpp"
+#include "picksight/vision/recognizer.hpp"
 
 namespace picksight::app {
 
-std::vector<LocatedPart> locateParts(const ReceivedFrame& frame, const VisionOptions& options) {
-  const auto& h = frame.header;
+cv::Point2d FrameMapping::toSensor(cv::Point2d p) const {
+  // Pixel centres are at integer coordinates in both frames.
+  return {roi_x + (p.x + 0.5) / scale_x - 0.5, roi_y + (p.y + 0.5) / scale_y - 0.5};
+}
+
+double FrameMapping::directionToSensor(double deg) const {
+  // A direction scales like a displacement: undo an anisotropic resize.
+  const double a = deg * M_PI / 180.0;
+  double out = std::atan2(std::sin(a) / scale_y, std::cos(a) / scale_x) * 180.0 / M_PI;
+  if (out < 0) out += 360.0;
+  return out >= 360.0 ? 0.0 : out;
+}
+
+cv::Mat greyImage(const ReceivedFrame& frame) {
   cv::Mat grey = frame.image();
   if (grey.channels() == 3) {
     cv::Mat converted;
     cv::cvtColor(grey, converted, cv::COLOR_BGR2GRAY);
     grey = converted;
   }
+  return grey;
+}
+
+FrameMapping frameMapping(const ReceivedFrame& frame) {
+  const auto& h = frame.header;
+  FrameMapping m;
+  m.roi_x = h.roi_x();
+  m.roi_y = h.roi_y();
+  m.scale_x = h.scale_x() > 0 ? h.scale_x() : 1.0;
+  m.scale_y = h.scale_y() > 0 ? h.scale_y() : 1.0;
+  return m;
+}
+
+std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
+                                       const VisionOptions& options, const ModelList& models,
+                                       int type) {
   const cv::Mat mask = vision::binarize(grey, options.binarize);
   const auto regions = vision::findRegions(mask, options.regions, grey);
-  const double sx = h.scale_x() > 0 ? h.scale_x() : 1.0;
-  const double sy = h.scale_y() > 0 ? h.scale_y() : 1.0;
+  const double area_scale = 1.0 / (mapping.scale_x * mapping.scale_y);
   std::vector<LocatedPart> parts;
-  parts.reserve(regions.size());
-  for (const auto& r : regions) {
+  if (models.empty()) {
+    parts.reserve(regions.size());
+    for (const auto& r : regions) {
+      LocatedPart p;
+      const cv::Point2d s = mapping.toSensor(r.centroid);
+      p.x = s.x;
+      p.y = s.y;
+      p.angle_deg = mapping.directionToSensor(r.angle_deg);
+      p.area = r.area * area_scale;
+      p.holes = r.holes;
+      parts.push_back(p);
+    }
+    return parts;
+  }
+  // Every model competes for every region, so that a part is reported as
+  // the type that explains it best, then the requested type is kept.
+  std::vector<const vision::PartModel*> list;
+  for (const auto& m : models) list.push_back(&m);
+  for (const auto& match : vision::recognize(regions, list)) {
+    if (type >= 0 && match.model->type != type) continue;
     LocatedPart p;
-    // Pixel centres are at integer coordinates in both frames.
-    p.x = h.roi_x() + (r.centroid.x + 0.5) / sx - 0.5;
-    p.y = h.roi_y() + (r.centroid.y + 0.5) / sy - 0.5;
-    // A direction scales like a displacement: undo an anisotropic resize.
-    const double a = r.angle_deg * M_PI / 180.0;
-    double deg = std::atan2(std::sin(a) / sy, std::cos(a) / sx) * 180.0 / M_PI;
-    if (deg < 0) deg += 360.0;
-    p.angle_deg = deg;
-    p.area = r.area / (sx * sy);
-    p.holes = r.holes;
+    const cv::Point2d s = mapping.toSensor(match.centroid);
+    p.x = s.x;
+    p.y = s.y;
+    p.angle_deg = match.angle_deg;
+    p.area = regions[match.region].area * area_scale;
+    p.holes = regions[match.region].holes;
+    p.type = match.model->type;
+    p.score = match.score;
+    p.symmetry_deg = match.symmetry_deg;
     parts.push_back(p);
   }
   return parts;
 }
 
+std::vector<LocatedPart> locateParts(const ReceivedFrame& frame, const VisionOptions& options) {
+  return locateInImage(greyImage(frame), frameMapping(frame), options, {}, -1);
+}
+
+std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const VisionOptions& options) {
+  const auto regions =
+      vision::findRegions(vision::binarize(grey, options.binarize), options.regions, grey);
+  vision::FeatureOptions features;
+  features.skeleton = false;
+  std::vector<vision::BlobFeatures> out;
+  out.reserve(regions.size());
+  for (const auto& r : regions) out.push_back(vision::blobFeatures(r, features));
+  return out;
+}
+
 VisionService::VisionService(zmq::context_t& context, const std::string& frames_endpoint,
                              const std::string& control_endpoint, std::string camera,
-                             VisionOptions options)
+                             VisionOptions options, ModelLibrary* models)
     : camera_(std::move(camera)),
       options_(std::move(options)),
+      models_(models),
       feed_(context, frames_endpoint, camera_),
       control_(context, control_endpoint) {}
 
@@ -52,33 +115,89 @@ void VisionService::start() { feed_.start(); }
 void VisionService::stop() { feed_.stop(); }
 
 Result<std::shared_ptr<const ReceivedFrame>> VisionService::freshFrame() {
+  // A triggered frame can be lost on the way (a subscription still joining,
+  // a full queue): trigger again after a while rather than wait in vain for
+  // the whole timeout. Any later frame will do.
+  constexpr std::chrono::milliseconds kRetrigger{500};
   const uint64_t requested_ns = monotonicNs();
-  proto::ControlRequest request;
-  request.mutable_trigger()->set_camera(camera_);
-  auto reply = control_.call(request);
-  if (!reply) {
-    return makeError(kNoVideoServer, "video server: " + reply.error().message);
+  const auto deadline = std::chrono::steady_clock::now() + options_.frame_timeout;
+  std::shared_ptr<const ReceivedFrame> frame;
+  while (!frame) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) {
+      return makeError(kNoFrame, "no frame from camera " + camera_ + " within " +
+                                     std::to_string(options_.frame_timeout.count()) + " ms");
+    }
+    proto::ControlRequest request;
+    request.mutable_trigger()->set_camera(camera_);
+    auto reply = control_.call(request);
+    if (!reply) {
+      return makeError(kNoVideoServer, "video server: " + reply.error().message);
+    }
+    const auto wait = std::min<std::chrono::milliseconds>(
+        kRetrigger, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now));
+    frame = feed_.waitFor(reply->trigger().sequence(), requested_ns, wait);
   }
-  const uint64_t sequence = reply->trigger().sequence();
-  auto frame = feed_.waitFor(sequence, requested_ns, options_.frame_timeout);
-  if (!frame) {
-    return makeError(kNoFrame, "no frame from camera " + camera_ + " within " +
-                                   std::to_string(options_.frame_timeout.count()) + " ms");
-  }
+  const auto& h = frame->header;
+  last_frame_ = FrameInfo{h.camera(), h.sequence(), h.host_timestamp_ns(),
+                          h.width(),  h.height(),   h.triggered()};
   return frame;
 }
 
-Result<LocateOutcome> VisionService::locate() {
+Result<LocateOutcome> VisionService::locate(int type) {
+  const auto models = models_ ? models_->snapshot() : std::make_shared<const ModelList>();
+  if (!models->empty()) {
+    bool known = false;
+    for (const auto& m : *models) known = known || m.type == type;
+    if (!known)
+      return makeError(kUnknownType, "no model for type " + std::to_string(type) + " (see MODELS)");
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  const auto& h = (*frame)->header;
   LocateOutcome outcome;
-  outcome.frame = FrameInfo{h.camera(), h.sequence(), h.host_timestamp_ns(), h.width(), h.height(),
-                            h.triggered()};
-  outcome.parts = locateParts(**frame, options_);
-  last_frame_ = outcome.frame;
+  outcome.frame = *last_frame_;
+  outcome.parts = locateInImage(greyImage(**frame), frameMapping(**frame), options_, *models, type);
   return outcome;
+}
+
+Result<vision::PartModel> VisionService::learn(int type, const std::string& name) {
+  if (!models_) return makeError(kStorageFailed, "no model library");
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto frame = freshFrame();
+  if (!frame) return frame.error();
+  vision::TrainOptions train;
+  train.binarize = options_.binarize;
+  train.regions = options_.regions;
+  const auto outcome = vision::trainModel(greyImage(**frame), type, name, train);
+  if (!outcome.ok) {
+    const bool none = outcome.error.rfind("no part", 0) == 0;
+    return makeError(none ? kNoPartToLearn : kSeveralParts, outcome.error);
+  }
+  auto stored = models_->store(outcome.model);
+  if (!stored)
+    return makeError(kStorageFailed, "cannot store the model: " + stored.error().message);
+  return outcome.model;
+}
+
+Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto frame = freshFrame();
+  if (!frame) return frame.error();
+  const FrameMapping mapping = frameMapping(**frame);
+  auto features = blobsInImage(greyImage(**frame), options_);
+  const double linear = 1.0 / std::sqrt(mapping.scale_x * mapping.scale_y);
+  for (auto& f : features) {
+    f.centroid = mapping.toSensor(f.centroid);
+    f.angle_deg = mapping.directionToSensor(f.angle_deg);
+    f.area *= linear * linear;
+    f.perimeter *= linear;
+    const cv::Point2d tl = mapping.toSensor(cv::Point2d(f.bbox.x, f.bbox.y));
+    f.bbox = cv::Rect(static_cast<int>(std::lround(tl.x)), static_cast<int>(std::lround(tl.y)),
+                      static_cast<int>(std::lround(f.bbox.width / mapping.scale_x)),
+                      static_cast<int>(std::lround(f.bbox.height / mapping.scale_y)));
+  }
+  return features;
 }
 
 std::optional<FrameInfo> VisionService::lastFrame() const {

@@ -13,13 +13,14 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
   for (auto field : splitFields(text, ",?&")) {
     const size_t eq = field.find('=');
     if (eq == std::string_view::npos) {
-      return makeError(kSourceBadConfig, "synthetic: expected key=value, got '" + std::string(field) + "'");
+      return makeError(kSourceBadConfig,
+                       "synthetic: expected key=value, got '" + std::string(field) + "'");
     }
     const std::string key(field.substr(0, eq));
     const std::string_view value = field.substr(eq + 1);
     const auto bad = [&](const std::string& what) {
-      return makeError(kSourceBadConfig,
-                       "synthetic: " + key + " must be " + what + ", got '" + std::string(value) + "'");
+      return makeError(kSourceBadConfig, "synthetic: " + key + " must be " + what + ", got '" +
+                                             std::string(value) + "'");
     };
     const auto integer = parseInt(value);
     const auto number = parseDouble(value);
@@ -43,7 +44,7 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
       o.scene.uneven_light = value == "uneven";
     } else if (key == "types") {
       o.scene.types.clear();
-      const auto& known = synthetic::partTypes();
+      const auto& known = synthetic::allPartTypes();
       for (auto t : splitFields(value, "+")) {
         if (std::find(known.begin(), known.end(), t) == known.end()) {
           std::string names;
@@ -52,6 +53,12 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
         }
         o.scene.types.emplace_back(t);
       }
+    } else if (key == "touching") {
+      if (value != "0" && value != "1") return bad("0 or 1");
+      o.scene.touching = value == "1";
+    } else if (key == "blur") {
+      if (!number || *number < 0 || *number > 20) return bad("a number in [0, 20]");
+      o.scene.blur_sigma = *number;
     } else if (key == "scene_every") {
       if (!integer || *integer < 0) return bad("a non-negative integer");
       o.scene_every = static_cast<uint64_t>(*integer);
@@ -59,7 +66,7 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
       return makeError(kSourceBadConfig,
                        "synthetic: unknown key '" + key +
                            "' (known: width, height, parts, seed, noise, size, light, types, "
-                           "scene_every)");
+                           "touching, blur, scene_every)");
     }
   }
   return o;

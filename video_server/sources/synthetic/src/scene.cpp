@@ -10,6 +10,7 @@
 #include <utility>
 
 #include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace picksight::synthetic {
 namespace {
@@ -244,6 +245,57 @@ Shape gearDesign(double size) {
   return shape;
 }
 
+// Equilateral, side `size`: isotropic inertia, so its design frame is kept
+// (a vertex on -y).
+Shape triangleDesign(double size) {
+  const double r = size / std::sqrt(3.0);
+  Loop loop;
+  for (int k = 0; k < 3; ++k) {
+    const double a = (-90.0 + 120.0 * k) * kPi / 180;
+    loop.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  return Shape{{loop}};
+}
+
+// Hexagon `size` across corners with a bore: 6-fold, isotropic.
+Shape hexNutDesign(double size) {
+  Loop outer;
+  for (int k = 0; k < 6; ++k) {
+    const double a = 60.0 * k * kPi / 180;
+    outer.emplace_back(0.5 * size * std::cos(a), 0.5 * size * std::sin(a));
+  }
+  Shape shape;
+  shape.loops.push_back(std::move(outer));
+  shape.loops.push_back(circleLoop({0, 0}, 0.22 * size));
+  return shape;
+}
+
+// A T: mirror-symmetric about its stem, directed along it.
+Shape tShapeDesign(double size) {
+  const double s = size;
+  return Shape{{{{-0.5 * s, 0},
+                 {0.5 * s, 0},
+                 {0.5 * s, 0.28 * s},
+                 {0.14 * s, 0.28 * s},
+                 {0.14 * s, 0.9 * s},
+                 {-0.14 * s, 0.9 * s},
+                 {-0.14 * s, 0.28 * s},
+                 {-0.5 * s, 0.28 * s}}}};
+}
+
+// A stadium (two half circles joined by lines) with a bore towards one end.
+Shape slotDesign(double size) {
+  const double r = 0.2 * size;
+  const double c = 0.5 * size - r;
+  Loop outer;
+  appendArc(outer, {c, 0}, r, -kPi / 2, kPi / 2);
+  appendArc(outer, {-c, 0}, r, kPi / 2, 3 * kPi / 2);
+  Shape shape;
+  shape.loops.push_back(std::move(outer));
+  shape.loops.push_back(circleLoop({0.25 * size, 0}, 0.1 * size));
+  return shape;
+}
+
 // Adds the exact area coverage of one directed polygon edge to an accumulation
 // buffer (the signed-area method of font-rs): cell i of a row holds the change
 // of coverage from pixel i-1 to pixel i, so a prefix sum along the row gives
@@ -463,6 +515,70 @@ bool tryLayout(const SceneOptions& o, const std::vector<const TypeInfo*>& parts,
   return true;
 }
 
+double pointSegmentDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+  const cv::Point2d d = b - a;
+  const double len2 = d.dot(d);
+  const double t = len2 > 0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+  return cv::norm(p - (a + d * t));
+}
+
+// Smallest distance between two outlines that do not cross.
+double clearance(const Loop& a, const Loop& b) {
+  double best = 1e300;
+  for (std::size_t i = 0, n = a.size(); i < n; ++i) {
+    const cv::Point2d& a0 = a[i];
+    const cv::Point2d& a1 = a[(i + 1) % n];
+    for (std::size_t j = 0, m = b.size(); j < m; ++j) {
+      const cv::Point2d& b0 = b[j];
+      const cv::Point2d& b1 = b[(j + 1) % m];
+      best = std::min({best, pointSegmentDistance(a0, b0, b1), pointSegmentDistance(b0, a0, a1)});
+    }
+  }
+  return best;
+}
+
+// Moves part `i` against part `anchor` from a random side until their edges
+// meet; false (leaving it alone) when no side gives a free spot.
+constexpr int kTouchAttempts = 36;
+constexpr double kContactPx = 0.01;
+bool moveIntoContact(const SceneOptions& o, const std::vector<const TypeInfo*>& parts,
+                     std::size_t i, std::size_t anchor, std::mt19937_64& rng,
+                     std::vector<Placement>& placed) {
+  const TypeInfo& a = *parts[anchor];
+  const TypeInfo& b = *parts[i];
+  const Loop outer_a =
+      placedShape(a.shape, placed[anchor].x, placed[anchor].y, placed[anchor].angle_deg).loops[0];
+  for (int attempt = 0; attempt < kTouchAttempts; ++attempt) {
+    const double dir = uniform(rng, 0, 2 * kPi);
+    const cv::Point2d u(std::cos(dir), std::sin(dir));
+    double d = a.radius + b.radius + 1;
+    cv::Point2d at;
+    // Moving by less than the clearance can never make the parts overlap.
+    for (int step = 0; step < 400; ++step) {
+      at = cv::Point2d(placed[anchor].x, placed[anchor].y) + u * d;
+      const double c =
+          clearance(outer_a, placedShape(b.shape, at.x, at.y, placed[i].angle_deg).loops[0]);
+      if (c < kContactPx) break;
+      d -= c;
+    }
+    const double r = b.radius;
+    if (at.x - r < -0.5 + kBorderMarginPx || at.x + r > o.width - 0.5 - kBorderMarginPx ||
+        at.y - r < -0.5 + kBorderMarginPx || at.y + r > o.height - 0.5 - kBorderMarginPx) {
+      continue;
+    }
+    bool free = true;
+    for (std::size_t j = 0; j < parts.size() && free; ++j) {
+      if (j == i || j == anchor) continue;
+      free = std::hypot(at.x - placed[j].x, at.y - placed[j].y) >= r + parts[j]->radius + kGapPx;
+    }
+    if (!free) continue;
+    placed[i].x = at.x;
+    placed[i].y = at.y;
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 const std::vector<std::string>& partTypes() {
@@ -496,7 +612,29 @@ Shape partShape(const std::string& type, double size) {
   if (type == "gear") {
     return canonicalize(gearDesign(size));
   }
+  if (type == "l_shape_small") {
+    return partShape("l_shape", 0.75 * size);
+  }
+  if (type == "triangle") {
+    return canonicalize(triangleDesign(size));
+  }
+  if (type == "hex_nut") {
+    return canonicalize(hexNutDesign(size));
+  }
+  if (type == "t_shape") {
+    return canonicalize(tShapeDesign(size));
+  }
+  if (type == "slot") {
+    return canonicalize(slotDesign(size));
+  }
   throw std::invalid_argument("partShape: unknown part type '" + type + "'");
+}
+
+const std::vector<std::string>& allPartTypes() {
+  static const std::vector<std::string> types{
+      "rectangle",     "l_shape",  "l_shape_mirror", "disc_holes", "gear",
+      "l_shape_small", "triangle", "hex_nut",        "t_shape",    "slot"};
+  return types;
 }
 
 ShapeMoments shapeMoments(const Shape& shape) {
@@ -587,6 +725,7 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
   // reports the size used.
   std::map<std::string, TypeInfo> infos;
   std::vector<Placement> placed;
+  std::vector<bool> touching;
   double size = o.part_size;
   for (int round = 0;; ++round) {
     infos.clear();
@@ -606,6 +745,14 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
       parts.push_back(&infos.at(type));
     }
     if (tryLayout(o, parts, rng, placed)) {
+      touching.assign(parts.size(), false);
+      if (o.touching) {
+        for (std::size_t i = 1; i < parts.size(); i += 2) {
+          if (moveIntoContact(o, parts, i, i - 1, rng, placed)) {
+            touching[i] = touching[i - 1] = true;
+          }
+        }
+      }
       break;
     }
     size *= kShrinkFactor;
@@ -634,7 +781,12 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
     t.angle_deg = p.angle_deg;
     t.symmetry_deg = info.symmetry;
     t.area_px = info.area;
+    t.touching = touching[i];
     truth_.push_back(std::move(t));
+  }
+  if (o.blur_sigma > 0) {
+    // A symmetric kernel moves no centroid and keeps every area.
+    cv::GaussianBlur(image, image, cv::Size(), o.blur_sigma, o.blur_sigma, cv::BORDER_REPLICATE);
   }
   image.convertTo(clean_, CV_8U);
 

@@ -52,7 +52,8 @@ HuArray logHu(const HuArray& hu);
 // with CHAIN_APPROX_NONE): Vossepoel and Smeulders' estimator from the counts
 // of straight steps, diagonal steps and direction changes. Counting steps as
 // 1 and sqrt(2) overestimates a disc's perimeter by ~5% (a staircase is not
-// a curve); this estimator is within ~1% for lines and circles at any angle.
+// a curve); this estimator is within ~1% for circles and slanted lines, and
+// 2% short on lines along a pixel axis.
 double boundaryLength(const std::vector<cv::Point>& closed);
 
 // Eccentricity of the moments' equivalent ellipse.

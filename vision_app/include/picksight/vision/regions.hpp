@@ -10,8 +10,8 @@
 namespace picksight::vision {
 
 struct Region {
-  double area = 0;        // pixels (covered fraction summed, with a grey image)
-  cv::Point2d centroid;   // sub-pixel, pixel centres at integer coordinates
+  double area = 0;       // pixels (covered fraction summed, with a grey image)
+  cv::Point2d centroid;  // sub-pixel, pixel centres at integer coordinates
   // Axis of least second moment, pointing along the longer path through the
   // region from its centroid; degrees in [0, 360), image axes (x right, y down).
   double angle_deg = 0;
@@ -35,7 +35,7 @@ struct Region {
 };
 
 struct RegionOptions {
-  double min_area = 50;         // smaller regions are noise
+  double min_area = 50;              // smaller regions are noise
   bool keep_border_regions = false;  // a part cut by the image edge cannot be located
 };
 

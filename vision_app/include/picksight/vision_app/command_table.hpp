@@ -33,6 +33,8 @@ struct Request {
 std::optional<Request> parseRequest(std::string_view line);
 
 std::string errorReply(int code, const std::string& text);
+// A part type argument: an integer in [0, 9999].
+std::optional<int> parseType(std::string_view text);
 // Up to `limit` characters of client text, safe to echo in a reply line.
 std::string printable(std::string_view text, size_t limit = 40);
 

@@ -1,9 +1,10 @@
 // The vision work behind robot requests: get a frame taken after the
-// request (a software trigger, or the next free-run frame), find the parts,
-// and express them in sensor pixels.
+// request (a software trigger, or the next free-run frame), find the parts
+// (recognize trained types, or every region when no model exists), and
+// express them in sensor pixels.
 //
-// Threading: locate() may be called from any connection thread; requests are
-// served one at a time (they share the control socket and the CPU).
+// Threading: every request method may be called from any connection thread;
+// requests are served one at a time (they share the control socket and the CPU).
 #pragma once
 
 #include <chrono>
@@ -18,8 +19,11 @@
 #include "picksight/common/result.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/vision/binarize.hpp"
+#include "picksight/vision/blob_features.hpp"
+#include "picksight/vision/part_model.hpp"
 #include "picksight/vision/regions.hpp"
 #include "picksight/vision_app/frame_feed.hpp"
+#include "picksight/vision_app/model_library.hpp"
 
 namespace picksight::app {
 
@@ -27,14 +31,33 @@ namespace picksight::app {
 enum VisionError : int {
   kNoFrame = 20,        // no fresh frame in time
   kNoVideoServer = 21,  // the video server did not answer or refused
+  kNoPartToLearn = 30,  // LEARN: no part in the frame
+  kSeveralParts = 31,   // LEARN: more than one part in the frame
+  kUnknownType = 32,    // no model for that type
+  kStorageFailed = 33,  // a model file could not be written or removed
 };
 
 struct LocatedPart {
   double x = 0;  // sensor pixels
   double y = 0;
-  double angle_deg = 0;  // [0, 360), image axes
-  double area = 0;       // sensor pixels
+  // Recognized part: rotation from the trained pose, [0, symmetry_deg).
+  // Region (no models): direction of its axis, [0, 360), image axes.
+  double angle_deg = 0;
+  double area = 0;  // sensor pixels
   int holes = 0;
+  int type = -1;              // -1: a region, no model
+  double score = 0;           // verified boundary fraction
+  double symmetry_deg = 360;  // period of angle_deg (0: any)
+};
+
+// Where a frame's pixels lie on the sensor (ROI offset and resize).
+struct FrameMapping {
+  double roi_x = 0;
+  double roi_y = 0;
+  double scale_x = 1;
+  double scale_y = 1;
+  cv::Point2d toSensor(cv::Point2d p) const;
+  double directionToSensor(double deg) const;
 };
 
 struct FrameInfo {
@@ -58,28 +81,52 @@ struct VisionOptions {
 };
 
 // Finds the parts in one frame and maps them to sensor pixels through the
-// frame header's ROI offset and scale.
+// frame header's ROI offset and scale: every region, largest first.
 std::vector<LocatedPart> locateParts(const ReceivedFrame& frame, const VisionOptions& options);
+
+// The frame as 8-bit grey (converted from colour if needed) and its mapping.
+cv::Mat greyImage(const ReceivedFrame& frame);
+FrameMapping frameMapping(const ReceivedFrame& frame);
+
+// Finds parts in a grey image: with `models` non-empty, the recognized parts
+// of type `type` (-1: all types), best first; with none, every region,
+// largest first.
+std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
+                                       const VisionOptions& options, const ModelList& models,
+                                       int type);
+
+// Blob features of every region of a grey image (skeleton left out).
+std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const VisionOptions& options);
 
 class VisionService {
  public:
+  // `models` (borrowed, may be null: no recognition) outlives the service.
   VisionService(zmq::context_t& context, const std::string& frames_endpoint,
-                const std::string& control_endpoint, std::string camera, VisionOptions options);
+                const std::string& control_endpoint, std::string camera, VisionOptions options,
+                ModelLibrary* models = nullptr);
 
   void start();
   void stop();
 
-  // Every part in a frame taken after this call.
-  Result<LocateOutcome> locate();
+  // The parts of `type` in a frame taken after this call (every region when
+  // no model exists; kUnknownType when models exist but none of `type`).
+  Result<LocateOutcome> locate(int type);
+  // Trains type `type` from the single part in a fresh frame and stores it.
+  Result<vision::PartModel> learn(int type, const std::string& name);
+  // Blob features of every region in a fresh frame, sensor pixels.
+  Result<std::vector<vision::BlobFeatures>> blobs();
+  ModelLibrary* models() const { return models_; }
   // The frame the last request worked on.
   std::optional<FrameInfo> lastFrame() const;
   const std::string& camera() const { return camera_; }
 
  private:
+  // Call with mutex_ held.
   Result<std::shared_ptr<const ReceivedFrame>> freshFrame();
 
   const std::string camera_;
   const VisionOptions options_;
+  ModelLibrary* const models_;
   FrameFeed feed_;
 
   mutable std::mutex mutex_;  // serializes requests; guards control_ and last_frame_

@@ -31,6 +31,7 @@ struct PartTruth {
   double angle_deg = 0;       // [0, 360)
   double symmetry_deg = 360;  // 360 directed, 180 axis only, 0 isotropic
   double area_px = 0;         // exact polygon area
+  bool touching = false;      // in contact with another part (SceneOptions::touching)
 };
 
 struct SceneOptions {
@@ -46,11 +47,24 @@ struct SceneOptions {
   bool uneven_light = true;       // smooth illumination gradient and vignetting
   double background_level = 200;  // grey level of the lit background
   double part_level = 45;         // grey level of a part
+  // Parts in contact by pairs: each second part is moved against the one
+  // before it (a random side, edges meeting with no gap), so that a binary
+  // image shows the two as one blob. Pairs that find no free spot stay apart.
+  bool touching = false;
+  // Gaussian blur of the rendered image (optics), sigma in pixels; 0 = none.
+  double blur_sigma = 0;
 };
 
-// The part types the generator knows: "rectangle", "l_shape", "l_shape_mirror",
+// The default part types: "rectangle", "l_shape", "l_shape_mirror",
 // "disc_holes", "gear".
 const std::vector<std::string>& partTypes();
+
+// Every type the generator knows: the default ones, then "l_shape_small"
+// (l_shape at 3/4 scale: same shape, other size), "triangle" (equilateral:
+// isotropic inertia, 3-fold), "hex_nut" (hexagon with a bore: 6-fold), "t_shape"
+// (mirror-symmetric, directed) and "slot" (a stadium with an off-centre bore:
+// lines and arcs).
+const std::vector<std::string>& allPartTypes();
 
 // The canonical silhouette of a part type whose longest side is `size` pixels.
 // Throws std::invalid_argument for an unknown type.

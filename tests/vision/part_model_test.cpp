@@ -1,0 +1,209 @@
+// Part models and recognition on synthetic scenes with exact ground truth:
+// training errors, symmetry, mirror images, size pairs, rotation from the
+// trained pose, boundary primitives.
+#include <catch2/catch.hpp>
+
+#include <map>
+#include <opencv2/imgproc.hpp>
+
+#include "picksight/common/angles.hpp"
+#include "picksight/synthetic/scene.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/recognizer.hpp"
+
+using namespace picksight::vision;
+namespace ps = picksight::synthetic;
+using picksight::angleDiffDeg;
+
+namespace {
+ps::SceneOptions scene(int width, int height, int parts, uint64_t seed,
+                       std::vector<std::string> types) {
+  ps::SceneOptions o;
+  o.width = width;
+  o.height = height;
+  o.parts = parts;
+  o.seed = seed;
+  o.types = std::move(types);
+  o.blur_sigma = 0.7;
+  return o;
+}
+
+struct Trained {
+  PartModel model;
+  double truth_angle = 0;
+};
+
+Trained train(const std::string& type, int id) {
+  const ps::SceneRenderer s(scene(400, 400, 1, 77 + static_cast<uint64_t>(id), {type}));
+  auto outcome = trainModel(s.render(0), id, type);
+  INFO(type << ": " << outcome.error);
+  REQUIRE(outcome.ok);
+  return {outcome.model, s.truth()[0].angle_deg};
+}
+
+std::vector<Match> recognizeScene(const ps::SceneRenderer& s,
+                                  const std::vector<const PartModel*>& models) {
+  const cv::Mat grey = s.render(1);
+  return recognize(findRegions(binarize(grey, {}), {}, grey), models);
+}
+
+const Match* nearest(const std::vector<Match>& matches, const ps::PartTruth& t) {
+  const Match* best = nullptr;
+  for (const auto& m : matches) {
+    if (std::hypot(m.centroid.x - t.x, m.centroid.y - t.y) < 5) best = &m;
+  }
+  return best;
+}
+}  // namespace
+
+TEST_CASE("training needs exactly one part", "[vision][model]") {
+  cv::Mat empty(200, 200, CV_8UC1, cv::Scalar(200));
+  auto outcome = trainModel(empty, 1, "x");
+  CHECK_FALSE(outcome.ok);
+  CHECK(outcome.error.find("no part") != std::string::npos);
+  const ps::SceneRenderer two(scene(640, 480, 2, 3, {"rectangle"}));
+  outcome = trainModel(two.render(0), 1, "x");
+  CHECK_FALSE(outcome.ok);
+  CHECK(outcome.error.find("2 parts") != std::string::npos);
+}
+
+TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][model]") {
+  const std::map<std::string, double> symmetry = {
+      {"rectangle", 180}, {"l_shape", 360},    {"gear", 30},     {"hex_nut", 60},
+      {"triangle", 120},  {"disc_holes", 360}, {"t_shape", 360}, {"slot", 360}};
+  const std::map<std::string, bool> mirror = {
+      {"rectangle", true}, {"l_shape", false},    {"gear", true},    {"hex_nut", true},
+      {"triangle", true},  {"disc_holes", false}, {"t_shape", true}, {"slot", true}};
+  int id = 1;
+  for (const auto& [type, deg] : symmetry) {
+    INFO(type);
+    const Trained t = train(type, id++);
+    CHECK(t.model.symmetryDeg() == deg);
+    CHECK(t.model.body.mirror_symmetric == mirror.at(type));
+    CHECK(validateModel(t.model).empty());
+  }
+  // A plain disc turns into itself at any angle.
+  cv::Mat grey(300, 300, CV_8UC1, cv::Scalar(200));
+  cv::circle(grey, {150, 150}, 60, cv::Scalar(40), cv::FILLED, cv::LINE_AA);
+  const auto disc = trainModel(grey, 9, "disc");
+  REQUIRE(disc.ok);
+  CHECK(disc.model.symmetryDeg() == 0);
+  CHECK(disc.model.orientation_order == 0);
+}
+
+TEST_CASE("a hole becomes one arc; a rectangle four lines with convex right-angle corners",
+          "[vision][model]") {
+  const Trained slot = train("slot", 1);
+  REQUIRE(slot.model.loops.size() == 2);
+  REQUIRE(slot.model.loops[1].primitives.size() == 1);
+  const Primitive& bore = slot.model.loops[1].primitives[0];
+  CHECK(bore.kind == PrimitiveKind::kArc);
+  CHECK(std::abs(bore.sweep_deg) == 360);
+  CHECK(bore.radius ==
+        Approx(0.1 * 120 + 0.5).margin(1.0));  // boundary pixel centres, just outside the hole
+  // The stadium's ends are arcs too: line-arc and arc-line corners.
+  int line_arc = 0;
+  for (const auto& c : slot.model.corners)
+    line_arc += c.kind == CornerClass::kLineArc || c.kind == CornerClass::kArcLine;
+  CHECK(line_arc >= 2);
+
+  cv::Mat grey(300, 300, CV_8UC1, cv::Scalar(200));
+  cv::rectangle(grey, cv::Rect(80, 100, 120, 60), cv::Scalar(40), cv::FILLED);
+  const auto rect = trainModel(grey, 2, "rect");
+  REQUIRE(rect.ok);
+  REQUIRE(rect.model.loops.size() == 1);
+  int long_lines = 0;
+  for (const auto& p : rect.model.loops[0].primitives)
+    long_lines += p.kind == PrimitiveKind::kLine && p.length() > 50;
+  CHECK(long_lines == 4);
+  int right_angles = 0;
+  for (const auto& c : rect.model.corners) {
+    if (c.kind == CornerClass::kLineLine && c.convex &&
+        (c.turn_deg.contains(90) || c.turn_deg.contains(-90))) {
+      ++right_angles;
+    }
+  }
+  CHECK(right_angles >= 4);
+}
+
+TEST_CASE("a part is never taken for its mirror image", "[vision][model][mirror]") {
+  const Trained l = train("l_shape", 1);
+  const Trained m = train("l_shape_mirror", 2);
+  for (uint64_t seed : {5u, 6u, 7u}) {
+    const ps::SceneRenderer s(scene(1280, 960, 12, seed, {"l_shape", "l_shape_mirror"}));
+    // With only the L trained, its mirror images are not reported at all.
+    const auto only_l = recognizeScene(s, {&l.model});
+    // With both trained, each is reported as itself.
+    const auto both = recognizeScene(s, {&l.model, &m.model});
+    for (const auto& t : s.truth()) {
+      INFO(t.type << " at " << t.x << ", " << t.y);
+      const Match* a = nearest(only_l, t);
+      CHECK((a != nullptr) == (t.type == "l_shape"));
+      const Match* b = nearest(both, t);
+      REQUIRE(b);
+      CHECK(b->model->name == t.type);
+    }
+  }
+}
+
+TEST_CASE("parts of the same shape and another size are told apart by area", "[vision][model]") {
+  const Trained big = train("l_shape", 1);
+  const Trained small = train("l_shape_small", 2);
+  const ps::SceneRenderer s(scene(1280, 960, 10, 9, {"l_shape", "l_shape_small"}));
+  const auto matches = recognizeScene(s, {&big.model, &small.model});
+  CHECK(matches.size() == 10);
+  for (const auto& t : s.truth()) {
+    const Match* m = nearest(matches, t);
+    REQUIRE(m);
+    CHECK(m->model->name == t.type);
+  }
+}
+
+TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vision][model]") {
+  const auto& types = ps::allPartTypes();
+  std::map<std::string, Trained> trained;
+  std::vector<const PartModel*> models;
+  int id = 1;
+  for (const auto& type : types) trained[type] = train(type, id++);
+  for (const auto& [type, t] : trained) models.push_back(&t.model);
+  double worst_position = 0;
+  double worst_angle = 0;
+  for (uint64_t seed : {21u, 22u}) {
+    const ps::SceneRenderer s(scene(1920, 1080, 20, seed, types));
+    const auto matches = recognizeScene(s, models);
+    CHECK(matches.size() == 20);
+    for (const auto& t : s.truth()) {
+      INFO(t.type << " at " << t.x << ", " << t.y << " turned " << t.angle_deg);
+      const Match* m = nearest(matches, t);
+      REQUIRE(m);
+      CHECK(m->model->name == t.type);
+      CHECK(m->score >= 0.9);
+      const double position = std::hypot(m->centroid.x - t.x, m->centroid.y - t.y);
+      CHECK(position < 0.1);
+      const double angle =
+          angleDiffDeg(m->angle_deg, t.angle_deg - trained.at(t.type).truth_angle, m->symmetry_deg);
+      CHECK(angle < 0.3);
+      CHECK(m->angle_deg >= 0);
+      CHECK(m->angle_deg < (m->symmetry_deg > 0 ? m->symmetry_deg : 360));
+      worst_position = std::max(worst_position, position);
+      worst_angle = std::max(worst_angle, angle);
+    }
+  }
+  WARN("worst position error " << worst_position << " px, worst rotation error " << worst_angle
+                               << " deg");
+}
+
+TEST_CASE("verification fails when the model is off the part", "[vision][model]") {
+  const Trained l = train("l_shape", 1);
+  const ps::SceneRenderer s(scene(400, 400, 1, 78, {"l_shape"}));
+  const cv::Mat grey = s.render(0);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  REQUIRE(regions.size() == 1);
+  std::vector<std::vector<cv::Point>> contours{regions[0].outer};
+  const EdgeDistance edges(contours, cv::Rect(0, 0, 400, 400));
+  const cv::Point2d c = regions[0].centroid;
+  CHECK(verifyScore(l.model.samples, c, 0, edges, l.model.edge_tolerance) > 0.95);
+  CHECK(verifyScore(l.model.samples, c + cv::Point2d(6, 0), 0, edges, l.model.edge_tolerance) <
+        0.6);
+  CHECK(verifyScore(l.model.samples, c, 0, edges, l.model.edge_tolerance, true) < 0.8);
+}

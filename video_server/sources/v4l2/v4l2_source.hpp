@@ -1,0 +1,114 @@
+// The V4L2 camera: USB webcams and capture cards through libv4l2, mmap
+// streaming, with the device's controls exposed as features.
+#pragma once
+
+#include <linux/videodev2.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "picksight/video_server/source.hpp"
+#include "v4l2_device.hpp"
+
+namespace picksight::video {
+
+// What "v4l2:" asks for: "/dev/video0?width=1280&height=720&format=mjpeg&fps=30&buffers=4".
+// width and height (both or neither): the frame size; the nearest the device
+// offers when it has not this one. format: yuyv, mjpeg, uyvy, grey, y16,
+// rgb24, bgr24 or a Bayer order (rggb, grbg, bggr, gbrg); without it YUYV,
+// else MJPEG, is chosen at that size, MJPEG first when only it reaches the
+// requested fps. fps: the initial frame rate, which the camera's own
+// frame-rate setting then overrides only when it changes at run time.
+// buffers: mmap buffers to request (2..32, default 4; the driver may grant another count).
+struct V4l2Options {
+  std::string path;
+  int width = 0;
+  int height = 0;
+  uint32_t fourcc = 0;  // 0 = choose
+  double fps = 0;       // 0 = the camera's setting
+  int buffers = 4;
+};
+
+// The error names the key or value that is wrong.
+Result<V4l2Options> parseV4l2Options(const std::string& text);
+
+// Threading: called from the camera's acquisition thread only. The kernel
+// fills the buffers; grab() only copies one out and queues it straight back.
+//
+// Software trigger: a webcam has none. In trigger mode it keeps streaming and
+// softwareTrigger() marks the moment; grab() then returns the first frame
+// captured after it (by the buffer's monotonic timestamp), dropping older
+// ones that were waiting in the driver.
+class V4l2Source : public Source {
+ public:
+  // `device` is the system interface; null means libv4l2.
+  explicit V4l2Source(V4l2Options options, std::unique_ptr<V4l2Device> device = nullptr);
+  ~V4l2Source() override;
+  V4l2Source(const V4l2Source&) = delete;
+  V4l2Source& operator=(const V4l2Source&) = delete;
+
+  Result<void> open() override;
+  void close() override;
+  SourceInfo info() const override;
+  Result<SourceFrame> grab(std::chrono::milliseconds timeout) override;
+  bool streams() const override { return true; }
+  Result<void> configureAcquisition(AcquisitionMode mode, double fps) override;
+  Result<void> softwareTrigger() override;
+
+  // Controls, named from their V4L2 names lower-cased with underscores
+  // ("Exposure Time, Absolute" -> exposure_time_absolute).
+  std::vector<Feature> features() override;
+  Result<Feature> feature(const std::string& name) override;
+  Result<void> setFeature(const std::string& name, const std::string& value) override;
+
+  // Frames dropped since open(): flagged bad by the driver, or short.
+  uint64_t droppedFrames() const { return dropped_; }
+
+ private:
+  // ioctl, retried while interrupted by a signal.
+  int xioctl(unsigned long request, void* arg);
+  // errno after a failed call, as a source error.
+  Error deviceError(const std::string& what, bool streaming = false);
+  // The rate to run at: a run-time change, else the URI's, else the camera's default.
+  double desiredFps() const;
+  Result<void> openDevice();
+  Result<void> chooseFormat();
+  Result<void> startStreaming();
+  void stopStreaming();
+  Result<void> queueBuffer(uint32_t index);
+  Result<void> applyFrameRate(double fps);
+  void drainReadyBuffers();
+  std::vector<v4l2_queryctrl> queryControls();
+  std::optional<v4l2_queryctrl> findControl(const std::string& name);
+  Result<Feature> describeControl(const v4l2_queryctrl& control);
+  // A menu control's choices by index, by name (integer menus: by value).
+  std::vector<std::pair<int32_t, std::string>> menuChoices(const v4l2_queryctrl& control);
+
+  const V4l2Options options_;
+  const std::unique_ptr<V4l2Device> device_;
+  V4l2Fd fd_;
+  std::vector<V4l2Mapping> buffers_;  // index = V4L2 buffer index
+  bool streaming_ = false;
+
+  std::string card_;
+  std::string driver_;
+  std::string bus_;
+  std::vector<std::string> formats_;  // what the device offers, by fourcc
+  v4l2_pix_format format_{};          // as the driver set it
+  PixelLayout layout_ = PixelLayout::kYUYV;
+
+  double applied_fps_ = 0;
+  std::optional<double> camera_fps_;   // last rate the camera passed
+  std::optional<double> runtime_fps_;  // set once the camera's rate changed at run time
+  bool trigger_mode_ = false;
+  bool trigger_pending_ = false;
+  bool timestamps_monotonic_ = false;  // as the last buffer said
+  uint64_t trigger_ns_ = 0;            // CLOCK_MONOTONIC at the trigger
+  uint64_t dropped_ = 0;
+};
+
+}  // namespace picksight::video

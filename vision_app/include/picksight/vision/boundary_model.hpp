@@ -1,0 +1,111 @@
+// Boundary models: a region's contours (outer and holes) as straight lines and
+// circular arcs within a conformity tolerance, the corners between them, and
+// the verification of a pose against the edges of an image (SPEC section 3).
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace picksight::vision {
+
+enum class PrimitiveKind { kLine, kArc };
+
+struct Primitive {
+  PrimitiveKind kind = PrimitiveKind::kLine;
+  cv::Point2d start;
+  cv::Point2d end;
+  // Arcs: centre, radius and the signed sweep from start to end (degrees,
+  // positive from the image x axis towards the y axis; 360 for a full circle).
+  cv::Point2d centre;
+  double radius = 0;
+  double sweep_deg = 0;
+  double weight = 1;  // share of this edge in the verified fraction
+
+  double length() const;
+  cv::Point2d pointAt(double t) const;  // t in [0, 1] from start to end
+  cv::Point2d startDirection() const;   // unit tangent, in the walking direction
+  cv::Point2d endDirection() const;
+};
+
+struct BoundaryLoop {
+  bool hole = false;
+  double weight = 1;  // per-region weight (outer boundary, each hole)
+  std::vector<Primitive> primitives;
+};
+
+struct Range {
+  double min = 0;
+  double max = 0;
+  bool contains(double v) const { return v >= min && v <= max; }
+};
+
+enum class CornerClass { kLineLine, kLineArc, kArcLine, kArcArc };
+const char* cornerClassName(CornerClass c);
+
+// The meeting of two consecutive primitives of a loop, with the ranges a
+// matching image corner may take (lengths may be shorter in the image, where
+// another part hides an edge).
+struct Corner {
+  CornerClass kind = CornerClass::kLineLine;
+  int loop = 0;
+  int index = 0;  // of the outgoing primitive in its loop
+  cv::Point2d at;
+  double direction_in_deg = 0;  // tangent directions, image axes
+  double direction_out_deg = 0;
+  Range turn_deg;  // signed turn from incoming to outgoing tangent
+  bool convex = true;
+  Range length_in;
+  Range length_out;
+  Range radius_in;  // arcs only (0..0 for lines)
+  Range radius_out;
+};
+
+// Splits a closed contour into lines and arcs: every contour point lies
+// within `conformity` pixels of its primitive.
+std::vector<Primitive> fitPrimitives(const std::vector<cv::Point2d>& closed, double conformity);
+
+// Loops from contours (outer first), fitted with fitPrimitives.
+std::vector<BoundaryLoop> fitLoops(const std::vector<std::vector<cv::Point2d>>& contours,
+                                   double conformity);
+
+std::vector<Corner> findCorners(const std::vector<BoundaryLoop>& loops, double conformity);
+
+struct BoundarySample {
+  cv::Point2d point;
+  double weight = 0;  // loop weight * edge weight * length represented
+};
+
+// Points every `step` pixels along every primitive.
+std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loops,
+                                           double step = 1.0);
+
+// Distance to the nearest boundary pixel of a set of contours, over a region
+// of interest; the image edges a pose is verified against.
+class EdgeDistance {
+ public:
+  EdgeDistance() = default;
+  EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi);
+  // Pixels; a large value outside the region of interest.
+  float at(cv::Point2d p) const;
+  bool empty() const { return distance_.empty(); }
+
+ private:
+  cv::Mat distance_;  // CV_32F
+  cv::Point origin_;
+};
+
+// The fraction (0..1) of the samples' weight that lies within `tolerance`
+// pixels of an edge once turned by `angle_deg` about the model origin and
+// moved to `centre`. `mirrored` reflects the samples (y -> -y) first.
+double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
+                   const EdgeDistance& edges, double tolerance, bool mirrored = false);
+
+// The weighted mean distance (pixels, each clipped at `clip`) from the placed
+// samples to the nearest edge: finer than verifyScore where two poses both
+// verify, e.g. a part against its own mirror image.
+double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
+                        double angle_deg, const EdgeDistance& edges, double clip,
+                        bool mirrored = false);
+
+}  // namespace picksight::vision

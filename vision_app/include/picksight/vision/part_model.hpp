@@ -1,0 +1,96 @@
+// Part models (prototypes) trained from an image of one part: body features
+// with tolerances, a boundary model, and the part's symmetries (SPEC section 3).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/vision/binarize.hpp"
+#include "picksight/vision/blob_features.hpp"
+#include "picksight/vision/boundary_model.hpp"
+#include "picksight/vision/regions.hpp"
+
+namespace picksight::vision {
+
+struct BodyModel {
+  double area = 0;              // pixels
+  double area_tolerance = 0.1;  // relative: a match is within area * (1 +- this)
+  int holes = 0;
+  HuArray log_hu{};
+  // Invariants too close to 0 for their sign and magnitude to survive
+  // rotation and resampling (most of a symmetric part's odd-order ones) are
+  // left out of the distance.
+  std::array<bool, 7> hu_used{};
+  double hu_tolerance = 1.0;  // on sum_i |H_i(a) - H_i(b)| over the used invariants
+  // A part that equals its mirror image (after a turn). A part that does not
+  // is never matched to its mirror image: the 7th invariant changes sign and
+  // the mirrored boundary fits worse than the direct one.
+  bool mirror_symmetric = false;
+};
+
+struct PartModel {
+  int type = 0;
+  std::string name;
+  BodyModel body;
+  // Rotation from the complex moment of order k (see complexMoment):
+  // rotation = (arg c_k - phase) / k + j 360 / k, j picked by verification.
+  // k = 2 is the axis of least inertia; parts with isotropic inertia (a
+  // square, a gear) need a higher order. 0: no order carries a direction (a
+  // disc): rotation 0.
+  int orientation_order = 2;
+  double orientation_phase_deg = 0;
+  // k-fold rotational symmetry: the part looks the same turned by 360/k.
+  // 1 = none, 0 = any turn (a disc).
+  int symmetry_order = 1;
+  // Where the part was in the training image (information only: the model
+  // frame is the trained pose with the centroid at the origin).
+  cv::Point2d trained_centroid;
+  double trained_angle_deg = 0;
+  // Boundary: primitives in the model frame, their corners, and the
+  // verification settings.
+  double conformity = 1.0;      // pixels
+  double edge_tolerance = 2.0;  // pixels between a model point and an image edge
+  double verify_percent = 80;   // of the weighted boundary length
+  std::vector<BoundaryLoop> loops;
+  std::vector<Corner> corners;
+
+  // Derived by prepareModel (not stored).
+  std::vector<BoundarySample> samples;
+  double radius = 0;  // of the boundary about the origin
+
+  // Period of the reported rotation: 360 / symmetry order, 0 for any.
+  double symmetryDeg() const { return symmetry_order == 0 ? 0.0 : 360.0 / symmetry_order; }
+};
+
+struct TrainOptions {
+  BinarizeOptions binarize;
+  RegionOptions regions;
+  double conformity = 1.0;
+  double verify_percent = 80;
+  double area_tolerance = 0.1;
+};
+
+struct TrainOutcome {
+  bool ok = false;
+  std::string error;  // when !ok: why (no part, several parts...)
+  PartModel model;
+};
+
+// Trains from a grey image holding exactly one part.
+TrainOutcome trainModel(const cv::Mat& grey, int type, const std::string& name,
+                        const TrainOptions& options = {});
+
+// Fills the derived members; call after training or loading.
+void prepareModel(PartModel& model);
+
+// Checks a model's values (finite, in range, consistent); empty when valid,
+// else what is wrong.
+std::string validateModel(const PartModel& model);
+
+// Sum |H_i(a) - H_i(b)| over the invariants the model uses.
+double huDistance(const BodyModel& body, const HuArray& log_hu);
+
+}  // namespace picksight::vision

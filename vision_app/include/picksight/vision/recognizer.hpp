@@ -1,0 +1,34 @@
+// Recognition: which trained parts are in a set of regions, where and how
+// turned; body features propose, the boundary model verifies.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/regions.hpp"
+
+namespace picksight::vision {
+
+struct Match {
+  const PartModel* model = nullptr;  // borrowed from the caller's list
+  size_t region = 0;                 // index into the regions
+  double score = 0;                  // verified fraction of the weighted boundary, 0..1
+  cv::Point2d centroid;              // pixels
+  // Rotation from the trained pose, in [0, symmetry) (or [0, 360)).
+  double angle_deg = 0;
+  double symmetry_deg = 360;  // the model's: 360 none, 180, 120..., 0 any turn
+  double body_distance = 0;   // Hu distance
+};
+
+// Every part of the given models among the regions, best score first: at
+// most one per region, the model that verifies best. Parts that touch (one
+// merged blob) are not found yet: their blob matches no model's body.
+std::vector<Match> recognize(const std::vector<Region>& regions,
+                             const std::vector<const PartModel*>& models);
+
+// The rotation candidates of a region for a model (before verification).
+std::vector<double> rotationCandidates(const Region& region, const PartModel& model);
+
+}  // namespace picksight::vision

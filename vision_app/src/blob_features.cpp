@@ -1,0 +1,209 @@
+// Blob features: closed-form measures of one region.
+#include "picksight/vision/blob_features.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace picksight::vision {
+
+HuArray huInvariants(const cv::Moments& m) {
+  HuArray hu{};
+  cv::HuMoments(m, hu.data());
+  return hu;
+}
+
+HuArray logHu(const HuArray& hu) {
+  HuArray h{};
+  for (size_t i = 0; i < hu.size(); ++i) {
+    h[i] = hu[i] == 0 ? 0.0 : -std::copysign(1.0, hu[i]) * std::log10(std::abs(hu[i]));
+  }
+  return h;
+}
+
+double boundaryLength(const std::vector<cv::Point>& closed) {
+  const size_t n = closed.size();
+  if (n < 2) return 0;
+  int even = 0;
+  int odd = 0;
+  int corners = 0;
+  int previous = -1;
+  int first = -1;
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point d = closed[(i + 1) % n] - closed[i];
+    // Chain code 0..7; even codes are axis steps, odd ones diagonal.
+    static const int kCode[3][3] = {{3, 2, 1}, {4, -1, 0}, {5, 6, 7}};
+    const int code = kCode[std::clamp(d.y, -1, 1) + 1][std::clamp(d.x, -1, 1) + 1];
+    if (code < 0) continue;
+    (code % 2 == 0 ? even : odd) += 1;
+    if (previous >= 0 && code != previous) ++corners;
+    if (first < 0) first = code;
+    previous = code;
+  }
+  if (previous >= 0 && previous != first) ++corners;
+  return 0.980 * even + 1.406 * odd - 0.091 * corners;
+}
+
+double eccentricity(const cv::Moments& m) {
+  const double common = std::sqrt((m.mu20 - m.mu02) * (m.mu20 - m.mu02) + 4 * m.mu11 * m.mu11);
+  const double major = m.mu20 + m.mu02 + common;
+  const double minor = m.mu20 + m.mu02 - common;
+  if (major <= 0) return 0;
+  return std::sqrt(std::max(0.0, 1.0 - minor / major));
+}
+
+std::vector<double> radialSignature(const std::vector<cv::Point>& outer, cv::Point2d centroid,
+                                    double start_deg, int samples) {
+  std::vector<double> r(static_cast<size_t>(std::max(samples, 0)), -1.0);
+  if (samples <= 0 || outer.empty()) return r;
+  const double step = 360.0 / samples;
+  for (const auto& p : outer) {
+    const double dx = p.x - centroid.x;
+    const double dy = p.y - centroid.y;
+    double a = std::atan2(dy, dx) * 180.0 / M_PI - start_deg + 0.5 * step;
+    a = std::fmod(a, 360.0);
+    if (a < 0) a += 360.0;
+    const size_t bin = std::min(static_cast<size_t>(a / step), r.size() - 1);
+    r[bin] = std::max(r[bin], std::hypot(dx, dy));
+  }
+  // A small part has fewer boundary pixels than bins: empty bins take the
+  // mean of their nearest filled neighbours.
+  for (size_t i = 0; i < r.size(); ++i) {
+    if (r[i] >= 0) continue;
+    double before = -1;
+    double after = -1;
+    for (size_t k = 1; k < r.size() && (before < 0 || after < 0); ++k) {
+      if (before < 0 && r[(i + r.size() - k) % r.size()] >= 0)
+        before = r[(i + r.size() - k) % r.size()];
+      if (after < 0 && r[(i + k) % r.size()] >= 0) after = r[(i + k) % r.size()];
+    }
+    r[i] = 0.5 * (std::max(before, 0.0) + std::max(after, 0.0));
+  }
+  return r;
+}
+
+cv::Mat skeletonize(const cv::Mat& mask) {
+  CV_Assert(mask.type() == CV_8UC1);
+  // A zero frame keeps every neighbourhood inside the image.
+  cv::Mat img(mask.rows + 2, mask.cols + 2, CV_8UC1, cv::Scalar(0));
+  cv::Mat inner = img(cv::Rect(1, 1, mask.cols, mask.rows));
+  cv::compare(mask, 0, inner, cv::CMP_NE);
+  img /= 255;
+  std::vector<cv::Point> removal;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int pass = 0; pass < 2; ++pass) {
+      removal.clear();
+      for (int y = 1; y < img.rows - 1; ++y) {
+        const uint8_t* up = img.ptr<uint8_t>(y - 1);
+        const uint8_t* row = img.ptr<uint8_t>(y);
+        const uint8_t* down = img.ptr<uint8_t>(y + 1);
+        for (int x = 1; x < img.cols - 1; ++x) {
+          if (!row[x]) continue;
+          // Neighbours p2..p9 clockwise from north.
+          const int p[8] = {up[x],   up[x + 1],   row[x + 1], down[x + 1],
+                            down[x], down[x - 1], row[x - 1], up[x - 1]};
+          int b = 0;
+          int a = 0;
+          for (int i = 0; i < 8; ++i) {
+            b += p[i];
+            a += (p[i] == 0 && p[(i + 1) % 8] == 1);
+          }
+          if (b < 2 || b > 6 || a != 1) continue;
+          const bool keep = pass == 0 ? (p[0] * p[2] * p[4] != 0 || p[2] * p[4] * p[6] != 0)
+                                      : (p[0] * p[2] * p[6] != 0 || p[0] * p[4] * p[6] != 0);
+          if (!keep) removal.emplace_back(x, y);
+        }
+      }
+      for (const auto& q : removal) img.at<uint8_t>(q) = 0;
+      changed = changed || !removal.empty();
+    }
+  }
+  cv::Mat out;
+  img(cv::Rect(1, 1, mask.cols, mask.rows)).convertTo(out, CV_8U, 255);
+  return out;
+}
+
+cv::Mat regionMask(const Region& region) {
+  cv::Mat mask(region.bbox.size(), CV_8UC1, cv::Scalar(0));
+  const cv::Point offset = -region.bbox.tl();
+  cv::drawContours(mask, std::vector<std::vector<cv::Point>>{region.outer}, 0, cv::Scalar(255),
+                   cv::FILLED, cv::LINE_8, cv::noArray(), INT_MAX, offset);
+  // A hole's boundary pixels belong to the body: fill the hole, then redraw
+  // its boundary.
+  for (const auto& hole : region.hole_boundaries) {
+    const std::vector<std::vector<cv::Point>> loops{hole};
+    cv::drawContours(mask, loops, 0, cv::Scalar(0), cv::FILLED, cv::LINE_8, cv::noArray(), INT_MAX,
+                     offset);
+    cv::drawContours(mask, loops, 0, cv::Scalar(255), 1, cv::LINE_8, cv::noArray(), INT_MAX,
+                     offset);
+  }
+  return mask;
+}
+
+std::complex<double> complexMoment(const Region& region, int k) {
+  const cv::Mat& w = region.coverage;
+  if (w.empty() || region.area <= 0 || k < 0) return {0, 0};
+  const double scale = 1.0 / std::sqrt(region.area);
+  std::complex<double> sum(0, 0);
+  for (int y = 0; y < w.rows; ++y) {
+    const float* row = w.ptr<float>(y);
+    const double dy = (region.coverage_origin.y + y - region.centroid.y) * scale;
+    for (int x = 0; x < w.cols; ++x) {
+      if (row[x] <= 0) continue;
+      const std::complex<double> z((region.coverage_origin.x + x - region.centroid.x) * scale, dy);
+      // z^k by squaring: at most 2 log2(k) products per pixel.
+      std::complex<double> power(1, 0);
+      std::complex<double> base = z;
+      for (int e = k; e > 0; e >>= 1) {
+        if (e & 1) power *= base;
+        base *= base;
+      }
+      sum += static_cast<double>(row[x]) * power;
+    }
+  }
+  return sum * scale * scale;
+}
+
+BlobFeatures blobFeatures(const Region& region, const FeatureOptions& options) {
+  BlobFeatures f;
+  f.area = region.area;
+  f.perimeter = boundaryLength(region.outer);
+  f.roundness = f.perimeter > 0 ? 4 * M_PI * f.area / (f.perimeter * f.perimeter) : 0;
+  f.holes = region.holes;
+  f.eccentricity = eccentricity(region.moments);
+  f.bbox = region.bbox;
+  f.centroid = region.centroid;
+  f.angle_deg = region.angle_deg;
+  // Raw moments about the image origin from the central ones: exact, whatever
+  // origin the region's own raw moments were taken about.
+  cv::Moments m = region.moments;
+  const double a = m.m00;
+  const double cx = region.centroid.x;
+  const double cy = region.centroid.y;
+  m.m10 = a * cx;
+  m.m01 = a * cy;
+  m.m20 = m.mu20 + a * cx * cx;
+  m.m11 = m.mu11 + a * cx * cy;
+  m.m02 = m.mu02 + a * cy * cy;
+  m.m30 = m.mu30 + 3 * cx * m.mu20 + a * cx * cx * cx;
+  m.m21 = m.mu21 + 2 * cx * m.mu11 + cy * m.mu20 + a * cx * cx * cy;
+  m.m12 = m.mu12 + 2 * cy * m.mu11 + cx * m.mu02 + a * cx * cy * cy;
+  m.m03 = m.mu03 + 3 * cy * m.mu02 + a * cy * cy * cy;
+  f.moments = m;
+  f.hu = huInvariants(region.moments);
+  f.log_hu = logHu(f.hu);
+  f.radial_signature =
+      radialSignature(region.outer, region.centroid, region.angle_deg, options.radial_samples);
+  if (options.skeleton) {
+    const cv::Mat skeleton = skeletonize(regionMask(region));
+    std::vector<cv::Point> points;
+    cv::findNonZero(skeleton, points);
+    for (auto& p : points) p += region.bbox.tl();
+    f.skeleton = std::move(points);
+  }
+  return f;
+}
+
+}  // namespace picksight::vision

@@ -1,0 +1,396 @@
+// Boundary models: Douglas-Peucker polygon, arcs grown over runs of its
+// segments, corners between primitives, and pose verification on a distance map.
+#include "picksight/vision/boundary_model.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace picksight::vision {
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+// An arc whose radius exceeds this many times the loop's extent is a line.
+constexpr double kMaxRadiusFactor = 4.0;
+
+double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kDeg; }
+
+double wrap180(double deg) {
+  deg = std::fmod(deg, 360.0);
+  if (deg > 180) deg -= 360;
+  if (deg <= -180) deg += 360;
+  return deg;
+}
+
+cv::Point2d unit(cv::Point2d v) {
+  const double n = std::hypot(v.x, v.y);
+  return n > 0 ? v / n : cv::Point2d(1, 0);
+}
+
+double pointLineDistance(cv::Point2d p, cv::Point2d a, cv::Point2d b) {
+  const cv::Point2d d = b - a;
+  const double n = std::hypot(d.x, d.y);
+  if (n == 0) return std::hypot(p.x - a.x, p.y - a.y);
+  return std::abs(d.x * (p.y - a.y) - d.y * (p.x - a.x)) / n;
+}
+
+// Douglas-Peucker over the cyclic index range [a, b] of `pts` (b may exceed
+// n: indices are taken modulo n); appends the split points strictly inside.
+void douglasPeucker(const std::vector<cv::Point2d>& pts, size_t a, size_t b, double eps,
+                    std::vector<size_t>& out) {
+  const size_t n = pts.size();
+  if (b <= a + 1) return;
+  double worst = -1;
+  size_t at = a;
+  for (size_t i = a + 1; i < b; ++i) {
+    const double d = pointLineDistance(pts[i % n], pts[a % n], pts[b % n]);
+    if (d > worst) {
+      worst = d;
+      at = i;
+    }
+  }
+  if (worst <= eps) return;
+  douglasPeucker(pts, a, at, eps, out);
+  out.push_back(at);
+  douglasPeucker(pts, at, b, eps, out);
+}
+
+struct Circle {
+  cv::Point2d centre;
+  double radius = 0;
+};
+
+// Algebraic (Kasa) circle fit over points first..last (cyclic, inclusive).
+bool fitCircle(const std::vector<cv::Point2d>& pts, size_t first, size_t last, Circle* circle) {
+  const size_t n = pts.size();
+  const size_t count = last - first + 1;
+  if (count < 3) return false;
+  cv::Point2d mean(0, 0);
+  for (size_t i = first; i <= last; ++i) mean += pts[i % n];
+  mean /= static_cast<double>(count);
+  cv::Matx33d a = cv::Matx33d::zeros();
+  cv::Vec3d rhs(0, 0, 0);
+  for (size_t i = first; i <= last; ++i) {
+    const cv::Point2d p = pts[i % n] - mean;
+    const cv::Vec3d v(p.x, p.y, 1.0);
+    a += v * v.t();
+    rhs += v * -(p.x * p.x + p.y * p.y);
+  }
+  cv::Vec3d s;
+  if (!cv::solve(a, rhs, s, cv::DECOMP_LU)) return false;
+  const double r2 = 0.25 * (s[0] * s[0] + s[1] * s[1]) - s[2];
+  if (!(r2 > 0)) return false;
+  circle->centre = mean + cv::Point2d(-0.5 * s[0], -0.5 * s[1]);
+  circle->radius = std::sqrt(r2);
+  return true;
+}
+
+double circleResidual(const std::vector<cv::Point2d>& pts, size_t first, size_t last,
+                      const Circle& c) {
+  double worst = 0;
+  for (size_t i = first; i <= last; ++i) {
+    const cv::Point2d d = pts[i % pts.size()] - c.centre;
+    worst = std::max(worst, std::abs(std::hypot(d.x, d.y) - c.radius));
+  }
+  return worst;
+}
+
+// Signed sweep of the arc through points first..last about `centre`.
+double sweepOf(const std::vector<cv::Point2d>& pts, size_t first, size_t last, cv::Point2d centre) {
+  double sweep = 0;
+  double previous = angleOf(pts[first % pts.size()] - centre);
+  for (size_t i = first + 1; i <= last; ++i) {
+    const double a = angleOf(pts[i % pts.size()] - centre);
+    sweep += wrap180(a - previous);
+    previous = a;
+  }
+  return sweep;
+}
+
+cv::Point2d onCircle(const Circle& c, cv::Point2d p) {
+  return c.centre + unit(p - c.centre) * c.radius;
+}
+
+Primitive makeLine(cv::Point2d a, cv::Point2d b) {
+  Primitive p;
+  p.kind = PrimitiveKind::kLine;
+  p.start = a;
+  p.end = b;
+  return p;
+}
+}  // namespace
+
+double Primitive::length() const {
+  if (kind == PrimitiveKind::kLine) return std::hypot(end.x - start.x, end.y - start.y);
+  return std::abs(sweep_deg) * kDeg * radius;
+}
+
+cv::Point2d Primitive::pointAt(double t) const {
+  if (kind == PrimitiveKind::kLine) return start + (end - start) * t;
+  const double a = angleOf(start - centre) * kDeg + t * sweep_deg * kDeg;
+  return centre + cv::Point2d(std::cos(a), std::sin(a)) * radius;
+}
+
+cv::Point2d Primitive::startDirection() const {
+  if (kind == PrimitiveKind::kLine) return unit(end - start);
+  const cv::Point2d r = unit(start - centre);
+  return sweep_deg >= 0 ? cv::Point2d(-r.y, r.x) : cv::Point2d(r.y, -r.x);
+}
+
+cv::Point2d Primitive::endDirection() const {
+  if (kind == PrimitiveKind::kLine) return unit(end - start);
+  const cv::Point2d r = unit(pointAt(1.0) - centre);
+  return sweep_deg >= 0 ? cv::Point2d(-r.y, r.x) : cv::Point2d(r.y, -r.x);
+}
+
+const char* cornerClassName(CornerClass c) {
+  switch (c) {
+    case CornerClass::kLineLine:
+      return "line-line";
+    case CornerClass::kLineArc:
+      return "line-arc";
+    case CornerClass::kArcLine:
+      return "arc-line";
+    case CornerClass::kArcArc:
+      return "arc-arc";
+  }
+  return "line-line";
+}
+
+std::vector<Primitive> fitPrimitives(const std::vector<cv::Point2d>& pts, double conformity) {
+  const size_t n = pts.size();
+  std::vector<Primitive> out;
+  if (n < 2) return out;
+  if (n < 4) {
+    for (size_t i = 0; i < n; ++i) out.push_back(makeLine(pts[i], pts[(i + 1) % n]));
+    return out;
+  }
+  double extent = 0;
+  {
+    double x0 = pts[0].x, x1 = x0, y0 = pts[0].y, y1 = y0;
+    for (const auto& p : pts) {
+      x0 = std::min(x0, p.x);
+      x1 = std::max(x1, p.x);
+      y0 = std::min(y0, p.y);
+      y1 = std::max(y1, p.y);
+    }
+    extent = std::max(x1 - x0, y1 - y0);
+  }
+  // Polygon: split at the point farthest from the first, then recursively.
+  size_t far = 0;
+  double far_d = -1;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = std::hypot(pts[i].x - pts[0].x, pts[i].y - pts[0].y);
+    if (d > far_d) {
+      far_d = d;
+      far = i;
+    }
+  }
+  std::vector<size_t> v{0};
+  douglasPeucker(pts, 0, far, conformity, v);
+  v.push_back(far);
+  douglasPeucker(pts, far, n, conformity, v);
+  const size_t m = v.size();
+
+  // Arcs must not run through the start: begin at the sharpest turn.
+  size_t start = 0;
+  double sharpest = -1;
+  for (size_t j = 0; j < m; ++j) {
+    const cv::Point2d in = pts[v[j]] - pts[v[(j + m - 1) % m]];
+    const cv::Point2d out_dir = pts[v[(j + 1) % m]] - pts[v[j]];
+    const double turn = std::abs(wrap180(angleOf(out_dir) - angleOf(in)));
+    if (turn > sharpest) {
+      sharpest = turn;
+      start = j;
+    }
+  }
+  // Vertex j of the rotated list as an unwrapped contour index.
+  std::vector<size_t> idx(m + 1);
+  for (size_t j = 0; j <= m; ++j) {
+    size_t k = v[(start + j) % m];
+    if (j > 0 && k <= idx[j - 1]) k += n * ((idx[j - 1] - k) / n + 1);
+    idx[j] = k;
+  }
+  idx[m] = idx[0] + n;
+
+  const auto arcFits = [&](size_t first, size_t last, Circle* c) {
+    if (!fitCircle(pts, first, last, c)) return false;
+    if (c->radius > kMaxRadiusFactor * extent) return false;
+    if (circleResidual(pts, first, last, *c) > conformity) return false;
+    // An arc flatter than the conformity is a line.
+    const cv::Point2d chord = pts[last % n] - pts[first % n];
+    const double half = 0.5 * std::hypot(chord.x, chord.y);
+    const double sagitta =
+        c->radius - std::sqrt(std::max(0.0, c->radius * c->radius - half * half));
+    return sagitta > conformity || std::abs(sweepOf(pts, first, last, c->centre)) > 180;
+  };
+
+  // A loop that is one circle (a hole, a disc) has no corner at all.
+  Circle whole;
+  if (fitCircle(pts, 0, n - 1, &whole) && circleResidual(pts, 0, n - 1, whole) <= conformity &&
+      whole.radius <= kMaxRadiusFactor * extent) {
+    Primitive p;
+    p.kind = PrimitiveKind::kArc;
+    p.centre = whole.centre;
+    p.radius = whole.radius;
+    p.start = onCircle(whole, pts[0]);
+    p.end = p.start;
+    p.sweep_deg = sweepOf(pts, 0, n, whole.centre) >= 0 ? 360.0 : -360.0;
+    out.push_back(p);
+    return out;
+  }
+
+  for (size_t j = 0; j < m;) {
+    size_t best = j;
+    Circle best_circle;
+    for (size_t k = j + 1; k < m; ++k) {
+      Circle c;
+      if (!arcFits(idx[j], idx[k + 1], &c)) break;
+      best = k;
+      best_circle = c;
+    }
+    if (best > j) {
+      Primitive p;
+      p.kind = PrimitiveKind::kArc;
+      p.centre = best_circle.centre;
+      p.radius = best_circle.radius;
+      p.start = onCircle(best_circle, pts[idx[j] % n]);
+      p.end = onCircle(best_circle, pts[idx[best + 1] % n]);
+      p.sweep_deg = sweepOf(pts, idx[j], idx[best + 1], best_circle.centre);
+      out.push_back(p);
+    } else {
+      out.push_back(makeLine(pts[idx[j] % n], pts[idx[j + 1] % n]));
+    }
+    j = best + 1;
+  }
+  return out;
+}
+
+std::vector<BoundaryLoop> fitLoops(const std::vector<std::vector<cv::Point2d>>& contours,
+                                   double conformity) {
+  std::vector<BoundaryLoop> loops;
+  for (size_t i = 0; i < contours.size(); ++i) {
+    BoundaryLoop loop;
+    loop.hole = i > 0;
+    loop.primitives = fitPrimitives(contours[i], conformity);
+    if (!loop.primitives.empty()) loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+std::vector<Corner> findCorners(const std::vector<BoundaryLoop>& loops, double conformity) {
+  std::vector<Corner> corners;
+  for (size_t l = 0; l < loops.size(); ++l) {
+    const auto& prims = loops[l].primitives;
+    const size_t n = prims.size();
+    if (n < 2) continue;
+    // The loop's winding: the sum of turns is +-360.
+    double winding = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const Primitive& a = prims[i];
+      const Primitive& b = prims[(i + 1) % n];
+      winding += wrap180(angleOf(b.startDirection()) - angleOf(a.endDirection()));
+      if (a.kind == PrimitiveKind::kArc) winding += a.sweep_deg;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const Primitive& a = prims[i];
+      const Primitive& b = prims[(i + 1) % n];
+      Corner c;
+      const bool arc_in = a.kind == PrimitiveKind::kArc;
+      const bool arc_out = b.kind == PrimitiveKind::kArc;
+      c.kind = arc_in ? (arc_out ? CornerClass::kArcArc : CornerClass::kArcLine)
+                      : (arc_out ? CornerClass::kLineArc : CornerClass::kLineLine);
+      c.loop = static_cast<int>(l);
+      c.index = static_cast<int>((i + 1) % n);
+      c.at = 0.5 * (a.end + b.start);
+      c.direction_in_deg = angleOf(a.endDirection());
+      c.direction_out_deg = angleOf(b.startDirection());
+      const double turn = wrap180(c.direction_out_deg - c.direction_in_deg);
+      // Turn ranges widen for short edges, whose directions are less sure.
+      const double slack =
+          8.0 + std::atan2(2 * conformity, std::min(a.length(), b.length())) / kDeg;
+      c.turn_deg = {turn - slack, turn + slack};
+      c.convex = (turn >= 0) == (winding >= 0);
+      const double tol = 2 * conformity;
+      c.length_in = {0, a.length() + tol};
+      c.length_out = {0, b.length() + tol};
+      c.radius_in = arc_in ? Range{0.8 * a.radius - tol, 1.2 * a.radius + tol} : Range{};
+      c.radius_out = arc_out ? Range{0.8 * b.radius - tol, 1.2 * b.radius + tol} : Range{};
+      corners.push_back(c);
+    }
+  }
+  return corners;
+}
+
+std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loops, double step) {
+  std::vector<BoundarySample> samples;
+  for (const auto& loop : loops) {
+    for (const auto& p : loop.primitives) {
+      const double length = p.length();
+      const int count = std::max(1, static_cast<int>(std::ceil(length / step)));
+      const double w = loop.weight * p.weight * length / count;
+      for (int i = 0; i < count; ++i) samples.push_back({p.pointAt((i + 0.5) / count), w});
+    }
+  }
+  return samples;
+}
+
+EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi)
+    : origin_(roi.tl()) {
+  cv::Mat free(roi.size(), CV_8UC1, cv::Scalar(255));
+  for (const auto& c : contours) {
+    for (const auto& p : c) {
+      const cv::Point q = p - origin_;
+      if (q.x >= 0 && q.y >= 0 && q.x < free.cols && q.y < free.rows) free.at<uint8_t>(q) = 0;
+    }
+  }
+  cv::distanceTransform(free, distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+}
+
+float EdgeDistance::at(cv::Point2d p) const {
+  const int x = static_cast<int>(std::lround(p.x)) - origin_.x;
+  const int y = static_cast<int>(std::lround(p.y)) - origin_.y;
+  if (x < 0 || y < 0 || x >= distance_.cols || y >= distance_.rows) return 1e9f;
+  return distance_.at<float>(y, x);
+}
+
+namespace {
+// Calls f(weight, distance to the nearest edge) for every placed sample.
+template <typename F>
+void forPlaced(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
+               const EdgeDistance& edges, bool mirrored, F&& f) {
+  const double c = std::cos(angle_deg * kDeg);
+  const double s = std::sin(angle_deg * kDeg);
+  const double flip = mirrored ? -1.0 : 1.0;
+  for (const auto& sample : samples) {
+    const double x = sample.point.x;
+    const double y = flip * sample.point.y;
+    f(sample.weight, edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}));
+  }
+}
+}  // namespace
+
+double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
+                   const EdgeDistance& edges, double tolerance, bool mirrored) {
+  double on = 0;
+  double total = 0;
+  forPlaced(samples, centre, angle_deg, edges, mirrored, [&](double w, double d) {
+    total += w;
+    if (d <= tolerance) on += w;
+  });
+  return total > 0 ? on / total : 0;
+}
+
+double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
+                        double angle_deg, const EdgeDistance& edges, double clip, bool mirrored) {
+  double sum = 0;
+  double total = 0;
+  forPlaced(samples, centre, angle_deg, edges, mirrored, [&](double w, double d) {
+    total += w;
+    sum += w * std::min(d, clip);
+  });
+  return total > 0 ? sum / total : clip;
+}
+
+}  // namespace picksight::vision
