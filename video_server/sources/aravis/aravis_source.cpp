@@ -1,0 +1,404 @@
+// Aravis camera source: open, describe, acquire and hand buffers over.
+#include "aravis_source.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "genicam_features.hpp"
+
+namespace picksight::video {
+namespace {
+// Enough buffers that the stream thread always has a free one while we hold
+// one and the camera sends a burst.
+constexpr int kBufferCount = 8;
+// Loopback and GigE bursts overflow the kernel's default socket buffer (frames
+// then arrive with missing packets), and Aravis's "auto" size (= one payload)
+// is too small for small ROIs: a few packets overflow it. Two payloads, never
+// less than 1 MiB; the kernel caps it at net.core.rmem_max.
+constexpr gint kMinSocketBuffer = 1 << 20;
+constexpr guint kFrameRetentionUs = 500000;
+// A free-running camera silent for this long gets a control read.
+constexpr std::chrono::seconds kLivenessCheck{2};
+// A software trigger whose frame has not come for this long is taken as lost
+// and sent again.
+constexpr std::chrono::seconds kTriggerRetry{3};
+
+// Features that change the payload or its layout: most devices refuse them
+// while acquiring (TLParamsLocked), and the buffer pool must follow them.
+const std::set<std::string>& streamFeatures() {
+  static const std::set<std::string> kNames = {"Width",
+                                               "Height",
+                                               "OffsetX",
+                                               "OffsetY",
+                                               "BinningHorizontal",
+                                               "BinningVertical",
+                                               "DecimationHorizontal",
+                                               "DecimationVertical",
+                                               "PixelFormat",
+                                               "RegionSelector",
+                                               "RegionMode"};
+  return kNames;
+}
+
+struct LayoutInfo {
+  PixelLayout layout;
+  int cv_type;
+  int bytes_per_pixel;
+};
+
+// Aravis (PFNC) pixel format ids to our layouts; nullopt for formats the
+// converter does not take (packed 10/12 bit, Bayer 10/12/16...).
+std::optional<LayoutInfo> layoutOf(ArvPixelFormat format) {
+  switch (format) {
+    case ARV_PIXEL_FORMAT_MONO_8:
+      return LayoutInfo{PixelLayout::kMono8, CV_8UC1, 1};
+    case ARV_PIXEL_FORMAT_MONO_10:
+      return LayoutInfo{PixelLayout::kMono10, CV_16UC1, 2};
+    case ARV_PIXEL_FORMAT_MONO_12:
+      return LayoutInfo{PixelLayout::kMono12, CV_16UC1, 2};
+    case ARV_PIXEL_FORMAT_MONO_16:
+      return LayoutInfo{PixelLayout::kMono16, CV_16UC1, 2};
+    case ARV_PIXEL_FORMAT_BAYER_RG_8:
+      return LayoutInfo{PixelLayout::kBayerRG8, CV_8UC1, 1};
+    case ARV_PIXEL_FORMAT_BAYER_GR_8:
+      return LayoutInfo{PixelLayout::kBayerGR8, CV_8UC1, 1};
+    case ARV_PIXEL_FORMAT_BAYER_BG_8:
+      return LayoutInfo{PixelLayout::kBayerBG8, CV_8UC1, 1};
+    case ARV_PIXEL_FORMAT_BAYER_GB_8:
+      return LayoutInfo{PixelLayout::kBayerGB8, CV_8UC1, 1};
+    case ARV_PIXEL_FORMAT_RGB_8_PACKED:
+      return LayoutInfo{PixelLayout::kRGB8, CV_8UC3, 3};
+    case ARV_PIXEL_FORMAT_BGR_8_PACKED:
+      return LayoutInfo{PixelLayout::kBGR8, CV_8UC3, 3};
+    case ARV_PIXEL_FORMAT_YUV_422_YUYV_PACKED:
+      return LayoutInfo{PixelLayout::kYUYV, CV_8UC2, 2};
+    case ARV_PIXEL_FORMAT_YUV_422_PACKED:
+      return LayoutInfo{PixelLayout::kUYVY, CV_8UC2, 2};
+    default:
+      return std::nullopt;
+  }
+}
+
+const char* statusName(ArvBufferStatus status) {
+  switch (status) {
+    case ARV_BUFFER_STATUS_TIMEOUT:
+      return "timed out before all packets arrived";
+    case ARV_BUFFER_STATUS_MISSING_PACKETS:
+      return "missing packets";
+    case ARV_BUFFER_STATUS_WRONG_PACKET_ID:
+      return "wrong packet id";
+    case ARV_BUFFER_STATUS_SIZE_MISMATCH:
+      return "larger than the buffer";
+    case ARV_BUFFER_STATUS_ABORTED:
+      return "aborted";
+    default:
+      return "not completed";
+  }
+}
+
+std::string orEmpty(const char* text) { return text != nullptr ? text : ""; }
+
+// Runs on Aravis's heartbeat thread: only flags, never throws.
+void onControlLost(ArvDevice* /*device*/, gpointer data) noexcept {
+  (*static_cast<std::shared_ptr<std::atomic<bool>>*>(data))->store(true);
+}
+
+void freeFlag(gpointer data, GClosure* /*closure*/) noexcept {
+  delete static_cast<std::shared_ptr<std::atomic<bool>>*>(data);
+}
+}  // namespace
+
+AravisSource::AravisSource(std::string device_id) : device_id_(std::move(device_id)) {}
+
+AravisSource::~AravisSource() { close(); }
+
+Error AravisSource::lost(const std::string& why) const {
+  return makeError(kSourceUnavailable, label() + ": " + why);
+}
+
+Result<void> AravisSource::open() {
+  close();
+  GErrorSlot error;
+  camera_.reset(arv_camera_new(device_id_.empty() ? nullptr : device_id_.c_str(), error.out()));
+  if (!camera_) {
+    const std::string why = error ? error.message() : std::string("no such device");
+    return lost(device_id_.empty() ? "no camera found: " + why : "cannot open: " + why);
+  }
+  ArvDevice* device = arv_camera_get_device(camera_.get());
+  control_lost_ = std::make_shared<std::atomic<bool>>(false);
+  control_lost_handler_ = g_signal_connect_data(
+      device, "control-lost", G_CALLBACK(onControlLost),
+      new std::shared_ptr<std::atomic<bool>>(control_lost_), freeFlag, GConnectFlags(0));
+  if (arv_camera_is_gv_device(camera_.get())) {
+    // Packet sockets need CAP_NET_RAW and see nothing on loopback.
+    arv_gv_device_set_stream_options(ARV_GV_DEVICE(device),
+                                     ARV_GV_STREAM_OPTION_PACKET_SOCKET_DISABLED);
+  }
+
+  SourceInfo i;
+  i.vendor = orEmpty(arv_camera_get_vendor_name(camera_.get(), error.out()));
+  i.model = orEmpty(arv_camera_get_model_name(camera_.get(), error.out()));
+  i.serial = orEmpty(arv_camera_get_device_serial_number(camera_.get(), error.out()));
+  if (i.serial.empty()) i.serial = orEmpty(arv_camera_get_device_id(camera_.get(), error.out()));
+  gint width = 0;
+  gint height = 0;
+  arv_camera_get_sensor_size(camera_.get(), &width, &height, error.out());
+  if (error) return lost("cannot read the sensor size: " + error.message());
+  i.sensor_width = width;
+  i.sensor_height = height;
+  guint n = 0;
+  GArrayPtr<const char*> formats(
+      arv_camera_dup_available_pixel_formats_as_strings(camera_.get(), &n, error.out()));
+  for (guint k = 0; formats && k < n; ++k) i.formats.emplace_back(orEmpty(formats.get()[k]));
+  info_ = std::move(i);
+  last_alive_ = Clock::now();
+  return {};
+}
+
+void AravisSource::close() {
+  stopAcquisition();
+  held_.reset();
+  stream_.reset();  // frees the buffers still queued in it
+  buffer_size_ = 0;
+  mode_.reset();
+  if (camera_ && control_lost_handler_ != 0) {
+    g_signal_handler_disconnect(arv_camera_get_device(camera_.get()), control_lost_handler_);
+  }
+  control_lost_handler_ = 0;
+  camera_.reset();
+  control_lost_.reset();
+}
+
+Result<void> AravisSource::createStream() {
+  held_.reset();
+  stream_.reset();
+  GErrorSlot error;
+  const guint payload = arv_camera_get_payload(camera_.get(), error.out());
+  if (error) return lost("cannot read the payload size: " + error.message());
+  stream_.reset(arv_camera_create_stream(camera_.get(), nullptr, nullptr, error.out()));
+  if (!stream_) return lost("cannot open the stream: " + error.message());
+  if (ARV_IS_GV_STREAM(stream_.get())) {
+    const gint socket_buffer = static_cast<gint>(
+        std::min<guint>(std::max<guint>(2 * payload, kMinSocketBuffer), 1u << 30));
+    // A loaded host can leave the stream thread unscheduled for longer than
+    // the default 100 ms retention, and complete frames are then dropped.
+    g_object_set(stream_.get(), "socket-buffer", ARV_GV_STREAM_SOCKET_BUFFER_FIXED,
+                 "socket-buffer-size", socket_buffer, "frame-retention", kFrameRetentionUs,
+                 nullptr);
+  }
+  for (int k = 0; k < kBufferCount; ++k) {
+    // The stream takes over the reference.
+    arv_stream_push_buffer(stream_.get(), arv_buffer_new_allocate(payload));
+  }
+  buffer_size_ = payload;
+  return {};
+}
+
+Result<void> AravisSource::startAcquisition() {
+  GErrorSlot error;
+  if (stream_) {
+    // Width, height or format may have changed since the pool was made.
+    const guint payload = arv_camera_get_payload(camera_.get(), error.out());
+    if (error) return lost("cannot read the payload size: " + error.message());
+    if (payload != buffer_size_) stream_.reset();
+  }
+  if (!stream_) {
+    if (auto made = createStream(); !made) return made;
+  }
+  arv_camera_set_acquisition_mode(camera_.get(), ARV_ACQUISITION_MODE_CONTINUOUS, error.out());
+  if (error) return lost("cannot set continuous acquisition: " + error.message());
+  arv_camera_start_acquisition(camera_.get(), error.out());
+  if (error) return lost("cannot start acquisition: " + error.message());
+  acquiring_ = true;
+  last_alive_ = Clock::now();
+  return {};
+}
+
+void AravisSource::stopAcquisition() {
+  if (!acquiring_ || !camera_) return;
+  acquiring_ = false;
+  GErrorSlot error;
+  arv_camera_stop_acquisition(camera_.get(),
+                              error.out());  // a lost device cannot stop: nothing to do
+  returnHeldBuffer();
+  // Frames taken before the stop (free-run frames before a switch to
+  // trigger) must not be handed out afterwards.
+  if (stream_) {
+    while (ArvBuffer* stale = arv_stream_try_pop_buffer(stream_.get())) {
+      arv_stream_push_buffer(stream_.get(), stale);
+    }
+  }
+  triggers_in_flight_ = 0;
+}
+
+void AravisSource::returnHeldBuffer() {
+  if (held_ && stream_) arv_stream_push_buffer(stream_.get(), held_.release());
+  held_.reset();
+}
+
+Result<void> AravisSource::checkDevice() {
+  GErrorSlot error;
+  // PayloadSize is computed from live registers: a real read on every call.
+  arv_camera_get_payload(camera_.get(), error.out());
+  if (error) return lost("the camera does not answer: " + error.message());
+  return {};
+}
+
+Result<void> AravisSource::configureAcquisition(AcquisitionMode mode, double fps) {
+  if (!camera_) return lost("not open");
+  stopAcquisition();
+  GErrorSlot error;
+  if (mode == AcquisitionMode::kFreeRun) {
+    arv_camera_clear_triggers(camera_.get(), error.out());
+    if (error)
+      return makeError(kSourceNotSupported,
+                       label() + ": cannot leave trigger mode: " + error.message());
+    const bool has_rate = arv_camera_is_frame_rate_available(camera_.get(), error.out());
+    if (has_rate && fps > 0) {
+      double lo = 0;
+      double hi = 0;
+      arv_camera_get_frame_rate_bounds(camera_.get(), &lo, &hi, error.out());
+      const double rate = !error && hi > lo ? std::clamp(fps, lo, hi) : fps;
+      arv_camera_set_frame_rate(camera_.get(), rate, error.out());
+      // A camera whose rate is fixed still streams: not worth failing over.
+      error.clear();
+    }
+  } else {
+    if (!arv_camera_is_software_trigger_supported(camera_.get(), error.out())) {
+      return makeError(kSourceNotSupported, label() + ": the camera has no software trigger");
+    }
+    // TriggerSelector FrameStart, TriggerMode On, TriggerSource Software.
+    arv_camera_set_trigger(camera_.get(), "Software", error.out());
+    if (error)
+      return makeError(kSourceNotSupported,
+                       label() + ": cannot set software trigger: " + error.message());
+  }
+  mode_ = mode;
+  return startAcquisition();
+}
+
+Result<void> AravisSource::softwareTrigger() {
+  if (!camera_) return lost("not open");
+  if (control_lost_ && control_lost_->load()) return lost("control lost");
+  if (!acquiring_) {
+    if (auto started = startAcquisition(); !started) return started;
+  }
+  const auto now = Clock::now();
+  if (triggers_in_flight_ > 0 && now - last_trigger_ < kTriggerRetry) return {};
+  GErrorSlot error;
+  arv_camera_software_trigger(camera_.get(), error.out());
+  if (error) {
+    if (auto alive = checkDevice(); !alive) return alive;
+    return makeError(kSourceNotSupported,
+                     label() + ": software trigger failed: " + error.message());
+  }
+  triggers_in_flight_ = 1;
+  last_trigger_ = now;
+  return {};
+}
+
+Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
+  if (!camera_) return lost("not open");
+  // The Camera has converted or copied the previous frame by now.
+  returnHeldBuffer();
+  if (control_lost_->load())
+    return lost("control lost (the camera stopped answering its heartbeat)");
+  if (!acquiring_) {
+    if (!mode_) {
+      if (auto configured = configureAcquisition(AcquisitionMode::kFreeRun, 0); !configured) {
+        return configured.error();
+      }
+    } else if (auto started = startAcquisition(); !started) {
+      return started.error();
+    }
+  }
+
+  GObjectPtr<ArvBuffer> buffer(arv_stream_timeout_pop_buffer(
+      stream_.get(), static_cast<guint64>(std::max<int64_t>(0, timeout.count())) * 1000));
+  if (!buffer) {
+    // Waiting for a trigger that was never sent is not a sign of loss.
+    const bool expecting = mode_ != AcquisitionMode::kTrigger || triggers_in_flight_ > 0;
+    if (expecting && Clock::now() - last_alive_ > kLivenessCheck) {
+      if (auto alive = checkDevice(); !alive) return alive.error();
+      last_alive_ = Clock::now();
+    }
+    return makeError(kSourceTimeout,
+                     label() + ": no frame within " + std::to_string(timeout.count()) + " ms");
+  }
+  last_alive_ = Clock::now();
+  triggers_in_flight_ = 0;
+
+  const ArvBufferStatus status = arv_buffer_get_status(buffer.get());
+  if (status != ARV_BUFFER_STATUS_SUCCESS) {
+    const uint64_t id = arv_buffer_get_frame_id(buffer.get());
+    arv_stream_push_buffer(stream_.get(), buffer.release());
+    return makeError(kSourceBadValue, label() + ": frame " + std::to_string(id) +
+                                          " incomplete: " + statusName(status));
+  }
+  const ArvPixelFormat format = arv_buffer_get_image_pixel_format(buffer.get());
+  const auto layout = layoutOf(format);
+  if (!layout) {
+    arv_stream_push_buffer(stream_.get(), buffer.release());
+    char hex[16];
+    g_snprintf(hex, sizeof hex, "0x%08x", static_cast<unsigned>(format));
+    return makeError(kSourceNotSupported,
+                     label() + ": pixel format " + hex +
+                         " is not supported (set PixelFormat to Mono8/10/12/16, "
+                         "Bayer**8, RGB8, BGR8, YUV422)");
+  }
+  const int width = arv_buffer_get_image_width(buffer.get());
+  const int height = arv_buffer_get_image_height(buffer.get());
+  gint x_padding = 0;
+  gint y_padding = 0;
+  arv_buffer_get_image_padding(buffer.get(), &x_padding, &y_padding);
+  size_t size = 0;
+  const void* data = arv_buffer_get_image_data(buffer.get(), &size);
+  const size_t stride =
+      static_cast<size_t>(width) * layout->bytes_per_pixel + std::max(0, x_padding);
+  if (data == nullptr || width <= 0 || height <= 0 ||
+      size < stride * static_cast<size_t>(height - 1) +
+                 static_cast<size_t>(width) * layout->bytes_per_pixel) {
+    arv_stream_push_buffer(stream_.get(), buffer.release());
+    return makeError(kSourceBadValue, label() + ": frame smaller than its " +
+                                          std::to_string(width) + "x" + std::to_string(height) +
+                                          " header says");
+  }
+
+  SourceFrame frame;
+  // Read-only view on the buffer's bytes, valid until the next grab().
+  frame.image = cv::Mat(height, width, layout->cv_type, const_cast<void*>(data), stride);
+  frame.layout = layout->layout;
+  frame.device_timestamp_ns = arv_buffer_get_timestamp(buffer.get());
+  held_ = std::move(buffer);
+  return frame;
+}
+
+std::vector<Feature> AravisSource::features() {
+  if (!camera_) return {};
+  return GenicamFeatures(arv_camera_get_device(camera_.get())).list();
+}
+
+Result<Feature> AravisSource::feature(const std::string& name) {
+  if (!camera_) return lost("not open");
+  if (control_lost_->load()) return lost("control lost");
+  return GenicamFeatures(arv_camera_get_device(camera_.get())).get(name);
+}
+
+Result<void> AravisSource::setFeature(const std::string& name, const std::string& value) {
+  if (!camera_) return lost("not open");
+  if (control_lost_->load()) return lost("control lost");
+  GenicamFeatures features(arv_camera_get_device(camera_.get()));
+  const bool restart = acquiring_ && streamFeatures().count(name) > 0;
+  if (restart) stopAcquisition();
+  Result<void> set = features.set(name, value);
+  if (restart) {
+    // startAcquisition() remakes the pool if the payload size changed.
+    if (auto started = startAcquisition(); !started) return started;
+  }
+  if (!set && set.error().code == kSourceBadValue) {
+    if (auto alive = checkDevice(); !alive) return alive;
+  }
+  return set;
+}
+
+}  // namespace picksight::video
