@@ -12,6 +12,7 @@
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/log.hpp"
+#include "picksight/video_server/pixel_format.hpp"
 
 namespace picksight::video {
 namespace {
@@ -20,6 +21,7 @@ constexpr std::chrono::milliseconds kMaxBackoff{5000};
 // requests are served promptly even when no frame comes.
 constexpr std::chrono::milliseconds kGrabSlice{200};
 constexpr std::chrono::milliseconds kCommandTimeout{5000};
+constexpr std::chrono::milliseconds kTriggerPatience{2000};
 }  // namespace
 
 Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& sink)
@@ -70,7 +72,10 @@ CameraStatus Camera::status() const {
 
 Result<void> Camera::setOutput(const OutputSettings& output) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const cv::Size sensor(status_.info.sensor_width, status_.info.sensor_height);
+  // The frames the device actually delivers bound the ROI: a camera whose
+  // own Width/Height feature is below its sensor size sends smaller images.
+  const cv::Size sensor = !frame_size_.empty() ? frame_size_
+                                               : cv::Size(status_.info.sensor_width, status_.info.sensor_height);
   if (auto ok = validateOutputSettings(output, sensor); !ok) return ok;
   output_ = output;
   return {};
@@ -294,11 +299,25 @@ void Camera::run() {
     const OutputSettings output = output_;
     lock.unlock();
 
-    Result<void> asked = triggered ? source_->softwareTrigger() : Result<void>();
+    // A streaming camera may take longer than one grab slice to deliver a
+    // triggered frame: trigger once, then keep waiting, and only trigger
+    // again if the frame never came (a lost trigger packet).
+    const auto now = Clock::now();
+    const bool retrigger = !trigger_sent_ || now - *trigger_sent_ > kTriggerPatience;
+    Result<void> asked;
+    if (triggered && retrigger) {
+      asked = source_->softwareTrigger();
+      trigger_sent_ = now;
+    }
     Result<SourceFrame> grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
                                         : Result<SourceFrame>(asked.error());
     const uint64_t host_ns = realtimeNs();
-    Result<OutputFrame> out = grabbed ? applyOutputSettings(*grabbed, output) : Result<OutputFrame>(grabbed.error());
+    // Standardize, then ROI and resize; the standardized size is the size of
+    // the frames the device delivers.
+    Result<cv::Mat> standard =
+        grabbed ? toOutputFormat(grabbed->image, grabbed->layout, output.format) : Result<cv::Mat>(grabbed.error());
+    Result<OutputFrame> out =
+        standard ? Result<OutputFrame>(applyOutputSettings(*standard, output)) : Result<OutputFrame>(standard.error());
 
     if (!out) {
       lock.lock();
@@ -324,6 +343,7 @@ void Camera::run() {
       continue;
     }
 
+    trigger_sent_.reset();
     PublishedFrame frame;
     frame.camera = config_.name;
     frame.sequence = sequence;
@@ -335,6 +355,7 @@ void Camera::run() {
     // Statistics first, then the hand-over: a subscriber must never hold a
     // frame that `stats` does not count yet.
     lock.lock();
+    frame_size_ = standard->size();
     last_frame_ = frame;
     ++status_.frames_acquired;
     status_.last_sequence = sequence;

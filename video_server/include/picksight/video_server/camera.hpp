@@ -130,6 +130,8 @@ class Camera {
   const std::unique_ptr<Source> source_;  // acquisition thread only
   FrameSink& sink_;
   std::thread thread_;
+  // When the pending software trigger was sent (acquisition thread only).
+  std::optional<std::chrono::steady_clock::time_point> trigger_sent_;
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable wake_;
@@ -140,6 +142,7 @@ class Camera {
   bool reconfigure_ = true;  // acquisition settings changed since the source last heard
   std::deque<Command> commands_;
   std::optional<PublishedFrame> last_frame_;
+  cv::Size frame_size_;  // of the frames the device delivers (sensor pixels)
   bool ever_opened_ = false;
   std::chrono::milliseconds backoff_{100};
   OutputSettings output_;
