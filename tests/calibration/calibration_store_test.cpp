@@ -2,6 +2,8 @@
 // files refused with the file named, and a failed write changes nothing.
 #include <catch2/catch.hpp>
 
+#include "temp_dir.hpp"
+
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -14,19 +16,12 @@ using namespace picksight::calibration;
 namespace fs = std::filesystem;
 
 namespace {
-struct TempDir {
-  TempDir() {
-    char name[] = "/tmp/picksight-store-XXXXXX";
-    path = ::mkdtemp(name);
-  }
-  ~TempDir() { fs::remove_all(path); }
-  std::string path;
-};
+using picksight::test::TempDir;
 }  // namespace
 
 TEST_CASE("calibration points, transform, scale and lens survive a reload", "[calibration][store]") {
   TempDir dir;
-  const std::string file = dir.path + "/calibration.yaml";
+  const std::string file = dir.file("calibration.yaml");
   {
     CalibrationStore store(file);
     REQUIRE(store.load());
@@ -68,7 +63,7 @@ TEST_CASE("calibration points, transform, scale and lens survive a reload", "[ca
 
 TEST_CASE("a damaged calibration file is refused, named, and left alone", "[calibration][store]") {
   TempDir dir;
-  const std::string file = dir.path + "/calibration.yaml";
+  const std::string file = dir.file("calibration.yaml");
   std::ofstream(file) << "format_version: 1\npoints:\n  - {id: 1, vision_x: 1}\n";
   CalibrationStore store(file);
   auto r = store.load();
@@ -83,7 +78,7 @@ TEST_CASE("a damaged calibration file is refused, named, and left alone", "[cali
 
 TEST_CASE("a failed write keeps memory and disk as they were", "[calibration][store]") {
   TempDir dir;
-  const std::string sub = dir.path + "/data";
+  const std::string sub = dir.file("data");
   fs::create_directory(sub);
   CalibrationStore store(sub + "/calibration.yaml");
   REQUIRE(store.addPoint({{1, 1}, {2, 2}}));

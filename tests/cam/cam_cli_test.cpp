@@ -14,6 +14,8 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
+
+#include "temp_dir.hpp"
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
@@ -139,26 +141,7 @@ std::string unusedEndpoint(zmq::context_t& context) {
   return socket.get(zmq::sockopt::last_endpoint);
 }
 
-// A fresh directory for the files a test writes, removed with everything in it.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "cam_test.XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
+using picksight::test::TempDir;
 
 // Value of channel `c` of pixel (x, y) in the frames the tests snap: varied
 // enough that a swapped channel, row or column shows.

@@ -11,6 +11,8 @@
 #include <string>
 
 #include <catch2/catch.hpp>
+
+#include "temp_dir.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
 
@@ -25,22 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    char pattern[] = "/tmp/picksight-dir-source-XXXXXX";
-    REQUIRE(::mkdtemp(pattern) != nullptr);
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using picksight::test::TempDir;
 
 // A flat grey image whose level identifies it.
 void writeImage(const fs::path& file, int level, cv::Size size = {32, 24}) {

@@ -15,6 +15,8 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
+
+#include "temp_dir.hpp"
 #include <opencv2/imgcodecs.hpp>
 
 #include "picksight/video_server/camera.hpp"
@@ -97,24 +99,7 @@ bool waitForState(const Camera& camera, const std::string& state) {
   return waitForStatus(camera, [&](const auto& s) { return s.state == state; });
 }
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "picksight-camera-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using picksight::test::TempDir;
 
 uint64_t maxSequence(const std::vector<PublishedFrame>& frames) {
   uint64_t m = 0;

@@ -9,6 +9,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "temp_dir.hpp"
+
 #include "picksight/video_server/server_config.hpp"
 
 namespace fs = std::filesystem;
@@ -19,29 +21,7 @@ using picksight::video::parseServerArgs;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "picksight-config-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  std::string write(const std::string& name, const std::string& content) const {
-    const std::string path = (path_ / name).string();
-    std::ofstream(path) << content;
-    return path;
-  }
-
- private:
-  fs::path path_;
-};
+using picksight::test::TempDir;
 
 // The error message of a configuration that must be rejected.
 std::string argsError(const std::vector<std::string>& args) {
