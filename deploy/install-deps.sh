@@ -7,6 +7,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   build-essential cmake pkg-config git clang clang-format
+  # libFuzzer and the sanitizer runtimes for clang (fuzz run in CI)
+  libclang-rt-14-dev
   # core libraries
   libopencv-dev libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
   libyaml-cpp-dev libeigen3-dev
