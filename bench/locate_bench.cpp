@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <zmq.hpp>
 
+#include "locate_args.hpp"
 #include "picksight/common/line_client.hpp"
 #include "picksight/common/subprocess.hpp"
 #include "picksight/common/text.hpp"
@@ -26,13 +27,6 @@
 namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
-
-std::string binDir() {
-  char path[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", path, sizeof(path) - 1);
-  std::string p(path, n > 0 ? static_cast<size_t>(n) : 0);
-  return p.substr(0, p.find_last_of('/'));
-}
 
 struct Stats {
   double median = 0;
@@ -81,38 +75,31 @@ void row(const char* what, const Stats& s, double baseline) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int requests = 300;
-  int width = 1920;
-  int height = 1080;
-  int parts = 20;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    const auto v = picksight::parseInt(argv[i + 1]);
-    if (!v || *v <= 0) break;
-    if (a == "--requests") requests = static_cast<int>(*v);
-    if (a == "--width") width = static_cast<int>(*v);
-    if (a == "--height") height = static_cast<int>(*v);
-    if (a == "--parts") parts = static_cast<int>(*v);
-  }
-  const std::string dir = binDir();
-  const std::string source = "cam0=synthetic:width=" + std::to_string(width) + ",height=" +
-                             std::to_string(height) + ",parts=" + std::to_string(parts) + ",seed=5";
+  const auto args = picksight::bench::parseLocateArgs(argc, argv, {300, 1920, 1080, 20});
+  const int requests = args.requests, width = args.width, height = args.height, parts = args.parts;
+  const std::string dir = picksight::bench::binDir();
+  const std::string source = "cam0=synthetic:width=" + std::to_string(width) +
+                             ",height=" + std::to_string(height) +
+                             ",parts=" + std::to_string(parts) + ",seed=5";
   picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
-                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode", "trigger"});
+                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
+                                "trigger"});
   const auto frames = server.waitForLine("frames ", 10s);
   const auto control = server.waitForLine("control ", 10s);
   if (!frames || !control) return 1;
   char data_dir[] = "/tmp/picksight-bench-XXXXXX";
   if (!::mkdtemp(data_dir)) return 1;
-  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control", *control,
-                                "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
+  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
+                                *control, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir",
+                                data_dir});
   const auto port = vision.waitForLine("robot ", 10s);
   if (!port || !vision.waitForLine("ready", 10s)) return 1;
 
   zmq::context_t context;
   picksight::FrameSubscriber watcher(context, *frames, "cam0", 64);
   std::this_thread::sleep_for(300ms);
-  auto robot = picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
+  auto robot =
+      picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
   if (!robot) return 1;
 
   // Warm-up: caches, page faults, TCP and ZeroMQ connections.
@@ -163,14 +150,16 @@ int main(int argc, char** argv) {
   }
   const Stats rt = stats(round_trips);
   const Stats base = stats(plain);
-  std::printf("LOCATE benchmark: %dx%d, %d parts, %d requests (%d failed), %.1f parts found per reply\n",
-              width, height, parts, requests, failures,
-              requests > failures ? static_cast<double>(found) / (requests - failures) : 0.0);
+  std::printf(
+      "LOCATE benchmark: %dx%d, %d parts, %d requests (%d failed), %.1f parts found per reply\n",
+      width, height, parts, requests, failures,
+      requests > failures ? static_cast<double>(found) / (requests - failures) : 0.0);
   std::printf("  %-44s %8s %8s %8s   %s\n", "ms", "median", "p99", "min", "vs OpenCV pass");
   row("plain OpenCV pass (Otsu+CC+contours+moments)", base, base.median);
   row("PickSight vision pass (adaptive, sub-pixel)", stats(ours), base.median);
   row("LOCATE round trip over TCP, fresh frame", rt, base.median);
-  std::printf("  (%zu regions per frame in the PickSight pass; %zu frames, %zu passes of each kind)\n", our_regions,
-              images.size(), plain.size());
+  std::printf(
+      "  (%zu regions per frame in the PickSight pass; %zu frames, %zu passes of each kind)\n",
+      our_regions, images.size(), plain.size());
   return failures == 0 ? 0 : 1;
 }

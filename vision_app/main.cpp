@@ -1,5 +1,5 @@
 // picksight-vision: subscribes to one camera, serves robot controllers; or,
-// with a subcommand (learn, locate, blobs), works on image files.
+// with a subcommand (learn, locate, blobs, lens), works on image files.
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -9,12 +9,9 @@
 
 #include "picksight/common/log.hpp"
 #include "picksight/vision_app/app_options.hpp"
-#include "picksight/vision_app/model_commands.hpp"
-#include "picksight/vision_app/model_library.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
-#include "picksight/vision_app/robot_protocol.hpp"
 #include "picksight/vision_app/robot_server.hpp"
-#include "picksight/vision_app/vision_service.hpp"
+#include "picksight/vision_app/vision_cell.hpp"
 
 int main(int argc, char** argv) {
   using namespace picksight;
@@ -43,18 +40,18 @@ int main(int argc, char** argv) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
   try {
-    app::ModelLibrary models(options->data_dir + "/models");
-    // A bad model file costs that model, never the start.
-    for (const auto& problem : models.load()) logError("model rejected: ", problem);
-    logInfo(models.snapshot()->size(), " part models from ", models.directory());
     zmq::context_t context;
-    app::VisionService vision(context, options->frames_endpoint, options->control_endpoint,
-                              options->camera, options->vision, &models);
-    app::RobotProtocol protocol(vision);
-    app::addModelCommands(protocol.table(), vision);
+    app::VisionCell cell(options->data_dir,
+                         std::make_unique<app::VideoServerCamera>(
+                             context, options->frames_endpoint, options->control_endpoint,
+                             options->camera, options->vision.frame_timeout),
+                         options->vision);
+    // A bad file costs what it holds, never the start.
+    for (const auto& problem : cell.load()) logError(problem);
+    logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
     app::RobotServer robots(options->robot,
-                            [&protocol](std::string_view line) { return protocol.handle(line); });
-    vision.start();
+                            [&cell](std::string_view line) { return cell.handle(line); });
+    cell.start();
     robots.start();
     std::cout << "robot " << robots.port() << "\n"
               << "ready" << std::endl;
@@ -64,7 +61,7 @@ int main(int argc, char** argv) {
     sigwait(&signals, &sig);
     logInfo("stopping on signal ", sig);
     robots.stop();
-    vision.stop();
+    cell.stop();
   } catch (const std::exception& e) {
     std::cerr << "picksight-vision: " << e.what() << "\n";
     return 1;

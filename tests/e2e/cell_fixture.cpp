@@ -15,8 +15,8 @@ using namespace std::chrono_literals;
 std::string binPath(const std::string& name) { return std::string(PICKSIGHT_BIN_DIR) + "/" + name; }
 
 VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
-  std::vector<std::string> argv = {binPath("picksight-video-server"), "--frames", "tcp://127.0.0.1:*",
-                                   "--control", "tcp://127.0.0.1:*"};
+  std::vector<std::string> argv = {binPath("picksight-video-server"), "--frames",
+                                   "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"};
   argv.insert(argv.end(), args.begin(), args.end());
   process = std::make_unique<Subprocess>(argv);
   auto f = process->waitForLine("frames ", 10s);
@@ -27,13 +27,19 @@ VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
   control = *c;
 }
 
-VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string& camera) {
-  char dir[] = "/tmp/picksight-e2e-XXXXXX";
-  REQUIRE(::mkdtemp(dir) != nullptr);
-  data_dir = dir;
+VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string& camera,
+                             const std::string& given_data_dir) {
+  if (given_data_dir.empty()) {
+    char dir[] = "/tmp/picksight-e2e-XXXXXX";
+    REQUIRE(::mkdtemp(dir) != nullptr);
+    data_dir = dir;
+  } else {
+    data_dir = given_data_dir;
+    own_data_dir = false;
+  }
   process = std::make_unique<Subprocess>(std::vector<std::string>{
-      binPath("picksight-vision"), "--frames", server.frames, "--control", server.control, "--camera",
-      camera, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
+      binPath("picksight-vision"), "--frames", server.frames, "--control", server.control,
+      "--camera", camera, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
   auto port = process->waitForLine("robot ", 10s);
   REQUIRE(port);
   auto value = parseInt(*port);
@@ -45,7 +51,7 @@ VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string
 VisionProcess::~VisionProcess() {
   process.reset();
   std::error_code ignored;
-  std::filesystem::remove_all(data_dir, ignored);
+  if (own_data_dir) std::filesystem::remove_all(data_dir, ignored);
 }
 
 LineClient VisionProcess::connect() const {
@@ -88,6 +94,15 @@ std::vector<Pose> parseLocateReply(const std::string& reply) {
     auto rz = parseDouble(words[i + 2]);
     REQUIRE((x && y && rz));
     poses.push_back({*x, *y, *rz});
+  }
+  return poses;
+}
+
+std::vector<Pose> imagePoses(const std::string& reply) {
+  auto poses = parseLocateReply(reply);
+  for (auto& p : poses) {
+    p.y = -p.y;
+    p.rz = p.rz == 0 ? 0 : 360 - p.rz;
   }
   return poses;
 }

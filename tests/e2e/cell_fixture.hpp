@@ -29,11 +29,15 @@ struct VideoServerProcess {
 };
 
 struct VisionProcess {
-  VisionProcess(const VideoServerProcess& server, const std::string& camera = "cam0");
+  // With an empty `data_dir` a fresh one, removed at the end; a given one
+  // is kept (restart tests).
+  VisionProcess(const VideoServerProcess& server, const std::string& camera = "cam0",
+                const std::string& data_dir = "");
   ~VisionProcess();
   std::unique_ptr<Subprocess> process;
   uint16_t robot_port = 0;
   std::string data_dir;
+  bool own_data_dir = true;
   LineClient connect() const;
 };
 
@@ -54,5 +58,8 @@ struct Pose {
   double x, y, rz;
 };
 std::vector<Pose> parseLocateReply(const std::string& reply);
+// The same poses back in image axes (y down, angles clockwise on screen):
+// LOCATE replies in the vision frame (y up) before any calibration.
+std::vector<Pose> imagePoses(const std::string& reply);
 
 }  // namespace picksight::e2e

@@ -55,7 +55,7 @@ TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
     auto reply = robot.request("LOCATE 1", 10s);
     REQUIRE(reply);
     INFO("reply: " << *reply);
-    const auto poses = parseLocateReply(*reply);
+    const auto poses = imagePoses(*reply);
     const UsedFrame used = usedFrame(robot);
     auto frame = receiveUntil(
         watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == used.sequence; });
@@ -174,7 +174,7 @@ TEST_CASE("LEARN a part, then LOCATE finds it turned from the trained pose",
     reply = robot.request("LOCATE 1", 10s);
     REQUIRE(reply);
     INFO("LOCATE reply: " << *reply);
-    const auto poses = parseLocateReply(*reply);
+    const auto poses = imagePoses(*reply);
     const auto truth = truthOf(usedFrame(robot).sequence);
     REQUIRE(poses.size() == 1);
     CHECK(std::hypot(poses[0].x - truth.x(), poses[0].y - truth.y()) < 0.1);

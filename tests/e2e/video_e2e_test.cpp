@@ -2,9 +2,9 @@
 // run time through picksight-cam, software trigger.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <filesystem>
 #include <thread>
 
 #include "cell_fixture.hpp"
@@ -25,7 +25,8 @@ CommandResult cam(const VideoServerProcess& server, std::vector<std::string> arg
 
 TEST_CASE("ROI and resize change both the pixels and the header", "[e2e][video]") {
   // Noise-free, so two frames of the scene are identical pixel for pixel.
-  VideoServerProcess server({"--source", "cam0=synthetic:width=800,height=600,parts=5,noise=0", "--fps", "20"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=800,height=600,parts=5,noise=0", "--fps", "20"});
   zmq::context_t context;
   FrameSubscriber sub(context, server.frames, "cam0", 4);
   auto full = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 800; });
@@ -51,7 +52,8 @@ TEST_CASE("ROI and resize change both the pixels and the header", "[e2e][video]"
   CHECK(resized->header.scale_x() == Approx(0.5));
   CHECK(resized->header.scale_y() == Approx(0.5));
   cv::Mat expected;
-  cv::resize(sensor(cv::Rect(100, 50, 400, 300)), expected, cv::Size(200, 150), 0, 0, cv::INTER_AREA);
+  cv::resize(sensor(cv::Rect(100, 50, 400, 300)), expected, cv::Size(200, 150), 0, 0,
+             cv::INTER_AREA);
   CHECK(cv::norm(resized->image(), expected, cv::NORM_INF) <= 1);
 
   // Out of range is refused with the reason, and changes nothing.
@@ -63,7 +65,8 @@ TEST_CASE("ROI and resize change both the pixels and the header", "[e2e][video]"
 }
 
 TEST_CASE("two subscribers receive the same sequence numbers", "[e2e][video]") {
-  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=4", "--fps", "25"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=4", "--fps", "25"});
   zmq::context_t context;
   FrameSubscriber a(context, server.frames, "cam0", 16);
   FrameSubscriber b(context, server.frames, "cam0", 16);
@@ -91,7 +94,8 @@ TEST_CASE("two subscribers receive the same sequence numbers", "[e2e][video]") {
 }
 
 TEST_CASE("a software trigger's frame carries the sequence its reply named", "[e2e][video]") {
-  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
   zmq::context_t context;
   FrameSubscriber sub(context, server.frames, "cam0", 4);
   std::this_thread::sleep_for(300ms);
@@ -103,7 +107,8 @@ TEST_CASE("a software trigger's frame carries the sequence its reply named", "[e
     REQUIRE(reply.exit_code == 0);
     const size_t at = reply.out.find("\"sequence\":");
     REQUIRE(at != std::string::npos);
-    const auto seq = parseInt(reply.out.substr(at + 11, reply.out.find_first_of(",}", at) - at - 11));
+    const auto seq =
+        parseInt(reply.out.substr(at + 11, reply.out.find_first_of(",}", at) - at - 11));
     REQUIRE(seq);
     auto frame = sub.receive(5s);
     REQUIRE(frame);
@@ -139,7 +144,8 @@ TEST_CASE("bad video server options fail at start with the option named", "[e2e]
 
 TEST_CASE("a stalled subscriber loses frames on its own side only", "[e2e][video]") {
   // Full-HD frames fill a stalled reader's queues within a second.
-  VideoServerProcess server({"--source", "cam0=synthetic:width=1920,height=1080,parts=4", "--fps", "15"});
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=1920,height=1080,parts=4", "--fps", "15"});
   zmq::context_t context;
   FrameSubscriber stalled(context, server.frames, "cam0", 2);
   // A deep queue: on a loaded machine the reader may pause, but must not lose.
@@ -168,8 +174,10 @@ TEST_CASE("a stalled subscriber loses frames on its own side only", "[e2e][video
   CHECK(stats.out.find("\"subscribers\":2") != std::string::npos);
 }
 
-TEST_CASE("snap saves the next frame; close releases the camera and open resumes it", "[e2e][video]") {
-  VideoServerProcess server({"--source", "cam0=synthetic:width=640,height=480,parts=3,noise=0", "--fps", "20"});
+TEST_CASE("snap saves the next frame; close releases the camera and open resumes it",
+          "[e2e][video]") {
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=3,noise=0", "--fps", "20"});
   char dir[] = "/tmp/picksight-snap-XXXXXX";
   REQUIRE(::mkdtemp(dir));
   const std::string file = std::string(dir) + "/frame.png";

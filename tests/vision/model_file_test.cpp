@@ -10,7 +10,7 @@
 #include "picksight/vision_app/model_commands.hpp"
 #include "picksight/vision_app/model_file.hpp"
 #include "picksight/vision_app/model_library.hpp"
-#include "picksight/vision_app/robot_protocol.hpp"
+#include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight;
 using namespace picksight::app;
@@ -47,7 +47,7 @@ void writeText(const std::string& path, const std::string& text) { std::ofstream
 TEST_CASE("a model survives its file unchanged", "[vision_app][models]") {
   const auto model = trainedModel("slot", 7);
   const std::string text = modelToYaml(model);
-  CHECK(text.find("version: 1") != std::string::npos);
+  CHECK(text.find("version: 2") != std::string::npos);
   auto back = modelFromYaml(text);
   REQUIRE(back);
   CHECK(back->type == 7);
@@ -71,16 +71,61 @@ TEST_CASE("a model survives its file unchanged", "[vision_app][models]") {
   CHECK(modelToYaml(*back) == text);
 }
 
+TEST_CASE("grasps travel with the model; version 1 files still load", "[vision_app][models]") {
+  const auto model = trainedModel("rectangle", 4);
+  const GraspSetup grasp{{{1.5, -2, 90}, {0, 3, 180}}, {{{-10, 0, 4, 8}, {10, 0, 4, 8}}}};
+  auto back = modelRecordFromYaml(modelToYaml(model, grasp));
+  REQUIRE(back);
+  REQUIRE(back->grasp.styles.size() == 2);
+  CHECK(back->grasp.styles[0].x_mm == 1.5);
+  CHECK(back->grasp.styles[1].rz_deg == 180);
+  REQUIRE(back->grasp.gripper.fingers.size() == 2);
+  CHECK(back->grasp.gripper.fingers[1].height_mm == 8);
+  // A version 1 file: the same model without the grasp section.
+  std::string v1 = modelToYaml(model);
+  v1.replace(v1.find("version: 2"), 10, "version: 1");
+  v1.erase(v1.find("grasp:"));
+  auto old = modelRecordFromYaml(v1);
+  REQUIRE(old);
+  CHECK(old->model.type == 4);
+  CHECK(old->grasp.styles.empty());
+  CHECK(old->grasp.gripper.fingers.empty());
+  // The grasp section is required from version 2 on.
+  std::string v2_without = v1;
+  v2_without.replace(v2_without.find("version: 1"), 10, "version: 2");
+  CHECK_FALSE(modelRecordFromYaml(v2_without));
+
+  TempDir dir;
+  {
+    ModelLibrary library(dir.path + "/models");
+    REQUIRE(library.store(model));
+    CHECK_FALSE(library.setGrasp(5, grasp));  // no model of type 5
+    REQUIRE(library.setGrasp(4, grasp));
+    REQUIRE(library.store(model));  // re-trained: keeps its grasps
+    CHECK(library.graspOf(4).styles.size() == 2);
+  }
+  ModelLibrary reloaded(dir.path + "/models");
+  CHECK(reloaded.load().empty());
+  CHECK(reloaded.graspOf(4).gripper.fingers.size() == 2);
+  REQUIRE(reloaded.remove(4));
+  CHECK(reloaded.graspOf(4).styles.empty());
+}
+
 TEST_CASE("bad model files are rejected with the problem", "[vision_app][models]") {
   const std::string good = modelToYaml(trainedModel("rectangle", 1));
   CHECK_FALSE(modelFromYaml("{{{ not yaml"));
   CHECK_FALSE(modelFromYaml("just a string"));
   CHECK_FALSE(modelFromYaml(""));
-  std::string v2 = good;
-  v2.replace(v2.find("version: 1"), 10, "version: 2");
-  auto r = modelFromYaml(v2);
+  std::string v3 = good;
+  v3.replace(v3.find("version: 2"), 10, "version: 3");
+  auto r = modelFromYaml(v3);
   REQUIRE_FALSE(r);
-  CHECK(r.error().message.find("version 2") != std::string::npos);
+  CHECK(r.error().message.find("version 3") != std::string::npos);
+  std::string bad_finger =
+      modelToYaml(trainedModel("rectangle", 1), GraspSetup{{}, {{{0, 0, -1, 2}}}});
+  r = modelFromYaml(bad_finger);
+  REQUIRE_FALSE(r);
+  CHECK(r.error().message.find("finger") != std::string::npos);
   std::string no_area = good;
   no_area.replace(no_area.find("  area:"), 7, "  aera:");
   r = modelFromYaml(no_area);
@@ -132,12 +177,8 @@ TEST_CASE("the library stores, reloads, forgets, and skips bad files by name",
 TEST_CASE("model commands check their arguments before touching the camera",
           "[vision_app][protocol]") {
   TempDir dir;
-  ModelLibrary library(dir.path + "/models");
-  zmq::context_t context;
-  VisionService vision{context, "tcp://127.0.0.1:1", "tcp://127.0.0.1:1",
-                       "cam0",  VisionOptions{},     &library};
-  RobotProtocol protocol{vision};
-  addModelCommands(protocol.table(), vision);
+  VisionCell protocol{dir.path, std::make_unique<NoCamera>(), VisionOptions{}};
+  ModelLibrary& library = protocol.models();
   CHECK(protocol.handle("MODELS") == "OK 0");
   CHECK(protocol.handle("MODELS 1").rfind("ERROR 11 ", 0) == 0);
   CHECK(protocol.handle("LEARN").rfind("ERROR 11 ", 0) == 0);

@@ -88,7 +88,7 @@ TEST_CASE("holes are counted and regions come largest first", "[vision][regions]
   CHECK(regions[0].area == Approx(M_PI * (2500 - 100 - 64)).epsilon(0.02));
 }
 
-TEST_CASE("a disc has no elongation; a bar has a lot", "[vision][regions]") {
+TEST_CASE("a disc has no elongation, a bar has a lot", "[vision][regions]") {
   cv::Mat img(300, 300, CV_8UC1, cv::Scalar(0));
   cv::circle(img, {80, 80}, 60, cv::Scalar(255), cv::FILLED);
   cv::rectangle(img, cv::Rect(180, 50, 20, 200), cv::Scalar(255), cv::FILLED);

@@ -1,21 +1,23 @@
 // Robot protocol parsing and the replies that need no camera.
 #include <catch2/catch.hpp>
 
-#include "picksight/vision_app/robot_protocol.hpp"
+#include <filesystem>
+
+#include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight::app;
 
 namespace {
-// A vision service pointing at a video server that does not exist: enough for
-// every command that fails before asking for a frame.
+// The whole command table with no camera: enough for every command that
+// fails before asking for a frame.
 struct Fixture {
-  zmq::context_t context;
-  VisionService vision{context, "tcp://127.0.0.1:1", "tcp://127.0.0.1:1", "cam0", VisionOptions{}};
-  RobotProtocol protocol{vision};
+  std::string dir = std::filesystem::temp_directory_path() / "picksight-protocol-test-nothing";
+  VisionCell protocol{dir, std::make_unique<NoCamera>(), VisionOptions{}};
 };
 }  // namespace
 
-TEST_CASE("requests split on spaces, tabs and commas, commands case-insensitive", "[vision_app][protocol]") {
+TEST_CASE("requests split on spaces, tabs and commas, commands case-insensitive",
+          "[vision_app][protocol]") {
   auto r = parseRequest("  locate,1 ");
   REQUIRE(r);
   CHECK(r->command == "LOCATE");
@@ -50,4 +52,60 @@ TEST_CASE("LOCATE rejects bad arguments before touching the camera", "[vision_ap
   CHECK(f.protocol.handle("LOCATE -1").rfind("ERROR 11 ", 0) == 0);
   CHECK(f.protocol.handle("LOCATE 1.5").rfind("ERROR 11 ", 0) == 0);
   CHECK(f.protocol.handle("FRAME").rfind("ERROR 20 ", 0) == 0);
+  // Good arguments reach the camera, which is missing: ERROR 20, not a crash.
+  CHECK(f.protocol.handle("LOCATE 1").rfind("ERROR 20 ", 0) == 0);
+}
+
+TEST_CASE("cell commands check their arguments before the camera or a file",
+          "[vision_app][protocol]") {
+  Fixture f;
+  for (const char* bad : {"CALCAM",
+                          "CALCAM 0",
+                          "CALCAM -3",
+                          "CALCAM x",
+                          "CALCAM 1 2",
+                          "CALCAM nan",
+                          "STORE 1",
+                          "STORE 1 2 3",
+                          "STORE a b",
+                          "DELETE",
+                          "DELETE x",
+                          "DELETE -1",
+                          "LIST 1",
+                          "COMPUTE X",
+                          "RESIDUALS 1",
+                          "GRASP",
+                          "GRASP 1",
+                          "GRASP x ADD 1 2 3",
+                          "GRASP 1 ADD 1 2",
+                          "GRASP 1 ADD 1 2 inf",
+                          "GRASP 1 FLY",
+                          "GRASP 1 CLEAR 2",
+                          "GRIPPER 1 FINGER 1 2 3",
+                          "STATUS 1",
+                          "EXPOSURE -1",
+                          "EXPOSURE x",
+                          "EXPOSURE 1 2",
+                          "ROI 1 2 3",
+                          "ROI 0 0 0 10",
+                          "ROI a b c d",
+                          "ROI HALF"}) {
+    INFO(bad);
+    CHECK(f.protocol.handle(bad).rfind("ERROR 11 ", 0) == 0);
+  }
+  CHECK(f.protocol.handle("CALCAM 10").rfind("ERROR 20 ", 0) == 0);
+  CHECK(f.protocol.handle("STORE 1 2").rfind("ERROR 20 ", 0) == 0);
+  CHECK(f.protocol.handle("DELETE 7").rfind("ERROR 40 ", 0) == 0);
+  CHECK(f.protocol.handle("DELETE 7").find("7") != std::string::npos);
+  CHECK(f.protocol.handle("LIST") == "OK 0");
+  CHECK(f.protocol.handle("COMPUTE").rfind("ERROR 41 ", 0) == 0);
+  CHECK(f.protocol.handle("RESIDUALS").rfind("ERROR 44 ", 0) == 0);
+  CHECK(f.protocol.handle("GRASP 1 ADD 1 2 3").rfind("ERROR 32 ", 0) == 0);
+  CHECK(f.protocol.handle("GRIPPER 1 LIST").rfind("ERROR 32 ", 0) == 0);
+  CHECK(f.protocol.handle("EXPOSURE 1000").rfind("ERROR 21 ", 0) == 0);
+  CHECK(f.protocol.handle("ROI FULL").rfind("ERROR 21 ", 0) == 0);
+  const std::string status = f.protocol.handle("STATUS");
+  CHECK(status.rfind("OK frame=vision-px scale=none ", 0) == 0);
+  CHECK(status.find(" skipped=0 ") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(f.dir));  // nothing was written
 }

@@ -134,14 +134,16 @@ int main(int argc, char** argv) {
       double best = std::numeric_limits<double>::max();
       double fx = 0, fy = 0, fr = 0;
       for (size_t i = 2; i + 2 < words.size(); i += 3) {
+        // An uncalibrated cell replies in the vision frame (y up, angles
+        // counter-clockwise); the truth is in image axes.
         const double x = picksight::parseDouble(words[i]).value_or(0);
-        const double y = picksight::parseDouble(words[i + 1]).value_or(0);
+        const double y = -picksight::parseDouble(words[i + 1]).value_or(0);
         const double d = std::hypot(x - t.x(), y - t.y());
         if (d < best) {
           best = d;
           fx = x;
           fy = y;
-          fr = picksight::parseDouble(words[i + 2]).value_or(0);
+          fr = 360.0 - picksight::parseDouble(words[i + 2]).value_or(0);
         }
       }
       const std::string angle_err = t.symmetry_deg() > 0

@@ -48,7 +48,8 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
       o.robot.bind_address = v;
     } else if (a == "--robot-port") {
       auto p = parseInt(v);
-      if (!p || *p < 0 || *p > 65535) return makeError(2, "--robot-port: must be in [0, 65535], got '" + v + "'");
+      if (!p || *p < 0 || *p > 65535)
+        return makeError(2, "--robot-port: must be in [0, 65535], got '" + v + "'");
       o.robot.port = static_cast<uint16_t>(*p);
     } else if (a == "--threshold") {
       if (v == "adaptive") {
@@ -66,11 +67,14 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
         return makeError(2, "--threshold: must be adaptive, otsu or fixed:LEVEL, got '" + v + "'");
       }
     } else if (a == "--polarity") {
-      if (v != "dark" && v != "light") return makeError(2, "--polarity: must be dark or light, got '" + v + "'");
-      o.vision.binarize.polarity = v == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
+      if (v != "dark" && v != "light")
+        return makeError(2, "--polarity: must be dark or light, got '" + v + "'");
+      o.vision.binarize.polarity =
+          v == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
     } else if (a == "--window") {
       auto w = parseInt(v);
-      if (!w || *w < 8 || *w > 16384) return makeError(2, "--window: must be in [8, 16384], got '" + v + "'");
+      if (!w || *w < 8 || *w > 16384)
+        return makeError(2, "--window: must be in [8, 16384], got '" + v + "'");
       o.vision.binarize.adaptive_window = static_cast<int>(*w);
     } else if (a == "--min-area") {
       auto m = parseDouble(v);

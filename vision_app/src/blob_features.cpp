@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace picksight::vision {
 
@@ -146,22 +147,33 @@ std::complex<double> complexMoment(const Region& region, int k) {
   const cv::Mat& w = region.coverage;
   if (w.empty() || region.area <= 0 || k < 0) return {0, 0};
   const double scale = 1.0 / std::sqrt(region.area);
+  // (x + i y)^k = sum_p C(k, p) x^p (i y)^(k-p): per row, the real sums
+  // S_p = sum w x^p (k + 1 products and sums a pixel, instead of a complex
+  // power), then one complex sum over p with the row's (i y) powers.
+  std::vector<double> binomial(static_cast<size_t>(k) + 1, 1.0);
+  for (int p = 1; p <= k; ++p) binomial[p] = binomial[p - 1] * (k - p + 1) / p;
+  std::vector<double> row_sums(static_cast<size_t>(k) + 1);
   std::complex<double> sum(0, 0);
   for (int y = 0; y < w.rows; ++y) {
     const float* row = w.ptr<float>(y);
-    const double dy = (region.coverage_origin.y + y - region.centroid.y) * scale;
+    std::fill(row_sums.begin(), row_sums.end(), 0.0);
+    bool any = false;
     for (int x = 0; x < w.cols; ++x) {
       if (row[x] <= 0) continue;
-      const std::complex<double> z((region.coverage_origin.x + x - region.centroid.x) * scale, dy);
-      // z^k by squaring: at most 2 log2(k) products per pixel.
-      std::complex<double> power(1, 0);
-      std::complex<double> base = z;
-      for (int e = k; e > 0; e >>= 1) {
-        if (e & 1) power *= base;
-        base *= base;
+      any = true;
+      const double dx = (region.coverage_origin.x + x - region.centroid.x) * scale;
+      double term = row[x];
+      for (int p = 0; p <= k; ++p) {
+        row_sums[p] += term;
+        term *= dx;
       }
-      sum += static_cast<double>(row[x]) * power;
     }
+    if (!any) continue;
+    const std::complex<double> iy(0, (region.coverage_origin.y + y - region.centroid.y) * scale);
+    // Horner in (i y) over p = k..0: sum_p C(k, p) S_p (i y)^(k-p).
+    std::complex<double> acc(0, 0);
+    for (int p = 0; p <= k; ++p) acc = acc * iy + binomial[p] * row_sums[p];
+    sum += acc;
   }
   return sum * scale * scale;
 }

@@ -336,8 +336,49 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
   return samples;
 }
 
-EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi)
+EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
+                           double max_distance)
     : origin_(roi.tl()) {
+  if (max_distance > 0) {
+    // Every boundary pixel stamps the exact distances of a disc of radius
+    // max_distance around it: a few dozen pixels per boundary pixel instead
+    // of a transform of every pixel of the box.
+    const int reach = static_cast<int>(std::floor(max_distance));
+    struct Offset {
+      int dx, dy;
+      float d;
+    };
+    std::vector<Offset> disc;
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const int d2 = dx * dx + dy * dy;
+        if (d2 <= max_distance * max_distance)
+          disc.push_back({dx, dy, std::sqrt(static_cast<float>(d2))});
+      }
+    }
+    distance_.create(roi.size(), CV_32F);
+    distance_.setTo(1e9f);
+    const cv::Rect inside(reach, reach, roi.width - 2 * reach, roi.height - 2 * reach);
+    for (const auto& c : contours) {
+      for (const auto& p : c) {
+        const cv::Point q = p - origin_;
+        if (inside.contains(q)) {
+          for (const Offset& o : disc) {
+            float& v = distance_.at<float>(q.y + o.dy, q.x + o.dx);
+            v = std::min(v, o.d);
+          }
+          continue;
+        }
+        for (const Offset& o : disc) {
+          const cv::Point t(q.x + o.dx, q.y + o.dy);
+          if (t.x < 0 || t.y < 0 || t.x >= roi.width || t.y >= roi.height) continue;
+          float& v = distance_.at<float>(t);
+          v = std::min(v, o.d);
+        }
+      }
+    }
+    return;
+  }
   cv::Mat free(roi.size(), CV_8UC1, cv::Scalar(255));
   for (const auto& c : contours) {
     for (const auto& p : c) {
@@ -349,8 +390,8 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
 }
 
 float EdgeDistance::at(cv::Point2d p) const {
-  const int x = static_cast<int>(std::lround(p.x)) - origin_.x;
-  const int y = static_cast<int>(std::lround(p.y)) - origin_.y;
+  const int x = cvRound(p.x) - origin_.x;
+  const int y = cvRound(p.y) - origin_.y;
   if (x < 0 || y < 0 || x >= distance_.cols || y >= distance_.rows) return 1e9f;
   return distance_.at<float>(y, x);
 }

@@ -15,6 +15,17 @@ std::optional<int> parseType(std::string_view text) {
   return static_cast<int>(*type);
 }
 
+std::optional<std::vector<double>> parseNumbers(const std::vector<std::string>& args,
+                                                size_t first) {
+  std::vector<double> out;
+  for (size_t i = first; i < args.size(); ++i) {
+    const auto v = parseDouble(args[i]);
+    if (!v) return std::nullopt;
+    out.push_back(*v);
+  }
+  return out;
+}
+
 std::string printable(std::string_view text, size_t limit) {
   std::string out;
   for (char c : text.substr(0, limit)) {

@@ -58,7 +58,7 @@ vision::Range asRange(const YAML::Node& node, const std::string& key) {
 }
 }  // namespace
 
-std::string modelToYaml(const PartModel& m) {
+std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);  // doubles read back bit-exact
   out << YAML::Comment("PickSight part model: see docs/PROTOCOL.md (LEARN)");
@@ -138,26 +138,71 @@ std::string modelToYaml(const PartModel& m) {
   }
   out << YAML::EndSeq;
   out << YAML::EndMap;
+
+  out << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "styles" << YAML::Value << YAML::BeginSeq;
+  for (const auto& st : grasp.styles) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << st.x_mm
+        << YAML::Key << "y_mm" << YAML::Value << st.y_mm << YAML::Key << "rz_deg" << YAML::Value
+        << st.rz_deg << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "fingers" << YAML::Value << YAML::BeginSeq;
+  for (const auto& f : grasp.gripper.fingers) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << f.x_mm << YAML::Key
+        << "y_mm" << YAML::Value << f.y_mm << YAML::Key << "width_mm" << YAML::Value << f.width_mm
+        << YAML::Key << "height_mm" << YAML::Value << f.height_mm << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
 
+std::string validateGrasp(const GraspSetup& grasp) {
+  // Beyond a few metres a value is a typo, not a gripper.
+  constexpr double kMaxMm = 10000;
+  const auto bad = [](double v, double limit) { return !std::isfinite(v) || std::abs(v) > limit; };
+  if (grasp.styles.size() > kMaxGraspStyles)
+    return "at most " + std::to_string(kMaxGraspStyles) + " grasp styles";
+  if (grasp.gripper.fingers.size() > kMaxFingers)
+    return "at most " + std::to_string(kMaxFingers) + " fingers";
+  for (const auto& s : grasp.styles) {
+    if (bad(s.x_mm, kMaxMm) || bad(s.y_mm, kMaxMm) || bad(s.rz_deg, 360))
+      return "a grasp style needs |x|, |y| <= 10000 mm and |rz| <= 360 deg";
+  }
+  for (const auto& f : grasp.gripper.fingers) {
+    if (bad(f.x_mm, kMaxMm) || bad(f.y_mm, kMaxMm) || bad(f.width_mm, kMaxMm) ||
+        bad(f.height_mm, kMaxMm) || !(f.width_mm > 0) || !(f.height_mm > 0))
+      return "a finger needs |x|, |y| <= 10000 mm and a size in (0, 10000] mm";
+  }
+  return {};
+}
+
 Result<PartModel> modelFromYaml(const std::string& text) {
+  auto record = modelRecordFromYaml(text);
+  if (!record) return record.error();
+  return std::move(record->model);
+}
+
+Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     return makeError(1, "not YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }
-  PartModel m;
+  ModelRecord record;
+  PartModel& m = record.model;
   try {
     if (!root.IsMap() || as<std::string>(root, "format") != "picksight-part-model") {
       return makeError(1, "not a PickSight part model (format: picksight-part-model)");
     }
     const int version = as<int>(root, "version");
-    if (version != kModelFormatVersion) {
+    if (version < kOldestModelFormatVersion || version > kModelFormatVersion) {
       return makeError(1, "format version " + std::to_string(version) +
-                              " (this program reads version " +
+                              " (this program reads versions " +
+                              std::to_string(kOldestModelFormatVersion) + " to " +
                               std::to_string(kModelFormatVersion) + ")");
     }
     m.type = as<int>(root, "type");
@@ -249,6 +294,24 @@ Result<PartModel> modelFromYaml(const std::string& text) {
       corner.radius_out = asRange(c, "radius_out");
       m.corners.push_back(corner);
     }
+    if (version >= 2) {
+      const YAML::Node grasp = need(root, "grasp");
+      const YAML::Node styles = need(grasp, "styles");
+      const YAML::Node fingers = need(grasp, "fingers");
+      if (!styles.IsSequence() || !fingers.IsSequence())
+        throw FieldError{"'grasp.styles' and 'grasp.fingers' must be lists"};
+      for (const auto& st : styles) {
+        record.grasp.styles.push_back(
+            {as<double>(st, "x_mm"), as<double>(st, "y_mm"), as<double>(st, "rz_deg")});
+      }
+      for (const auto& f : fingers) {
+        record.grasp.gripper.fingers.push_back({as<double>(f, "x_mm"), as<double>(f, "y_mm"),
+                                                as<double>(f, "width_mm"),
+                                                as<double>(f, "height_mm")});
+      }
+      const std::string problem = validateGrasp(record.grasp);
+      if (!problem.empty()) throw FieldError{"grasp: " + problem};
+    }
   } catch (const FieldError& e) {
     return makeError(1, e.what);
   } catch (const YAML::Exception& e) {
@@ -257,7 +320,7 @@ Result<PartModel> modelFromYaml(const std::string& text) {
   const std::string problem = vision::validateModel(m);
   if (!problem.empty()) return makeError(1, problem);
   vision::prepareModel(m);
-  return m;
+  return record;
 }
 
 }  // namespace picksight::app

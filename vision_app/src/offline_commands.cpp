@@ -3,10 +3,14 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <filesystem>
 #include <ostream>
 
+#include "picksight/calibration/camera_calibration.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision_app/app_options.hpp"
+#include "picksight/vision_app/cell_calibration.hpp"
+#include "picksight/vision_app/cell_locator.hpp"
 #include "picksight/vision_app/command_table.hpp"
 #include "picksight/vision_app/model_commands.hpp"
 #include "picksight/vision_app/model_library.hpp"
@@ -18,18 +22,90 @@ std::string offlineUsage() {
   return "usage: picksight-vision learn --type N [--name NAME] [options] IMAGE\n"
          "       picksight-vision locate [--type N] [options] IMAGE...\n"
          "       picksight-vision blobs [options] IMAGE...\n"
+         "       picksight-vision lens [--data-dir DIR] [--corners 9x6] [--square MM] IMAGE...\n"
          "\n"
          "  learn   trains type N from the single part in IMAGE into DATA_DIR/models\n"
-         "  locate  prints one 'OK <n> x y rz ...' line per image: parts of type N\n"
-         "          (all trained types without --type; every region without models)\n"
+         "  locate  prints one 'OK <n> x y rz ...' line per image: grasp poses of type N\n"
+         "          (all trained types without --type; every region without models), in\n"
+         "          the frame the data dir's calibration gives (docs/PROTOCOL.md)\n"
          "  blobs   prints one BLOBS reply line per image\n"
+         "  lens    calibrates the lens from chessboard views (inner corners, square size)\n"
+         "          into DATA_DIR/calibration.yaml: 'OK fx fy cx cy rms_px views'; stop the\n"
+         "          vision app first, it reads the file at start\n"
          "Options: --data-dir DIR, --threshold, --polarity, --window, --min-area as in server "
          "mode.\n";
 }
 
 bool isOfflineCommand(const std::vector<std::string>& args) {
-  return !args.empty() && (args[0] == "learn" || args[0] == "locate" || args[0] == "blobs");
+  return !args.empty() &&
+         (args[0] == "learn" || args[0] == "locate" || args[0] == "blobs" || args[0] == "lens");
 }
+
+namespace {
+// picksight-vision lens: chessboard views to the lens model in the data dir.
+int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  calibration::ChessboardOptions board;
+  std::string data_dir = "picksight-data";
+  std::vector<cv::Mat> views;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.rfind("--", 0) == 0 && i + 1 >= args.size()) {
+      err << "picksight-vision lens: " << a << ": missing value\n";
+      return 2;
+    }
+    if (a == "--data-dir") {
+      data_dir = args[++i];
+    } else if (a == "--corners") {
+      const auto wh = splitFields(args[++i], "x");
+      const auto w = wh.size() == 2 ? parseInt(wh[0]) : std::nullopt;
+      const auto h = wh.size() == 2 ? parseInt(wh[1]) : std::nullopt;
+      if (!w || !h || *w < 2 || *h < 2 || *w > 100 || *h > 100) {
+        err << "picksight-vision lens: --corners must be WxH inner corners, e.g. 9x6\n";
+        return 2;
+      }
+      board.inner_corners = cv::Size(static_cast<int>(*w), static_cast<int>(*h));
+    } else if (a == "--square") {
+      const auto mm = parseDouble(args[++i]);
+      if (!mm || !(*mm > 0)) {
+        err << "picksight-vision lens: --square must be a positive size in mm\n";
+        return 2;
+      }
+      board.square_mm = *mm;
+    } else if (a.rfind("--", 0) == 0) {
+      err << "picksight-vision lens: unknown option '" << a << "'\n";
+      return 2;
+    } else {
+      views.push_back(cv::imread(a, cv::IMREAD_GRAYSCALE));
+      if (views.back().empty()) err << "picksight-vision lens: cannot read '" << a << "'\n";
+    }
+  }
+  if (views.empty()) {
+    err << offlineUsage();
+    return 2;
+  }
+  std::vector<int> skipped;
+  auto lens = calibration::calibrateChessboard(views, board, &skipped);
+  for (int i : skipped) err << "picksight-vision lens: no board in view " << i + 1 << "\n";
+  if (!lens) {
+    out << errorReply(kBadArguments, lens.error().message) << "\n";
+    return 1;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(data_dir, ec);
+  CellCalibration store(data_dir + "/calibration.yaml");
+  auto loaded = store.load();
+  auto saved = loaded ? store.setLens(*lens) : Result<void>(loaded.error());
+  if (!saved) {
+    out << errorReply(kCalibrationStorage, saved.error().message) << "\n";
+    return 1;
+  }
+  const auto& k = lens->camera_matrix;
+  out << "OK " << formatFixed(k(0, 0)) << " " << formatFixed(k(1, 1)) << " " << formatFixed(k(0, 2))
+      << " " << formatFixed(k(1, 2)) << " " << formatFixed(lens->rms_reprojection_px) << " "
+      << lens->views << "\n";
+  return 0;
+}
+}  // namespace
 
 int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   if (!isOfflineCommand(args)) {
@@ -37,6 +113,7 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
     return 2;
   }
   const std::string command = args[0];
+  if (command == "lens") return runLens(args, out, err);
   std::vector<std::string> rest;
   std::vector<std::string> images;
   int type = -1;
@@ -76,6 +153,9 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   ModelLibrary library(options->data_dir + "/models");
   for (const auto& problem : library.load())
     err << "picksight-vision: model rejected: " << problem << "\n";
+  CellCalibration calibration(options->data_dir + "/calibration.yaml");
+  if (auto loaded = calibration.load(); !loaded)
+    err << "picksight-vision: calibration rejected: " << loaded.error().message << "\n";
 
   int status = 0;
   for (const auto& path : images) {
@@ -109,12 +189,15 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       out << "OK " << modelSummary(outcome.model) << " "
           << (outcome.model.body.mirror_symmetric ? "1" : "0") << "\n";
     } else if (command == "locate") {
-      const auto models = library.snapshot();
-      const auto parts = locateInImage(grey, FrameMapping{}, options->vision, *models, type);
-      std::string line = "OK " + std::to_string(parts.size());
-      for (const auto& p : parts) {
-        line += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.angle_deg);
-      }
+      // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
+      LocateOutcome outcome;
+      outcome.scene.models = library.snapshot();
+      outcome.parts = locateInImage(grey, FrameMapping{}, options->vision, *outcome.scene.models,
+                                    type, &outcome.scene);
+      const CellPick pick = pickPoses(outcome, *library.grasps(), calibration.geometry());
+      std::string line = "OK " + std::to_string(pick.poses.size());
+      for (const auto& p : pick.poses)
+        line += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
       out << line << "\n";
     } else {
       const auto blobs = blobsInImage(grey, options->vision);

@@ -1,6 +1,7 @@
 // Part model training: body features, stability of the Hu invariants under
 // rotation, boundary primitives, orientation order and symmetries.
 #include "picksight/vision/part_model.hpp"
+#include "picksight/vision/part_locator.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -149,6 +150,7 @@ TrainOutcome trainModel(const cv::Mat& grey, int type, const std::string& name,
     contours.push_back(std::move(loop));
   }
   m.loops = fitLoops(contours, m.conformity);
+  snapToEdges(m.loops, r, r.centroid);
   m.corners = findCorners(m.loops, m.conformity);
   prepareModel(m);
 

@@ -1,9 +1,11 @@
-// Region extraction: labels first (one pass over the image), then per-region
-// work limited to the region's bounding box.
+// Region extraction: the boundaries of all regions first (one pass over the
+// image), then per-region work limited to the region's bounding box.
 #include "picksight/vision/regions.hpp"
 
 #include <algorithm>
 #include <cmath>
+
+#include <opencv2/imgproc.hpp>
 
 namespace picksight::vision {
 
@@ -36,24 +38,41 @@ constexpr double kMinContrast = 0.08;
 // Darker backgrounds (grey levels) are not lit: see greyMoments.
 constexpr double kMinLitBackground = 16;
 
-// Least-squares plane z = a + b x + c y through the grey levels of the pixels
-// of `where` in `grey` (box coordinates). False when too few or degenerate.
-bool fitPlane(const cv::Mat& grey, const cv::Mat& where, cv::Vec3d* plane) {
-  cv::Matx33d normal = cv::Matx33d::zeros();
-  cv::Vec3d rhs(0, 0, 0);
-  int n = 0;
+// Least-squares plane z = a + b x + c y through the grey levels of the ring
+// pixels (within `far`, outside `near`, in no region of `set`) in `grey`
+// (box coordinates). False when too few or degenerate.
+bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, const cv::Mat& set,
+              cv::Vec3d* plane) {
+  // Scalar sums: a 3x3 outer product per pixel costs more than the rest.
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sg = 0, sxg = 0, syg = 0;
   for (int y = 0; y < grey.rows; ++y) {
     const uint8_t* g = grey.ptr<uint8_t>(y);
-    const uint8_t* w = where.ptr<uint8_t>(y);
+    const uint8_t* f = far.ptr<uint8_t>(y);
+    const uint8_t* nr = near.ptr<uint8_t>(y);
+    const uint8_t* st = set.ptr<uint8_t>(y);
+    double rn = 0, rx = 0, rxx = 0, rg = 0, rxg = 0;
     for (int x = 0; x < grey.cols; ++x) {
-      if (!w[x]) continue;
-      const cv::Vec3d v(1.0, x, y);
-      normal += v * v.t();
-      rhs += v * static_cast<double>(g[x]);
-      ++n;
+      if (!f[x] || nr[x] || st[x]) continue;
+      const double v = g[x];
+      rn += 1;
+      rx += x;
+      rxx += static_cast<double>(x) * x;
+      rg += v;
+      rxg += x * v;
     }
+    n += rn;
+    sx += rx;
+    sy += y * rn;
+    sxx += rxx;
+    sxy += y * rx;
+    syy += static_cast<double>(y) * y * rn;
+    sg += rg;
+    sxg += rxg;
+    syg += y * rg;
   }
   if (n < 8) return false;
+  const cv::Matx33d normal(n, sx, sy, sx, sxx, sxy, sy, sxy, syy);
+  const cv::Vec3d rhs(sg, sxg, syg);
   cv::Vec3d solution;
   if (!cv::solve(normal, rhs, solution, cv::DECOMP_CHOLESKY)) return false;
   *plane = solution;
@@ -70,60 +89,127 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& where, cv::Vec3d* plane) {
 // coverage is (1 - R) / (1 - R_part). Constant levels instead would weigh one
 // side of a part more than the other and pull its centroid by a tenth of a
 // pixel under a few percent of light gradient.
-bool greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, const cv::Rect& bbox,
-                 cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin) {
-  const cv::Rect box =
-      (bbox + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(0, 0, grey.cols, grey.rows);
-  const cv::Mat own = labels(box) == label;
-  const cv::Mat free = labels(box) == 0;
-  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+//
+// `own` is the region's mask over `box` (the bounding box with a margin for
+// the edge blur and the background ring), `set` the mask of all regions
+// there. Two passes over the box and no full-box temporaries besides the
+// coverage itself: the contrast over the interior, then coverage and
+// moments together (moments from per-row sums of w x^p, as cv::moments does).
+bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set,
+                 const cv::Rect& box, cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights,
+                 cv::Point* origin) {
+  // One pass with a wide square is two or four passes of the 3x3 one
+  // (rectangles are separable), at a fraction of the cost.
+  const auto square = [](int side) {
+    return cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side));
+  };
   cv::Mat interior;
   cv::Mat near;
   cv::Mat far;
-  cv::erode(own, interior, kernel, cv::Point(-1, -1), 2);
-  cv::dilate(own, near, kernel, cv::Point(-1, -1), 2);
-  cv::dilate(own, far, kernel, cv::Point(-1, -1), 4);
+  cv::erode(own, interior, square(5));
+  cv::dilate(own, near, square(5));
+  cv::dilate(own, far, square(9));
   // Background from a ring just outside the edge blur, free of other parts.
-  const cv::Mat ring = far & ~near & free;
-  if (cv::countNonZero(interior) < 8) return false;
   cv::Vec3d plane;
-  if (!fitPlane(grey(box), ring, &plane)) return false;
+  if (!fitPlane(grey_box, far, near, set, &plane)) return false;
+  const auto background = [&](int x, int y) {
+    return static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
+  };
+  // The plane's least value is at a corner of the box.
+  const int w = box.width;
+  const int h = box.height;
+  const float min_background = std::min(std::min(background(0, 0), background(w - 1, 0)),
+                                        std::min(background(0, h - 1), background(w - 1, h - 1)));
+  // A black background carries no light to divide by: parts are lit on
+  // their own, and levels are read against the background additively.
+  const bool lit = min_background >= kMinLitBackground;
+  const auto level = [&](uint8_t g, float b) {
+    return lit ? static_cast<float>(g) / b : static_cast<float>(g) - b;
+  };
 
-  cv::Mat background(box.size(), CV_32F);
-  for (int y = 0; y < box.height; ++y) {
-    float* b = background.ptr<float>(y);
-    for (int x = 0; x < box.width; ++x)
-      b[x] = static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
+  double level_sum = 0;
+  int interior_count = 0;
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* g = grey_box.ptr<uint8_t>(y);
+    const uint8_t* in = interior.ptr<uint8_t>(y);
+    for (int x = 0; x < w; ++x) {
+      if (!in[x]) continue;
+      level_sum += level(g[x], background(x, y));
+      ++interior_count;
+    }
   }
-  cv::Mat level;
-  grey(box).convertTo(level, CV_32F);
-  cv::Mat coverage;
-  double min_background = 0;
-  cv::minMaxLoc(background, &min_background);
-  if (min_background >= kMinLitBackground) {
-    cv::Mat ratio;
-    cv::divide(level, background, ratio);
-    const double contrast = 1.0 - cv::mean(ratio, interior)[0];
-    if (std::abs(contrast) < kMinContrast) return false;
-    ratio.convertTo(coverage, CV_32F, -1.0 / contrast, 1.0 / contrast);
-  } else {
-    // A black background carries no light to divide by: parts are lit on
-    // their own, and levels are read against the background additively.
-    const cv::Mat offset = level - background;
-    const double contrast = cv::mean(offset, interior)[0];
-    if (std::abs(contrast) < kMinContrast * 255) return false;
-    offset.convertTo(coverage, CV_32F, 1.0 / contrast);
+  if (interior_count < 8) return false;
+  const double mean_level = level_sum / interior_count;
+  const double contrast = lit ? 1.0 - mean_level : mean_level;
+  if (std::abs(contrast) < (lit ? kMinContrast : kMinContrast * 255)) return false;
+  // Coverage = scale * level + offset: (1 - R) / contrast, or offset / contrast.
+  const float scale = static_cast<float>(lit ? -1.0 / contrast : 1.0 / contrast);
+  const float offset = static_cast<float>(lit ? 1.0 / contrast : 0.0);
+
+  cv::Mat coverage(box.size(), CV_32F);
+  double m00 = 0, m10 = 0, m01 = 0, m20 = 0, m11 = 0, m02 = 0, m30 = 0, m21 = 0, m12 = 0, m03 = 0;
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* g = grey_box.ptr<uint8_t>(y);
+    const uint8_t* o = own.ptr<uint8_t>(y);
+    const uint8_t* nr = near.ptr<uint8_t>(y);
+    const uint8_t* st = set.ptr<uint8_t>(y);
+    float* c = coverage.ptr<float>(y);
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    for (int x = 0; x < w; ++x) {
+      // Only the region and its blurred edge count, never a neighbour's pixels.
+      if (!nr[x] || (st[x] && !o[x])) {
+        c[x] = 0;
+        continue;
+      }
+      const float v =
+          std::min(std::max(scale * level(g[x], background(x, y)) + offset, 0.0f), 1.0f);
+      c[x] = v;
+      const double xv = static_cast<double>(x) * v;
+      const double xxv = xv * x;
+      s0 += v;
+      s1 += xv;
+      s2 += xxv;
+      s3 += xxv * x;
+    }
+    const double yd = y;
+    m00 += s0;
+    m10 += s1;
+    m01 += yd * s0;
+    m20 += s2;
+    m11 += yd * s1;
+    m02 += yd * yd * s0;
+    m30 += s3;
+    m21 += yd * s2;
+    m12 += yd * yd * s1;
+    m03 += yd * yd * yd * s0;
   }
-  cv::min(cv::max(coverage, 0.0), 1.0, coverage);
-  // Only the region and its blurred edge count, never a neighbour's pixels.
-  coverage.setTo(0, ~(near & (free | own)));
-  const cv::Moments m = cv::moments(coverage, false);
-  if (m.m00 <= 0) return false;
-  *moments = m;
-  *centroid = cv::Point2d(box.x + m.m10 / m.m00, box.y + m.m01 / m.m00);
+  if (m00 <= 0) return false;
+  *moments = cv::Moments(m00, m10, m01, m20, m11, m02, m30, m21, m12, m03);
+  *centroid = cv::Point2d(box.x + m10 / m00, box.y + m01 / m00);
   *weights = coverage;
   *origin = box.tl();
   return true;
+}
+
+// The pixels of one region over `box`: inside its outer boundary, outside its
+// holes. Islands in a hole (other regions) and pixels of other regions the
+// fill reaches are masked off by `mask`.
+void fillRegion(const cv::Mat& mask, const cv::Rect& box,
+                const std::vector<std::vector<cv::Point>>& contours,
+                const std::vector<cv::Vec4i>& hierarchy, int outer, cv::Mat& own) {
+  own.create(box.size(), CV_8UC1);
+  own.setTo(0);
+  const cv::Point shift = -box.tl();
+  cv::fillPoly(own, std::vector<std::vector<cv::Point>>{contours[outer]}, cv::Scalar(255),
+               cv::LINE_8, 0, shift);
+  for (int h = hierarchy[outer][2]; h >= 0; h = hierarchy[h][0]) {
+    // A hole's boundary runs through the region's own pixels: clear the
+    // hole's polygon, then put its boundary pixels back.
+    cv::fillPoly(own, std::vector<std::vector<cv::Point>>{contours[h]}, cv::Scalar(0), cv::LINE_8,
+                 0, shift);
+    for (const cv::Point& p : contours[h]) own.at<uint8_t>(p + shift) = 255;
+  }
+  own &= mask(box);
 }
 }  // namespace
 
@@ -131,66 +217,92 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
                                 const cv::Mat& grey) {
   CV_Assert(mask.type() == CV_8UC1);
   CV_Assert(grey.empty() || (grey.type() == CV_8UC1 && grey.size() == mask.size()));
-  cv::Mat labels;
-  cv::Mat stats;
-  cv::Mat centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  std::vector<Region> regions;
-  for (int label = 1; label < count; ++label) {
-    const int area = stats.at<int>(label, cv::CC_STAT_AREA);
-    if (area < options.min_area) continue;
-    const cv::Rect bbox(
-        stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-        stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+  // One boundary trace of the whole mask instead of labelling it: labels cost
+  // as much again as the trace, and every region needs its boundary anyway.
+  // RETR_CCOMP: outer boundaries on top, each with its holes as children.
+  std::vector<std::vector<cv::Point>> contours;
+  std::vector<cv::Vec4i> hierarchy;
+  cv::findContours(mask, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+  const cv::Rect frame(0, 0, mask.cols, mask.rows);
+  std::vector<int> outers;
+  // Boxes of every region, noise too: a region whose box meets no other
+  // region's box owns every set pixel of its box, and needs no fill.
+  std::vector<cv::Rect> boxes(contours.size());
+  for (int i = 0; i < static_cast<int>(contours.size()); ++i) {
+    if (hierarchy[i][3] < 0) boxes[static_cast<size_t>(i)] = cv::boundingRect(contours[i]);
+  }
+  for (int i = 0; i < static_cast<int>(contours.size()); ++i) {
+    if (hierarchy[i][3] >= 0) continue;  // a hole
+    const cv::Rect bbox = boxes[static_cast<size_t>(i)];
+    if (bbox.area() < options.min_area) continue;  // fewer pixels than that, surely
     const bool border =
         bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
     if (border && !options.keep_border_regions) continue;
-
-    Region r;
-    r.bbox = bbox;
-    r.touches_border = border;
-    // The region alone, in its box with a one-pixel frame so its boundary is
-    // closed even where it touches the box edge.
-    cv::Mat local(bbox.height + 2, bbox.width + 2, CV_8UC1, cv::Scalar(0));
-    cv::Mat inner = local(cv::Rect(1, 1, bbox.width, bbox.height));
-    cv::compare(labels(bbox), cv::Scalar(label), inner, cv::CMP_EQ);
-
-    const cv::Moments m = cv::moments(inner, true);
-    r.moments = m;
-    r.area = m.m00;
-    r.centroid = cv::Point2d(bbox.x + m.m10 / m.m00, bbox.y + m.m01 / m.m00);
-
-    std::vector<std::vector<cv::Point>> contours;
-    std::vector<cv::Vec4i> hierarchy;
-    cv::findContours(local, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE,
-                     cv::Point(bbox.x - 1, bbox.y - 1));
-    for (size_t i = 0; i < contours.size(); ++i) {
-      if (hierarchy[i][3] < 0) {
-        if (contours[i].size() > r.outer.size()) r.outer = std::move(contours[i]);
-      } else {
-        r.hole_boundaries.push_back(std::move(contours[i]));
-      }
-    }
-    r.holes = static_cast<int>(r.hole_boundaries.size());
-
-    if (!grey.empty() && greyMoments(grey, labels, label, bbox, &r.moments, &r.centroid,
-                                     &r.coverage, &r.coverage_origin)) {
-      r.area = r.moments.m00;
-    } else {
-      inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
-      r.coverage_origin = bbox.tl();
-    }
-    r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
-    const cv::Moments& rm = r.moments;
-    const double common =
-        std::sqrt((rm.mu20 - rm.mu02) * (rm.mu20 - rm.mu02) + 4 * rm.mu11 * rm.mu11);
-    const double major = rm.mu20 + rm.mu02 + common;
-    const double minor = rm.mu20 + rm.mu02 - common;
-    r.elongation = major > 0 ? 1.0 - minor / major : 0;
-    regions.push_back(std::move(r));
+    outers.push_back(i);
   }
-  std::sort(regions.begin(), regions.end(),
-            [](const Region& a, const Region& b) { return a.area > b.area; });
+  // Regions are measured independently, on all cores (the labelling this
+  // replaces ran on all cores too); each writes only its own slot and its
+  // own contours, so the result does not depend on the scheduling.
+  std::vector<Region> found(outers.size());
+  std::vector<char> kept(outers.size(), 0);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(outers.size())), [&](const cv::Range& range) {
+    cv::Mat own;
+    for (int k = range.start; k < range.end; ++k) {
+      const int i = outers[static_cast<size_t>(k)];
+      const cv::Rect bbox = boxes[static_cast<size_t>(i)];
+      // The box the grey-level moments need: the edge blur and a background
+      // ring around the region.
+      const cv::Rect box = (bbox + cv::Size(8, 8) - cv::Point(4, 4)) & frame;
+      bool alone = true;
+      for (size_t j = 0; j < boxes.size() && alone; ++j) {
+        alone = static_cast<int>(j) == i || hierarchy[j][3] >= 0 || (boxes[j] & box).empty();
+      }
+      if (alone) {
+        mask(box).copyTo(own);
+      } else {
+        fillRegion(mask, box, contours, hierarchy, i, own);
+      }
+      const cv::Mat inner = own(bbox - box.tl());
+      if (cv::countNonZero(inner) < options.min_area) continue;
+
+      Region& r = found[static_cast<size_t>(k)];
+      r.bbox = bbox;
+      r.touches_border =
+          bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+      r.outer = std::move(contours[i]);
+      for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0])
+        r.hole_boundaries.push_back(std::move(contours[h]));
+      r.holes = static_cast<int>(r.hole_boundaries.size());
+
+      if (!grey.empty() && greyMoments(grey(box), own, mask(box), box, &r.moments, &r.centroid,
+                                       &r.coverage, &r.coverage_origin)) {
+        r.area = r.moments.m00;
+      } else {
+        // Binary moments only where the grey levels cannot be trusted.
+        const cv::Moments m = cv::moments(inner, true);
+        r.moments = m;
+        r.area = m.m00;
+        r.centroid = cv::Point2d(bbox.x + m.m10 / m.m00, bbox.y + m.m01 / m.m00);
+        inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
+        r.coverage_origin = bbox.tl();
+      }
+      r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
+      const cv::Moments& rm = r.moments;
+      const double common =
+          std::sqrt((rm.mu20 - rm.mu02) * (rm.mu20 - rm.mu02) + 4 * rm.mu11 * rm.mu11);
+      const double major = rm.mu20 + rm.mu02 + common;
+      const double minor = rm.mu20 + rm.mu02 - common;
+      r.elongation = major > 0 ? 1.0 - minor / major : 0;
+      kept[static_cast<size_t>(k)] = 1;
+    }
+  });
+  std::vector<Region> regions;
+  regions.reserve(found.size());
+  for (size_t k = 0; k < found.size(); ++k) {
+    if (kept[k]) regions.push_back(std::move(found[k]));
+  }
+  std::stable_sort(regions.begin(), regions.end(),
+                   [](const Region& a, const Region& b) { return a.area > b.area; });
   return regions;
 }
 

@@ -1,6 +1,5 @@
-// Robot TCP server. Line framing is strict and bounded: a request is at most
-// max_line bytes; a longer one is answered with ERROR and skipped up to its
-// line end, so the connection stays in step with the client.
+// Robot TCP server: sockets and threads; the bounded line framing is
+// LineFramer's.
 #include "picksight/vision_app/robot_server.hpp"
 
 #include <arpa/inet.h>
@@ -15,6 +14,8 @@
 #include <stdexcept>
 
 #include "picksight/common/log.hpp"
+#include "picksight/vision_app/command_table.hpp"
+#include "picksight/vision_app/line_framer.hpp"
 
 namespace picksight::app {
 namespace {
@@ -34,7 +35,8 @@ bool sendAll(int fd, const std::string& data) {
 RobotServer::RobotServer(RobotServerOptions options, Handler handler)
     : options_(std::move(options)), handler_(std::move(handler)) {
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (listen_fd_ < 0) throw std::runtime_error(std::string("robot server: socket: ") + strerror(errno));
+  if (listen_fd_ < 0)
+    throw std::runtime_error(std::string("robot server: socket: ") + strerror(errno));
   int one = 1;
   ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
   sockaddr_in addr{};
@@ -48,8 +50,8 @@ RobotServer::RobotServer(RobotServerOptions options, Handler handler)
       ::listen(listen_fd_, 64) != 0) {
     const std::string why = strerror(errno);
     ::close(listen_fd_);
-    throw std::runtime_error("robot server: cannot listen on port " + std::to_string(options_.port) +
-                             ": " + why);
+    throw std::runtime_error("robot server: cannot listen on port " +
+                             std::to_string(options_.port) + ": " + why);
   }
   socklen_t len = sizeof(addr);
   ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&addr), &len);
@@ -104,7 +106,8 @@ void RobotServer::acceptLoop() {
     int one = 1;
     ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
     if (active_ >= options_.max_connections) {
-      sendAll(fd, "ERROR 13 too many connections (limit " + std::to_string(options_.max_connections) + ")\n");
+      sendAll(fd, "ERROR 13 too many connections (limit " +
+                      std::to_string(options_.max_connections) + ")\n");
       ::close(fd);
       continue;
     }
@@ -119,8 +122,21 @@ void RobotServer::acceptLoop() {
 
 void RobotServer::serve(Connection& connection) {
   const int fd = connection.fd;
-  std::string buffer;
-  bool discarding = false;  // inside an over-long line, skipping to its end
+  LineFramer framer(options_.max_line);
+  const std::string too_long =
+      "ERROR 12 request too long (limit " + std::to_string(options_.max_line) + " bytes)\n";
+  const auto on_line = [&](std::string_view line) {
+    std::string reply;
+    try {
+      reply = handler_(line);
+    } catch (const std::exception& e) {
+      // A bug in a command must cost one request, not the server.
+      logError("robot request '", printable(line, 80), "': ", e.what());
+      reply = "ERROR 99 internal error";
+    }
+    return sendAll(fd, reply + "\n");
+  };
+  const auto on_too_long = [&] { return sendAll(fd, too_long); };
   char chunk[4096];
   while (!stop_) {
     pollfd p{fd, POLLIN, 0};
@@ -131,45 +147,7 @@ void RobotServer::serve(Connection& connection) {
     const ssize_t n = ::recv(fd, chunk, sizeof(chunk), 0);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n <= 0) break;  // closed by the client, maybe mid-request: nothing to answer
-    buffer.append(chunk, static_cast<size_t>(n));
-
-    bool alive = true;
-    size_t start = 0;
-    for (;;) {
-      const size_t nl = buffer.find('\n', start);
-      if (nl == std::string::npos) break;
-      std::string_view line(buffer.data() + start, nl - start);
-      start = nl + 1;
-      if (discarding) {
-        discarding = false;  // the end of the over-long line: already answered
-        continue;
-      }
-      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-      if (line.size() > options_.max_line) {
-        alive = sendAll(fd, "ERROR 12 request too long (limit " + std::to_string(options_.max_line) + " bytes)\n");
-      } else {
-        std::string reply;
-        try {
-          reply = handler_(line);
-        } catch (const std::exception& e) {
-          // A bug in a command must cost one request, not the server.
-          logError("robot request '", std::string(line.substr(0, 80)), "': ", e.what());
-          reply = "ERROR 99 internal error";
-        }
-        alive = sendAll(fd, reply + "\n");
-      }
-      if (!alive) break;
-    }
-    buffer.erase(0, start);
-    if (!alive) break;
-    if (!discarding && buffer.size() > options_.max_line) {
-      alive = sendAll(fd, "ERROR 12 request too long (limit " + std::to_string(options_.max_line) + " bytes)\n");
-      buffer.clear();
-      discarding = true;
-      if (!alive) break;
-    } else if (discarding) {
-      buffer.clear();
-    }
+    if (!framer.feed(std::string_view(chunk, static_cast<size_t>(n)), on_line, on_too_long)) break;
   }
   --active_;
   connection.done = true;

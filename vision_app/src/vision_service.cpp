@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "picksight/common/clock.hpp"
 #include "picksight/vision/recognizer.hpp"
 
 namespace picksight::app {
@@ -47,15 +46,21 @@ FrameMapping frameMapping(const ReceivedFrame& frame) {
 
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
-                                       int type) {
-  const cv::Mat mask = vision::binarize(grey, options.binarize);
-  const auto regions = vision::findRegions(mask, options.regions, grey);
+                                       int type, LocateScene* scene) {
+  LocateScene local;
+  LocateScene& s = scene ? *scene : local;
+  s.mask = vision::binarize(grey, options.binarize);
+  s.regions = vision::findRegions(s.mask, options.regions, grey);
+  s.mapping = mapping;
+  const auto& regions = s.regions;
   const double area_scale = 1.0 / (mapping.scale_x * mapping.scale_y);
   std::vector<LocatedPart> parts;
   if (models.empty()) {
     parts.reserve(regions.size());
-    for (const auto& r : regions) {
+    for (size_t i = 0; i < regions.size(); ++i) {
+      const auto& r = regions[i];
       LocatedPart p;
+      p.region = static_cast<int>(i);
       const cv::Point2d s = mapping.toSensor(r.centroid);
       p.x = s.x;
       p.y = s.y;
@@ -82,6 +87,7 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& 
     p.type = match.model->type;
     p.score = match.score;
     p.symmetry_deg = match.symmetry_deg;
+    p.region = static_cast<int>(match.region);
     parts.push_back(p);
   }
   return parts;
@@ -102,42 +108,45 @@ std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const Vision
   return out;
 }
 
+Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& mapping,
+                                    const VisionOptions& options) {
+  const auto regions =
+      vision::findRegions(vision::binarize(grey, options.binarize), options.regions, grey);
+  if (regions.empty()) return makeError(kNoTarget, "no target found");
+  if (regions.size() > 1) {
+    return makeError(kSeveralTargets,
+                     "more than one target found (" + std::to_string(regions.size()) + " regions)");
+  }
+  const vision::Region& r = regions.front();
+  TargetOutcome t;
+  t.centroid = mapping.toSensor(r.centroid);
+  // Moments in frame pixels to sensor pixels: x lengths grow by 1/scale_x.
+  const double sx = mapping.scale_x, sy = mapping.scale_y;
+  t.moments.m00 = r.moments.m00 / (sx * sy);
+  t.moments.mu20 = r.moments.mu20 / (sx * sx * sx * sy);
+  t.moments.mu02 = r.moments.mu02 / (sx * sy * sy * sy);
+  t.moments.mu11 = r.moments.mu11 / (sx * sx * sy * sy);
+  return t;
+}
+
+VisionService::VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
+                             ModelLibrary* models)
+    : camera_(std::move(camera)), options_(std::move(options)), models_(models) {}
+
 VisionService::VisionService(zmq::context_t& context, const std::string& frames_endpoint,
                              const std::string& control_endpoint, std::string camera,
                              VisionOptions options, ModelLibrary* models)
-    : camera_(std::move(camera)),
-      options_(std::move(options)),
-      models_(models),
-      feed_(context, frames_endpoint, camera_),
-      control_(context, control_endpoint) {}
+    : VisionService(std::make_unique<VideoServerCamera>(context, frames_endpoint, control_endpoint,
+                                                        std::move(camera), options.frame_timeout),
+                    options, models) {}
 
-void VisionService::start() { feed_.start(); }
-void VisionService::stop() { feed_.stop(); }
+void VisionService::start() { camera_->start(); }
+void VisionService::stop() { camera_->stop(); }
 
 Result<std::shared_ptr<const ReceivedFrame>> VisionService::freshFrame() {
-  // A triggered frame can be lost on the way (a subscription still joining,
-  // a full queue): trigger again after a while rather than wait in vain for
-  // the whole timeout. Any later frame will do.
-  constexpr std::chrono::milliseconds kRetrigger{500};
-  const uint64_t requested_ns = monotonicNs();
-  const auto deadline = std::chrono::steady_clock::now() + options_.frame_timeout;
-  std::shared_ptr<const ReceivedFrame> frame;
-  while (!frame) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= deadline) {
-      return makeError(kNoFrame, "no frame from camera " + camera_ + " within " +
-                                     std::to_string(options_.frame_timeout.count()) + " ms");
-    }
-    proto::ControlRequest request;
-    request.mutable_trigger()->set_camera(camera_);
-    auto reply = control_.call(request);
-    if (!reply) {
-      return makeError(kNoVideoServer, "video server: " + reply.error().message);
-    }
-    const auto wait = std::min<std::chrono::milliseconds>(
-        kRetrigger, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now));
-    frame = feed_.waitFor(reply->trigger().sequence(), requested_ns, wait);
-  }
+  auto fresh = camera_->freshFrame();
+  if (!fresh) return fresh.error();
+  const auto frame = *fresh;
   const auto& h = frame->header;
   last_frame_ = FrameInfo{h.camera(), h.sequence(), h.host_timestamp_ns(),
                           h.width(),  h.height(),   h.triggered()};
@@ -157,7 +166,9 @@ Result<LocateOutcome> VisionService::locate(int type) {
   if (!frame) return frame.error();
   LocateOutcome outcome;
   outcome.frame = *last_frame_;
-  outcome.parts = locateInImage(greyImage(**frame), frameMapping(**frame), options_, *models, type);
+  outcome.parts = locateInImage(greyImage(**frame), frameMapping(**frame), options_, *models, type,
+                                &outcome.scene);
+  outcome.scene.models = models;
   return outcome;
 }
 
@@ -198,6 +209,20 @@ Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {
                       static_cast<int>(std::lround(f.bbox.height / mapping.scale_y)));
   }
   return features;
+}
+
+Result<TargetOutcome> VisionService::target() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto frame = freshFrame();
+  if (!frame) return frame.error();
+  auto outcome = targetInImage(greyImage(**frame), frameMapping(**frame), options_);
+  if (outcome) outcome->frame = *last_frame_;
+  return outcome;
+}
+
+Result<proto::ControlReply> VisionService::control(const proto::ControlRequest& request) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return camera_->control(request);
 }
 
 std::optional<FrameInfo> VisionService::lastFrame() const {

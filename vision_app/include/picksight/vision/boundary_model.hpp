@@ -85,7 +85,11 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
 class EdgeDistance {
  public:
   EdgeDistance() = default;
-  EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi);
+  // `max_distance` > 0: distances are exact up to it and a large value
+  // beyond, for callers that only ask "within a tolerance?" or clip there;
+  // much cheaper than the exact transform of the whole region of interest.
+  EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
+               double max_distance = 0);
   // Pixels; a large value outside the region of interest.
   float at(cv::Point2d p) const;
   bool empty() const { return distance_.empty(); }

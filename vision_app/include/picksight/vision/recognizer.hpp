@@ -19,12 +19,16 @@ struct Match {
   // Rotation from the trained pose, in [0, symmetry) (or [0, 360)).
   double angle_deg = 0;
   double symmetry_deg = 360;  // the model's: 360 none, 180, 120..., 0 any turn
-  double body_distance = 0;   // Hu distance
+  double body_distance = 0;   // Hu distance (0 for a part found inside a merged blob)
+  // Found inside a blob it shares with other parts (they touch), located
+  // from its edges instead of the blob's moments.
+  bool touching = false;
 };
 
-// Every part of the given models among the regions, best score first: at
-// most one per region, the model that verifies best. Parts that touch (one
-// merged blob) are not found yet: their blob matches no model's body.
+// Every part of the given models among the regions, best score first. A
+// region that matches a model as a whole holds one part, the model that
+// verifies best; a region that matches none is searched for parts that
+// touch (one merged blob) with the boundary models (see locateInBlob).
 std::vector<Match> recognize(const std::vector<Region>& regions,
                              const std::vector<const PartModel*>& models);
 

@@ -35,6 +35,9 @@ std::optional<Request> parseRequest(std::string_view line);
 std::string errorReply(int code, const std::string& text);
 // A part type argument: an integer in [0, 9999].
 std::optional<int> parseType(std::string_view text);
+// Every argument from `first` on as a finite number; nullopt if one is not.
+std::optional<std::vector<double>> parseNumbers(const std::vector<std::string>& args,
+                                                size_t first = 0);
 // Up to `limit` characters of client text, safe to echo in a reply line.
 std::string printable(std::string_view text, size_t limit = 40);
 

@@ -4,18 +4,44 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "picksight/common/result.hpp"
+#include "picksight/grasp/grasp.hpp"
 #include "picksight/vision/part_model.hpp"
 
 namespace picksight::app {
 
-constexpr int kModelFormatVersion = 1;
+// Version 2 added the grasp section; version 1 files are still read (no
+// grasp styles, no fingers).
+constexpr int kModelFormatVersion = 2;
+constexpr int kOldestModelFormatVersion = 1;
 
-std::string modelToYaml(const vision::PartModel& model);
+// How the robot picks a part type: grasp styles in order of preference (in
+// the part's frame, vision-frame mm and degrees) and the gripper's fingers.
+struct GraspSetup {
+  std::vector<grasp::GraspStyle> styles;
+  grasp::Gripper gripper;
+};
+
+// Limits that keep a model file (and a reply line) small.
+constexpr size_t kMaxGraspStyles = 16;
+constexpr size_t kMaxFingers = 8;
+
+struct ModelRecord {
+  vision::PartModel model;
+  GraspSetup grasp;
+};
+
+std::string modelToYaml(const vision::PartModel& model, const GraspSetup& grasp = {});
 
 // Parses and validates; errors say what is wrong (not which file: the caller
 // knows). The model comes back prepared (vision::prepareModel).
+Result<ModelRecord> modelRecordFromYaml(const std::string& text);
 Result<vision::PartModel> modelFromYaml(const std::string& text);
+
+// Checks grasp values (finite, in range, within the limits); empty when
+// valid, else what is wrong.
+std::string validateGrasp(const GraspSetup& grasp);
 
 }  // namespace picksight::app

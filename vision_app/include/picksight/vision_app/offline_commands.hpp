@@ -1,5 +1,6 @@
 // picksight-vision's offline subcommands: learn, locate and blobs on image
-// files, with the same model library and reply lines as the robot protocol.
+// files, with the same model library and reply lines as the robot protocol;
+// lens, the lens model from chessboard views into the calibration file.
 #pragma once
 
 #include <iosfwd>
@@ -8,7 +9,7 @@
 
 namespace picksight::app {
 
-// True when args[0] names a subcommand (learn, locate, blobs).
+// True when args[0] names a subcommand (learn, locate, blobs, lens).
 bool isOfflineCommand(const std::vector<std::string>& args);
 
 // Runs one subcommand (args without the program name); returns the exit

@@ -1,5 +1,6 @@
 // The robot protocol (docs/PROTOCOL.md): the core commands (PING, VERSION,
-// HELP, FRAME, LOCATE) over a CommandTable that other features extend.
+// HELP, FRAME) over a CommandTable that the other features extend (LOCATE
+// and the cell: cell_commands.hpp; VisionCell wires them all).
 #pragma once
 
 #include <string>
@@ -20,7 +21,6 @@ class RobotProtocol {
   CommandTable& table() { return table_; }
 
  private:
-  std::string locate(const Request& request);
   std::string frame(const Request& request);
 
   VisionService& vision_;

@@ -18,7 +18,7 @@ namespace picksight::app {
 
 struct RobotServerOptions {
   std::string bind_address = "0.0.0.0";
-  uint16_t port = 5600;  // 0 = any free port (read it back with port())
+  uint16_t port = 5600;         // 0 = any free port (read it back with port())
   size_t max_line = 4096;       // longer requests get ERROR 12
   size_t max_connections = 64;  // more get ERROR 13 and are closed
 };

@@ -1,7 +1,7 @@
 // The vision work behind robot requests: get a frame taken after the
-// request (a software trigger, or the next free-run frame), find the parts
-// (recognize trained types, or every region when no model exists), and
-// express them in sensor pixels.
+// request from the camera link (a software trigger, or the next free-run
+// frame), find the parts (recognize trained types, or every region when no
+// model exists) or the calibration target, and express them in sensor pixels.
 //
 // Threading: every request method may be called from any connection thread;
 // requests are served one at a time (they share the control socket and the CPU).
@@ -22,15 +22,17 @@
 #include "picksight/vision/blob_features.hpp"
 #include "picksight/vision/part_model.hpp"
 #include "picksight/vision/regions.hpp"
-#include "picksight/vision_app/frame_feed.hpp"
+#include "picksight/vision_app/camera_link.hpp"
 #include "picksight/vision_app/model_library.hpp"
 
 namespace picksight::app {
 
 // Error codes of VisionService results; they are also the robot protocol's.
+// (kNoFrame, kNoVideoServer and kCameraRefused come from the camera link.)
 enum VisionError : int {
-  kNoFrame = 20,        // no fresh frame in time
-  kNoVideoServer = 21,  // the video server did not answer or refused
+  kNoTarget = 1,        // STORE, CALCAM: no target in the frame
+  kSeveralTargets = 2,  // STORE, CALCAM: more than one
+  kNotADisc = 3,        // CALCAM: the target is not a disc
   kNoPartToLearn = 30,  // LEARN: no part in the frame
   kSeveralParts = 31,   // LEARN: more than one part in the frame
   kUnknownType = 32,    // no model for that type
@@ -48,6 +50,7 @@ struct LocatedPart {
   int type = -1;              // -1: a region, no model
   double score = 0;           // verified boundary fraction
   double symmetry_deg = 360;  // period of angle_deg (0: any)
+  int region = -1;            // index into the scene's regions
 };
 
 // Where a frame's pixels lie on the sensor (ROI offset and resize).
@@ -69,9 +72,28 @@ struct FrameInfo {
   bool triggered = false;
 };
 
+// What a location saw beyond the parts: the binary mask and the regions
+// (frame pixels), for grasp clearance.
+struct LocateScene {
+  cv::Mat mask;  // CV_8UC1, non-zero = part
+  std::vector<vision::Region> regions;
+  FrameMapping mapping;
+  std::shared_ptr<const ModelList> models;  // the models the parts refer to
+};
+
 struct LocateOutcome {
   FrameInfo frame;
-  std::vector<LocatedPart> parts;  // largest first
+  std::vector<LocatedPart> parts;  // best (or largest) first
+  LocateScene scene;
+};
+
+// The single calibration target in a frame, in sensor pixels.
+struct TargetOutcome {
+  FrameInfo frame;
+  cv::Point2d centroid;
+  // Area and central second moments (m00, mu20, mu11, mu02), grey-level
+  // weighted, in sensor pixels.
+  cv::Moments moments;
 };
 
 struct VisionOptions {
@@ -91,9 +113,14 @@ FrameMapping frameMapping(const ReceivedFrame& frame);
 // Finds parts in a grey image: with `models` non-empty, the recognized parts
 // of type `type` (-1: all types), best first; with none, every region,
 // largest first.
+// With `scene`, also keeps the mask and regions there.
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
-                                       int type);
+                                       int type, LocateScene* scene = nullptr);
+
+// The single region of a grey image as a calibration target.
+Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& mapping,
+                                    const VisionOptions& options);
 
 // Blob features of every region of a grey image (skeleton left out).
 std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const VisionOptions& options);
@@ -101,6 +128,9 @@ std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const Vision
 class VisionService {
  public:
   // `models` (borrowed, may be null: no recognition) outlives the service.
+  VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
+                ModelLibrary* models = nullptr);
+  // With a VideoServerCamera.
   VisionService(zmq::context_t& context, const std::string& frames_endpoint,
                 const std::string& control_endpoint, std::string camera, VisionOptions options,
                 ModelLibrary* models = nullptr);
@@ -115,22 +145,26 @@ class VisionService {
   Result<vision::PartModel> learn(int type, const std::string& name);
   // Blob features of every region in a fresh frame, sensor pixels.
   Result<std::vector<vision::BlobFeatures>> blobs();
+  // The single calibration target in a fresh frame.
+  Result<TargetOutcome> target();
+  // A camera setting passed to the video server.
+  Result<proto::ControlReply> control(const proto::ControlRequest& request);
+  uint64_t framesReceived() const { return camera_->framesReceived(); }
   ModelLibrary* models() const { return models_; }
   // The frame the last request worked on.
   std::optional<FrameInfo> lastFrame() const;
-  const std::string& camera() const { return camera_; }
+  const std::string& camera() const { return camera_->camera(); }
+  const VisionOptions& options() const { return options_; }
 
  private:
   // Call with mutex_ held.
   Result<std::shared_ptr<const ReceivedFrame>> freshFrame();
 
-  const std::string camera_;
+  const std::unique_ptr<CameraLink> camera_;
   const VisionOptions options_;
   ModelLibrary* const models_;
-  FrameFeed feed_;
 
-  mutable std::mutex mutex_;  // serializes requests; guards control_ and last_frame_
-  ControlClient control_;
+  mutable std::mutex mutex_;  // serializes requests; guards camera_ calls and last_frame_
   std::optional<FrameInfo> last_frame_;
 };
 

@@ -1,0 +1,180 @@
+// LOCATE end to end in robot coordinates, as a calibrated cell runs it: 9
+// trained part types (each with two grasp styles and a two-finger gripper),
+// a robot-camera calibration, a 1920x1080 synthetic camera with 20 parts;
+// a robot's request sent to its reply received over TCP, fresh frame
+// (software trigger) included. Prints median, p99 and min; never fails on time.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "locate_args.hpp"
+#include "picksight/common/line_client.hpp"
+#include "picksight/common/subprocess.hpp"
+#include "picksight/common/text.hpp"
+#include "picksight/synthetic/scene.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision_app/cell_calibration.hpp"
+#include "picksight/vision_app/cell_locator.hpp"
+#include "picksight/vision_app/model_library.hpp"
+
+namespace {
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+const std::vector<std::string> kTypes{"rectangle",  "l_shape", "l_shape_mirror",
+                                      "disc_holes", "gear",    "triangle",
+                                      "hex_nut",    "t_shape", "slot"};
+
+picksight::synthetic::SceneOptions scene(int width, int height, int parts, uint64_t seed,
+                                         std::vector<std::string> types) {
+  picksight::synthetic::SceneOptions o;
+  o.width = width;
+  o.height = height;
+  o.parts = parts;
+  o.seed = seed;
+  o.types = std::move(types);
+  o.part_size = 120;
+  return o;
+}
+
+// Models, grasps and a calibration written as a cell set up through the
+// protocol would have them.
+bool prepareDataDir(const std::string& dir) {
+  picksight::app::ModelLibrary library(dir + "/models");
+  int type = 1;
+  for (const auto& name : kTypes) {
+    const picksight::synthetic::SceneRenderer one(scene(400, 400, 1, 1000 + type, {name}));
+    const auto trained = picksight::vision::trainModel(one.render(0), type, name);
+    if (!trained.ok || !library.store(trained.model)) {
+      std::fprintf(stderr, "bench: training %s failed: %s\n", name.c_str(), trained.error.c_str());
+      return false;
+    }
+    picksight::app::GraspSetup grasp;
+    grasp.styles = {{0, 0, 0}, {0, 0, 90}};
+    grasp.gripper.fingers = {{0, 8, 2, 1.5}, {0, -8, 2, 1.5}};
+    if (!library.setGrasp(type, grasp)) return false;
+    ++type;
+  }
+  picksight::app::CellCalibration calibration(dir + "/calibration.yaml");
+  if (!calibration.setScale({0.1, 0.1, 0})) return false;
+  const picksight::calibration::RigidTransform truth{350, -80, 30, false};
+  for (const cv::Point2d v : {cv::Point2d(10, -10), cv::Point2d(180, -15), cv::Point2d(170, -100),
+                              cv::Point2d(20, -95)}) {
+    if (!calibration.addPoint({v, truth.apply(v)})) return false;
+  }
+  return static_cast<bool>(calibration.compute());
+}
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+struct Breakdown {
+  double recognition_ms = 0;
+  double grasps_ms = 0;
+};
+
+// Where a request's vision time goes, in process on the camera's scene: the
+// other engineer's recognition, and this cell's grasp selection.
+Breakdown breakdown(const std::string& data_dir, int width, int height, int parts) {
+  picksight::app::ModelLibrary library(data_dir + "/models");
+  picksight::app::CellCalibration calibration(data_dir + "/calibration.yaml");
+  if (!library.load().empty() || !calibration.load()) return {};
+  const picksight::synthetic::SceneRenderer renderer(scene(width, height, parts, 5, kTypes));
+  const cv::Mat grey = renderer.render(1);
+  const auto geometry = calibration.geometry();
+  std::vector<double> recognition, grasps;
+  for (int i = 0; i < 100; ++i) {
+    picksight::app::LocateOutcome outcome;
+    outcome.scene.models = library.snapshot();
+    const int type = 1 + i % static_cast<int>(kTypes.size());
+    auto t0 = Clock::now();
+    outcome.parts =
+        picksight::app::locateInImage(grey, {}, {}, *outcome.scene.models, type, &outcome.scene);
+    recognition.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    t0 = Clock::now();
+    const auto pick = picksight::app::pickPoses(outcome, *library.grasps(), geometry);
+    grasps.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    if (pick.poses.size() > outcome.parts.size()) return {};
+  }
+  return {median(recognition), median(grasps)};
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  const auto args = picksight::bench::parseLocateArgs(argc, argv, {500, 1920, 1080, 20});
+  const int requests = args.requests, width = args.width, height = args.height, parts = args.parts;
+  char data_dir[] = "/tmp/picksight-cell-bench-XXXXXX";
+  if (!::mkdtemp(data_dir) || !prepareDataDir(data_dir)) return 1;
+  std::string types;
+  for (const auto& t : kTypes) types += (types.empty() ? "" : "+") + t;
+  const std::string dir = picksight::bench::binDir();
+  const std::string source = "cam0=synthetic:width=" + std::to_string(width) +
+                             ",height=" + std::to_string(height) +
+                             ",parts=" + std::to_string(parts) + ",size=120,seed=5,types=" + types;
+  picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
+                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
+                                "trigger"});
+  const auto frames = server.waitForLine("frames ", 10s);
+  const auto control = server.waitForLine("control ", 10s);
+  if (!frames || !control) return 1;
+  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
+                                *control, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir",
+                                data_dir});
+  const auto port = vision.waitForLine("robot ", 10s);
+  if (!port || !vision.waitForLine("ready", 10s)) return 1;
+  auto robot =
+      picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
+  if (!robot) return 1;
+
+  for (int i = 0; i < 10; ++i) (void)robot->request("LOCATE 1", 10s);  // warm-up
+  std::vector<double> ms;
+  int failures = 0;
+  size_t offered = 0;
+  for (int i = 0; i < requests; ++i) {
+    const std::string request = "LOCATE " + std::to_string(1 + i % static_cast<int>(kTypes.size()));
+    const auto t0 = Clock::now();
+    auto reply = robot->request(request, 10s);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    const std::string text = reply ? *reply : std::string();
+    const auto words = picksight::splitFields(text, " ");
+    if (words.size() < 2 || words[0] != "OK") {
+      ++failures;
+    } else {
+      offered += static_cast<size_t>(picksight::parseInt(words[1]).value_or(0));
+    }
+  }
+  auto status = robot->request("STATUS", 5s);
+  robot->close();
+  vision.terminate();
+  server.terminate();
+  const Breakdown inside = breakdown(data_dir, width, height, parts);
+  std::error_code ignored;
+  std::filesystem::remove_all(data_dir, ignored);
+
+  std::sort(ms.begin(), ms.end());
+  const double median = ms[ms.size() / 2];
+  const double p99 =
+      ms[std::min(ms.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(ms.size())))];
+  std::printf(
+      "cell LOCATE benchmark: %dx%d, %d parts, %zu trained types with grasps, robot frame\n", width,
+      height, parts, kTypes.size());
+  std::printf("  %d requests (%d failed), %.2f grasps offered per reply (one type per request)\n",
+              requests, failures,
+              requests > failures ? static_cast<double>(offered) / (requests - failures) : 0.0);
+  std::printf(
+      "  round trip ms: median %.2f  p99 %.2f  min %.2f  max %.2f   (goal: median <= 10, p99 <= "
+      "20)\n",
+      median, p99, ms.front(), ms.back());
+  std::printf(
+      "  in process, same scene, median ms: recognition of %zu types %.2f, grasp selection and\n"
+      "  robot frame %.3f\n",
+      kTypes.size(), inside.recognition_ms, inside.grasps_ms);
+  std::printf("  %s\n", status ? status->c_str() : "STATUS failed");
+  return failures == 0 ? 0 : 1;
+}

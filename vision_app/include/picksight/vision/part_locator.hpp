@@ -1,0 +1,56 @@
+// Parts inside merged blobs (parts that touch): pose hypotheses from the
+// boundary model's corners and arcs, verification on the blob's edges,
+// sub-pixel refinement on the grey-level edges, best-first acceptance.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/recognizer.hpp"
+#include "picksight/vision/regions.hpp"
+
+namespace picksight::vision {
+
+// Where a model lies in the image: model point m lands at
+// centre + R(angle) (m.x, s m.y), s = -1 for the mirror image of the model.
+struct Pose {
+  cv::Point2d centre;
+  double angle_deg = 0;
+  bool mirrored = false;
+};
+
+struct EdgeFit {
+  bool ok = false;
+  Pose pose;
+  double rms_px = 0;           // of the inlier edge points about the fitted boundary
+  double inlier_fraction = 0;  // of the model's edge samples (weighted) found on an edge
+};
+
+// Moves `start` so that the model boundary lies on the region's grey-level
+// edges (the 0.5 crossing of the region's coverage along each boundary
+// normal): iterative least squares in (x, y, angle) plus a uniform offset
+// of the boundary, which absorbs the half-pixel by which a boundary fitted
+// to pixel centres lies inside the true edge. Edge points with no clean
+// crossing (where the part touches another) are left out. `search_px`: how
+// far along the normals an edge is looked for in the first iteration.
+EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Pose& start,
+                          double search_px = 4.0, int iterations = 6);
+
+// Moves each primitive of `loops` (model frame: image point minus `origin`)
+// onto the grey-level edges of `region`, the part it was fitted to: lines by
+// a shift and a turn, arcs by a new circle, each a least-squares fit to the
+// edge crossings along its normals. Pixel-centre contours lie 0.3 to 0.5 px
+// inside the true edge, by an amount that changes with an edge's slope, so
+// a model left there is off-centre by tenths of a pixel wherever parts
+// are located from their edges.
+void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin);
+
+// The parts of the given models inside region `index` of `regions`, a blob
+// that matched no model as a whole. Best score first; Match::touching set.
+// A part whose mirrored model verifies about as well is not reported.
+std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
+                                const std::vector<const PartModel*>& models);
+
+}  // namespace picksight::vision
