@@ -12,8 +12,8 @@ using namespace picksight::vision;
 namespace {
 // A background lit from `left` to `right` grey levels across the image, with
 // dark square parts reflecting `reflectance` of the local light, and noise.
-cv::Mat litScene(int width, int height, double left, double right, const std::vector<cv::Rect>& parts,
-                 double reflectance, double noise = 2.0) {
+cv::Mat litScene(int width, int height, double left, double right,
+                 const std::vector<cv::Rect>& parts, double reflectance, double noise = 2.0) {
   cv::Mat light(height, width, CV_32F);
   for (int x = 0; x < width; ++x) light.col(x).setTo(left + (right - left) * x / (width - 1));
   cv::Mat reflect(height, width, CV_32F, cv::Scalar(1.0));
@@ -52,8 +52,8 @@ TEST_CASE("a part wider than the default window needs a wider window", "[vision]
   // The default window (a sixth of 720 px) is narrower than the part: its
   // middle reads as background and the part is no longer one solid region.
   const auto narrow = findRegions(binarize(img, {}));
-  const bool whole = narrow.size() == 1 && narrow[0].holes == 0 &&
-                     std::abs(narrow[0].area - 320.0 * 320.0) < 1000;
+  const bool whole =
+      narrow.size() == 1 && narrow[0].holes == 0 && std::abs(narrow[0].area - 320.0 * 320.0) < 1000;
   CHECK_FALSE(whole);
 
   BinarizeOptions wide;
@@ -73,7 +73,8 @@ TEST_CASE("light parts on a dark background with the other polarity", "[vision][
   cv::Mat img(300, 400, CV_8UC1, cv::Scalar(30));
   img(cv::Rect(50, 50, 60, 40)).setTo(220);
   img(cv::Rect(250, 150, 50, 50)).setTo(200);
-  for (auto method : {ThresholdMethod::kAdaptive, ThresholdMethod::kOtsu, ThresholdMethod::kFixed}) {
+  for (auto method :
+       {ThresholdMethod::kAdaptive, ThresholdMethod::kOtsu, ThresholdMethod::kFixed}) {
     BinarizeOptions o;
     o.method = method;
     o.polarity = Polarity::kLightOnDark;
@@ -104,7 +105,8 @@ TEST_CASE("binarize never writes into the image it is given", "[vision][binarize
   img(cv::Rect(20, 20, 30, 30)).setTo(220);
   const cv::Mat before = img.clone();
   for (auto polarity : {Polarity::kDarkOnLight, Polarity::kLightOnDark}) {
-    for (auto method : {ThresholdMethod::kAdaptive, ThresholdMethod::kOtsu, ThresholdMethod::kFixed}) {
+    for (auto method :
+         {ThresholdMethod::kAdaptive, ThresholdMethod::kOtsu, ThresholdMethod::kFixed}) {
       BinarizeOptions o;
       o.method = method;
       o.polarity = polarity;

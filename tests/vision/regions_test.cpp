@@ -43,7 +43,8 @@ Drawn drawL(double deg, bool mirrored) {
   cv::resize(big, coverage, cv::Size(400, 400), 0, 0, cv::INTER_AREA);
   coverage.convertTo(d.grey, CV_8U, -170.0 / 255.0, 220.0);
   const cv::Moments m = cv::moments(big, true);
-  d.centroid = cv::Point2d((m.m10 / m.m00 + 0.5) / kSuper - 0.5, (m.m01 / m.m00 + 0.5) / kSuper - 0.5);
+  d.centroid =
+      cv::Point2d((m.m10 / m.m00 + 0.5) / kSuper - 0.5, (m.m01 / m.m00 + 0.5) / kSuper - 0.5);
   d.axis_deg = 0.5 * std::atan2(2 * m.mu11, m.mu20 - m.mu02) * 180.0 / M_PI;
   return d;
 }
@@ -88,6 +89,33 @@ TEST_CASE("holes are counted and regions come largest first", "[vision][regions]
   CHECK(regions[0].area == Approx(M_PI * (2500 - 100 - 64)).epsilon(0.02));
 }
 
+// Regions are traced, not labelled: a region's pixels are what its boundary
+// encloses less its holes. A part lying in another's hole, or close enough
+// that their boxes overlap, must count for itself alone.
+TEST_CASE("a part in a hole and a close neighbour keep their own pixels", "[vision][regions]") {
+  cv::Mat ring(300, 300, CV_8UC1, cv::Scalar(0));
+  cv::circle(ring, {100, 100}, 50, cv::Scalar(255), cv::FILLED);
+  cv::circle(ring, {100, 100}, 30, cv::Scalar(0), cv::FILLED);
+  cv::Mat island(ring.size(), CV_8UC1, cv::Scalar(0));
+  cv::circle(island, {100, 100}, 12, cv::Scalar(255), cv::FILLED);
+  cv::Mat square(ring.size(), CV_8UC1, cv::Scalar(0));
+  square(cv::Rect(153, 70, 20, 20)).setTo(255);  // 3 px right of the ring's box
+  const cv::Mat img = ring | island | square;
+  cv::Mat grey;
+  img.convertTo(grey, CV_8U, -170.0 / 255.0, 220.0);
+  for (const bool use_grey : {false, true}) {
+    const auto regions = findRegions(img, {}, use_grey ? grey : cv::Mat());
+    REQUIRE(regions.size() == 3);
+    CHECK(regions[0].holes == 1);
+    CHECK(regions[0].area == Approx(cv::countNonZero(ring)).epsilon(1e-3));
+    CHECK(regions[0].centroid.x == Approx(100).margin(0.01));
+    // Largest first: the island (441 px), then the square (400 px).
+    CHECK(regions[1].area == Approx(cv::countNonZero(island)).epsilon(1e-3));
+    CHECK(regions[2].area == Approx(cv::countNonZero(square)).epsilon(1e-3));
+    CHECK(regions[2].bbox == cv::Rect(153, 70, 20, 20));
+  }
+}
+
 TEST_CASE("a disc has no elongation, a bar has a lot", "[vision][regions]") {
   cv::Mat img(300, 300, CV_8UC1, cv::Scalar(0));
   cv::circle(img, {80, 80}, 60, cv::Scalar(255), cv::FILLED);
@@ -103,9 +131,9 @@ TEST_CASE("a disc has no elongation, a bar has a lot", "[vision][regions]") {
 
 TEST_CASE("small regions and regions cut by the border are left out", "[vision][regions]") {
   cv::Mat img(200, 200, CV_8UC1, cv::Scalar(0));
-  img(cv::Rect(0, 50, 40, 40)).setTo(255);     // touches the left edge
-  img(cv::Rect(100, 100, 5, 5)).setTo(255);    // 25 px: noise
-  img(cv::Rect(120, 20, 30, 30)).setTo(255);   // a part
+  img(cv::Rect(0, 50, 40, 40)).setTo(255);    // touches the left edge
+  img(cv::Rect(100, 100, 5, 5)).setTo(255);   // 25 px: noise
+  img(cv::Rect(120, 20, 30, 30)).setTo(255);  // a part
   auto regions = findRegions(img);
   REQUIRE(regions.size() == 1);
   CHECK(regions[0].bbox == cv::Rect(120, 20, 30, 30));

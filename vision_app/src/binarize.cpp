@@ -72,16 +72,21 @@ cv::Mat widen(const cv::Mat& small, int width) {
     w1[static_cast<size_t>(x)] =
         static_cast<int>(std::lround((sx - x0[static_cast<size_t>(x)]) * 16));
   }
+  // The last column repeated once more: the right neighbour of every column
+  // exists, and past the last pixel centre the threshold stays level.
+  cv::Mat padded;
+  cv::copyMakeBorder(small, padded, 0, 0, 0, 1, cv::BORDER_REPLICATE);
   cv::Mat wide(small.rows, width, CV_16U);
-  for (int y = 0; y < small.rows; ++y) {
-    const uint16_t* in = small.ptr<uint16_t>(y);
-    uint16_t* out = wide.ptr<uint16_t>(y);
-    for (size_t x = 0; x < x0.size(); ++x) {
-      const int a = x0[x];
-      const int b = std::min(a + 1, small.cols - 1);
-      out[x] = static_cast<uint16_t>((in[a] * (16 - w1[x]) + in[b] * w1[x] + 8) >> 4);
+  cv::parallel_for_(cv::Range(0, small.rows), [&](const cv::Range& range) {
+    for (int y = range.start; y < range.end; ++y) {
+      const uint16_t* in = padded.ptr<uint16_t>(y);
+      uint16_t* out = wide.ptr<uint16_t>(y);
+      for (size_t x = 0; x < x0.size(); ++x) {
+        const int a = x0[x];
+        out[x] = static_cast<uint16_t>((in[a] * (16 - w1[x]) + in[a + 1] * w1[x] + 8) >> 4);
+      }
     }
-  }
+  });
   return wide;
 }
 

@@ -4,7 +4,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 namespace picksight::vision {
@@ -143,37 +145,96 @@ cv::Mat regionMask(const Region& region) {
   return mask;
 }
 
-std::complex<double> complexMoment(const Region& region, int k) {
+namespace {
+// sum_p C(k, p) S_p (i y)^(k-p) summed over the rows, S_p = sum_x w x^p of
+// the row: k + 1 products and sums a pixel instead of a complex power. The
+// order K a constant where it can be (the sums then stay in registers);
+// K = -1: the order `k` known only at run time.
+template <int K>
+std::complex<double> rowPowerSums(const Region& region, int k, double scale) {
+  using Sums =
+      std::conditional_t<(K < 0), std::vector<double>, std::array<double, (K < 0 ? 1 : K + 1)>>;
+  const int n = K < 0 ? k + 1 : K + 1;
+  const int order = n - 1;
+  Sums binomial{};
+  if constexpr (K < 0) binomial.resize(static_cast<size_t>(n));
+  binomial[0] = 1;
+  for (int p = 1; p < n; ++p) binomial[p] = binomial[p - 1] * (order - p + 1) / p;
   const cv::Mat& w = region.coverage;
-  if (w.empty() || region.area <= 0 || k < 0) return {0, 0};
-  const double scale = 1.0 / std::sqrt(region.area);
-  // (x + i y)^k = sum_p C(k, p) x^p (i y)^(k-p): per row, the real sums
-  // S_p = sum w x^p (k + 1 products and sums a pixel, instead of a complex
-  // power), then one complex sum over p with the row's (i y) powers.
-  std::vector<double> binomial(static_cast<size_t>(k) + 1, 1.0);
-  for (int p = 1; p <= k; ++p) binomial[p] = binomial[p - 1] * (k - p + 1) / p;
-  std::vector<double> row_sums(static_cast<size_t>(k) + 1);
   std::complex<double> sum(0, 0);
   for (int y = 0; y < w.rows; ++y) {
     const float* row = w.ptr<float>(y);
-    std::fill(row_sums.begin(), row_sums.end(), 0.0);
+    Sums sums{};
+    if constexpr (K < 0) sums.resize(static_cast<size_t>(n));
     bool any = false;
     for (int x = 0; x < w.cols; ++x) {
       if (row[x] <= 0) continue;
       any = true;
       const double dx = (region.coverage_origin.x + x - region.centroid.x) * scale;
       double term = row[x];
-      for (int p = 0; p <= k; ++p) {
-        row_sums[p] += term;
+      for (int p = 0; p < n; ++p) {
+        sums[p] += term;
         term *= dx;
       }
     }
     if (!any) continue;
     const std::complex<double> iy(0, (region.coverage_origin.y + y - region.centroid.y) * scale);
-    // Horner in (i y) over p = k..0: sum_p C(k, p) S_p (i y)^(k-p).
+    // Horner in (i y): the p = 0 sum takes (i y)^k.
     std::complex<double> acc(0, 0);
-    for (int p = 0; p <= k; ++p) acc = acc * iy + binomial[p] * row_sums[p];
+    for (int p = 0; p < n; ++p) acc = acc * iy + binomial[p] * sums[p];
     sum += acc;
+  }
+  return sum;
+}
+}  // namespace
+
+std::complex<double> complexMoment(const Region& region, int k) {
+  const cv::Mat& w = region.coverage;
+  if (w.empty() || region.area <= 0 || k < 0) return {0, 0};
+  const double scale = 1.0 / std::sqrt(region.area);
+  std::complex<double> sum;
+  switch (k) {
+    case 0:
+      sum = rowPowerSums<0>(region, k, scale);
+      break;
+    case 1:
+      sum = rowPowerSums<1>(region, k, scale);
+      break;
+    case 2:
+      sum = rowPowerSums<2>(region, k, scale);
+      break;
+    case 3:
+      sum = rowPowerSums<3>(region, k, scale);
+      break;
+    case 4:
+      sum = rowPowerSums<4>(region, k, scale);
+      break;
+    case 5:
+      sum = rowPowerSums<5>(region, k, scale);
+      break;
+    case 6:
+      sum = rowPowerSums<6>(region, k, scale);
+      break;
+    case 7:
+      sum = rowPowerSums<7>(region, k, scale);
+      break;
+    case 8:
+      sum = rowPowerSums<8>(region, k, scale);
+      break;
+    case 9:
+      sum = rowPowerSums<9>(region, k, scale);
+      break;
+    case 10:
+      sum = rowPowerSums<10>(region, k, scale);
+      break;
+    case 11:
+      sum = rowPowerSums<11>(region, k, scale);
+      break;
+    case 12:
+      sum = rowPowerSums<12>(region, k, scale);
+      break;
+    default:
+      sum = rowPowerSums<-1>(region, k, scale);
   }
   return sum * scale * scale;
 }

@@ -79,7 +79,7 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, cons
   return true;
 }
 
-// Grey-level coverage moments of region `label` (see findRegions). Returns
+// Grey-level coverage moments of one region (see findRegions). Returns
 // false, leaving the moments alone, when the grey levels cannot be trusted.
 //
 // Light falls unevenly, and a part reflects a fixed fraction of the light
@@ -127,14 +127,32 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
     return lit ? static_cast<float>(g) / b : static_cast<float>(g) - b;
   };
 
+  // First pass: the level of every pixel that counts (the region and its
+  // blurred edge, never a neighbour's pixels), kept in the coverage buffer
+  // so that each is divided once; the interior's mean level on the way.
+  cv::Mat coverage(box.size(), CV_32F);
+  // Row by row, the pixels that count as one mask (1 = counts).
+  cv::Mat counted(box.size(), CV_8UC1);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* nr = near.ptr<uint8_t>(y);
+    const uint8_t* st = set.ptr<uint8_t>(y);
+    const uint8_t* o = own.ptr<uint8_t>(y);
+    uint8_t* k = counted.ptr<uint8_t>(y);
+    for (int x = 0; x < w; ++x) k[x] = nr[x] && (!st[x] || o[x]);
+  }
   double level_sum = 0;
   int interior_count = 0;
   for (int y = 0; y < h; ++y) {
     const uint8_t* g = grey_box.ptr<uint8_t>(y);
     const uint8_t* in = interior.ptr<uint8_t>(y);
+    const uint8_t* k = counted.ptr<uint8_t>(y);
+    float* c = coverage.ptr<float>(y);
+    const double row_background = plane[0] + plane[2] * y;
     for (int x = 0; x < w; ++x) {
+      if (!k[x]) continue;
+      c[x] = level(g[x], static_cast<float>(row_background + plane[1] * x));
       if (!in[x]) continue;
-      level_sum += level(g[x], background(x, y));
+      level_sum += c[x];
       ++interior_count;
     }
   }
@@ -146,23 +164,17 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
   const float scale = static_cast<float>(lit ? -1.0 / contrast : 1.0 / contrast);
   const float offset = static_cast<float>(lit ? 1.0 / contrast : 0.0);
 
-  cv::Mat coverage(box.size(), CV_32F);
   double m00 = 0, m10 = 0, m01 = 0, m20 = 0, m11 = 0, m02 = 0, m30 = 0, m21 = 0, m12 = 0, m03 = 0;
   for (int y = 0; y < h; ++y) {
-    const uint8_t* g = grey_box.ptr<uint8_t>(y);
-    const uint8_t* o = own.ptr<uint8_t>(y);
-    const uint8_t* nr = near.ptr<uint8_t>(y);
-    const uint8_t* st = set.ptr<uint8_t>(y);
+    const uint8_t* k = counted.ptr<uint8_t>(y);
     float* c = coverage.ptr<float>(y);
     double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     for (int x = 0; x < w; ++x) {
-      // Only the region and its blurred edge count, never a neighbour's pixels.
-      if (!nr[x] || (st[x] && !o[x])) {
+      if (!k[x]) {
         c[x] = 0;
         continue;
       }
-      const float v =
-          std::min(std::max(scale * level(g[x], background(x, y)) + offset, 0.0f), 1.0f);
+      const float v = std::min(std::max(scale * c[x] + offset, 0.0f), 1.0f);
       c[x] = v;
       const double xv = static_cast<double>(x) * v;
       const double xxv = xv * x;

@@ -29,6 +29,8 @@ struct Match {
 // region that matches a model as a whole holds one part, the model that
 // verifies best; a region that matches none is searched for parts that
 // touch (one merged blob) with the boundary models (see locateInBlob).
+// Regions are searched on OpenCV's worker threads (cv::setNumThreads); the
+// result does not depend on their number.
 std::vector<Match> recognize(const std::vector<Region>& regions,
                              const std::vector<const PartModel*>& models);
 

@@ -47,6 +47,9 @@ struct RegionOptions {
 // the part's own level and the background's around it. A binary mask alone
 // quantizes every edge pixel to 0 or 1, which biases the centroid by tenths
 // of a pixel when edges run along a pixel diagonal.
+//
+// Regions are measured on OpenCV's worker threads (cv::setNumThreads); the
+// result does not depend on their number.
 std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& options = {},
                                 const cv::Mat& grey = cv::Mat());
 
