@@ -3,12 +3,15 @@
 // squares outlier rejection.
 #include "picksight/calibration/robot_camera.hpp"
 
+#include "picksight/common/angles.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace picksight::calibration {
 namespace {
+using picksight::signedDeg;
 constexpr double kDeg = 180.0 / M_PI;
 // Points closer together than this (mm) along their spread's minor axis are
 // taken as lying on one line: rotation and handedness are then unobservable.
@@ -16,12 +19,6 @@ constexpr double kMinSpreadMm = 1.0;
 
 cv::Point2d mirror(cv::Point2d p, bool mirrored) { return mirrored ? cv::Point2d(p.x, -p.y) : p; }
 
-double normalizeSigned(double deg) {
-  double d = std::fmod(deg, 360.0);
-  if (d <= -180) d += 360;
-  if (d > 180) d -= 360;
-  return d;
-}
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -64,7 +61,7 @@ RigidTransform leastSquares(const std::vector<PointPair>& pts, const std::vector
   const double theta = std::atan2(sxy - syx, sxx + syy);
   RigidTransform t;
   t.mirrored = mirrored;
-  t.rz_deg = normalizeSigned(theta * kDeg);
+  t.rz_deg = signedDeg(theta * kDeg);
   const double c = std::cos(theta), s = std::sin(theta);
   t.dx = cr_mean.x - (c * cv_mean.x - s * cv_mean.y);
   t.dy = cr_mean.y - (s * cv_mean.x + c * cv_mean.y);
@@ -136,7 +133,7 @@ RigidTransform geometric(const std::vector<PointPair>& pts, const std::vector<bo
   }
   RigidTransform t;
   t.mirrored = mirrored;
-  t.rz_deg = normalizeSigned(std::atan2(sy, sx) * kDeg);
+  t.rz_deg = signedDeg(std::atan2(sy, sx) * kDeg);
   t.dx = origin.x;
   t.dy = origin.y;
   return t;

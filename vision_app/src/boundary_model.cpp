@@ -2,11 +2,14 @@
 // segments, corners between primitives, and pose verification on a distance map.
 #include "picksight/vision/boundary_model.hpp"
 
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+
+#include "picksight/common/angles.hpp"
 
 namespace picksight::vision {
 namespace {
@@ -16,12 +19,7 @@ constexpr double kMaxRadiusFactor = 4.0;
 
 double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kDeg; }
 
-double wrap180(double deg) {
-  deg = std::fmod(deg, 360.0);
-  if (deg > 180) deg -= 360;
-  if (deg <= -180) deg += 360;
-  return deg;
-}
+using picksight::signedDeg;
 
 cv::Point2d unit(cv::Point2d v) {
   const double n = std::hypot(v.x, v.y);
@@ -102,7 +100,7 @@ double sweepOf(const std::vector<cv::Point2d>& pts, size_t first, size_t last, c
   double previous = angleOf(pts[first % pts.size()] - centre);
   for (size_t i = first + 1; i <= last; ++i) {
     const double a = angleOf(pts[i % pts.size()] - centre);
-    sweep += wrap180(a - previous);
+    sweep += signedDeg(a - previous);
     previous = a;
   }
   return sweep;
@@ -199,7 +197,7 @@ std::vector<Primitive> fitPrimitives(const std::vector<cv::Point2d>& pts, double
   for (size_t j = 0; j < m; ++j) {
     const cv::Point2d in = pts[v[j]] - pts[v[(j + m - 1) % m]];
     const cv::Point2d out_dir = pts[v[(j + 1) % m]] - pts[v[j]];
-    const double turn = std::abs(wrap180(angleOf(out_dir) - angleOf(in)));
+    const double turn = std::abs(signedDeg(angleOf(out_dir) - angleOf(in)));
     if (turn > sharpest) {
       sharpest = turn;
       start = j;
@@ -290,7 +288,7 @@ std::vector<Corner> findCorners(const std::vector<BoundaryLoop>& loops, double c
     for (size_t i = 0; i < n; ++i) {
       const Primitive& a = prims[i];
       const Primitive& b = prims[(i + 1) % n];
-      winding += wrap180(angleOf(b.startDirection()) - angleOf(a.endDirection()));
+      winding += signedDeg(angleOf(b.startDirection()) - angleOf(a.endDirection()));
       if (a.kind == PrimitiveKind::kArc) winding += a.sweep_deg;
     }
     for (size_t i = 0; i < n; ++i) {
@@ -306,7 +304,7 @@ std::vector<Corner> findCorners(const std::vector<BoundaryLoop>& loops, double c
       c.at = 0.5 * (a.end + b.start);
       c.direction_in_deg = angleOf(a.endDirection());
       c.direction_out_deg = angleOf(b.startDirection());
-      const double turn = wrap180(c.direction_out_deg - c.direction_in_deg);
+      const double turn = signedDeg(c.direction_out_deg - c.direction_in_deg);
       // Turn ranges widen for short edges, whose directions are less sure.
       const double slack =
           8.0 + std::atan2(2 * conformity, std::min(a.length(), b.length())) / kDeg;

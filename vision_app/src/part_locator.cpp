@@ -3,11 +3,14 @@
 // them, the grey-level edges refine them, and the best are accepted first.
 #include "picksight/vision/part_locator.hpp"
 
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <optional>
+
+#include "picksight/common/angles.hpp"
 
 namespace picksight::vision {
 namespace {
@@ -41,12 +44,7 @@ constexpr double kCornerClearancePx = 2.0;
 
 double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kDeg; }
 
-double wrap180(double deg) {
-  deg = std::fmod(deg, 360.0);
-  if (deg > 180) deg -= 360;
-  if (deg <= -180) deg += 360;
-  return deg;
-}
+using picksight::signedDeg;
 
 double normalizeDeg(double deg) {
   double d = std::fmod(deg, 360.0);
@@ -112,7 +110,7 @@ void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>
         if (cv::norm(b.start - a.end) > kMaxChamferPx) continue;
         const cv::Point2d in = a.endDirection();
         const cv::Point2d out = b.startDirection();
-        const double turn = wrap180(angleOf(out) - angleOf(in));
+        const double turn = signedDeg(angleOf(out) - angleOf(in));
         if (std::abs(turn) < kMinCornerTurnDeg) continue;
         const cv::Point2d u = out - in;
         if (std::hypot(u.x, u.y) < 1e-6) continue;

@@ -12,6 +12,14 @@ inline double normalizeDeg(double deg) {
   return d >= 360.0 ? 0.0 : d;
 }
 
+// Into (-180, 180]: a turn or a difference of directions.
+inline double signedDeg(double deg) {
+  double d = std::fmod(deg, 360.0);
+  if (d > 180.0) d -= 360.0;
+  if (d <= -180.0) d += 360.0;
+  return d;
+}
+
 // Smallest absolute difference between two angles, modulo `period` degrees
 // (360 for a directed part, 180 for one whose direction is ambiguous, 90 for a
 // square...). A period of 0 means no angle exists: the difference is 0.
