@@ -3,6 +3,8 @@
 // edge fit on its own.
 #include <catch2/catch.hpp>
 
+#include "recognition_support.hpp"
+
 #include <map>
 
 #include "picksight/common/angles.hpp"
@@ -26,31 +28,16 @@ ps::SceneOptions scene(int parts, uint64_t seed, std::vector<std::string> types,
   return o;
 }
 
-struct Trained {
-  PartModel model;
-  double truth_angle = 0;
-};
+using picksight::test::nearest;
+using picksight::test::Trained;
 
 Trained train(const std::string& type, int id) {
-  const ps::SceneRenderer s(scene(1, 300 + static_cast<uint64_t>(id), {type}, false));
-  auto outcome = trainModel(s.render(0), id, type);
-  INFO(type << ": " << outcome.error);
-  REQUIRE(outcome.ok);
-  return {outcome.model, s.truth()[0].angle_deg};
+  return picksight::test::trainOn(scene(1, 300 + static_cast<uint64_t>(id), {type}, false), id, type);
 }
 
 std::vector<Match> recognizeScene(const ps::SceneRenderer& s,
                                   const std::vector<const PartModel*>& models) {
-  const cv::Mat grey = s.render(3);
-  return recognize(findRegions(binarize(grey, {}), {}, grey), models);
-}
-
-const Match* nearest(const std::vector<Match>& matches, const ps::PartTruth& t) {
-  const Match* best = nullptr;
-  for (const auto& m : matches) {
-    if (std::hypot(m.centroid.x - t.x, m.centroid.y - t.y) < 5) best = &m;
-  }
-  return best;
+  return picksight::test::recognizeFrame(s, 3, models);
 }
 
 // A scene whose two parts touch (the generator may fail to bring a pair into

@@ -3,6 +3,8 @@
 // trained pose, boundary primitives.
 #include <catch2/catch.hpp>
 
+#include "recognition_support.hpp"
+
 #include <map>
 #include <opencv2/imgproc.hpp>
 
@@ -28,31 +30,16 @@ ps::SceneOptions scene(int width, int height, int parts, uint64_t seed,
   return o;
 }
 
-struct Trained {
-  PartModel model;
-  double truth_angle = 0;
-};
+using picksight::test::nearest;
+using picksight::test::Trained;
 
 Trained train(const std::string& type, int id) {
-  const ps::SceneRenderer s(scene(400, 400, 1, 77 + static_cast<uint64_t>(id), {type}));
-  auto outcome = trainModel(s.render(0), id, type);
-  INFO(type << ": " << outcome.error);
-  REQUIRE(outcome.ok);
-  return {outcome.model, s.truth()[0].angle_deg};
+  return picksight::test::trainOn(scene(400, 400, 1, 77 + static_cast<uint64_t>(id), {type}), id, type);
 }
 
 std::vector<Match> recognizeScene(const ps::SceneRenderer& s,
                                   const std::vector<const PartModel*>& models) {
-  const cv::Mat grey = s.render(1);
-  return recognize(findRegions(binarize(grey, {}), {}, grey), models);
-}
-
-const Match* nearest(const std::vector<Match>& matches, const ps::PartTruth& t) {
-  const Match* best = nullptr;
-  for (const auto& m : matches) {
-    if (std::hypot(m.centroid.x - t.x, m.centroid.y - t.y) < 5) best = &m;
-  }
-  return best;
+  return picksight::test::recognizeFrame(s, 1, models);
 }
 }  // namespace
 

@@ -1,0 +1,49 @@
+// Helpers shared by the recognition tests: train a model on a synthetic
+// part, recognize a synthetic scene, find the match for a truth part.
+#pragma once
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "picksight/synthetic/scene.hpp"
+#include "picksight/vision/binarize.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/recognizer.hpp"
+#include "picksight/vision/regions.hpp"
+
+namespace picksight::test {
+
+struct Trained {
+  vision::PartModel model;
+  double truth_angle = 0;
+};
+
+// Trains type id `id` on frame 0 of a one-part scene made with `options`.
+inline Trained trainOn(const synthetic::SceneOptions& options, int id, const std::string& type) {
+  const synthetic::SceneRenderer s(options);
+  auto outcome = vision::trainModel(s.render(0), id, type);
+  INFO(type << ": " << outcome.error);
+  REQUIRE(outcome.ok);
+  return {outcome.model, s.truth()[0].angle_deg};
+}
+
+// The whole recognition (adaptive binarization, regions, models) of one frame.
+inline std::vector<vision::Match> recognizeFrame(const synthetic::SceneRenderer& s, uint64_t frame,
+                                                 const std::vector<const vision::PartModel*>& models) {
+  const cv::Mat grey = s.render(frame);
+  return vision::recognize(vision::findRegions(vision::binarize(grey, {}), {}, grey), models);
+}
+
+// The match within 5 px of a truth part, or nullptr.
+inline const vision::Match* nearest(const std::vector<vision::Match>& matches, const synthetic::PartTruth& t) {
+  const vision::Match* best = nullptr;
+  for (const auto& m : matches) {
+    if (std::hypot(m.centroid.x - t.x, m.centroid.y - t.y) < 5) best = &m;
+  }
+  return best;
+}
+
+}  // namespace picksight::test
