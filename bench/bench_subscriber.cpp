@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
       zmq::pollitem_t item{sub.handle(), 0, ZMQ_POLLIN, 0};
       if (zmq::poll(&item, 1, std::chrono::milliseconds(100)) == 0) continue;
       zmq::message_t topic, stamp, payload;
-      if (!sub.recv(topic) || !sub.recv(stamp) || !sub.recv(payload) || stamp.size() != 16) continue;
+      if (!sub.recv(topic) || !sub.recv(stamp) || !sub.recv(payload) || stamp.size() != 16)
+        continue;
       uint64_t seq = 0, sent_ns = 0;
       std::memcpy(&seq, stamp.data(), 8);
       std::memcpy(&sent_ns, static_cast<const char*>(stamp.data()) + 8, 8);
@@ -79,9 +80,13 @@ int main(int argc, char** argv) {
     lost = sub.framesLost();
   }
   std::sort(latency_ms.begin(), latency_ms.end());
-  const double fps = received > 1 ? (received - 1) * 1e9 / static_cast<double>(last_ns - first_ns) : 0;
+  const double fps =
+      received > 1 ? (received - 1) * 1e9 / static_cast<double>(last_ns - first_ns) : 0;
   const double median = latency_ms.empty() ? 0 : latency_ms[latency_ms.size() / 2];
-  const double p99 = latency_ms.empty() ? 0 : latency_ms[std::min(latency_ms.size() - 1, latency_ms.size() * 99 / 100)];
+  const double p99 =
+      latency_ms.empty()
+          ? 0
+          : latency_ms[std::min(latency_ms.size() - 1, latency_ms.size() * 99 / 100)];
   std::printf("result %llu %llu %.2f %.3f %.3f\n", static_cast<unsigned long long>(received),
               static_cast<unsigned long long>(lost), fps, median, p99);
   return 0;

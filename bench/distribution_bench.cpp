@@ -5,8 +5,8 @@
 // frames lost and one-way latency (median and 99th percentile).
 #include <unistd.h>
 
-#include <cstdio>
 #include <atomic>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <thread>
@@ -35,23 +35,27 @@ struct Summary {
 };
 
 // Starts `count` subscribers, waits until each subscribed, lets them run.
-Summary runSubscribers(const std::string& dir, const std::string& endpoint, int count, double seconds,
-                       bool bare) {
+Summary runSubscribers(const std::string& dir, const std::string& endpoint, int count,
+                       double seconds, bool bare) {
   std::vector<std::unique_ptr<picksight::Subprocess>> subs;
   for (int i = 0; i < count; ++i) {
-    std::vector<std::string> argv = {dir + "/picksight-bench-subscriber", "--frames", endpoint, "--camera", "cam0",
-                                     "--seconds", picksight::formatFixed(seconds, 1)};
+    std::vector<std::string> argv = {
+        dir + "/picksight-bench-subscriber", "--frames", endpoint, "--camera", "cam0", "--seconds",
+        picksight::formatFixed(seconds, 1)};
     if (bare) argv.push_back("--bare");
     subs.push_back(std::make_unique<picksight::Subprocess>(argv));
     subs.back()->waitForLine("subscribed", 5s);
   }
   Summary s;
   for (auto& p : subs) {
-    auto line = p->waitForLine("result ", std::chrono::milliseconds(static_cast<int>(seconds * 1000) + 10000));
+    auto line = p->waitForLine("result ",
+                               std::chrono::milliseconds(static_cast<int>(seconds * 1000) + 10000));
     if (!line) continue;
     unsigned long long received = 0, lost = 0;
     double fps = 0, median = 0, p99 = 0;
-    if (std::sscanf(line->c_str(), "%llu %llu %lf %lf %lf", &received, &lost, &fps, &median, &p99) != 5) continue;
+    if (std::sscanf(line->c_str(), "%llu %llu %lf %lf %lf", &received, &lost, &fps, &median,
+                    &p99) != 5)
+      continue;
     s.received += received;
     s.lost += lost;
     s.fps_min = std::min(s.fps_min, fps);
@@ -63,8 +67,8 @@ Summary runSubscribers(const std::string& dir, const std::string& endpoint, int 
 }
 
 // A bare PUB sending 1920x1080 payloads at `fps` until stopped.
-void barePublisher(zmq::context_t& context, const std::string& endpoint, double fps, std::atomic<bool>& stop,
-                   std::string* bound) {
+void barePublisher(zmq::context_t& context, const std::string& endpoint, double fps,
+                   std::atomic<bool>& stop, std::string* bound) {
   zmq::socket_t pub(context, zmq::socket_type::pub);
   pub.set(zmq::sockopt::sndhwm, 12);
   pub.bind(endpoint);
@@ -95,11 +99,13 @@ void row(const char* what, int n, const Summary& s) {
 
 int main(int argc, char** argv) {
   double seconds = 5;
-  if (argc == 3 && std::string(argv[1]) == "--seconds") seconds = picksight::parseDouble(argv[2]).value_or(5);
+  if (argc == 3 && std::string(argv[1]) == "--seconds")
+    seconds = picksight::parseDouble(argv[2]).value_or(5);
   const std::string dir = binDir();
-  std::printf("Distribution benchmark: 1920x1080 mono8 at 60 fps, %.0f s per run, TCP loopback\n", seconds);
-  std::printf("  %-28s %3s %10s %10s %8s %10s %10s\n", "publisher", "subs", "fps mean", "fps min", "lost",
-              "lat med ms", "lat p99 ms");
+  std::printf("Distribution benchmark: 1920x1080 mono8 at 60 fps, %.0f s per run, TCP loopback\n",
+              seconds);
+  std::printf("  %-28s %3s %10s %10s %8s %10s %10s\n", "publisher", "subs", "fps mean", "fps min",
+              "lost", "lat med ms", "lat p99 ms");
   for (int n : {1, 4, 8}) {
     {
       zmq::context_t context;
@@ -114,8 +120,9 @@ int main(int argc, char** argv) {
     }
     {
       picksight::Subprocess server({dir + "/picksight-video-server", "--source",
-                                    "cam0=synthetic:width=1920,height=1080,parts=20", "--fps", "60", "--frames",
-                                    "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"});
+                                    "cam0=synthetic:width=1920,height=1080,parts=20", "--fps", "60",
+                                    "--frames", "tcp://127.0.0.1:*", "--control",
+                                    "tcp://127.0.0.1:*"});
       auto frames = server.waitForLine("frames ", 10s);
       if (!frames) return 1;
       const Summary s = runSubscribers(dir, *frames, n, seconds, false);

@@ -16,7 +16,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (!config) {
-    std::cerr << "picksight-video-server: " << config.error().message << "\n\n" << video::serverUsage();
+    std::cerr << "picksight-video-server: " << config.error().message << "\n\n"
+              << video::serverUsage();
     return 2;
   }
   // Block the stop signals in every thread; the main thread waits for them.

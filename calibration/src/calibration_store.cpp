@@ -5,8 +5,8 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cerrno>
 #include <sys/stat.h>
+#include <cerrno>
 
 #include "picksight/common/atomic_file.hpp"
 
@@ -30,17 +30,18 @@ std::string CalibrationStore::serialize() const {
   out << YAML::Key << "next_id" << YAML::Value << next_id_;
   out << YAML::Key << "points" << YAML::Value << YAML::BeginSeq;
   for (const auto& [id, p] : points_) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << id << YAML::Key << "vision_x"
-        << YAML::Value << p.vision.x << YAML::Key << "vision_y" << YAML::Value << p.vision.y << YAML::Key
-        << "robot_x" << YAML::Value << p.robot.x << YAML::Key << "robot_y" << YAML::Value << p.robot.y
-        << YAML::EndMap;
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << id << YAML::Key
+        << "vision_x" << YAML::Value << p.vision.x << YAML::Key << "vision_y" << YAML::Value
+        << p.vision.y << YAML::Key << "robot_x" << YAML::Value << p.robot.x << YAML::Key
+        << "robot_y" << YAML::Value << p.robot.y << YAML::EndMap;
   }
   out << YAML::EndSeq;
   if (transform_) {
     const auto& t = transform_->transform;
     out << YAML::Key << "transform" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "dx" << YAML::Value << t.dx << YAML::Key << "dy" << YAML::Value << t.dy;
-    out << YAML::Key << "rz_deg" << YAML::Value << t.rz_deg << YAML::Key << "mirrored" << YAML::Value << t.mirrored;
+    out << YAML::Key << "rz_deg" << YAML::Value << t.rz_deg << YAML::Key << "mirrored"
+        << YAML::Value << t.mirrored;
     out << YAML::Key << "method" << YAML::Value << methodName(transform_->method);
     out << YAML::Key << "rms" << YAML::Value << transform_->rms;
     out << YAML::Key << "inliers" << YAML::Value << transform_->inliers;
@@ -84,7 +85,8 @@ Result<void> CalibrationStore::load() {
     loaded.next_id_ = root["next_id"] ? root["next_id"].as<int>() : 1;
     for (const auto& p : root["points"]) {
       const int id = p["id"].as<int>();
-      if (id <= 0 || loaded.points_.count(id)) throw std::runtime_error("bad or repeated point id " + std::to_string(id));
+      if (id <= 0 || loaded.points_.count(id))
+        throw std::runtime_error("bad or repeated point id " + std::to_string(id));
       loaded.points_[id] = PointPair{{number(p, "vision_x"), number(p, "vision_y")},
                                      {number(p, "robot_x"), number(p, "robot_y")}};
       loaded.next_id_ = std::max(loaded.next_id_, id + 1);
@@ -100,8 +102,10 @@ Result<void> CalibrationStore::load() {
       loaded.transform_ = r;
     }
     if (const auto s = root["scale"]) {
-      PixelScale scale{number(s, "mm_per_px_x"), number(s, "mm_per_px_y"), s["skew_deg"] ? number(s, "skew_deg") : 0};
-      if (!(scale.mm_per_px_x > 0) || !(scale.mm_per_px_y > 0)) throw std::runtime_error("scale must be positive");
+      PixelScale scale{number(s, "mm_per_px_x"), number(s, "mm_per_px_y"),
+                       s["skew_deg"] ? number(s, "skew_deg") : 0};
+      if (!(scale.mm_per_px_x > 0) || !(scale.mm_per_px_y > 0))
+        throw std::runtime_error("scale must be positive");
       loaded.scale_ = scale;
     }
     if (const auto l = root["lens"]) {
@@ -111,7 +115,8 @@ Result<void> CalibrationStore::load() {
       if (k.size() != 9) throw std::runtime_error("lens camera_matrix must have 9 values");
       for (int i = 0; i < 9; ++i) lens.camera_matrix(i / 3, i % 3) = k[static_cast<size_t>(i)];
       lens.distortion = l["distortion"].as<std::vector<double>>();
-      if (lens.distortion.size() < 4) throw std::runtime_error("lens distortion needs at least 4 values");
+      if (lens.distortion.size() < 4)
+        throw std::runtime_error("lens distortion needs at least 4 values");
       lens.rms_reprojection_px = number(l, "rms_reprojection_px");
       lens.views = l["views"] ? l["views"].as<int>() : 0;
       loaded.lens_ = lens;

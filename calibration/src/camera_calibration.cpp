@@ -27,16 +27,18 @@ Result<PixelScale> scaleFromCircle(const cv::Moments& m, double radius_mm) {
 std::vector<cv::Point2d> LensModel::undistort(const std::vector<cv::Point2d>& pixels) const {
   if (pixels.empty()) return {};
   std::vector<cv::Point2d> out;
-  cv::undistortPoints(pixels, out, cv::Mat(camera_matrix), distortion, cv::noArray(), cv::Mat(camera_matrix));
+  cv::undistortPoints(pixels, out, cv::Mat(camera_matrix), distortion, cv::noArray(),
+                      cv::Mat(camera_matrix));
   return out;
 }
 
-Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views, const ChessboardOptions& options,
-                                      std::vector<int>* skipped) {
+Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views,
+                                      const ChessboardOptions& options, std::vector<int>* skipped) {
   std::vector<cv::Point3f> board;
   for (int y = 0; y < options.inner_corners.height; ++y) {
     for (int x = 0; x < options.inner_corners.width; ++x) {
-      board.emplace_back(static_cast<float>(x * options.square_mm), static_cast<float>(y * options.square_mm), 0.f);
+      board.emplace_back(static_cast<float>(x * options.square_mm),
+                         static_cast<float>(y * options.square_mm), 0.f);
     }
   }
   std::vector<std::vector<cv::Point3f>> object_points;
@@ -50,8 +52,9 @@ Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views, const C
       continue;
     }
     std::vector<cv::Point2f> corners;
-    const bool found = cv::findChessboardCorners(
-        grey, options.inner_corners, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
+    const bool found =
+        cv::findChessboardCorners(grey, options.inner_corners, corners,
+                                  cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
     if (!found) {
       if (skipped) skipped->push_back(static_cast<int>(i));
       continue;
@@ -71,7 +74,8 @@ Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views, const C
   std::vector<cv::Mat> rvecs, tvecs;
   const int flags = options.fix_aspect_ratio ? cv::CALIB_FIX_ASPECT_RATIO : 0;
   LensModel model;
-  model.rms_reprojection_px = cv::calibrateCamera(object_points, image_points, size, k, dist, rvecs, tvecs, flags);
+  model.rms_reprojection_px =
+      cv::calibrateCamera(object_points, image_points, size, k, dist, rvecs, tvecs, flags);
   model.image_size = size;
   model.camera_matrix = cv::Matx33d(k);
   dist.reshape(1, 1).copyTo(model.distortion);
@@ -93,21 +97,26 @@ Result<LensModel> lensModelFromYaml(const std::string& text) {
   try {
     cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
     if (!fs.isOpened()) return makeError(1, "not a YAML document");
-    if (static_cast<int>(fs["format_version"]) != 1) return makeError(1, "format_version must be 1");
+    if (static_cast<int>(fs["format_version"]) != 1)
+      return makeError(1, "format_version must be 1");
     LensModel m;
-    m.image_size = cv::Size(static_cast<int>(fs["image_width"]), static_cast<int>(fs["image_height"]));
+    m.image_size =
+        cv::Size(static_cast<int>(fs["image_width"]), static_cast<int>(fs["image_height"]));
     cv::Mat k;
     cv::Mat d;
     fs["camera_matrix"] >> k;
     fs["distortion_coefficients"] >> d;
-    if (k.rows != 3 || k.cols != 3 || k.type() != CV_64F) return makeError(1, "camera_matrix must be 3x3");
-    if (d.total() < 4 || d.total() > 14) return makeError(1, "distortion_coefficients must have 4 to 14 values");
+    if (k.rows != 3 || k.cols != 3 || k.type() != CV_64F)
+      return makeError(1, "camera_matrix must be 3x3");
+    if (d.total() < 4 || d.total() > 14)
+      return makeError(1, "distortion_coefficients must have 4 to 14 values");
     m.camera_matrix = cv::Matx33d(k);
     d.reshape(1, 1).convertTo(d, CV_64F);
     d.copyTo(m.distortion);
     m.rms_reprojection_px = static_cast<double>(fs["rms_reprojection_px"]);
     m.views = static_cast<int>(fs["views"]);
-    if (m.image_size.width <= 0 || m.image_size.height <= 0) return makeError(1, "image size missing");
+    if (m.image_size.width <= 0 || m.image_size.height <= 0)
+      return makeError(1, "image size missing");
     return m;
   } catch (const cv::Exception& e) {
     return makeError(1, std::string("unreadable lens model: ") + e.what());

@@ -19,7 +19,6 @@ constexpr double kMinSpreadMm = 1.0;
 
 cv::Point2d mirror(cv::Point2d p, bool mirrored) { return mirrored ? cv::Point2d(p.x, -p.y) : p; }
 
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
@@ -37,7 +36,8 @@ std::vector<double> squaredResiduals(const RigidTransform& t, const std::vector<
 }
 
 // Least squares over the points flagged in `use` (2D Kabsch).
-RigidTransform leastSquares(const std::vector<PointPair>& pts, const std::vector<bool>& use, bool mirrored) {
+RigidTransform leastSquares(const std::vector<PointPair>& pts, const std::vector<bool>& use,
+                            bool mirrored) {
   cv::Point2d cv_sum(0, 0), cr_sum(0, 0);
   int n = 0;
   for (size_t i = 0; i < pts.size(); ++i) {
@@ -74,8 +74,8 @@ RigidTransform leastSquares(const std::vector<PointPair>& pts, const std::vector
 // two candidates; the right ones cluster at the origin. The rotation then
 // follows from each point's bearing from that origin in both frames (the
 // law of cosines in the paper; bearings here).
-RigidTransform geometric(const std::vector<PointPair>& pts, const std::vector<bool>& use, bool mirrored,
-                         double cluster_radius) {
+RigidTransform geometric(const std::vector<PointPair>& pts, const std::vector<bool>& use,
+                         bool mirrored, double cluster_radius) {
   std::vector<cv::Point2d> candidates;
   std::vector<std::pair<cv::Point2d, cv::Point2d>> pairs;
   for (size_t i = 0; i < pts.size(); ++i) {
@@ -161,7 +161,8 @@ std::vector<bool> findInliers(const std::vector<PointPair>& pts, bool* mirrored_
   *mirrored_out = best.mirrored;
   // Rousseeuw's scale estimate with its small-sample correction.
   const size_t n = pts.size();
-  const double scale = 1.4826 * (1.0 + 5.0 / static_cast<double>(std::max<size_t>(n, 3) - 2)) * std::sqrt(best_median);
+  const double scale = 1.4826 * (1.0 + 5.0 / static_cast<double>(std::max<size_t>(n, 3) - 2)) *
+                       std::sqrt(best_median);
   // Below a tenth of a millimetre the scale is noise in the noise: never cut
   // tighter than that.
   const double cut = std::max(2.5 * scale, 0.1);
@@ -176,8 +177,8 @@ std::vector<bool> findInliers(const std::vector<PointPair>& pts, bool* mirrored_
   return use;
 }
 
-CalibrationResult evaluate(const RigidTransform& t, Method method, const std::vector<PointPair>& pts,
-                           const std::vector<bool>& use) {
+CalibrationResult evaluate(const RigidTransform& t, Method method,
+                           const std::vector<PointPair>& pts, const std::vector<bool>& use) {
   CalibrationResult r;
   r.transform = t;
   r.method = method;
@@ -210,16 +211,20 @@ double RigidTransform::applyToAngleDeg(double vision_deg) const {
 
 const char* methodName(Method method) {
   switch (method) {
-    case Method::kGeometric: return "geometric";
-    case Method::kLeastSquares: return "lsq";
-    case Method::kBest: return "best";
+    case Method::kGeometric:
+      return "geometric";
+    case Method::kLeastSquares:
+      return "lsq";
+    case Method::kBest:
+      return "best";
   }
   return "?";
 }
 
 Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method method) {
   if (points.size() < 3) {
-    return makeError(kTooFewPoints, "need at least 3 points, have " + std::to_string(points.size()));
+    return makeError(kTooFewPoints,
+                     "need at least 3 points, have " + std::to_string(points.size()));
   }
   // Spread of the vision points along their minor axis.
   cv::Mat data(static_cast<int>(points.size()), 2, CV_64F);
@@ -230,13 +235,15 @@ Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method
   cv::PCA pca(data, cv::Mat(), cv::PCA::DATA_AS_ROW);
   const double minor = std::sqrt(std::max(0.0, pca.eigenvalues.at<double>(1)));
   if (minor < kMinSpreadMm) {
-    return makeError(kDegeneratePoints, "the points lie (nearly) on one line: spread them over the work area");
+    return makeError(kDegeneratePoints,
+                     "the points lie (nearly) on one line: spread them over the work area");
   }
   bool mirrored = false;
   const std::vector<bool> use = findInliers(points, &mirrored);
   const int inliers = static_cast<int>(std::count(use.begin(), use.end(), true));
   if (inliers < 3) {
-    return makeError(kTooFewPoints, "fewer than 3 points agree with each other: check the stored points");
+    return makeError(kTooFewPoints,
+                     "fewer than 3 points agree with each other: check the stored points");
   }
   // Cluster radius for the geometric method: a few times the noise level,
   // never below a tenth of a millimetre.
@@ -244,7 +251,8 @@ Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method
   CalibrationResult by_lsq = evaluate(lsq, Method::kLeastSquares, points, use);
   if (method == Method::kLeastSquares) return by_lsq;
   const double radius = std::max(0.1, 5 * by_lsq.rms);
-  CalibrationResult by_geometry = evaluate(geometric(points, use, mirrored, radius), Method::kGeometric, points, use);
+  CalibrationResult by_geometry =
+      evaluate(geometric(points, use, mirrored, radius), Method::kGeometric, points, use);
   if (method == Method::kGeometric) return by_geometry;
   return by_geometry.rms < by_lsq.rms ? by_geometry : by_lsq;
 }

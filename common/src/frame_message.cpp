@@ -47,7 +47,8 @@ std::optional<ReceivedFrame> FrameSubscriber::receive(std::chrono::milliseconds 
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
     zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
-    if (zmq::poll(&item, 1, std::max<std::chrono::milliseconds>(left, std::chrono::milliseconds(0))) == 0) {
+    if (zmq::poll(&item, 1,
+                  std::max<std::chrono::milliseconds>(left, std::chrono::milliseconds(0))) == 0) {
       return std::nullopt;
     }
     zmq::message_t topic;
@@ -68,7 +69,8 @@ std::optional<ReceivedFrame> FrameSubscriber::receive(std::chrono::milliseconds 
     }
     // Subscriptions match prefixes: "cam1" also receives "cam10".
     if (!camera_.empty() && topic.to_string_view() != camera_) continue;
-    if (parts != 3 || !frame.header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size())) ||
+    if (parts != 3 ||
+        !frame.header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size())) ||
         !frameIsConsistent(frame.header, frame.pixels.size())) {
       ++malformed_;
       continue;

@@ -40,8 +40,7 @@ std::optional<long long> parseInt(std::string_view text) {
 std::string formatFixed(double value, int decimals) {
   if (!std::isfinite(value)) return "nan";
   char buf[64];
-  auto [ptr, ec] =
-      std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::fixed, decimals);
+  auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::fixed, decimals);
   if (ec != std::errc()) return "nan";
   std::string out(buf, ptr);
   // "-0.000" reads as a sign error to a robot programmer.

@@ -38,15 +38,16 @@ std::vector<std::vector<cv::Point2d>> fingerPolygons(const Pose& gripper, const 
   return polygons;
 }
 
-bool fingersClear(const Pose& gripper, const Gripper& fingers, const calibration::VisionFrame& frame,
-                  const Obstacles& obstacles) {
+bool fingersClear(const Pose& gripper, const Gripper& fingers,
+                  const calibration::VisionFrame& frame, const Obstacles& obstacles) {
   const cv::Rect image(0, 0, obstacles.mask.cols, obstacles.mask.rows);
   for (const auto& poly : fingerPolygons(gripper, fingers, frame)) {
     std::vector<cv::Point> fixed;
     std::vector<cv::Point2d> in_mask;
     for (const auto& p : poly) {
       const cv::Matx23d& a = obstacles.sensor_to_mask;
-      const cv::Point2d m(a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2), a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2));
+      const cv::Point2d m(a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2),
+                          a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2));
       in_mask.push_back(m);
       fixed.emplace_back(static_cast<int>(std::lround(m.x * (1 << kShift))),
                          static_cast<int>(std::lround(m.y * (1 << kShift))));
@@ -54,12 +55,14 @@ bool fingersClear(const Pose& gripper, const Gripper& fingers, const calibration
     std::vector<cv::Point2f> as_float(in_mask.begin(), in_mask.end());
     const cv::Rect box = cv::boundingRect(as_float);
     // Pixel centres at integers: a finger edge at -0.5 is still inside.
-    if (box.x < -1 || box.y < -1 || box.br().x > image.width + 1 || box.br().y > image.height + 1) return false;
+    if (box.x < -1 || box.y < -1 || box.br().x > image.width + 1 || box.br().y > image.height + 1)
+      return false;
     const cv::Rect clipped = (box + cv::Size(2, 2)) & image;
     if (clipped.empty()) return false;
     cv::Mat footprint(clipped.size(), CV_8UC1, cv::Scalar(0));
     for (auto& p : fixed) p -= cv::Point(clipped.x << kShift, clipped.y << kShift);
-    cv::fillPoly(footprint, std::vector<std::vector<cv::Point>>{fixed}, cv::Scalar(255), cv::LINE_8, kShift);
+    cv::fillPoly(footprint, std::vector<std::vector<cv::Point>>{fixed}, cv::Scalar(255), cv::LINE_8,
+                 kShift);
     if (cv::countNonZero(footprint & obstacles.mask(clipped)) > 0) return false;
   }
   return true;

@@ -44,7 +44,8 @@ std::string tempCsv(const std::string& content) {
 TEST_CASE("picksight-calib prints the transform and every residual", "[calibration][cli]") {
   const calibration::RigidTransform truth{100, 50, 90, false};
   std::string csv = "robot_x,robot_y,vision_x,vision_y\n";
-  for (auto v : {cv::Point2d(0, 0), cv::Point2d(100, 0), cv::Point2d(0, 80), cv::Point2d(120, 90)}) {
+  for (auto v :
+       {cv::Point2d(0, 0), cv::Point2d(100, 0), cv::Point2d(0, 80), cv::Point2d(120, 90)}) {
     const cv::Point2d r = truth.apply(v);
     char row[128];
     std::snprintf(row, sizeof(row), "%.4f,%.4f,%.4f,%.4f\n", r.x, r.y, v.x, v.y);

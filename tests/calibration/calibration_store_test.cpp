@@ -19,7 +19,8 @@ namespace {
 using picksight::test::TempDir;
 }  // namespace
 
-TEST_CASE("calibration points, transform, scale and lens survive a reload", "[calibration][store]") {
+TEST_CASE("calibration points, transform, scale and lens survive a reload",
+          "[calibration][store]") {
   TempDir dir;
   const std::string file = dir.file("calibration.yaml");
   {
@@ -90,7 +91,8 @@ TEST_CASE("a failed write keeps memory and disk as they were", "[calibration][st
   CHECK(store.points().size() == 1);
 }
 
-TEST_CASE("the vision frame flips y so that a camera looking down is right-handed", "[calibration][frame]") {
+TEST_CASE("the vision frame flips y so that a camera looking down is right-handed",
+          "[calibration][frame]") {
   VisionFrame frame(PixelScale{0.5, 0.25, 0});
   const cv::Point2d mm = frame.toMm({100, 40});
   CHECK(mm.x == 50);

@@ -11,16 +11,20 @@
 using namespace picksight::calibration;
 
 namespace {
-const std::string kBoardDir = std::string(PICKSIGHT_SHARED_DATA_DIR) + "/calibration/opencv_chessboard/";
+const std::string kBoardDir =
+    std::string(PICKSIGHT_SHARED_DATA_DIR) + "/calibration/opencv_chessboard/";
 
 // Moments of an ellipse of semi-axes a, b (pixels), drawn 8x larger and
 // averaged down so edges are partial pixels as a camera sees them.
 cv::Moments ellipseMoments(double a, double b) {
   constexpr int kSuper = 8;
   cv::Mat big(400 * kSuper, 400 * kSuper, CV_8UC1, cv::Scalar(0));
-  cv::ellipse(big, cv::RotatedRect({200.f * kSuper, 200.f * kSuper},
-                                   cv::Size2f(static_cast<float>(2 * a * kSuper), static_cast<float>(2 * b * kSuper)), 0),
-              cv::Scalar(255), cv::FILLED, cv::LINE_8);
+  cv::ellipse(
+      big,
+      cv::RotatedRect(
+          {200.f * kSuper, 200.f * kSuper},
+          cv::Size2f(static_cast<float>(2 * a * kSuper), static_cast<float>(2 * b * kSuper)), 0),
+      cv::Scalar(255), cv::FILLED, cv::LINE_8);
   cv::Mat small;
   cv::resize(big, small, cv::Size(400, 400), 0, 0, cv::INTER_AREA);
   return cv::moments(small, false);
@@ -62,9 +66,10 @@ TEST_CASE("the chessboard views give OpenCV's own calibration of them", "[calibr
   CHECK(model->camera_matrix(0, 2) == Approx(k_ref.at<double>(0, 2)).margin(3.0));
   CHECK(model->camera_matrix(1, 2) == Approx(k_ref.at<double>(1, 2)).margin(3.0));
   CHECK(model->rms_reprojection_px < 2 * err_ref);
-  WARN("lens model: fx " << model->camera_matrix(0, 0) << " fy " << model->camera_matrix(1, 1) << " cx "
-                         << model->camera_matrix(0, 2) << " cy " << model->camera_matrix(1, 2) << ", RMS "
-                         << model->rms_reprojection_px << " px over " << model->views << " views (OpenCV's: fx "
+  WARN("lens model: fx " << model->camera_matrix(0, 0) << " fy " << model->camera_matrix(1, 1)
+                         << " cx " << model->camera_matrix(0, 2) << " cy "
+                         << model->camera_matrix(1, 2) << ", RMS " << model->rms_reprojection_px
+                         << " px over " << model->views << " views (OpenCV's: fx "
                          << k_ref.at<double>(0, 0) << ", RMS " << err_ref << ")");
 
   // Undistorting the corners of a view makes the board's rows straight.

@@ -21,7 +21,8 @@ std::vector<PointPair> makePoints(const RigidTransform& truth, int n, double sig
   for (int i = 0; i < n; ++i) {
     const cv::Point2d v(ux(rng), uy(rng));
     const cv::Point2d r = truth.apply(v);
-    pts.push_back({v + cv::Point2d(noise(rng), noise(rng)), r + cv::Point2d(noise(rng), noise(rng))});
+    pts.push_back(
+        {v + cv::Point2d(noise(rng), noise(rng)), r + cv::Point2d(noise(rng), noise(rng))});
   }
   return pts;
 }
@@ -30,7 +31,8 @@ std::vector<PointPair> makePoints(const RigidTransform& truth, int n, double sig
 double worstPlacementError(const RigidTransform& a, const RigidTransform& b) {
   double worst = 0;
   for (double x = -200; x <= 200; x += 50) {
-    for (double y = -150; y <= 150; y += 50) worst = std::max(worst, cv::norm(a.apply({x, y}) - b.apply({x, y})));
+    for (double y = -150; y <= 150; y += 50)
+      worst = std::max(worst, cv::norm(a.apply({x, y}) - b.apply({x, y})));
   }
   return worst;
 }
@@ -40,7 +42,8 @@ double rmsPlacementError(const RigidTransform& a, const RigidTransform& b) {
   double sum = 0;
   int n = 0;
   for (double x = -200; x <= 200; x += 50) {
-    for (double y = -150; y <= 150; y += 50, ++n) sum += std::pow(cv::norm(a.apply({x, y}) - b.apply({x, y})), 2);
+    for (double y = -150; y <= 150; y += 50, ++n)
+      sum += std::pow(cv::norm(a.apply({x, y}) - b.apply({x, y})), 2);
   }
   return std::sqrt(sum / n);
 }
@@ -73,20 +76,22 @@ TEST_CASE("a known transform is recovered within 0.1 mm and 0.05 degree from noi
     Method method;
     double mm;
   };
-  for (Bound b : {Bound{Method::kBest, 0.1}, Bound{Method::kLeastSquares, 0.1}, Bound{Method::kGeometric, 0.2}}) {
+  for (Bound b : {Bound{Method::kBest, 0.1}, Bound{Method::kLeastSquares, 0.1},
+                  Bound{Method::kGeometric, 0.2}}) {
     double worst_translation = 0, worst_rms = 0, worst_deg = 0;
     for (uint64_t seed = 1; seed <= 30; ++seed) {
       RigidTransform truth = kTruth;
       truth.rz_deg = -170 + 11.0 * static_cast<double>(seed);
       auto r = calibrate(makePoints(truth, 12, 0.05, seed), b.method);
       REQUIRE(r);
-      worst_translation = std::max(worst_translation, std::hypot(r->transform.dx - truth.dx, r->transform.dy - truth.dy));
+      worst_translation = std::max(
+          worst_translation, std::hypot(r->transform.dx - truth.dx, r->transform.dy - truth.dy));
       worst_rms = std::max(worst_rms, rmsPlacementError(r->transform, truth));
       worst_deg = std::max(worst_deg, picksight::angleDiffDeg(r->transform.rz_deg, truth.rz_deg));
       CHECK(r->rms < 0.2);
     }
-    INFO(methodName(b.method) << ": translation " << worst_translation << " mm, work area RMS " << worst_rms
-                              << " mm, " << worst_deg << " deg");
+    INFO(methodName(b.method) << ": translation " << worst_translation << " mm, work area RMS "
+                              << worst_rms << " mm, " << worst_deg << " deg");
     CHECK(worst_translation < b.mm);
     CHECK(worst_rms < b.mm);
     CHECK(worst_deg < 0.05);
@@ -95,7 +100,7 @@ TEST_CASE("a known transform is recovered within 0.1 mm and 0.05 degree from noi
 
 TEST_CASE("outliers do not move the result and are reported", "[calibration]") {
   auto pts = makePoints(kTruth, 12, 0.05, 7);
-  pts[3].robot += cv::Point2d(12.0, -4.0);  // touched the wrong spot
+  pts[3].robot += cv::Point2d(12.0, -4.0);    // touched the wrong spot
   pts[8].vision += cv::Point2d(-30.0, 25.0);  // found the wrong target
   auto clean = makePoints(kTruth, 12, 0.05, 7);
   for (Method m : {Method::kLeastSquares, Method::kGeometric, Method::kBest}) {

@@ -15,10 +15,10 @@
 
 #include <catch2/catch.hpp>
 
-#include "temp_dir.hpp"
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
+#include "temp_dir.hpp"
 
 #include "cam_cli.hpp"
 #include "picksight.pb.h"

@@ -12,9 +12,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "temp_dir.hpp"
 #include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
+#include "temp_dir.hpp"
 
 #include "picksight/common/subprocess.hpp"
 #include "picksight/transport/frame_message.hpp"

@@ -16,8 +16,8 @@
 
 #include <catch2/catch.hpp>
 
-#include "temp_dir.hpp"
 #include <opencv2/imgcodecs.hpp>
+#include "temp_dir.hpp"
 
 #include "picksight/video_server/camera.hpp"
 

@@ -13,9 +13,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "temp_dir.hpp"
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include "temp_dir.hpp"
 
 #include "picksight/video_server/source.hpp"
 

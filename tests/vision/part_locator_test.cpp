@@ -32,7 +32,8 @@ using picksight::test::nearest;
 using picksight::test::Trained;
 
 Trained train(const std::string& type, int id) {
-  return picksight::test::trainOn(scene(1, 300 + static_cast<uint64_t>(id), {type}, false), id, type);
+  return picksight::test::trainOn(scene(1, 300 + static_cast<uint64_t>(id), {type}, false), id,
+                                  type);
 }
 
 std::vector<Match> recognizeScene(const ps::SceneRenderer& s,

@@ -34,7 +34,8 @@ using picksight::test::nearest;
 using picksight::test::Trained;
 
 Trained train(const std::string& type, int id) {
-  return picksight::test::trainOn(scene(400, 400, 1, 77 + static_cast<uint64_t>(id), {type}), id, type);
+  return picksight::test::trainOn(scene(400, 400, 1, 77 + static_cast<uint64_t>(id), {type}), id,
+                                  type);
 }
 
 std::vector<Match> recognizeScene(const ps::SceneRenderer& s,

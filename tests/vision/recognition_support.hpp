@@ -31,14 +31,16 @@ inline Trained trainOn(const synthetic::SceneOptions& options, int id, const std
 }
 
 // The whole recognition (adaptive binarization, regions, models) of one frame.
-inline std::vector<vision::Match> recognizeFrame(const synthetic::SceneRenderer& s, uint64_t frame,
-                                                 const std::vector<const vision::PartModel*>& models) {
+inline std::vector<vision::Match> recognizeFrame(
+    const synthetic::SceneRenderer& s, uint64_t frame,
+    const std::vector<const vision::PartModel*>& models) {
   const cv::Mat grey = s.render(frame);
   return vision::recognize(vision::findRegions(vision::binarize(grey, {}), {}, grey), models);
 }
 
 // The match within 5 px of a truth part, or nullptr.
-inline const vision::Match* nearest(const std::vector<vision::Match>& matches, const synthetic::PartTruth& t) {
+inline const vision::Match* nearest(const std::vector<vision::Match>& matches,
+                                    const synthetic::PartTruth& t) {
   const vision::Match* best = nullptr;
   for (const auto& m : matches) {
     if (std::hypot(m.centroid.x - t.x, m.centroid.y - t.y) < 5) best = &m;

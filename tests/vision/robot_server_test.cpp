@@ -34,7 +34,8 @@ struct Server {
 };
 }  // namespace
 
-TEST_CASE("one reply per line, LF or CR LF, pipelined or split across writes", "[vision_app][robot_server]") {
+TEST_CASE("one reply per line, LF or CR LF, pipelined or split across writes",
+          "[vision_app][robot_server]") {
   Server s;
   auto c = s.connect();
   CHECK(*c.request("PING", 2s) == "OK 4 PING");

@@ -28,10 +28,14 @@ int main(int argc, char** argv) {
       path = argv[++i];
     } else if (a == "--method" && i + 1 < argc) {
       const std::string m = argv[++i];
-      if (m == "geometric") method = calibration::Method::kGeometric;
-      else if (m == "lsq") method = calibration::Method::kLeastSquares;
-      else if (m == "best") method = calibration::Method::kBest;
-      else return usage();
+      if (m == "geometric")
+        method = calibration::Method::kGeometric;
+      else if (m == "lsq")
+        method = calibration::Method::kLeastSquares;
+      else if (m == "best")
+        method = calibration::Method::kBest;
+      else
+        return usage();
     } else {
       return usage();
     }
@@ -52,16 +56,16 @@ int main(int argc, char** argv) {
     if (fields.empty() || line[0] == '#') continue;
     if (number == 1 && !parseDouble(fields[0])) continue;  // the header
     if (fields.size() != 4) {
-      std::cerr << "picksight-calib: " << path << ":" << number << ": expected 4 numbers, got " << fields.size()
-                << "\n";
+      std::cerr << "picksight-calib: " << path << ":" << number << ": expected 4 numbers, got "
+                << fields.size() << "\n";
       return 1;
     }
     double v[4];
     for (int k = 0; k < 4; ++k) {
       auto d = parseDouble(fields[static_cast<size_t>(k)]);
       if (!d) {
-        std::cerr << "picksight-calib: " << path << ":" << number << ": '" << std::string(fields[static_cast<size_t>(k)])
-                  << "' is not a number\n";
+        std::cerr << "picksight-calib: " << path << ":" << number << ": '"
+                  << std::string(fields[static_cast<size_t>(k)]) << "' is not a number\n";
         return 1;
       }
       v[k] = *d;
@@ -78,9 +82,10 @@ int main(int argc, char** argv) {
   std::printf("dx %s\ndy %s\nrz %s\n", formatFixed(t.dx, 4).c_str(), formatFixed(t.dy, 4).c_str(),
               formatFixed(t.rz_deg, 4).c_str());
   std::printf("mirrored %s\n", t.mirrored ? "yes" : "no");
-  std::printf("rms %s\ninliers %d of %zu\n", formatFixed(result->rms, 4).c_str(), result->inliers, points.size());
-  std::printf("%5s %10s %10s %10s %10s %9s %9s %9s %s\n", "point", "robot_x", "robot_y", "vision_x", "vision_y",
-              "err_x", "err_y", "err", "");
+  std::printf("rms %s\ninliers %d of %zu\n", formatFixed(result->rms, 4).c_str(), result->inliers,
+              points.size());
+  std::printf("%5s %10s %10s %10s %10s %9s %9s %9s %s\n", "point", "robot_x", "robot_y", "vision_x",
+              "vision_y", "err_x", "err_y", "err", "");
   for (size_t i = 0; i < points.size(); ++i) {
     const auto& r = result->residuals[i];
     std::printf("%5zu %10.3f %10.3f %10.3f %10.3f %9.4f %9.4f %9.4f %s\n", i + 1, points[i].robot.x,

@@ -32,7 +32,8 @@ std::string binDir() {
 }
 
 int usage() {
-  std::cerr << "usage: picksight-demo [--requests N] [--parts N] [--width W] [--height H] [--seed S]\n";
+  std::cerr
+      << "usage: picksight-demo [--requests N] [--parts N] [--width W] [--height H] [--seed S]\n";
   return 2;
 }
 }  // namespace
@@ -48,12 +49,18 @@ int main(int argc, char** argv) {
     if (a == "--help" || a == "-h" || i + 1 >= argc) return usage();
     auto v = picksight::parseInt(argv[++i]);
     if (!v || *v < 0) return usage();
-    if (a == "--requests") requests = static_cast<int>(*v);
-    else if (a == "--parts") parts = static_cast<int>(*v);
-    else if (a == "--width") width = static_cast<int>(*v);
-    else if (a == "--height") height = static_cast<int>(*v);
-    else if (a == "--seed") seed = *v;
-    else return usage();
+    if (a == "--requests")
+      requests = static_cast<int>(*v);
+    else if (a == "--parts")
+      parts = static_cast<int>(*v);
+    else if (a == "--width")
+      width = static_cast<int>(*v);
+    else if (a == "--height")
+      height = static_cast<int>(*v);
+    else if (a == "--seed")
+      seed = *v;
+    else
+      return usage();
   }
 
   const std::string dir = binDir();
@@ -63,9 +70,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   // Trigger mode with a new layout on every frame: each LOCATE sees a new scene.
-  const std::string source = "cam0=synthetic:width=" + std::to_string(width) + ",height=" +
-                             std::to_string(height) + ",parts=" + std::to_string(parts) +
-                             ",seed=" + std::to_string(seed) + ",scene_every=1";
+  const std::string source =
+      "cam0=synthetic:width=" + std::to_string(width) + ",height=" + std::to_string(height) +
+      ",parts=" + std::to_string(parts) + ",seed=" + std::to_string(seed) + ",scene_every=1";
   std::cout << "PickSight demo: synthetic camera " << width << "x" << height << ", " << parts
             << " parts per scene\n";
   picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
@@ -103,7 +110,8 @@ int main(int argc, char** argv) {
   for (int r = 0; r < requests; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
     auto reply = robot->request("LOCATE 1", 10s);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!reply) {
       std::cerr << "demo: LOCATE failed: " << reply.error().message << "\n";
       ++failures;
@@ -146,11 +154,12 @@ int main(int argc, char** argv) {
           fr = 360.0 - picksight::parseDouble(words[i + 2]).value_or(0);
         }
       }
-      const std::string angle_err = t.symmetry_deg() > 0
-                                        ? formatFixed(picksight::angleDiffDeg(fr, t.angle_deg(), t.symmetry_deg()), 3)
-                                        : std::string("any");
-      std::printf("  %-16s %9.3f %9.3f %8.3f | %9.3f %9.3f %8.3f | %7.3f %7s\n", t.type().c_str(), t.x(),
-                  t.y(), t.angle_deg(), fx, fy, fr, best, angle_err.c_str());
+      const std::string angle_err =
+          t.symmetry_deg() > 0
+              ? formatFixed(picksight::angleDiffDeg(fr, t.angle_deg(), t.symmetry_deg()), 3)
+              : std::string("any");
+      std::printf("  %-16s %9.3f %9.3f %8.3f | %9.3f %9.3f %8.3f | %7.3f %7s\n", t.type().c_str(),
+                  t.x(), t.y(), t.angle_deg(), fx, fy, fr, best, angle_err.c_str());
     }
   }
   robot->close();

@@ -74,8 +74,9 @@ Result<void> Camera::setOutput(const OutputSettings& output) {
   std::lock_guard<std::mutex> lock(mutex_);
   // The frames the device actually delivers bound the ROI: a camera whose
   // own Width/Height feature is below its sensor size sends smaller images.
-  const cv::Size sensor = !frame_size_.empty() ? frame_size_
-                                               : cv::Size(status_.info.sensor_width, status_.info.sensor_height);
+  const cv::Size sensor = !frame_size_.empty()
+                              ? frame_size_
+                              : cv::Size(status_.info.sensor_width, status_.info.sensor_height);
   if (auto ok = validateOutputSettings(output, sensor); !ok) return ok;
   output_ = output;
   return {};
@@ -126,7 +127,8 @@ TriggerTicket Camera::trigger() {
   return ticket;
 }
 
-std::optional<PublishedFrame> Camera::waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout) {
+std::optional<PublishedFrame> Camera::waitForFrame(uint64_t sequence,
+                                                   std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto ready = [&] { return last_frame_ && last_frame_->sequence >= sequence; };
   frame_published_.wait_for(lock, timeout, ready);
@@ -158,10 +160,11 @@ Result<T> Camera::onAcquisitionThread(std::function<Result<T>(Source&, bool open
 }
 
 Result<std::vector<Feature>> Camera::features() {
-  return onAcquisitionThread<std::vector<Feature>>([](Source& s, bool open) -> Result<std::vector<Feature>> {
-    if (!open) return makeError(kSourceUnavailable, "camera is not connected");
-    return s.features();
-  });
+  return onAcquisitionThread<std::vector<Feature>>(
+      [](Source& s, bool open) -> Result<std::vector<Feature>> {
+        if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+        return s.features();
+      });
 }
 
 Result<Feature> Camera::feature(const std::string& name) {
@@ -190,7 +193,8 @@ void Camera::runCommands(std::unique_lock<std::mutex>& lock) {
 }
 
 void Camera::waitBackoff(std::unique_lock<std::mutex>& lock) {
-  wake_.wait_for(lock, backoff_, [this] { return stop_ || !commands_.empty() || !open_requested_; });
+  wake_.wait_for(lock, backoff_,
+                 [this] { return stop_ || !commands_.empty() || !open_requested_; });
   backoff_ = std::min(backoff_ * 2, kMaxBackoff);
 }
 
@@ -210,7 +214,8 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
   if (opened) {
     for (const auto& [name, value] : config_.features) {
       if (auto set = source_->setFeature(name, value); !set) {
-        logWarning("camera ", config_.name, ": feature ", name, " = ", value, ": ", set.error().message);
+        logWarning("camera ", config_.name, ": feature ", name, " = ", value, ": ",
+                   set.error().message);
       }
     }
     info = source_->info();
@@ -274,8 +279,8 @@ void Camera::run() {
     bool triggered = false;
     if (mode_ == AcquisitionMode::kTrigger) {
       wake_.wait(lock, [this] {
-        return stop_ || pending_triggers_ > 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
-               !open_requested_ || !commands_.empty();
+        return stop_ || pending_triggers_ > 0 || mode_ != AcquisitionMode::kTrigger ||
+               reconfigure_ || !open_requested_ || !commands_.empty();
       });
       if (stop_ || pending_triggers_ == 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
           !open_requested_) {
@@ -309,15 +314,17 @@ void Camera::run() {
       asked = source_->softwareTrigger();
       trigger_sent_ = now;
     }
-    Result<SourceFrame> grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
-                                        : Result<SourceFrame>(asked.error());
+    Result<SourceFrame> grabbed =
+        asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
+              : Result<SourceFrame>(asked.error());
     const uint64_t host_ns = realtimeNs();
     // Standardize, then ROI and resize; the standardized size is the size of
     // the frames the device delivers.
-    Result<cv::Mat> standard =
-        grabbed ? toOutputFormat(grabbed->image, grabbed->layout, output.format) : Result<cv::Mat>(grabbed.error());
-    Result<OutputFrame> out =
-        standard ? Result<OutputFrame>(applyOutputSettings(*standard, output)) : Result<OutputFrame>(standard.error());
+    Result<cv::Mat> standard = grabbed
+                                   ? toOutputFormat(grabbed->image, grabbed->layout, output.format)
+                                   : Result<cv::Mat>(grabbed.error());
+    Result<OutputFrame> out = standard ? Result<OutputFrame>(applyOutputSettings(*standard, output))
+                                       : Result<OutputFrame>(standard.error());
 
     if (!out) {
       lock.lock();
@@ -363,7 +370,8 @@ void Camera::run() {
       // Exponential average of the instantaneous rate: smooth, and follows a
       // rate change within a few frames.
       const double rate = 1e9 / static_cast<double>(std::max<uint64_t>(1, host_ns - last_frame_ns));
-      status_.fps_measured = status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
+      status_.fps_measured =
+          status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
     }
     last_frame_ns = host_ns;
     lock.unlock();

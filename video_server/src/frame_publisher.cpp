@@ -128,7 +128,8 @@ void FramePublisher::pollMonitor() {
 void FramePublisher::run() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
-    wake_.wait_for(lock, std::chrono::milliseconds(100), [this] { return stop_ || !queue_.empty(); });
+    wake_.wait_for(lock, std::chrono::milliseconds(100),
+                   [this] { return stop_ || !queue_.empty(); });
     while (!queue_.empty() && !stop_) {
       PublishedFrame frame = std::move(queue_.front());
       queue_.pop_front();

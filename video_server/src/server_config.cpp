@@ -41,7 +41,8 @@ Result<std::vector<int>> intList(const YAML::Node& node, size_t n) {
   for (const auto& item : node) {
     auto v = parseInt(item.Scalar());
     if (!item.IsScalar() || !v || *v < 0 || *v > 100000) {
-      return makeError(kConfigError, "must be a list of " + std::to_string(n) + " non-negative integers");
+      return makeError(kConfigError,
+                       "must be a list of " + std::to_string(n) + " non-negative integers");
     }
     out.push_back(static_cast<int>(*v));
   }
@@ -51,8 +52,8 @@ Result<std::vector<int>> intList(const YAML::Node& node, size_t n) {
 Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& where) {
   if (!node.IsMap()) return makeError(kConfigError, where + ": must be a map");
   CameraConfig c;
-  static const std::set<std::string> kKeys = {"name", "source", "mode", "fps", "format",
-                                              "roi", "size", "scale", "features"};
+  static const std::set<std::string> kKeys = {"name", "source", "mode",  "fps",     "format",
+                                              "roi",  "size",   "scale", "features"};
   for (const auto& kv : node) {
     // as<std::string>() throws on a key that is a list or a map.
     if (!kv.first.IsScalar()) return makeError(kConfigError, where + ": keys must be plain names");
@@ -84,17 +85,21 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
   }
   if (node["roi"]) {
     auto r = intList(node["roi"], 4);
-    if (!r) return makeError(kConfigError, where + ".roi: " + r.error().message + " [x, y, width, height]");
+    if (!r)
+      return makeError(kConfigError,
+                       where + ".roi: " + r.error().message + " [x, y, width, height]");
     c.output.roi = cv::Rect((*r)[0], (*r)[1], (*r)[2], (*r)[3]);
   }
   if (node["size"]) {
     auto s = intList(node["size"], 2);
-    if (!s) return makeError(kConfigError, where + ".size: " + s.error().message + " [width, height]");
+    if (!s)
+      return makeError(kConfigError, where + ".size: " + s.error().message + " [width, height]");
     c.output.size = cv::Size((*s)[0], (*s)[1]);
   }
   if (node["scale"]) {
     auto s = parseDouble(node["scale"].Scalar());
-    if (!s || *s <= 0 || *s > 16) return makeError(kConfigError, where + ".scale: must be a number in (0, 16]");
+    if (!s || *s <= 0 || *s > 16)
+      return makeError(kConfigError, where + ".scale: must be a number in (0, 16]");
     c.output.scale = *s;
   }
   if (node["features"]) {
@@ -118,7 +123,8 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
 Result<void> checkUniqueNames(const std::vector<CameraConfig>& cameras) {
   std::set<std::string> seen;
   for (const auto& c : cameras) {
-    if (!seen.insert(c.name).second) return makeError(kConfigError, "camera name '" + c.name + "' used twice");
+    if (!seen.insert(c.name).second)
+      return makeError(kConfigError, "camera name '" + c.name + "' used twice");
   }
   return {};
 }
@@ -137,20 +143,23 @@ Result<ServerConfig> loadServerConfig(const std::string& path) {
     if (!kv.first.IsScalar()) return makeError(kConfigError, path + ": keys must be plain names");
     const std::string key = kv.first.Scalar();
     if (key != "frames" && key != "control" && key != "cameras") {
-      return makeError(kConfigError, path + ": " + key + ": unknown key (known: frames, control, cameras)");
+      return makeError(kConfigError,
+                       path + ": " + key + ": unknown key (known: frames, control, cameras)");
     }
   }
   if (root["frames"]) config.frames_endpoint = root["frames"].Scalar();
   if (root["control"]) config.control_endpoint = root["control"].Scalar();
   if (root["cameras"]) {
-    if (!root["cameras"].IsSequence()) return makeError(kConfigError, path + ": cameras: must be a list");
+    if (!root["cameras"].IsSequence())
+      return makeError(kConfigError, path + ": cameras: must be a list");
     for (size_t i = 0; i < root["cameras"].size(); ++i) {
       auto c = cameraFromYaml(root["cameras"][i], "cameras[" + std::to_string(i) + "]");
       if (!c) return makeError(kConfigError, path + ": " + c.error().message);
       config.cameras.push_back(std::move(*c));
     }
   }
-  if (auto ok = checkUniqueNames(config.cameras); !ok) return makeError(kConfigError, path + ": " + ok.error().message);
+  if (auto ok = checkUniqueNames(config.cameras); !ok)
+    return makeError(kConfigError, path + ": " + ok.error().message);
   return config;
 }
 
@@ -159,13 +168,15 @@ std::string serverUsage() {
          "         [--frames ENDPOINT] [--control ENDPOINT] [--mode freerun|trigger] [--fps F]\n"
          "\n"
          "  --source NAME=URI  a camera (default: cam0=synthetic:), one of\n"
-         "                       aravis:<device-id>       GigE Vision / USB3 Vision (empty id: first found)\n"
+         "                       aravis:<device-id>       GigE Vision / USB3 Vision (empty id: "
+         "first found)\n"
          "                       v4l2:/dev/videoN[?width=W&height=H&format=yuyv|mjpeg&fps=F]\n"
          "                       stream:<url>             RTSP, HTTP MJPEG, any file FFmpeg reads\n"
          "                       file:<path>              one image, re-read when it changes\n"
          "                       dir:<path>               images in name order, looping\n"
          "                       synthetic:[key=value,...] generated scene with ground truth\n"
-         "                         (width, height, parts, seed, noise, size, light, types, scene_every)\n"
+         "                         (width, height, parts, seed, noise, size, light, types, "
+         "scene_every)\n"
          "  --frames E         frame PUB endpoint (default tcp://*:5555)\n"
          "  --control E        control REP endpoint (default tcp://*:5556)\n"
          "  --mode M           acquisition mode of the --source cameras (default freerun)\n"
@@ -189,7 +200,8 @@ Result<ServerConfig> parseServerArgs(const std::vector<std::string>& args, bool*
       if (help) *help = true;
       return config;
     }
-    if (i + 1 >= args.size()) return makeError(kConfigError, a + ": missing value or unknown option");
+    if (i + 1 >= args.size())
+      return makeError(kConfigError, a + ": missing value or unknown option");
     const std::string& v = args[++i];
     if (a == "--config") {
       auto loaded = loadServerConfig(v);

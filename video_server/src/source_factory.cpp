@@ -28,7 +28,8 @@ Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
     return std::unique_ptr<Source>(std::make_unique<AravisSource>(rest));
   }
   if (scheme == "file") {
-    if (rest.empty()) return makeError(kSourceBadConfig, "file: needs a path, as in file:/data/part.png");
+    if (rest.empty())
+      return makeError(kSourceBadConfig, "file: needs a path, as in file:/data/part.png");
     return std::unique_ptr<Source>(std::make_unique<FileSource>(rest));
   }
   if (scheme == "v4l2") {

@@ -21,12 +21,18 @@ constexpr std::chrono::milliseconds kSnapTimeout{3000};
 // Source error codes to the wire's.
 proto::ControlReply sourceErrorReply(const Error& e) {
   switch (e.code) {
-    case kSourceUnknownFeature: return errorReply(proto::Error::UNKNOWN_FEATURE, e.message);
-    case kSourceBadValue: return errorReply(proto::Error::OUT_OF_RANGE, e.message);
-    case kSourceUnavailable: return errorReply(proto::Error::CAMERA_UNAVAILABLE, e.message);
-    case kSourceTimeout: return errorReply(proto::Error::TIMEOUT, e.message);
-    case kSourceNotSupported: return errorReply(proto::Error::NOT_SUPPORTED, e.message);
-    default: return errorReply(proto::Error::INTERNAL, e.message);
+    case kSourceUnknownFeature:
+      return errorReply(proto::Error::UNKNOWN_FEATURE, e.message);
+    case kSourceBadValue:
+      return errorReply(proto::Error::OUT_OF_RANGE, e.message);
+    case kSourceUnavailable:
+      return errorReply(proto::Error::CAMERA_UNAVAILABLE, e.message);
+    case kSourceTimeout:
+      return errorReply(proto::Error::TIMEOUT, e.message);
+    case kSourceNotSupported:
+      return errorReply(proto::Error::NOT_SUPPORTED, e.message);
+    default:
+      return errorReply(proto::Error::INTERNAL, e.message);
   }
 }
 
@@ -108,7 +114,8 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
     auto* stats = reply.mutable_statistics();
     stats->set_subscribers(static_cast<uint32_t>(publisher_->subscribers()));
     const std::string& only = request.statistics().camera();
-    if (!only.empty() && !find(only)) return errorReply(proto::Error::UNKNOWN_CAMERA, "unknown camera '" + only + "'");
+    if (!only.empty() && !find(only))
+      return errorReply(proto::Error::UNKNOWN_CAMERA, "unknown camera '" + only + "'");
     for (auto& c : cameras_) {
       if (!only.empty() && c->name() != only) continue;
       const CameraStatus s = c->status();
@@ -129,19 +136,44 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
   // Every other request names one camera.
   std::string name;
   switch (request.request_case()) {
-    case R::kDescribeCamera: name = request.describe_camera().camera(); break;
-    case R::kSetRoi: name = request.set_roi().camera(); break;
-    case R::kSetSize: name = request.set_size().camera(); break;
-    case R::kSetMode: name = request.set_mode().camera(); break;
-    case R::kSetFormat: name = request.set_format().camera(); break;
-    case R::kTrigger: name = request.trigger().camera(); break;
-    case R::kListFeatures: name = request.list_features().camera(); break;
-    case R::kGetFeature: name = request.get_feature().camera(); break;
-    case R::kSetFeature: name = request.set_feature().camera(); break;
-    case R::kOpenStream: name = request.open_stream().camera(); break;
-    case R::kCloseStream: name = request.close_stream().camera(); break;
-    case R::kSnap: name = request.snap().camera(); break;
-    default: return errorReply(proto::Error::NOT_SUPPORTED, "request not supported by this server");
+    case R::kDescribeCamera:
+      name = request.describe_camera().camera();
+      break;
+    case R::kSetRoi:
+      name = request.set_roi().camera();
+      break;
+    case R::kSetSize:
+      name = request.set_size().camera();
+      break;
+    case R::kSetMode:
+      name = request.set_mode().camera();
+      break;
+    case R::kSetFormat:
+      name = request.set_format().camera();
+      break;
+    case R::kTrigger:
+      name = request.trigger().camera();
+      break;
+    case R::kListFeatures:
+      name = request.list_features().camera();
+      break;
+    case R::kGetFeature:
+      name = request.get_feature().camera();
+      break;
+    case R::kSetFeature:
+      name = request.set_feature().camera();
+      break;
+    case R::kOpenStream:
+      name = request.open_stream().camera();
+      break;
+    case R::kCloseStream:
+      name = request.close_stream().camera();
+      break;
+    case R::kSnap:
+      name = request.snap().camera();
+      break;
+    default:
+      return errorReply(proto::Error::NOT_SUPPORTED, "request not supported by this server");
   }
   Camera* camera = find(name);
   if (!camera) return errorReply(proto::Error::UNKNOWN_CAMERA, "unknown camera '" + name + "'");
@@ -179,10 +211,11 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
     case R::kSetRoi: {
       OutputSettings o = camera->output();
       const auto& r = request.set_roi().roi();
-      o.roi = cv::Rect(static_cast<int>(r.x()), static_cast<int>(r.y()), static_cast<int>(r.width()),
-                       static_cast<int>(r.height()));
+      o.roi = cv::Rect(static_cast<int>(r.x()), static_cast<int>(r.y()),
+                       static_cast<int>(r.width()), static_cast<int>(r.height()));
       if (r.width() == 0 && r.height() == 0) o.roi = cv::Rect();  // back to the full sensor
-      if (auto ok = camera->setOutput(o); !ok) return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
+      if (auto ok = camera->setOutput(o); !ok)
+        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
       return reply;
     }
     case R::kSetSize: {
@@ -190,7 +223,8 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
       const auto& s = request.set_size();
       o.size = cv::Size(static_cast<int>(s.width()), static_cast<int>(s.height()));
       o.scale = s.scale();
-      if (auto ok = camera->setOutput(o); !ok) return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
+      if (auto ok = camera->setOutput(o); !ok)
+        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
       return reply;
     }
     case R::kSetFormat: {
@@ -200,7 +234,8 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
         return errorReply(proto::Error::OUT_OF_RANGE, "pixel format must be mono8 or bgr8");
       }
       o.format = f == proto::BGR8 ? OutputFormat::kBgr8 : OutputFormat::kMono8;
-      if (auto ok = camera->setOutput(o); !ok) return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
+      if (auto ok = camera->setOutput(o); !ok)
+        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
       return reply;
     }
     case R::kSetMode: {
@@ -208,8 +243,10 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
       if (m.mode() != proto::FREERUN && m.mode() != proto::TRIGGER) {
         return errorReply(proto::Error::OUT_OF_RANGE, "mode must be freerun or trigger");
       }
-      const AcquisitionMode mode = m.mode() == proto::TRIGGER ? AcquisitionMode::kTrigger : AcquisitionMode::kFreeRun;
-      if (auto ok = camera->setMode(mode, m.fps()); !ok) return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
+      const AcquisitionMode mode =
+          m.mode() == proto::TRIGGER ? AcquisitionMode::kTrigger : AcquisitionMode::kFreeRun;
+      if (auto ok = camera->setMode(mode, m.fps()); !ok)
+        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
       return reply;
     }
     case R::kTrigger: {

@@ -2,7 +2,6 @@
 // segments, corners between primitives, and pose verification on a distance map.
 #include "picksight/vision/boundary_model.hpp"
 
-
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

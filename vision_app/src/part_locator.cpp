@@ -3,7 +3,6 @@
 // them, the grey-level edges refine them, and the best are accepted first.
 #include "picksight/vision/part_locator.hpp"
 
-
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>

@@ -33,7 +33,11 @@ FileSource::FileSource(std::string path) : path_(std::move(path)) {}
 
 Result<void> FileSource::open() { return refresh(); }
 
-void FileSource::close() { image_.release(); inode_ = 0; size_ = -1; }
+void FileSource::close() {
+  image_.release();
+  inode_ = 0;
+  size_ = -1;
+}
 
 SourceInfo FileSource::info() const {
   SourceInfo i;

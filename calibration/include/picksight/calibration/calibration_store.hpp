@@ -31,7 +31,7 @@ class CalibrationStore {
   Result<void> load();
 
   Result<int> addPoint(const PointPair& pair);  // the new id
-  Result<void> deletePoint(int id);              // error names the missing id
+  Result<void> deletePoint(int id);             // error names the missing id
   const std::map<int, PointPair>& points() const { return points_; }
 
   Result<void> setTransform(const CalibrationResult& result);

@@ -48,7 +48,8 @@ struct ChessboardOptions {
 
 // Calibrates from chessboard views; views where the board is not found are
 // skipped (their names reported in `skipped`). Needs at least 3 good views.
-Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views, const ChessboardOptions& options,
+Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views,
+                                      const ChessboardOptions& options,
                                       std::vector<int>* skipped = nullptr);
 
 // Text form (OpenCV YAML) for storage; parse errors name the problem.

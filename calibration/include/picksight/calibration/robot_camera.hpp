@@ -51,8 +51,8 @@ struct Residual {
 struct CalibrationResult {
   RigidTransform transform;
   Method method = Method::kLeastSquares;  // the estimator that produced it
-  double rms = 0;                          // over inliers, mm
-  std::vector<Residual> residuals;         // one per input point, same order
+  double rms = 0;                         // over inliers, mm
+  std::vector<Residual> residuals;        // one per input point, same order
   int inliers = 0;
 };
 
@@ -65,7 +65,8 @@ enum CalibrationError : int {
 // Estimates the transform. kBest runs both estimators on the same inliers
 // and keeps the lower RMS. Outliers (a mis-touched point) are found by least
 // median of squares and left out of the fit; at least 3 inliers must remain.
-Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method method = Method::kBest);
+Result<CalibrationResult> calibrate(const std::vector<PointPair>& points,
+                                    Method method = Method::kBest);
 
 const char* methodName(Method method);
 

@@ -54,15 +54,15 @@ std::vector<std::vector<cv::Point2d>> fingerPolygons(const Pose& gripper, const 
 // Obstacles: a mask (non-zero = another part) and the affine map from sensor
 // pixels to mask pixels (the frame's ROI and scale).
 struct Obstacles {
-  cv::Mat mask;                                   // CV_8UC1
+  cv::Mat mask;                                  // CV_8UC1
   cv::Matx23d sensor_to_mask{1, 0, 0, 0, 1, 0};  // identity: mask in sensor pixels
 };
 
 // True when no finger covers an obstacle pixel. A finger reaching outside
 // the mask covers what the camera cannot see, and counts as blocked: a
 // robot must not be sent into the unknown.
-bool fingersClear(const Pose& gripper, const Gripper& fingers, const calibration::VisionFrame& frame,
-                  const Obstacles& obstacles);
+bool fingersClear(const Pose& gripper, const Gripper& fingers,
+                  const calibration::VisionFrame& frame, const Obstacles& obstacles);
 
 // Index of the first style whose grasp is clear; nullopt when none is (or
 // when there are no styles). With no fingers every grasp is clear.

@@ -54,7 +54,7 @@ class FrameSink {
 };
 
 struct TriggerTicket {
-  uint64_t sequence = 0;  // the frame to wait for (or any later one)
+  uint64_t sequence = 0;   // the frame to wait for (or any later one)
   bool triggered = false;  // false in free-run: no frame was forced
 };
 

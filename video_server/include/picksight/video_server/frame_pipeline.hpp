@@ -13,9 +13,9 @@ struct SourceFrame;
 enum class OutputFormat { kMono8, kBgr8 };
 
 struct OutputSettings {
-  cv::Rect roi;           // in sensor pixels; empty = full sensor
-  cv::Size size;          // output size; empty = ROI size (or scaled)
-  double scale = 0;       // used when `size` is empty; 0 = 1
+  cv::Rect roi;      // in sensor pixels; empty = full sensor
+  cv::Size size;     // output size; empty = ROI size (or scaled)
+  double scale = 0;  // used when `size` is empty; 0 = 1
   OutputFormat format = OutputFormat::kMono8;
 };
 

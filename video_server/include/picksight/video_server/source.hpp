@@ -51,7 +51,7 @@ struct Feature {
   bool has_range = false;
   double min = 0;
   double max = 0;
-  double increment = 0;  // 0 = any
+  double increment = 0;              // 0 = any
   std::vector<std::string> choices;  // enumerations
   std::string unit;
   std::string description;
@@ -63,7 +63,7 @@ struct TruthPart {
   std::string type;
   double x = 0;
   double y = 0;
-  double angle_deg = 0;     // [0, 360), image axes (x right, y down)
+  double angle_deg = 0;       // [0, 360), image axes (x right, y down)
   double symmetry_deg = 360;  // period of the measurable angle; 0 = none
   double area_px = 0;
 };
@@ -93,7 +93,7 @@ enum SourceError : int {
   kSourceUnavailable = 2,  // device gone or not openable; reopen with back-off
   kSourceBadConfig = 3,    // the source string is wrong; retrying will not help
   kSourceUnknownFeature = 4,
-  kSourceBadValue = 5,     // feature value out of range or of the wrong type
+  kSourceBadValue = 5,  // feature value out of range or of the wrong type
   kSourceNotSupported = 6,
 };
 
