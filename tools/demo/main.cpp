@@ -94,7 +94,9 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::cout << "video server: frames " << *frames << ", control " << *control
-            << "\nvision app: robot port " << *port << "\n";
+            << "\nvision app: robot port " << *port << "\n"
+            << "Uncalibrated, LOCATE replies in the vision frame in pixels (x right, y up,\n"
+            << "angles counter-clockwise); the tables show both in image axes (y down).\n";
 
   // The demo also watches the frames, as a viewer would, to read the truth.
   zmq::context_t context;
