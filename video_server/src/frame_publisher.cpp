@@ -49,8 +49,7 @@ proto::FrameHeader frameHeaderOf(const PublishedFrame& f) {
 
 FramePublisher::FramePublisher(zmq::context_t& context, const std::string& endpoint,
                                size_t queue_limit, int subscriber_queue)
-    : context_(context),
-      socket_(context, zmq::socket_type::pub),
+    : socket_(context, zmq::socket_type::pub),
       monitor_(context, zmq::socket_type::pair),
       queue_limit_(queue_limit) {
   socket_.set(zmq::sockopt::sndhwm, subscriber_queue * 3);  // HWM counts parts

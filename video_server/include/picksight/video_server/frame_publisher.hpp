@@ -54,7 +54,6 @@ class FramePublisher : public FrameSink {
   void send(PublishedFrame& frame);
   void pollMonitor();
 
-  zmq::context_t& context_;
   zmq::socket_t socket_;   // publisher thread only (after start)
   zmq::socket_t monitor_;  // publisher thread only (after start)
   std::string bound_endpoint_;
