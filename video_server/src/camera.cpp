@@ -323,8 +323,10 @@ void Camera::run() {
     Result<cv::Mat> standard = grabbed
                                    ? toOutputFormat(grabbed->image, grabbed->layout, output.format)
                                    : Result<cv::Mat>(grabbed.error());
-    Result<OutputFrame> out = standard ? Result<OutputFrame>(applyOutputSettings(*standard, output))
-                                       : Result<OutputFrame>(standard.error());
+    Result<OutputFrame> out =
+        standard ? Result<OutputFrame>(applyOutputSettings(
+                       *standard, output, standard->datastart != grabbed->image.datastart))
+                 : Result<OutputFrame>(standard.error());
 
     if (!out) {
       lock.lock();

@@ -59,7 +59,8 @@ Result<void> validateOutputSettings(const OutputSettings& s, cv::Size sensor) {
   return {};
 }
 
-OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings) {
+OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings,
+                                bool sensor_is_private) {
   OutputFrame out;
   cv::Rect roi = effectiveRoi(settings, sensor.size());
   if (roi.empty()) roi = cv::Rect(0, 0, sensor.cols, sensor.rows);
@@ -83,7 +84,7 @@ OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& set
     cv::cvtColor(sized, out.image, cv::COLOR_BGR2GRAY);
   } else if (!want_mono && sized.channels() == 1) {
     cv::cvtColor(sized, out.image, cv::COLOR_GRAY2BGR);
-  } else if (sized.datastart == sensor.datastart || !sized.isContinuous()) {
+  } else if ((!sensor_is_private && sized.datastart == sensor.datastart) || !sized.isContinuous()) {
     // Never publish the source's own buffer (it is reused for the next
     // frame), and publish only continuous images (sent as one block).
     out.image = sized.clone();
@@ -96,7 +97,7 @@ OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& set
 Result<OutputFrame> applyOutputSettings(const SourceFrame& frame, const OutputSettings& settings) {
   auto standard = toOutputFormat(frame.image, frame.layout, settings.format);
   if (!standard) return standard.error();
-  return applyOutputSettings(*standard, settings);
+  return applyOutputSettings(*standard, settings, standard->datastart != frame.image.datastart);
 }
 
 }  // namespace picksight::video

@@ -32,7 +32,10 @@ Result<void> validateOutputSettings(const OutputSettings& settings, cv::Size sen
 // Applies the settings to a sensor frame (CV_8UC1 or CV_8UC3 BGR). Settings
 // that do not fit this frame (a sensor that changed size) are clamped. The
 // output never shares memory with `sensor`.
-OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings);
+// `sensor_is_private`: the caller made `sensor` for this frame alone (a
+// format conversion), so it may be published as it is instead of copied.
+OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings,
+                                bool sensor_is_private = false);
 
 // The same for a frame in any source layout: standardized first.
 Result<OutputFrame> applyOutputSettings(const SourceFrame& frame, const OutputSettings& settings);
