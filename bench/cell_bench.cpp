@@ -32,12 +32,7 @@ const std::vector<std::string> kTypes{"rectangle",  "l_shape", "l_shape_mirror",
 
 picksight::synthetic::SceneOptions scene(int width, int height, int parts, uint64_t seed,
                                          std::vector<std::string> types) {
-  picksight::synthetic::SceneOptions o;
-  o.width = width;
-  o.height = height;
-  o.parts = parts;
-  o.seed = seed;
-  o.types = std::move(types);
+  auto o = picksight::synthetic::sceneOptions(width, height, parts, seed, std::move(types));
   o.part_size = 120;
   return o;
 }

@@ -139,12 +139,7 @@ void print(const char* title, const Tally& tally) {
 
 ps::SceneOptions sceneOptions(int width, int height, int parts, uint64_t seed,
                               std::vector<std::string> types) {
-  ps::SceneOptions o;
-  o.width = width;
-  o.height = height;
-  o.parts = parts;
-  o.seed = seed;
-  o.types = std::move(types);
+  ps::SceneOptions o = ps::sceneOptions(width, height, parts, seed, std::move(types));
   o.part_size = 120;
   o.noise_sigma = 3;
   o.uneven_light = true;

@@ -41,12 +41,7 @@ double angleError(double measured_deg, double truth_deg, double period_deg) {
 }
 
 ps::SceneOptions flatScene(std::vector<std::string> types, uint64_t seed, int parts = 12) {
-  ps::SceneOptions o;
-  o.width = 1280;
-  o.height = 960;
-  o.parts = parts;
-  o.seed = seed;
-  o.types = std::move(types);
+  ps::SceneOptions o = ps::sceneOptions(1280, 960, parts, seed, std::move(types));
   o.noise_sigma = 0;
   o.uneven_light = false;
   o.background_level = kBackground;

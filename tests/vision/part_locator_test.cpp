@@ -17,12 +17,7 @@ using picksight::angleDiffDeg;
 
 namespace {
 ps::SceneOptions scene(int parts, uint64_t seed, std::vector<std::string> types, bool touching) {
-  ps::SceneOptions o;
-  o.width = 640;
-  o.height = 480;
-  o.parts = parts;
-  o.seed = seed;
-  o.types = std::move(types);
+  ps::SceneOptions o = ps::sceneOptions(640, 480, parts, seed, std::move(types));
   o.blur_sigma = 0.7;
   o.touching = touching;
   return o;
@@ -53,11 +48,9 @@ ps::SceneRenderer touchingPair(std::vector<std::string> types, uint64_t seed) {
 
 TEST_CASE("touching parts of every type are found inside their merged blob", "[vision][locator]") {
   const auto& types = ps::allPartTypes();
-  std::map<std::string, Trained> trained;
-  std::vector<const PartModel*> models;
-  int id = 1;
-  for (const auto& type : types) trained[type] = train(type, id++);
-  for (const auto& [type, t] : trained) models.push_back(&t.model);
+  const auto set = picksight::test::trainAll(types, train);
+  const auto& trained = set.trained;
+  const auto& models = set.models;
   uint64_t seed = 40;
   for (const auto& type : types) {
     const ps::SceneRenderer s = touchingPair({type}, seed);

@@ -20,12 +20,7 @@ using picksight::angleDiffDeg;
 namespace {
 ps::SceneOptions scene(int width, int height, int parts, uint64_t seed,
                        std::vector<std::string> types) {
-  ps::SceneOptions o;
-  o.width = width;
-  o.height = height;
-  o.parts = parts;
-  o.seed = seed;
-  o.types = std::move(types);
+  ps::SceneOptions o = ps::sceneOptions(width, height, parts, seed, std::move(types));
   o.blur_sigma = 0.7;
   return o;
 }
@@ -149,11 +144,9 @@ TEST_CASE("parts of the same shape and another size are told apart by area", "[v
 
 TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vision][model]") {
   const auto& types = ps::allPartTypes();
-  std::map<std::string, Trained> trained;
-  std::vector<const PartModel*> models;
-  int id = 1;
-  for (const auto& type : types) trained[type] = train(type, id++);
-  for (const auto& [type, t] : trained) models.push_back(&t.model);
+  const auto set = picksight::test::trainAll(types, train);
+  const auto& trained = set.trained;
+  const auto& models = set.models;
   double worst_position = 0;
   double worst_angle = 0;
   for (uint64_t seed : {21u, 22u}) {

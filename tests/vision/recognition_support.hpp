@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,22 @@ inline Trained trainOn(const synthetic::SceneOptions& options, int id, const std
   INFO(type << ": " << outcome.error);
   REQUIRE(outcome.ok);
   return {outcome.model, s.truth()[0].angle_deg};
+}
+
+// Every type trained by `train(type, id)` with ids 1, 2, ..., and the
+// models as the recognizer takes them (pointers into `trained`).
+struct TrainedSet {
+  std::map<std::string, Trained> trained;
+  std::vector<const vision::PartModel*> models;
+};
+
+template <typename TrainFn>
+TrainedSet trainAll(const std::vector<std::string>& types, TrainFn train) {
+  TrainedSet set;
+  int id = 1;
+  for (const auto& type : types) set.trained[type] = train(type, id++);
+  for (const auto& entry : set.trained) set.models.push_back(&entry.second.model);
+  return set;
 }
 
 // The whole recognition (adaptive binarization, regions, models) of one frame.

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -54,6 +55,20 @@ struct SceneOptions {
   // Gaussian blur of the rendered image (optics), sigma in pixels; 0 = none.
   double blur_sigma = 0;
 };
+
+// Options for a scene of `parts` parts of `types` (empty = all) in a
+// width x height image, everything else at its default: what most scenes
+// differ by.
+inline SceneOptions sceneOptions(int width, int height, int parts, uint64_t seed,
+                                 std::vector<std::string> types = {}) {
+  SceneOptions o;
+  o.width = width;
+  o.height = height;
+  o.parts = parts;
+  o.seed = seed;
+  o.types = std::move(types);
+  return o;
+}
 
 // The default part types: "rectangle", "l_shape", "l_shape_mirror",
 // "disc_holes", "gear".
