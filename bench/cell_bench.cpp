@@ -13,14 +13,14 @@
 #include <vector>
 
 #include "locate_args.hpp"
-#include "picksight/common/line_client.hpp"
-#include "picksight/common/subprocess.hpp"
+#include "picksight/tool_support/line_client.hpp"
+#include "picksight/tool_support/subprocess.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/synthetic/scene.hpp"
 #include "picksight/vision/part_model.hpp"
-#include "picksight/vision_app/cell_calibration.hpp"
-#include "picksight/vision_app/cell_locator.hpp"
-#include "picksight/vision_app/model_library.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/cell/grasp_planner.hpp"
+#include "picksight/store/model_library.hpp"
 
 namespace {
 using namespace std::chrono_literals;

@@ -15,7 +15,7 @@
 #include <zmq.hpp>
 
 #include "picksight/common/clock.hpp"
-#include "picksight/common/subprocess.hpp"
+#include "picksight/tool_support/subprocess.hpp"
 #include "picksight/common/text.hpp"
 
 namespace {

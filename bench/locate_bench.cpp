@@ -17,8 +17,8 @@
 #include <zmq.hpp>
 
 #include "locate_args.hpp"
-#include "picksight/common/line_client.hpp"
-#include "picksight/common/subprocess.hpp"
+#include "picksight/tool_support/line_client.hpp"
+#include "picksight/tool_support/subprocess.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/transport/frame_message.hpp"
 #include "picksight/vision/binarize.hpp"

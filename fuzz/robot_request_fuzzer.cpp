@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "picksight/vision_app/line_framer.hpp"
+#include "picksight/protocol/line_framer.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 namespace {

@@ -10,7 +10,7 @@
 #include "picksight/common/log.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
-#include "picksight/vision_app/robot_server.hpp"
+#include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 int main(int argc, char** argv) {

@@ -8,7 +8,7 @@
 #include <fstream>
 
 #include "picksight/calibration/robot_camera.hpp"
-#include "picksight/common/subprocess.hpp"
+#include "picksight/tool_support/subprocess.hpp"
 
 using namespace picksight;
 using namespace std::chrono_literals;

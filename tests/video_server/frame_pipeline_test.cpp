@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/video_server/frame_pipeline.hpp"
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 using Catch::Detail::Approx;
 using picksight::video::applyOutputSettings;

@@ -23,7 +23,7 @@
 #include <string>
 
 #include "glib_ptr.hpp"
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
 

@@ -8,7 +8,7 @@
 #include <ctime>
 #include <string>
 
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
 

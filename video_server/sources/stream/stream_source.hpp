@@ -8,7 +8,7 @@
 #include <string>
 #include <thread>
 
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace cv {
 class VideoCapture;

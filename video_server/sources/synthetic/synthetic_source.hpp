@@ -6,7 +6,7 @@
 #include <string>
 
 #include "picksight/synthetic/scene.hpp"
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
 

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 #include "v4l2_device.hpp"
 
 namespace picksight::video {

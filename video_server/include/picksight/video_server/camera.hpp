@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "picksight/video_server/frame_pipeline.hpp"
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
 

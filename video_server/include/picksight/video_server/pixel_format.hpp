@@ -6,7 +6,7 @@
 
 #include "picksight/common/result.hpp"
 #include "picksight/video_server/frame_pipeline.hpp"
-#include "picksight/video_server/source.hpp"
+#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
 

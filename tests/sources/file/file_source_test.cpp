@@ -1,0 +1,187 @@
+// Pins the file camera: serves the image on every grab, picks up a new image
+// renamed over the path (even with equal size and mtime), keeps the last good
+// image while the file is missing or half-written, and fails cleanly.
+#include <fcntl.h>
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include "temp_dir.hpp"
+
+#include "picksight/sources/source.hpp"
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+using picksight::video::makeSource;
+using picksight::video::Source;
+
+namespace {
+
+using picksight::test::TempDir;
+
+// A mono image whose content depends on `seed`.
+cv::Mat sceneImage(int seed) {
+  cv::Mat image(48, 64, CV_8UC1);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      image.at<uint8_t>(y, x) = static_cast<uint8_t>((x * 3 + y * 5 + seed * 101) % 256);
+    }
+  }
+  return image;
+}
+
+bool sameImage(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
+}
+
+std::unique_ptr<Source> fileSource(const std::string& path) {
+  auto source = makeSource("file:" + path);
+  REQUIRE(source);
+  return std::move(*source);
+}
+
+cv::Mat grabImage(Source& source) {
+  auto frame = source.grab(1000ms);
+  REQUIRE(frame);
+  return frame->image;
+}
+
+struct stat statOf(const std::string& path) {
+  struct stat st {};
+  REQUIRE(::stat(path.c_str(), &st) == 0);
+  return st;
+}
+
+}  // namespace
+
+TEST_CASE("FileSource serves the image on every grab", "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+  const cv::Mat a = sceneImage(1);
+  REQUIRE(cv::imwrite(path, a));
+  auto source = fileSource(path);
+  REQUIRE(source->open());
+  const auto info = source->info();
+  CHECK(info.sensor_width == 64);
+  CHECK(info.sensor_height == 48);
+  CHECK(info.serial == path);
+  CHECK(sameImage(grabImage(*source), a));
+  CHECK(sameImage(grabImage(*source), a));
+}
+
+TEST_CASE("FileSource serves colour as BGR and 16-bit images as 8-bit", "[video_server]") {
+  TempDir dir;
+  SECTION("colour") {
+    cv::Mat bgr(10, 12, CV_8UC3, cv::Scalar(10, 20, 30));
+    const std::string path = dir.file("colour.png");
+    REQUIRE(cv::imwrite(path, bgr));
+    auto source = fileSource(path);
+    REQUIRE(source->open());
+    const cv::Mat image = grabImage(*source);
+    REQUIRE(image.type() == CV_8UC3);
+    CHECK(image.at<cv::Vec3b>(5, 5) == cv::Vec3b(10, 20, 30));
+  }
+  SECTION("16-bit") {
+    cv::Mat deep(10, 12, CV_16UC1, cv::Scalar(200 * 257));
+    const std::string path = dir.file("deep.png");
+    REQUIRE(cv::imwrite(path, deep));
+    auto source = fileSource(path);
+    REQUIRE(source->open());
+    const cv::Mat image = grabImage(*source);
+    REQUIRE(image.type() == CV_8UC1);
+    CHECK(int(image.at<uint8_t>(3, 3)) == 200);
+  }
+}
+
+TEST_CASE("FileSource picks up a new image renamed over the path", "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  auto source = fileSource(path);
+  REQUIRE(source->open());
+  CHECK(sameImage(grabImage(*source), sceneImage(1)));
+
+  const std::string tmp = dir.file("scene.tmp.png");
+  REQUIRE(cv::imwrite(tmp, sceneImage(2)));
+  REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
+  CHECK(sameImage(grabImage(*source), sceneImage(2)));
+  CHECK(sameImage(grabImage(*source), sceneImage(2)));
+}
+
+TEST_CASE("FileSource picks up a renamed image of equal size and mtime (new inode)",
+          "[video_server]") {
+  TempDir dir;
+  // PGM: the file size depends only on the image size.
+  const std::string path = dir.file("scene.pgm");
+  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  auto source = fileSource(path);
+  REQUIRE(source->open());
+  CHECK(sameImage(grabImage(*source), sceneImage(1)));
+  const struct stat before = statOf(path);
+
+  const std::string tmp = dir.file("scene.tmp.pgm");
+  REQUIRE(cv::imwrite(tmp, sceneImage(2)));
+  const timespec times[2] = {before.st_atim, before.st_mtim};
+  REQUIRE(::utimensat(AT_FDCWD, tmp.c_str(), times, 0) == 0);
+  REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
+
+  const struct stat after = statOf(path);
+  REQUIRE(after.st_size == before.st_size);
+  REQUIRE(after.st_mtim.tv_sec == before.st_mtim.tv_sec);
+  REQUIRE(after.st_mtim.tv_nsec == before.st_mtim.tv_nsec);
+  REQUIRE(after.st_ino != before.st_ino);
+  CHECK(sameImage(grabImage(*source), sceneImage(2)));
+}
+
+TEST_CASE("FileSource of a missing file is kSourceUnavailable naming the path", "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("absent.png");
+  auto source = fileSource(path);
+  auto opened = source->open();
+  REQUIRE_FALSE(opened);
+  CHECK(opened.error().code == picksight::video::kSourceUnavailable);
+  CHECK_THAT(opened.error().message, Catch::Contains(path));
+  auto grabbed = source->grab(100ms);
+  REQUIRE_FALSE(grabbed);
+  CHECK(grabbed.error().code == picksight::video::kSourceUnavailable);
+}
+
+TEST_CASE("FileSource of a file that is not an image is kSourceUnavailable", "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("garbage.png");
+  std::ofstream(path) << "this is not a PNG";
+  auto source = fileSource(path);
+  auto opened = source->open();
+  REQUIRE_FALSE(opened);
+  CHECK(opened.error().code == picksight::video::kSourceUnavailable);
+}
+
+TEST_CASE("FileSource keeps the last image while the file is missing or unreadable",
+          "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  auto source = fileSource(path);
+  REQUIRE(source->open());
+  CHECK(sameImage(grabImage(*source), sceneImage(1)));
+
+  REQUIRE(std::remove(path.c_str()) == 0);
+  CHECK(sameImage(grabImage(*source), sceneImage(1)));
+
+  std::ofstream(path) << "half-written";
+  CHECK(sameImage(grabImage(*source), sceneImage(1)));
+
+  const std::string tmp = dir.file("scene.tmp.png");
+  REQUIRE(cv::imwrite(tmp, sceneImage(3)));
+  REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
+  CHECK(sameImage(grabImage(*source), sceneImage(3)));
+}

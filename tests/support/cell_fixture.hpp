@@ -1,0 +1,65 @@
+// A cell for end-to-end tests: the real picksight-video-server and
+// picksight-vision processes started on free ports, and helpers to talk to
+// them as a robot, a viewer or an integrator at a shell would.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <zmq.hpp>
+
+#include "picksight/tool_support/line_client.hpp"
+#include "picksight/tool_support/subprocess.hpp"
+#include "picksight/transport/frame_message.hpp"
+
+namespace picksight::e2e {
+
+std::string binPath(const std::string& name);
+
+struct VideoServerProcess {
+  // Starts the server with `args` plus free-port endpoints; REQUIREs that it
+  // printed its endpoints.
+  explicit VideoServerProcess(std::vector<std::string> args);
+  std::unique_ptr<Subprocess> process;
+  std::string frames;
+  std::string control;
+};
+
+struct VisionProcess {
+  // With an empty `data_dir` a fresh one, removed at the end; a given one
+  // is kept (restart tests).
+  VisionProcess(const VideoServerProcess& server, const std::string& camera = "cam0",
+                const std::string& data_dir = "");
+  ~VisionProcess();
+  std::unique_ptr<Subprocess> process;
+  uint16_t robot_port = 0;
+  std::string data_dir;
+  bool own_data_dir = true;
+  LineClient connect() const;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;
+};
+// Runs a command line tool to completion, capturing stdout.
+CommandResult run(const std::vector<std::string>& argv);
+
+// Receives frames until one satisfies `accept` or `tries` frames went by.
+std::optional<ReceivedFrame> receiveUntil(FrameSubscriber& subscriber,
+                                          const std::function<bool(const ReceivedFrame&)>& accept,
+                                          int tries = 100);
+
+// The reply "OK n x y rz ..." as (x, y, rz) triples; REQUIREs the format.
+struct Pose {
+  double x, y, rz;
+};
+std::vector<Pose> parseLocateReply(const std::string& reply);
+// The same poses back in image axes (y down, angles clockwise on screen):
+// LOCATE replies in the vision frame (y up) before any calibration.
+std::vector<Pose> imagePoses(const std::string& reply);
+
+}  // namespace picksight::e2e

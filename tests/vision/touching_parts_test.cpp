@@ -1,0 +1,112 @@
+// Parts that touch (one merged blob) against the generator's exact truth:
+// every part type in a touching pair, the mirrored pair, and the sub-pixel
+// edge fit on its own.
+#include <catch2/catch.hpp>
+
+#include "recognition_support.hpp"
+
+#include <map>
+
+#include "picksight/common/angles.hpp"
+#include "picksight/synthetic/scene.hpp"
+#include "picksight/vision/touching_parts.hpp"
+
+using namespace picksight::vision;
+namespace ps = picksight::synthetic;
+using picksight::angleDiffDeg;
+
+namespace {
+ps::SceneOptions scene(int parts, uint64_t seed, std::vector<std::string> types, bool touching) {
+  ps::SceneOptions o = ps::sceneOptions(640, 480, parts, seed, std::move(types));
+  o.blur_sigma = 0.7;
+  o.touching = touching;
+  return o;
+}
+
+using picksight::test::nearest;
+using picksight::test::Trained;
+
+Trained train(const std::string& type, int id) {
+  return picksight::test::trainOn(scene(1, 300 + static_cast<uint64_t>(id), {type}, false), id,
+                                  type);
+}
+
+std::vector<Match> recognizeScene(const ps::SceneRenderer& s,
+                                  const std::vector<const PartModel*>& models) {
+  return picksight::test::recognizeFrame(s, 3, models);
+}
+
+// A scene whose two parts touch (the generator may fail to bring a pair into
+// contact from a seed: the next seed is tried).
+ps::SceneRenderer touchingPair(std::vector<std::string> types, uint64_t seed) {
+  for (uint64_t s = seed;; ++s) {
+    ps::SceneRenderer r(scene(2, s, types, true));
+    if (r.truth()[0].touching) return r;
+  }
+}
+}  // namespace
+
+TEST_CASE("touching parts of every type are found inside their merged blob", "[vision][locator]") {
+  const auto& types = ps::allPartTypes();
+  const auto set = picksight::test::trainAll(types, train);
+  const auto& trained = set.trained;
+  const auto& models = set.models;
+  uint64_t seed = 40;
+  for (const auto& type : types) {
+    const ps::SceneRenderer s = touchingPair({type}, seed);
+    seed += 10;
+    const cv::Mat grey = s.render(3);
+    const auto regions = findRegions(binarize(grey, {}), {}, grey);
+    // Otherwise the pair would not test the locator at all.
+    REQUIRE(regions.size() == 1);
+    const auto matches = recognize(regions, models);
+    CHECK(matches.size() == 2);
+    for (const auto& t : s.truth()) {
+      INFO(t.type << " at " << t.x << ", " << t.y << " turned " << t.angle_deg);
+      const Match* m = nearest(matches, t);
+      REQUIRE(m);
+      CHECK(m->model->name == t.type);
+      CHECK(m->touching);
+      CHECK(m->score * 100 >= m->model->verify_percent);
+      CHECK(std::hypot(m->centroid.x - t.x, m->centroid.y - t.y) < 0.15);
+      CHECK(angleDiffDeg(m->angle_deg, t.angle_deg - trained.at(t.type).truth_angle,
+                         m->symmetry_deg) < 0.2);
+    }
+  }
+}
+
+TEST_CASE("a touching part is never taken for its mirror image", "[vision][locator][mirror]") {
+  const Trained l = train("l_shape", 1);
+  const Trained m = train("l_shape_mirror", 2);
+  for (uint64_t seed : {11u, 31u, 51u}) {
+    const ps::SceneRenderer s = touchingPair({"l_shape", "l_shape_mirror"}, seed);
+    const auto only_l = recognizeScene(s, {&l.model});
+    const auto both = recognizeScene(s, {&l.model, &m.model});
+    for (const auto& t : s.truth()) {
+      INFO(t.type << " at " << t.x << ", " << t.y << " (seed " << seed << ")");
+      const Match* a = nearest(only_l, t);
+      CHECK((a != nullptr) == (t.type == "l_shape"));
+      const Match* b = nearest(both, t);
+      REQUIRE(b);
+      CHECK(b->model->name == t.type);
+    }
+    for (const auto& match : only_l) CHECK(match.model->name == "l_shape");
+  }
+}
+
+TEST_CASE("the edge fit moves a pose a few pixels off onto the part", "[vision][locator]") {
+  const Trained t = train("l_shape", 1);
+  const ps::SceneRenderer s(scene(1, 9, {"l_shape"}, false));
+  const cv::Mat grey = s.render(0);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  REQUIRE(regions.size() == 1);
+  const ps::PartTruth& truth = s.truth()[0];
+  const double angle = truth.angle_deg - t.truth_angle;
+  const Pose start{{truth.x + 1.5, truth.y - 1.0}, angle + 2.0, false};
+  const EdgeFit fit = refinePoseOnEdges(t.model, regions[0], start);
+  REQUIRE(fit.ok);
+  CHECK(std::hypot(fit.pose.centre.x - truth.x, fit.pose.centre.y - truth.y) < 0.05);
+  CHECK(angleDiffDeg(fit.pose.angle_deg, angle) < 0.05);
+  CHECK(fit.inlier_fraction > 0.95);
+  CHECK(fit.rms_px < 0.2);
+}

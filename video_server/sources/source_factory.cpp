@@ -1,0 +1,57 @@
+// The one place that knows every driver: builds a source from its string.
+#include "aravis/aravis_source.hpp"
+#include "dir/dir_source.hpp"
+#include "file/file_source.hpp"
+#include "stream/stream_source.hpp"
+#include "synthetic/synthetic_source.hpp"
+#include "v4l2/v4l2_source.hpp"
+#include "picksight/sources/source.hpp"
+
+namespace picksight::video {
+
+Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
+  const size_t colon = uri.find(':');
+  if (colon == std::string::npos) {
+    return makeError(kSourceBadConfig, "source '" + uri +
+                                           "' has no scheme (synthetic:, file:<path>, dir:<path>, "
+                                           "v4l2:/dev/videoN, stream:<url>)");
+  }
+  const std::string scheme = uri.substr(0, colon);
+  const std::string rest = uri.substr(colon + 1);
+  if (scheme == "synthetic") {
+    auto options = parseSyntheticOptions(rest);
+    if (!options) return options.error();
+    return std::unique_ptr<Source>(std::make_unique<SyntheticSource>(std::move(*options)));
+  }
+  if (scheme == "aravis") {
+    // Empty id: the first camera Aravis finds.
+    return std::unique_ptr<Source>(std::make_unique<AravisSource>(rest));
+  }
+  if (scheme == "file") {
+    if (rest.empty())
+      return makeError(kSourceBadConfig, "file: needs a path, as in file:/data/part.png");
+    return std::unique_ptr<Source>(std::make_unique<FileSource>(rest));
+  }
+  if (scheme == "v4l2") {
+    auto options = parseV4l2Options(rest);
+    if (!options) return options.error();
+    return std::unique_ptr<Source>(std::make_unique<V4l2Source>(std::move(*options)));
+  }
+  if (scheme == "stream") {
+    if (rest.empty()) {
+      return makeError(kSourceBadConfig, "stream: needs a URL, as in stream:rtsp://host/path");
+    }
+    return std::unique_ptr<Source>(std::make_unique<StreamSource>(rest));
+  }
+  if (scheme == "dir") {
+    if (rest.empty()) {
+      return makeError(kSourceBadConfig, "dir: needs a directory, as in dir:/data/run1");
+    }
+    return std::unique_ptr<Source>(std::make_unique<DirSource>(rest));
+  }
+  return makeError(kSourceBadConfig,
+                   "unknown source scheme '" + scheme + "' in '" + uri +
+                       "' (known: synthetic:, file:, dir:, v4l2:, stream:, aravis:)");
+}
+
+}  // namespace picksight::video

@@ -1,0 +1,279 @@
+// Part model training: body features, stability of the Hu invariants under
+// rotation, boundary primitives, orientation order and symmetries.
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/touching_parts.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+namespace picksight::vision {
+namespace {
+constexpr int kMaxOrder = 24;
+// Relative strength |c_k| / sum w |z|^k an orientation order needs. Below it
+// the phase of c_k is mostly pixel noise.
+constexpr double kMinOrderStrength = 0.05;
+constexpr double kWeakOrderStrength = 0.01;
+// Higher orders weigh the rim ever more, where noise and small defects sit.
+constexpr int kMaxPreferredOrder = 6;
+// Fraction of the boundary that must coincide with itself turned (or
+// mirrored) for the part to count as symmetric.
+constexpr double kSymmetryScore = 0.97;
+// Turns of the training image that measure how stable each Hu invariant is.
+constexpr double kProbeTurnsDeg[] = {23, 67, 141, 212, 299};
+// An invariant whose log changes by more than this under a turn is noise.
+constexpr double kMaxHuSpread = 1.0;
+constexpr double kMinHuTolerance = 0.5;
+// Invariants below 1e-7 (H above 7) are what a symmetry makes 0: what is
+// measured is pixel noise, of random sign (a 100 px part resolves normalized
+// moments to ~1e-4, their products to ~1e-8).
+constexpr double kMaxLogHu = 7.0;
+
+// |c_k| / sum w |z|^k for k = 0..kMaxOrder, and arg c_k (degrees).
+void complexMoments(const Region& r, std::vector<double>* strength,
+                    std::vector<double>* phase_deg) {
+  std::vector<std::complex<double>> c(kMaxOrder + 1, {0, 0});
+  std::vector<double> a(kMaxOrder + 1, 0);
+  const double scale = 1.0 / std::sqrt(std::max(r.area, 1.0));
+  for (int y = 0; y < r.coverage.rows; ++y) {
+    const float* row = r.coverage.ptr<float>(y);
+    for (int x = 0; x < r.coverage.cols; ++x) {
+      if (row[x] <= 0) continue;
+      const std::complex<double> z((r.coverage_origin.x + x - r.centroid.x) * scale,
+                                   (r.coverage_origin.y + y - r.centroid.y) * scale);
+      const double m = std::abs(z);
+      std::complex<double> p(1, 0);
+      double pm = 1;
+      for (int k = 0; k <= kMaxOrder; ++k) {
+        c[k] += static_cast<double>(row[x]) * p;
+        a[k] += row[x] * pm;
+        p *= z;
+        pm *= m;
+      }
+    }
+  }
+  strength->assign(kMaxOrder + 1, 0);
+  phase_deg->assign(kMaxOrder + 1, 0);
+  for (int k = 0; k <= kMaxOrder; ++k) {
+    (*strength)[k] = a[k] > 0 ? std::abs(c[k]) / a[k] : 0;
+    (*phase_deg)[k] = std::arg(c[k]) * 180.0 / M_PI;
+  }
+}
+
+std::vector<std::vector<cv::Point>> contoursOf(const Region& r) {
+  std::vector<std::vector<cv::Point>> all{r.outer};
+  all.insert(all.end(), r.hole_boundaries.begin(), r.hole_boundaries.end());
+  return all;
+}
+
+// Log Hu invariants of the part turned by `deg` about its centroid.
+bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOptions& options,
+                 HuArray* out) {
+  double reach = 0;
+  for (const auto& p : r.outer)
+    reach = std::max(reach, std::hypot(p.x - r.centroid.x, p.y - r.centroid.y));
+  const int half = static_cast<int>(std::ceil(reach)) + 12;
+  const cv::Point c(static_cast<int>(std::lround(r.centroid.x)),
+                    static_cast<int>(std::lround(r.centroid.y)));
+  cv::Mat padded;
+  cv::copyMakeBorder(grey, padded, half, half, half, half, cv::BORDER_REPLICATE);
+  const cv::Mat window = padded(cv::Rect(c.x, c.y, 2 * half + 1, 2 * half + 1));
+  const cv::Point2f centre(static_cast<float>(r.centroid.x - c.x + half),
+                           static_cast<float>(r.centroid.y - c.y + half));
+  cv::Mat turned;
+  cv::warpAffine(window, turned, cv::getRotationMatrix2D(centre, -deg, 1.0), window.size(),
+                 cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  BinarizeOptions b = options.binarize;
+  b.method = ThresholdMethod::kOtsu;
+  RegionOptions ro = options.regions;
+  ro.keep_border_regions = true;
+  const auto regions = findRegions(binarize(turned, b), ro, turned);
+  if (regions.empty()) return false;
+  *out = logHu(huInvariants(regions.front().moments));
+  return true;
+}
+}  // namespace
+
+double huDistance(const BodyModel& body, const HuArray& log_hu) {
+  double d = 0;
+  for (size_t i = 0; i < log_hu.size(); ++i) {
+    if (body.hu_used[i]) d += std::abs(body.log_hu[i] - log_hu[i]);
+  }
+  return d;
+}
+
+void prepareModel(PartModel& model) {
+  model.samples = sampleBoundary(model.loops, 1.0);
+  model.radius = 0;
+  for (const auto& s : model.samples)
+    model.radius = std::max(model.radius, std::hypot(s.point.x, s.point.y));
+}
+
+TrainOutcome trainModel(const cv::Mat& grey, int type, const std::string& name,
+                        const TrainOptions& options) {
+  TrainOutcome out;
+  if (grey.empty() || grey.type() != CV_8UC1) {
+    out.error = "the training image must be 8-bit grey";
+    return out;
+  }
+  const auto regions = findRegions(binarize(grey, options.binarize), options.regions, grey);
+  if (regions.empty()) {
+    out.error = "no part in the image";
+    return out;
+  }
+  if (regions.size() > 1) {
+    out.error = std::to_string(regions.size()) + " parts in the image, training needs exactly one";
+    return out;
+  }
+  const Region& r = regions.front();
+  PartModel& m = out.model;
+  m.type = type;
+  m.name = name;
+  m.trained_centroid = r.centroid;
+  m.trained_angle_deg = r.angle_deg;
+  m.conformity = options.conformity;
+  m.verify_percent = options.verify_percent;
+  m.edge_tolerance = options.conformity + 1.0;
+  m.body.area = r.area;
+  m.body.area_tolerance = options.area_tolerance;
+  m.body.holes = r.holes;
+  m.body.log_hu = logHu(huInvariants(r.moments));
+
+  // Boundary in the model frame: the trained pose, centroid at the origin.
+  std::vector<std::vector<cv::Point2d>> contours;
+  for (const auto& c : contoursOf(r)) {
+    std::vector<cv::Point2d> loop;
+    loop.reserve(c.size());
+    for (const auto& p : c) loop.emplace_back(p.x - r.centroid.x, p.y - r.centroid.y);
+    contours.push_back(std::move(loop));
+  }
+  m.loops = fitLoops(contours, m.conformity);
+  snapToEdges(m.loops, r, r.centroid);
+  m.corners = findCorners(m.loops, m.conformity);
+  prepareModel(m);
+
+  // Orientation order: the lowest whose complex moment has a direction.
+  std::vector<double> strength;
+  std::vector<double> phase;
+  complexMoments(r, &strength, &phase);
+  // Among the orders with a clear direction, the one whose phase gives the
+  // finest rotation: an error e in arg c_k turns the estimate by e / k, and e
+  // shrinks as |c_k| grows.
+  m.orientation_order = 0;
+  int strongest = 0;
+  double finest = 0;
+  for (int k = 2; k <= kMaxOrder; ++k) {
+    if (strength[k] >= kMinOrderStrength && k <= kMaxPreferredOrder && k * strength[k] > finest) {
+      m.orientation_order = k;
+      finest = k * strength[k];
+    }
+    if (strength[k] > strength[strongest]) strongest = k;
+  }
+  for (int k = kMaxPreferredOrder + 1; k <= kMaxOrder && m.orientation_order == 0; ++k) {
+    if (strength[k] >= kMinOrderStrength) m.orientation_order = k;
+  }
+  if (m.orientation_order == 0 && strongest >= 2 && strength[strongest] >= kWeakOrderStrength) {
+    m.orientation_order = strongest;
+  }
+  m.orientation_phase_deg = m.orientation_order > 0 ? phase[m.orientation_order] : 0;
+
+  // Symmetries, by verifying the model against its own training edges.
+  const int margin = static_cast<int>(std::ceil(m.edge_tolerance)) + 4;
+  const cv::Rect roi = cv::Rect(r.bbox.x - margin, r.bbox.y - margin, r.bbox.width + 2 * margin,
+                                r.bbox.height + 2 * margin);
+  const EdgeDistance edges(contoursOf(r), roi);
+  m.symmetry_order = 1;
+  int passed = 0;
+  for (int s = 2; s <= kMaxOrder; ++s) {
+    if (verifyScore(m.samples, r.centroid, 360.0 / s, edges, m.edge_tolerance) >= kSymmetryScore) {
+      m.symmetry_order = s;
+      ++passed;
+    }
+  }
+  if (m.orientation_order == 0 && passed == kMaxOrder - 1) m.symmetry_order = 0;
+  if (m.orientation_order == 0) {
+    m.body.mirror_symmetric = true;
+  } else {
+    const int k = m.orientation_order;
+    double best = 0;
+    for (int j = 0; j < k; ++j) {
+      const double turn = 2 * m.orientation_phase_deg / k + j * 360.0 / k;
+      best =
+          std::max(best, verifyScore(m.samples, r.centroid, turn, edges, m.edge_tolerance, true));
+    }
+    m.body.mirror_symmetric = best >= kSymmetryScore;
+  }
+
+  // Which Hu invariants survive turning, and how far they move.
+  const HuArray& h0 = m.body.log_hu;
+  std::array<double, 7> spread{};
+  std::array<bool, 7> same_sign;
+  same_sign.fill(true);
+  std::vector<HuArray> probes;
+  for (double deg : kProbeTurnsDeg) {
+    HuArray h;
+    if (!turnedLogHu(grey, r, deg, options, &h)) continue;
+    probes.push_back(h);
+    for (size_t i = 0; i < h.size(); ++i) {
+      spread[i] = std::max(spread[i], std::abs(h[i] - h0[i]));
+      same_sign[i] = same_sign[i] && (h[i] >= 0) == (h0[i] >= 0);
+    }
+  }
+  for (size_t i = 0; i < h0.size(); ++i) {
+    m.body.hu_used[i] = !probes.empty() && same_sign[i] && spread[i] <= kMaxHuSpread &&
+                        std::abs(h0[i]) <= kMaxLogHu;
+  }
+  double worst = 0;
+  for (const auto& h : probes) worst = std::max(worst, huDistance(m.body, h));
+  m.body.hu_tolerance = std::max(kMinHuTolerance, 3 * worst);
+  out.ok = true;
+  return out;
+}
+
+std::string validateModel(const PartModel& m) {
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (m.type < 0 || m.type > 9999) return "type must be in [0, 9999]";
+  if (!finite(m.body.area) || m.body.area <= 0) return "body area must be a positive number";
+  if (!finite(m.body.area_tolerance) || m.body.area_tolerance <= 0 || m.body.area_tolerance >= 1) {
+    return "area tolerance must be in (0, 1)";
+  }
+  if (m.body.holes < 0 || m.body.holes > 10000) return "hole count out of range";
+  for (double h : m.body.log_hu) {
+    if (!finite(h)) return "log Hu invariants must be finite";
+  }
+  if (!finite(m.body.hu_tolerance) || m.body.hu_tolerance <= 0)
+    return "Hu tolerance must be positive";
+  if (m.orientation_order < 0 || m.orientation_order > kMaxOrder)
+    return "orientation order out of range";
+  if (!finite(m.orientation_phase_deg)) return "orientation phase must be finite";
+  if (m.symmetry_order < 0 || m.symmetry_order > kMaxOrder) return "symmetry order out of range";
+  if (!finite(m.conformity) || m.conformity <= 0 || m.conformity > 50)
+    return "conformity must be in (0, 50] px";
+  if (!finite(m.edge_tolerance) || m.edge_tolerance <= 0 || m.edge_tolerance > 50) {
+    return "edge tolerance must be in (0, 50] px";
+  }
+  if (!finite(m.verify_percent) || m.verify_percent <= 0 || m.verify_percent > 100) {
+    return "verify percent must be in (0, 100]";
+  }
+  if (m.loops.empty() || m.loops[0].hole) return "the boundary needs an outer loop first";
+  for (const auto& loop : m.loops) {
+    if (loop.primitives.empty()) return "a boundary loop has no primitives";
+    if (!finite(loop.weight) || loop.weight < 0) return "loop weights must be >= 0";
+    for (const auto& p : loop.primitives) {
+      if (!finite(p.start.x) || !finite(p.start.y) || !finite(p.end.x) || !finite(p.end.y) ||
+          !finite(p.weight) || p.weight < 0) {
+        return "a primitive has a bad point or weight";
+      }
+      if (p.kind == PrimitiveKind::kArc &&
+          (!finite(p.radius) || p.radius <= 0 || !finite(p.sweep_deg) ||
+           std::abs(p.sweep_deg) > 360 || !finite(p.centre.x) || !finite(p.centre.y))) {
+        return "an arc has a bad centre, radius or sweep";
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace picksight::vision

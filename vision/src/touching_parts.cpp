@@ -1,0 +1,544 @@
+// Parts inside merged blobs: corners and arcs of the boundary model matched
+// to those of the blob propose poses, the blob's edge-distance map verifies
+// them, the grey-level edges refine them, and the best are accepted first.
+#include "picksight/vision/touching_parts.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "picksight/common/angles.hpp"
+
+namespace picksight::vision {
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+// A corner turning less than this has no reliable direction (a line running
+// tangentially into an arc, a wobble of the fit).
+constexpr double kMinCornerTurnDeg = 30;
+// How far the opening angles of a model and an image corner may differ:
+// directions of short fitted edges are a few degrees off.
+constexpr double kCornerAngleSlackDeg = 15;
+constexpr double kMinEdgePx = 4;
+constexpr double kMaxChamferPx = 12;
+constexpr double kMinArcSweepDeg = 50;
+constexpr double kMinArcRadiusPx = 4;
+// Hypotheses are screened on this many boundary samples before a full check.
+constexpr size_t kSparseSamples = 64;
+// Screening score a hypothesis needs, below the verify fraction: a pose from
+// one corner is a few degrees off, which costs verification at the rim.
+constexpr double kCoarseSlack = 0.25;
+// Rotation scan about an arc's centre: the largest step at the model's rim.
+constexpr double kScanStepPx = 1.5;
+constexpr int kMaxRefinedPerModel = 16;
+// A mirror-image candidate that verifies within this of the direct one
+// means the part cannot be told from its mirror image: neither is reported.
+constexpr double kMirrorMargin = 0.03;
+// Parts that touch share at most their contact pixels; a part lies in its blob.
+constexpr double kMaxOverlap = 0.04;
+constexpr double kMaxOutside = 0.06;
+// Edge samples this close to a primitive's end see the neighbouring edge.
+constexpr double kCornerClearancePx = 2.0;
+
+double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kDeg; }
+
+using picksight::signedDeg;
+
+double normalizeDeg(double deg) {
+  double d = std::fmod(deg, 360.0);
+  if (d < 0) d += 360.0;
+  return d >= 360.0 ? 0.0 : d;
+}
+
+cv::Point2d rotate(cv::Point2d p, double c, double s) {
+  return {c * p.x - s * p.y, s * p.x + c * p.y};
+}
+
+// Twice the signed area of a loop: > 0 when its interior lies on the side of
+// the left normal (-t.y, t.x) of the walking direction t.
+double loopOrientation(const BoundaryLoop& loop) {
+  std::vector<cv::Point2d> pts;
+  for (const auto& p : loop.primitives) {
+    const int n = p.kind == PrimitiveKind::kArc ? 16 : 1;
+    for (int i = 0; i < n; ++i) pts.push_back(p.pointAt(static_cast<double>(i) / n));
+  }
+  double a = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const cv::Point2d& p = pts[i];
+    const cv::Point2d& q = pts[(i + 1) % pts.size()];
+    a += p.x * q.y - q.x * p.y;
+  }
+  return a;
+}
+
+// A corner as an unordered pair of edges leaving a point, so that it reads
+// the same on a mirrored model: the bisector of the two edges, the opening
+// angle between them, and whether the body fills the opening.
+struct CornerAnchor {
+  cv::Point2d at;
+  double bisector_deg = 0;
+  double opening_deg = 0;
+  bool convex = true;
+};
+
+struct ArcAnchor {
+  cv::Point2d centre;
+  double radius = 0;
+};
+
+void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
+               std::vector<ArcAnchor>* arcs) {
+  for (const auto& loop : loops) {
+    const auto& prims = loop.primitives;
+    const size_t n = prims.size();
+    const bool left_interior = loopOrientation(loop) > 0;
+    // Corners between long edges, each also across the next long edge when
+    // that one is short: a corner the fit cut off with a chamfer (a blurred
+    // sharp tip, pixel steps, a contact point) is still one corner, at the
+    // meeting of its two edges' tangents.
+    std::vector<size_t> long_edges;
+    for (size_t i = 0; i < n; ++i) {
+      if (prims[i].length() >= kMinEdgePx) long_edges.push_back(i);
+    }
+    const size_t count = n >= 2 ? long_edges.size() : 0;
+    for (size_t k = 0; count >= 2 && k < count; ++k) {
+      for (size_t skip = 1; skip <= std::min<size_t>(2, count - 1); ++skip) {
+        const Primitive& a = prims[long_edges[k]];
+        const Primitive& b = prims[long_edges[(k + skip) % count]];
+        if (cv::norm(b.start - a.end) > kMaxChamferPx) continue;
+        const cv::Point2d in = a.endDirection();
+        const cv::Point2d out = b.startDirection();
+        const double turn = signedDeg(angleOf(out) - angleOf(in));
+        if (std::abs(turn) < kMinCornerTurnDeg) continue;
+        const cv::Point2d u = out - in;
+        if (std::hypot(u.x, u.y) < 1e-6) continue;
+        // a.end + p in = b.start - q out, solved for p.
+        const cv::Point2d gap = b.start - a.end;
+        const double det = in.x * out.y - in.y * out.x;
+        const double along = (gap.x * out.y - gap.y * out.x) / det;
+        const bool loop_convex = (turn > 0) == left_interior;
+        corners->push_back({a.end + in * along, angleOf(u), 180.0 - std::abs(turn),
+                            loop.hole ? !loop_convex : loop_convex});
+      }
+    }
+    for (const auto& p : prims) {
+      if (p.kind == PrimitiveKind::kArc && std::abs(p.sweep_deg) >= kMinArcSweepDeg &&
+          p.radius >= kMinArcRadiusPx) {
+        arcs->push_back({p.centre, p.radius});
+      }
+    }
+  }
+}
+
+// A boundary point of the model with its normal pointing away from the body.
+struct EdgeSample {
+  cv::Point2d point;
+  cv::Point2d normal;
+  double weight = 0;
+};
+
+// The unit normal of primitive `p` at `t`, pointing away from the body: out
+// of the outer loop, into a hole.
+cv::Point2d awayNormal(const Primitive& p, double t, bool left_interior, bool hole) {
+  cv::Point2d tangent;
+  if (p.kind == PrimitiveKind::kLine) {
+    tangent = (p.end - p.start) / std::max(p.length(), 1e-9);
+  } else {
+    const double a = angleOf(p.start - p.centre) * kDeg + t * p.sweep_deg * kDeg;
+    const cv::Point2d r(std::cos(a), std::sin(a));
+    tangent = p.sweep_deg >= 0 ? cv::Point2d(-r.y, r.x) : cv::Point2d(r.y, -r.x);
+  }
+  const cv::Point2d left(-tangent.y, tangent.x);
+  const cv::Point2d interior = left_interior ? left : -left;
+  return hole ? interior : -interior;
+}
+
+// Calls f(t, weight) every `step` pixels along primitive `p`, away from
+// its ends where a normal sees the neighbouring edge (unless the primitive
+// is a whole loop: a circle).
+template <typename F>
+void alongPrimitive(const Primitive& p, bool whole_loop, double weight, double step, F&& f) {
+  const double length = p.length();
+  const int count = std::max(1, static_cast<int>(std::floor(length / step)));
+  for (int i = 0; i < count; ++i) {
+    const double t = (i + 0.5) / count;
+    const double along = t * length;
+    if (!whole_loop && (along < kCornerClearancePx || length - along < kCornerClearancePx))
+      continue;
+    f(t, weight * p.weight * length / count);
+  }
+}
+
+std::vector<EdgeSample> edgeSamples(const PartModel& model, double step) {
+  std::vector<EdgeSample> out;
+  for (const auto& loop : model.loops) {
+    const bool left_interior = loopOrientation(loop) > 0;
+    for (const auto& p : loop.primitives) {
+      alongPrimitive(p, loop.primitives.size() == 1, loop.weight, step, [&](double t, double w) {
+        out.push_back({p.pointAt(t), awayNormal(p, t, left_interior, loop.hole), w});
+      });
+    }
+  }
+  return out;
+}
+
+// Bilinear reading of a region's coverage (0 outside its box).
+class Coverage {
+ public:
+  explicit Coverage(const Region& r) : c_(r.coverage), origin_(r.coverage_origin) {}
+  float at(cv::Point2d p) const {
+    const double x = p.x - origin_.x;
+    const double y = p.y - origin_.y;
+    const int x0 = static_cast<int>(std::floor(x));
+    const int y0 = static_cast<int>(std::floor(y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= c_.cols || y0 + 1 >= c_.rows) return 0.f;
+    const float fx = static_cast<float>(x - x0);
+    const float fy = static_cast<float>(y - y0);
+    const float* r0 = c_.ptr<float>(y0) + x0;
+    const float* r1 = c_.ptr<float>(y0 + 1) + x0;
+    return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+  }
+
+ private:
+  const cv::Mat& c_;
+  cv::Point origin_;
+};
+
+// Where, along p + s n (n pointing away from the body), the coverage falls
+// through 0.5 from a clean inside to a clean outside, nearest to `expected`;
+// none where the part touches another (no outside) or the edge is a mess.
+std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point2d n, double window,
+                                   double expected, double step) {
+  std::optional<double> best;
+  double previous = cov.at(p - n * window);
+  for (double s = -window + step; s <= window + 1e-9; s += step) {
+    const double v = cov.at(p + n * s);
+    if (previous >= 0.5 && v < 0.5) {
+      const double at = s - step + step * (previous - 0.5) / (previous - v);
+      if (!best || std::abs(at - expected) < std::abs(*best - expected)) {
+        if (cov.at(p + n * (at - 1.5)) >= 0.7 && cov.at(p + n * (at + 1.5)) <= 0.3) best = at;
+      }
+    }
+    previous = v;
+  }
+  return best;
+}
+
+std::vector<BoundarySample> sparseSamples(const std::vector<BoundarySample>& all) {
+  const size_t stride = std::max<size_t>(1, all.size() / kSparseSamples);
+  std::vector<BoundarySample> out;
+  for (size_t i = stride / 2; i < all.size(); i += stride) out.push_back(all[i]);
+  return out;
+}
+
+struct Candidate {
+  const PartModel* model = nullptr;
+  Pose pose;
+  double score = 0;
+  double rms = 0;
+};
+
+bool samePose(const PartModel& m, const Pose& a, const Pose& b, double px, double deg) {
+  if (a.mirrored != b.mirrored) return false;
+  if (std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) > px) return false;
+  const double period = m.symmetryDeg();
+  if (period <= 0) return true;
+  double d = std::fmod(std::abs(a.angle_deg - b.angle_deg), period);
+  return std::min(d, period - d) <= deg;
+}
+
+// The model's loops placed at a pose, as polygons in canvas coordinates:
+// filled together, the holes stay empty.
+std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Pose& pose,
+                                                  cv::Point origin) {
+  std::vector<std::vector<cv::Point>> polys;
+  const double c = std::cos(pose.angle_deg * kDeg);
+  const double s = std::sin(pose.angle_deg * kDeg);
+  const double flip = pose.mirrored ? -1.0 : 1.0;
+  for (const auto& loop : m.loops) {
+    std::vector<cv::Point> poly;
+    for (const auto& p : loop.primitives) {
+      const int n = std::max(1, static_cast<int>(p.length() / 2.0));
+      for (int i = 0; i < n; ++i) {
+        const cv::Point2d q = p.pointAt(static_cast<double>(i) / n);
+        const cv::Point2d r = pose.centre + rotate({q.x, flip * q.y}, c, s);
+        poly.emplace_back(static_cast<int>(std::lround(r.x)) - origin.x,
+                          static_cast<int>(std::lround(r.y)) - origin.y);
+      }
+    }
+    polys.push_back(std::move(poly));
+  }
+  return polys;
+}
+
+// Screens the poses proposed for one model (direct or mirrored) in a blob.
+void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnchor>& image_corners,
+             const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
+             std::vector<Candidate>* out) {
+  std::vector<CornerAnchor> corners;
+  std::vector<ArcAnchor> arcs;
+  anchorsOf(model.loops, &corners, &arcs);
+  const auto sparse = sparseSamples(model.samples);
+  const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
+  const double f = mirrored ? -1.0 : 1.0;
+  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle) {
+    const double c = std::cos(angle * kDeg);
+    const double s = std::sin(angle * kDeg);
+    const cv::Point2d centre = image_point - rotate({model_point.x, f * model_point.y}, c, s);
+    const double score = verifyScore(sparse, centre, angle, edges, model.edge_tolerance, mirrored);
+    return Candidate{&model, Pose{centre, normalizeDeg(angle), mirrored}, score, 0};
+  };
+  for (const auto& mc : corners) {
+    for (const auto& ic : image_corners) {
+      if (mc.convex != ic.convex) continue;
+      if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
+      const Candidate c = screen(mc.at, ic.at, ic.bisector_deg - f * mc.bisector_deg);
+      if (c.score >= threshold) out->push_back(c);
+    }
+  }
+  // An arc fixes where its centre goes; the rotation about it is scanned,
+  // keeping the local maxima of the screening score.
+  const double step = kScanStepPx / std::max(model.radius, 1.0) / kDeg;
+  const int steps = static_cast<int>(std::ceil(360.0 / step));
+  std::vector<Candidate> scan(static_cast<size_t>(steps));
+  for (const auto& ma : arcs) {
+    for (const auto& ia : image_arcs) {
+      if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
+      for (int k = 0; k < steps; ++k) scan[k] = screen(ma.centre, ia.centre, k * 360.0 / steps);
+      for (int k = 0; k < steps; ++k) {
+        const double s = scan[k].score;
+        if (s >= threshold && s >= scan[(k + steps - 1) % steps].score &&
+            s > scan[(k + 1) % steps].score) {
+          out->push_back(scan[k]);
+        }
+      }
+    }
+  }
+}
+}  // namespace
+
+EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Pose& start,
+                          double search_px, int iterations) {
+  const auto samples = edgeSamples(model, 1.0);
+  const Coverage cov(region);
+  const double flip = start.mirrored ? -1.0 : 1.0;
+  EdgeFit fit;
+  fit.pose = start;
+  double offset = 0;
+  double window = search_px;
+  double gate = search_px;
+  double total = 0;
+  for (const auto& e : samples) total += e.weight;
+  if (total <= 0) return fit;
+  // The last pass only measures: residuals and inliers at the final pose.
+  for (int it = 0; it <= iterations; ++it) {
+    const bool measure_only = it == iterations;
+    const double c = std::cos(fit.pose.angle_deg * kDeg);
+    const double s = std::sin(fit.pose.angle_deg * kDeg);
+    const double step = window > 2.0 ? 0.5 : 0.25;
+    cv::Matx44d a = cv::Matx44d::zeros();
+    cv::Vec4d b(0, 0, 0, 0);
+    double found = 0;
+    double sum2 = 0;
+    int used = 0;
+    for (const auto& e : samples) {
+      const cv::Point2d r = rotate({e.point.x, flip * e.point.y}, c, s);
+      const cv::Point2d n = rotate({e.normal.x, flip * e.normal.y}, c, s);
+      const auto crossing = edgeCrossing(cov, fit.pose.centre + r, n, window, offset, step);
+      if (!crossing || std::abs(*crossing - offset) > gate) continue;
+      const double residual = *crossing - offset;
+      found += e.weight;
+      sum2 += residual * residual;
+      ++used;
+      if (measure_only) continue;
+      const cv::Vec4d j(n.x, n.y, n.x * -r.y + n.y * r.x, 1.0);
+      a += e.weight * (j * j.t());
+      b += e.weight * *crossing * j;
+    }
+    if (used < 8) return fit;
+    const double rms = std::sqrt(sum2 / used);
+    fit.rms_px = rms;
+    fit.inlier_fraction = found / total;
+    if (measure_only) break;
+    cv::Vec4d x;
+    if (!cv::solve(a, b, x, cv::DECOMP_CHOLESKY)) return fit;
+    fit.pose.centre += cv::Point2d(x[0], x[1]);
+    fit.pose.angle_deg = normalizeDeg(fit.pose.angle_deg + x[2] / kDeg);
+    offset = x[3];
+    // Narrow the search as the pose settles; outliers (the other part's
+    // edges near a contact) fall outside the gate.
+    window = std::max(1.5, std::min(window, 3.0 * rms + 1.0));
+    gate = std::max(0.5, std::min(gate, 3.0 * rms + 0.3));
+  }
+  fit.ok = true;
+  return fit;
+}
+
+void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin) {
+  const Coverage cov(region);
+  for (auto& loop : loops) {
+    const bool left_interior = loopOrientation(loop) > 0;
+    for (auto& p : loop.primitives) {
+      std::vector<cv::Point2d> edge;
+      alongPrimitive(p, loop.primitives.size() == 1, 1.0, 1.0, [&](double t, double) {
+        const cv::Point2d at = p.pointAt(t) + origin;
+        const cv::Point2d n = awayNormal(p, t, left_interior, loop.hole);
+        if (const auto s = edgeCrossing(cov, at, n, 2.5, 0.0, 0.25)) edge.push_back(at + n * *s);
+      });
+      if (p.kind == PrimitiveKind::kLine) {
+        if (edge.size() < 4) continue;
+        cv::Vec4f line;
+        std::vector<cv::Point2f> pts(edge.begin(), edge.end());
+        cv::fitLine(pts, line, cv::DIST_L2, 0, 0.01, 0.01);
+        const cv::Point2d d(line[0], line[1]);
+        const cv::Point2d c = cv::Point2d(line[2], line[3]) - origin;
+        p.start = c + d * (p.start - c).dot(d);
+        p.end = c + d * (p.end - c).dot(d);
+      } else {
+        if (edge.size() < 6) continue;
+        // Kasa fit: x^2 + y^2 + D x + E y + F = 0, about the points' mean.
+        cv::Point2d mean(0, 0);
+        for (const auto& q : edge) mean += q;
+        mean /= static_cast<double>(edge.size());
+        cv::Matx33d a = cv::Matx33d::zeros();
+        cv::Vec3d rhs(0, 0, 0);
+        for (const auto& q : edge) {
+          const cv::Point2d d = q - mean;
+          const cv::Vec3d v(d.x, d.y, 1.0);
+          a += v * v.t();
+          rhs += v * -(d.x * d.x + d.y * d.y);
+        }
+        cv::Vec3d x;
+        if (!cv::solve(a, rhs, x, cv::DECOMP_LU)) continue;
+        const double r2 = 0.25 * (x[0] * x[0] + x[1] * x[1]) - x[2];
+        if (!(r2 > 0)) continue;
+        const double radius = std::sqrt(r2);
+        // A short arc's circle is poorly determined: keep the old one then.
+        if (std::abs(radius - p.radius) > 1.5) continue;
+        const cv::Point2d centre = mean + cv::Point2d(-0.5 * x[0], -0.5 * x[1]) - origin;
+        const auto onCircle = [&](cv::Point2d q) {
+          const cv::Point2d d = q - centre;
+          const double n = std::hypot(d.x, d.y);
+          return n > 0 ? centre + d * (radius / n) : q;
+        };
+        p.centre = centre;
+        p.radius = radius;
+        p.start = onCircle(p.start);
+        p.end = onCircle(p.end);
+      }
+    }
+  }
+}
+
+std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
+                                const std::vector<const PartModel*>& models) {
+  std::vector<Match> found;
+  const Region& region = regions[index];
+  double tolerance = 0;
+  double conformity = 1e9;
+  std::vector<const PartModel*> fitting;
+  for (const PartModel* m : models) {
+    // A part in the blob is no larger than the blob.
+    if (m->loops.empty() || m->body.area * (1 - m->body.area_tolerance) > region.area) continue;
+    fitting.push_back(m);
+    tolerance = std::max(tolerance, m->edge_tolerance);
+    conformity = std::min(conformity, m->conformity);
+  }
+  if (fitting.empty()) return found;
+
+  std::vector<std::vector<cv::Point>> contours{region.outer};
+  contours.insert(contours.end(), region.hole_boundaries.begin(), region.hole_boundaries.end());
+  const int margin = static_cast<int>(std::ceil(tolerance)) + 2;
+  // Only verifyScore reads it, at no more than the largest tolerance.
+  const EdgeDistance edges(
+      contours,
+      cv::Rect(region.bbox.x - margin, region.bbox.y - margin, region.bbox.width + 2 * margin,
+               region.bbox.height + 2 * margin),
+      tolerance);
+  std::vector<std::vector<cv::Point2d>> loops2d;
+  for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
+  std::vector<CornerAnchor> image_corners;
+  std::vector<ArcAnchor> image_arcs;
+  anchorsOf(fitLoops(loops2d, conformity), &image_corners, &image_arcs);
+
+  std::vector<Candidate> direct;
+  std::vector<Candidate> mirror;
+  for (const PartModel* m : fitting) {
+    for (const bool mirrored : {false, true}) {
+      if (mirrored && m->body.mirror_symmetric) continue;
+      std::vector<Candidate> proposed;
+      propose(*m, mirrored, image_corners, image_arcs, edges, &proposed);
+      std::stable_sort(proposed.begin(), proposed.end(),
+                       [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+      std::vector<Pose> tried;
+      std::vector<Candidate> refined;
+      for (const auto& p : proposed) {
+        if (static_cast<int>(tried.size()) >= kMaxRefinedPerModel) break;
+        const auto near = [&](const Pose& q) { return samePose(*m, p.pose, q, 2.0, 3.0); };
+        if (std::any_of(tried.begin(), tried.end(), near)) continue;
+        tried.push_back(p.pose);
+        const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
+        if (!fit.ok) continue;
+        const auto same = [&](const Candidate& q) {
+          return samePose(*m, fit.pose, q.pose, 1.0, 1.0);
+        };
+        if (std::any_of(refined.begin(), refined.end(), same)) continue;
+        const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
+                                         m->edge_tolerance, mirrored);
+        refined.push_back({m, fit.pose, score, fit.rms_px});
+      }
+      auto& to = mirrored ? mirror : direct;
+      to.insert(to.end(), refined.begin(), refined.end());
+    }
+  }
+
+  // Best first; among equal scores the closer fit to the grey-level edges.
+  std::stable_sort(direct.begin(), direct.end(), [](const Candidate& a, const Candidate& b) {
+    return a.score > b.score + 1e-9 || (std::abs(a.score - b.score) <= 1e-9 && a.rms < b.rms);
+  });
+  // A canvas around the blob wide enough for any part placed on it, so that
+  // what a placed part has outside the blob is counted.
+  double reach = 0;
+  for (const PartModel* m : fitting) reach = std::max(reach, m->radius);
+  const int pad = static_cast<int>(std::ceil(reach)) + 2;
+  const cv::Point origin = region.coverage_origin - cv::Point(pad, pad);
+  cv::Mat inside(region.coverage.rows + 2 * pad, region.coverage.cols + 2 * pad, CV_8UC1,
+                 cv::Scalar(0));
+  cv::compare(region.coverage, 0.5, inside(cv::Rect(cv::Point(pad, pad), region.coverage.size())),
+              cv::CMP_GE);
+  cv::Mat claimed(inside.size(), CV_8UC1, cv::Scalar(0));
+  cv::Mat shape(inside.size(), CV_8UC1);
+  for (const auto& c : direct) {
+    const PartModel& m = *c.model;
+    if (c.score * 100 < m.verify_percent) continue;
+    const bool mirror_as_good = std::any_of(mirror.begin(), mirror.end(), [&](const Candidate& q) {
+      return q.model == c.model &&
+             std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
+                 0.5 * m.radius &&
+             q.score >= c.score - kMirrorMargin;
+    });
+    if (mirror_as_good) continue;
+    shape.setTo(0);
+    cv::fillPoly(shape, placedOutline(m, c.pose, origin), cv::Scalar(255));
+    const int drawn = cv::countNonZero(shape);
+    if (drawn <= 0) continue;
+    const double outside = cv::countNonZero(shape & ~inside);
+    const double overlap = cv::countNonZero(shape & claimed);
+    if (overlap > kMaxOverlap * drawn || outside > kMaxOutside * drawn) continue;
+    claimed |= shape;
+    Match match;
+    match.model = c.model;
+    match.region = index;
+    match.score = c.score;
+    match.centroid = c.pose.centre;
+    match.symmetry_deg = m.symmetryDeg();
+    match.angle_deg =
+        match.symmetry_deg > 0 ? std::fmod(c.pose.angle_deg, match.symmetry_deg) : 0.0;
+    match.touching = true;
+    found.push_back(match);
+  }
+  return found;
+}
+
+}  // namespace picksight::vision

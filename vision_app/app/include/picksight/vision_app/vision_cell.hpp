@@ -1,0 +1,55 @@
+// One robot cell's vision: the model library and calibration of a data
+// directory, the vision service over a camera link, and the complete robot
+// protocol command table. main.cpp, the fuzzer and the tests all build the
+// protocol through this class, so they serve the same commands.
+//
+// Threading: handle() is thread-safe once load() returned.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "picksight/camera_link/camera_link.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/protocol/cell_commands.hpp"
+#include "picksight/store/model_library.hpp"
+#include "picksight/protocol/robot_protocol.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+class VisionCell {
+ public:
+  // Files live in `data_dir` (models/, calibration.yaml); nothing is read
+  // or written before load().
+  VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera,
+             VisionOptions options);
+  VisionCell(const VisionCell&) = delete;
+  VisionCell& operator=(const VisionCell&) = delete;
+
+  // Loads models and calibration; one message per problem. A bad file costs
+  // what it holds, never the start.
+  std::vector<std::string> load();
+
+  void start() { vision_.start(); }
+  void stop() { vision_.stop(); }
+
+  // One request line in, one reply line out.
+  std::string handle(std::string_view line) const { return protocol_.handle(line); }
+
+  VisionService& vision() { return vision_; }
+  ModelLibrary& models() { return models_; }
+  CellCalibration& calibration() { return calibration_; }
+  const CellContext& context() const { return context_; }
+
+ private:
+  ModelLibrary models_;
+  CellCalibration calibration_;
+  VisionService vision_;
+  RobotProtocol protocol_;
+  CellContext context_;
+};
+
+}  // namespace picksight::app

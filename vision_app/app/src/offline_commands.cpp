@@ -1,0 +1,212 @@
+// Offline subcommands over image files.
+#include "picksight/vision_app/offline_commands.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <ostream>
+
+#include "picksight/calibration/camera_calibration.hpp"
+#include "picksight/common/text.hpp"
+#include "picksight/vision_app/app_options.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/cell/grasp_planner.hpp"
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/protocol/model_commands.hpp"
+#include "picksight/store/model_library.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+std::string offlineUsage() {
+  return "usage: picksight-vision learn --type N [--name NAME] [options] IMAGE\n"
+         "       picksight-vision locate [--type N] [options] IMAGE...\n"
+         "       picksight-vision blobs [options] IMAGE...\n"
+         "       picksight-vision lens [--data-dir DIR] [--corners 9x6] [--square MM] IMAGE...\n"
+         "\n"
+         "  learn   trains type N from the single part in IMAGE into DATA_DIR/models\n"
+         "  locate  prints one 'OK <n> x y rz ...' line per image: grasp poses of type N\n"
+         "          (all trained types without --type; every region without models), in\n"
+         "          the frame the data dir's calibration gives (docs/PROTOCOL.md)\n"
+         "  blobs   prints one BLOBS reply line per image\n"
+         "  lens    calibrates the lens from chessboard views (inner corners, square size)\n"
+         "          into DATA_DIR/calibration.yaml: 'OK fx fy cx cy rms_px views'; stop the\n"
+         "          vision app first, it reads the file at start\n"
+         "Options: --data-dir DIR, --threshold, --polarity, --window, --min-area as in server "
+         "mode.\n";
+}
+
+bool isOfflineCommand(const std::vector<std::string>& args) {
+  return !args.empty() &&
+         (args[0] == "learn" || args[0] == "locate" || args[0] == "blobs" || args[0] == "lens");
+}
+
+namespace {
+// picksight-vision lens: chessboard views to the lens model in the data dir.
+int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  calibration::ChessboardOptions board;
+  std::string data_dir = "picksight-data";
+  std::vector<cv::Mat> views;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.rfind("--", 0) == 0 && i + 1 >= args.size()) {
+      err << "picksight-vision lens: " << a << ": missing value\n";
+      return 2;
+    }
+    if (a == "--data-dir") {
+      data_dir = args[++i];
+    } else if (a == "--corners") {
+      const auto wh = splitFields(args[++i], "x");
+      const auto w = wh.size() == 2 ? parseInt(wh[0]) : std::nullopt;
+      const auto h = wh.size() == 2 ? parseInt(wh[1]) : std::nullopt;
+      if (!w || !h || *w < 2 || *h < 2 || *w > 100 || *h > 100) {
+        err << "picksight-vision lens: --corners must be WxH inner corners, e.g. 9x6\n";
+        return 2;
+      }
+      board.inner_corners = cv::Size(static_cast<int>(*w), static_cast<int>(*h));
+    } else if (a == "--square") {
+      const auto mm = parseDouble(args[++i]);
+      if (!mm || !(*mm > 0)) {
+        err << "picksight-vision lens: --square must be a positive size in mm\n";
+        return 2;
+      }
+      board.square_mm = *mm;
+    } else if (a.rfind("--", 0) == 0) {
+      err << "picksight-vision lens: unknown option '" << a << "'\n";
+      return 2;
+    } else {
+      views.push_back(cv::imread(a, cv::IMREAD_GRAYSCALE));
+      if (views.back().empty()) err << "picksight-vision lens: cannot read '" << a << "'\n";
+    }
+  }
+  if (views.empty()) {
+    err << offlineUsage();
+    return 2;
+  }
+  std::vector<int> skipped;
+  auto lens = calibration::calibrateChessboard(views, board, &skipped);
+  for (int i : skipped) err << "picksight-vision lens: no board in view " << i + 1 << "\n";
+  if (!lens) {
+    out << errorReply(kBadArguments, lens.error().message) << "\n";
+    return 1;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(data_dir, ec);
+  CellCalibration store(data_dir + "/calibration.yaml");
+  auto loaded = store.load();
+  auto saved = loaded ? store.setLens(*lens) : Result<void>(loaded.error());
+  if (!saved) {
+    out << errorReply(kCalibrationStorage, saved.error().message) << "\n";
+    return 1;
+  }
+  const auto& k = lens->camera_matrix;
+  out << "OK " << formatFixed(k(0, 0)) << " " << formatFixed(k(1, 1)) << " " << formatFixed(k(0, 2))
+      << " " << formatFixed(k(1, 2)) << " " << formatFixed(lens->rms_reprojection_px) << " "
+      << lens->views << "\n";
+  return 0;
+}
+}  // namespace
+
+int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  if (!isOfflineCommand(args)) {
+    err << offlineUsage();
+    return 2;
+  }
+  const std::string command = args[0];
+  if (command == "lens") return runLens(args, out, err);
+  std::vector<std::string> rest;
+  std::vector<std::string> images;
+  int type = -1;
+  std::string name;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if ((a == "--type" || a == "--name") && i + 1 < args.size()) {
+      const std::string& v = args[++i];
+      if (a == "--name") {
+        name = v;
+        continue;
+      }
+      const auto t = parseType(v);
+      if (!t) {
+        err << "picksight-vision " << command << ": --type must be an integer in [0, 9999], got '"
+            << v << "'\n";
+        return 2;
+      }
+      type = *t;
+    } else if (a.rfind("--", 0) == 0) {
+      rest.push_back(a);
+      if (i + 1 < args.size()) rest.push_back(args[++i]);
+    } else {
+      images.push_back(a);
+    }
+  }
+  auto options = parseAppArgs(rest, nullptr);
+  if (!options) {
+    err << "picksight-vision " << command << ": " << options.error().message << "\n\n"
+        << offlineUsage();
+    return 2;
+  }
+  if (images.empty() || (command == "learn" && (images.size() != 1 || type < 0))) {
+    err << offlineUsage();
+    return 2;
+  }
+  ModelLibrary library(options->data_dir + "/models");
+  for (const auto& problem : library.load())
+    err << "picksight-vision: model rejected: " << problem << "\n";
+  CellCalibration calibration(options->data_dir + "/calibration.yaml");
+  if (auto loaded = calibration.load(); !loaded)
+    err << "picksight-vision: calibration rejected: " << loaded.error().message << "\n";
+
+  int status = 0;
+  for (const auto& path : images) {
+    const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (grey.empty()) {
+      out << errorReply(kBadArguments, "cannot read image '" + printable(path, 200) + "'") << "\n";
+      status = 1;
+      continue;
+    }
+    if (command == "learn") {
+      if (name.empty()) name = "type" + std::to_string(type);
+      if (!validModelName(name)) {
+        err << "picksight-vision learn: name must be 1-32 of A-Z a-z 0-9 _ - .\n";
+        return 2;
+      }
+      vision::TrainOptions train;
+      train.binarize = options->vision.binarize;
+      train.regions = options->vision.regions;
+      const auto outcome = vision::trainModel(grey, type, name, train);
+      if (!outcome.ok) {
+        const bool none = outcome.error.rfind("no part", 0) == 0;
+        out << errorReply(none ? kNoPartToLearn : kSeveralParts, outcome.error) << "\n";
+        return 1;
+      }
+      auto stored = library.store(outcome.model);
+      if (!stored) {
+        out << errorReply(kStorageFailed, "cannot store the model: " + stored.error().message)
+            << "\n";
+        return 1;
+      }
+      out << "OK " << modelSummary(outcome.model) << " "
+          << (outcome.model.body.mirror_symmetric ? "1" : "0") << "\n";
+    } else if (command == "locate") {
+      // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
+      LocateOutcome outcome;
+      outcome.scene.models = library.snapshot();
+      outcome.parts = locateInImage(grey, FrameMapping{}, options->vision, *outcome.scene.models,
+                                    type, &outcome.scene);
+      const CellPick pick = pickPoses(outcome, *library.grasps(), calibration.geometry());
+      std::string line = "OK " + std::to_string(pick.poses.size());
+      for (const auto& p : pick.poses)
+        line += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
+      out << line << "\n";
+    } else {
+      const auto blobs = blobsInImage(grey, options->vision);
+      std::string line = "OK " + std::to_string(blobs.size());
+      for (const auto& b : blobs) line += " " + blobSummary(b);
+      out << line << "\n";
+    }
+  }
+  return status;
+}
+
+}  // namespace picksight::app

@@ -1,0 +1,33 @@
+// From located parts to the poses a robot picks at: each part's pose in the
+// vision frame, its first grasp style whose fingers cover no other part
+// (SPEC section 3, Grasping), then the reply frame (robot once computed).
+#pragma once
+
+#include <vector>
+
+#include "picksight/grasp/grasp.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/store/model_library.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+struct CellPick {
+  std::vector<grasp::Pose> poses;  // reply frame, in the order of the parts
+  size_t skipped = 0;              // parts with no free grasp, not offered
+  CoordinateFrame frame = CoordinateFrame::kVisionPixels;
+};
+
+// A located part's own pose in the vision frame: position in vision units,
+// rotation counter-clockwise (a recognized part: from its trained pose, in
+// [0, symmetry); a region: its axis direction, [0, 360)).
+grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision);
+
+// The grasp poses of the parts of `outcome`. Obstacles are the scene's
+// mask without the part's own pixels (for a region holding more than one
+// part, without the placed model's footprint). A part of a type with no
+// grasp styles is grasped at its own pose, checked against the fingers.
+CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
+                   const CellGeometry& geometry);
+
+}  // namespace picksight::app

@@ -1,0 +1,171 @@
+// The vision work behind robot requests: get a frame taken after the
+// request from the camera link (a software trigger, or the next free-run
+// frame), find the parts (recognize trained types, or every region when no
+// model exists) or the calibration target, and express them in sensor pixels.
+//
+// Threading: every request method may be called from any connection thread;
+// requests are served one at a time (they share the control socket and the CPU).
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <zmq.hpp>
+
+#include "picksight/common/result.hpp"
+#include "picksight/transport/control_client.hpp"
+#include "picksight/vision/binarize.hpp"
+#include "picksight/vision/blob_features.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/regions.hpp"
+#include "picksight/camera_link/camera_link.hpp"
+#include "picksight/store/model_library.hpp"
+
+namespace picksight::app {
+
+// Error codes of VisionService results; they are also the robot protocol's.
+// (kNoFrame, kNoVideoServer and kCameraRefused come from the camera link.)
+enum VisionError : int {
+  kNoTarget = 1,        // STORE, CALCAM: no target in the frame
+  kSeveralTargets = 2,  // STORE, CALCAM: more than one
+  kNotADisc = 3,        // CALCAM: the target is not a disc
+  kNoPartToLearn = 30,  // LEARN: no part in the frame
+  kSeveralParts = 31,   // LEARN: more than one part in the frame
+  kUnknownType = 32,    // no model for that type
+  kStorageFailed = 33,  // a model file could not be written or removed
+};
+
+struct LocatedPart {
+  double x = 0;  // sensor pixels
+  double y = 0;
+  // Recognized part: rotation from the trained pose, [0, symmetry_deg).
+  // Region (no models): direction of its axis, [0, 360), image axes.
+  double angle_deg = 0;
+  double area = 0;  // sensor pixels
+  int holes = 0;
+  int type = -1;              // -1: a region, no model
+  double score = 0;           // verified boundary fraction
+  double symmetry_deg = 360;  // period of angle_deg (0: any)
+  int region = -1;            // index into the scene's regions
+};
+
+// Where a frame's pixels lie on the sensor (ROI offset and resize).
+struct FrameMapping {
+  double roi_x = 0;
+  double roi_y = 0;
+  double scale_x = 1;
+  double scale_y = 1;
+  cv::Point2d toSensor(cv::Point2d p) const;
+  double directionToSensor(double deg) const;
+};
+
+struct FrameInfo {
+  std::string camera;
+  uint64_t sequence = 0;
+  uint64_t host_timestamp_ns = 0;
+  uint32_t width = 0;
+  uint32_t height = 0;
+  bool triggered = false;
+};
+
+// What a location saw beyond the parts: the binary mask and the regions
+// (frame pixels), for grasp clearance.
+struct LocateScene {
+  cv::Mat mask;  // CV_8UC1, non-zero = part
+  std::vector<vision::Region> regions;
+  FrameMapping mapping;
+  std::shared_ptr<const ModelList> models;  // the models the parts refer to
+};
+
+struct LocateOutcome {
+  FrameInfo frame;
+  std::vector<LocatedPart> parts;  // best (or largest) first
+  LocateScene scene;
+};
+
+// The single calibration target in a frame, in sensor pixels.
+struct TargetOutcome {
+  FrameInfo frame;
+  cv::Point2d centroid;
+  // Area and central second moments (m00, mu20, mu11, mu02), grey-level
+  // weighted, in sensor pixels.
+  cv::Moments moments;
+};
+
+struct VisionOptions {
+  vision::BinarizeOptions binarize;
+  vision::RegionOptions regions;
+  std::chrono::milliseconds frame_timeout{3000};
+};
+
+// Finds the parts in one frame and maps them to sensor pixels through the
+// frame header's ROI offset and scale: every region, largest first.
+std::vector<LocatedPart> locateParts(const ReceivedFrame& frame, const VisionOptions& options);
+
+// The frame as 8-bit grey (converted from colour if needed) and its mapping.
+cv::Mat greyImage(const ReceivedFrame& frame);
+FrameMapping frameMapping(const ReceivedFrame& frame);
+
+// Finds parts in a grey image: with `models` non-empty, the recognized parts
+// of type `type` (-1: all types), best first; with none, every region,
+// largest first.
+// With `scene`, also keeps the mask and regions there.
+std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
+                                       const VisionOptions& options, const ModelList& models,
+                                       int type, LocateScene* scene = nullptr);
+
+// The single region of a grey image as a calibration target.
+Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& mapping,
+                                    const VisionOptions& options);
+
+// Blob features of every region of a grey image (skeleton left out).
+std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const VisionOptions& options);
+
+class VisionService {
+ public:
+  // `models` (borrowed, may be null: no recognition) outlives the service.
+  VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
+                ModelLibrary* models = nullptr);
+  // With a VideoServerCamera.
+  VisionService(zmq::context_t& context, const std::string& frames_endpoint,
+                const std::string& control_endpoint, std::string camera, VisionOptions options,
+                ModelLibrary* models = nullptr);
+
+  void start();
+  void stop();
+
+  // The parts of `type` in a frame taken after this call (every region when
+  // no model exists; kUnknownType when models exist but none of `type`).
+  Result<LocateOutcome> locate(int type);
+  // Trains type `type` from the single part in a fresh frame and stores it.
+  Result<vision::PartModel> learn(int type, const std::string& name);
+  // Blob features of every region in a fresh frame, sensor pixels.
+  Result<std::vector<vision::BlobFeatures>> blobs();
+  // The single calibration target in a fresh frame.
+  Result<TargetOutcome> target();
+  // A camera setting passed to the video server.
+  Result<proto::ControlReply> control(const proto::ControlRequest& request);
+  uint64_t framesReceived() const { return camera_->framesReceived(); }
+  ModelLibrary* models() const { return models_; }
+  // The frame the last request worked on.
+  std::optional<FrameInfo> lastFrame() const;
+  const std::string& camera() const { return camera_->camera(); }
+  const VisionOptions& options() const { return options_; }
+
+ private:
+  // Call with mutex_ held.
+  Result<std::shared_ptr<const ReceivedFrame>> freshFrame();
+
+  const std::unique_ptr<CameraLink> camera_;
+  const VisionOptions options_;
+  ModelLibrary* const models_;
+
+  mutable std::mutex mutex_;  // serializes requests; guards camera_ calls and last_frame_
+  std::optional<FrameInfo> last_frame_;
+};
+
+}  // namespace picksight::app

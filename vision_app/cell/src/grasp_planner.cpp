@@ -1,0 +1,151 @@
+// Grasp selection over a located scene, with local obstacle masks so that a
+// frame with many parts costs a few small copies, not a full mask per part.
+#include "picksight/cell/grasp_planner.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace picksight::app {
+namespace {
+// Footprint margin (frame pixels) around a placed model: covers its
+// anti-aliased edge and a small pose error, so that a part never blocks
+// its own grasp.
+constexpr int kFootprintMargin = 3;
+
+double normalizeDeg(double deg, double period) {
+  if (!(period > 0)) return 0;
+  double d = std::fmod(deg, period);
+  if (d < 0) d += period;
+  return d >= period ? 0.0 : d;
+}
+
+const vision::PartModel* modelOf(const LocateScene& scene, int type) {
+  if (!scene.models || type < 0) return nullptr;
+  for (const auto& m : *scene.models)
+    if (m.type == type) return &m;
+  return nullptr;
+}
+
+// Sensor pixels to frame (mask) pixels: the inverse of FrameMapping::toSensor.
+cv::Matx23d sensorToFrame(const FrameMapping& m) {
+  return {m.scale_x, 0,         (0.5 - m.roi_x) * m.scale_x - 0.5,
+          0,         m.scale_y, (0.5 - m.roi_y) * m.scale_y - 0.5};
+}
+
+cv::Point2d apply(const cv::Matx23d& a, cv::Point2d p) {
+  return {a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2), a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2)};
+}
+
+// The outer boundary of `model` placed at a part's pose, in frame pixels.
+std::vector<std::vector<cv::Point>> placedFootprint(const vision::PartModel& model,
+                                                    cv::Point2d centre, double image_deg,
+                                                    cv::Point offset) {
+  const double a = image_deg * M_PI / 180.0;
+  const double c = std::cos(a), s = std::sin(a);
+  std::vector<std::vector<cv::Point>> polys;
+  for (const auto& loop : model.loops) {
+    if (loop.hole) continue;
+    std::vector<cv::Point> poly;
+    for (const auto& prim : loop.primitives) {
+      const int steps = prim.kind == vision::PrimitiveKind::kLine
+                            ? 1
+                            : std::clamp(static_cast<int>(prim.length() / 2.0), 2, 256);
+      for (int k = 0; k < steps; ++k) {
+        const cv::Point2d p = prim.pointAt(static_cast<double>(k) / steps);
+        const cv::Point2d q(centre.x + c * p.x - s * p.y, centre.y + s * p.x + c * p.y);
+        poly.emplace_back(static_cast<int>(std::lround(q.x)) - offset.x,
+                          static_cast<int>(std::lround(q.y)) - offset.y);
+      }
+    }
+    if (poly.size() >= 3) polys.push_back(std::move(poly));
+  }
+  return polys;
+}
+
+// Obstacles around one part: the mask over the box the fingers can reach,
+// without the part's own pixels.
+grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
+                              const std::vector<std::vector<cv::Point2d>>& finger_polys) {
+  const cv::Matx23d to_frame = sensorToFrame(scene.mapping);
+  std::vector<cv::Point2f> corners;
+  for (const auto& poly : finger_polys)
+    for (const auto& p : poly) corners.emplace_back(apply(to_frame, p));
+  const cv::Rect image(0, 0, scene.mask.cols, scene.mask.rows);
+  cv::Rect box = cv::boundingRect(corners);
+  box = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & image;
+  if (box.empty()) box = cv::Rect(0, 0, 1, 1) & image;  // fingers outside: blocked anyway
+
+  grasp::Obstacles obstacles;
+  obstacles.mask = scene.mask(box).clone();
+  obstacles.sensor_to_mask = to_frame;
+  obstacles.sensor_to_mask(0, 2) -= box.x;
+  obstacles.sensor_to_mask(1, 2) -= box.y;
+  if (part.region < 0 || static_cast<size_t>(part.region) >= scene.regions.size()) return obstacles;
+
+  const vision::Region& region = scene.regions[static_cast<size_t>(part.region)];
+  cv::Mat own(box.size(), CV_8UC1, cv::Scalar(0));
+  const std::vector<std::vector<cv::Point>> outer{region.outer};
+  cv::drawContours(own, outer, 0, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
+                   -box.tl());
+  // A region of one part's area is that part alone; a larger one holds
+  // touching parts, and only this part's placed footprint is its own.
+  const vision::PartModel* model = modelOf(scene, part.type);
+  const double frame_area = part.area * scene.mapping.scale_x * scene.mapping.scale_y;
+  if (model && region.area > model->body.area * (1 + 2 * model->body.area_tolerance) &&
+      frame_area > 0) {
+    const cv::Point2d centre = apply(to_frame, {part.x, part.y});
+    const auto polys = placedFootprint(*model, centre, part.angle_deg, box.tl());
+    cv::Mat footprint(box.size(), CV_8UC1, cv::Scalar(0));
+    cv::fillPoly(footprint, polys, cv::Scalar(255));
+    cv::polylines(footprint, polys, true, cv::Scalar(255), 2 * kFootprintMargin + 1);
+    own &= footprint;
+  }
+  obstacles.mask.setTo(0, own);
+  return obstacles;
+}
+}  // namespace
+
+grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision) {
+  const cv::Point2d at = vision.toMm({part.x, part.y});
+  // The vision frame flips y: an image rotation turns the other way.
+  const double rz = part.type >= 0 ? normalizeDeg(-part.angle_deg, part.symmetry_deg)
+                                   : calibration::VisionFrame::angleToVision(part.angle_deg);
+  return {at.x, at.y, rz};
+}
+
+CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
+                   const CellGeometry& geometry) {
+  static const std::vector<grasp::GraspStyle> kOwnPose{grasp::GraspStyle{}};
+  CellPick pick;
+  pick.frame = geometry.frame();
+  for (const auto& part : outcome.parts) {
+    const grasp::Pose pose = partPoseInVisionFrame(part, geometry.vision);
+    const auto setup = part.type >= 0 ? grasps.find(part.type) : grasps.end();
+    const bool has_setup = setup != grasps.end();
+    const auto& styles =
+        has_setup && !setup->second.styles.empty() ? setup->second.styles : kOwnPose;
+    if (!has_setup || setup->second.gripper.fingers.empty()) {
+      pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles.front())));
+      continue;
+    }
+    const grasp::Gripper& gripper = setup->second.gripper;
+    std::vector<std::vector<cv::Point2d>> reach;
+    for (const auto& style : styles) {
+      for (auto& poly :
+           grasp::fingerPolygons(grasp::gripperPose(pose, style), gripper, geometry.vision))
+        reach.push_back(std::move(poly));
+    }
+    const grasp::Obstacles obstacles = obstaclesFor(part, outcome.scene, reach);
+    const auto chosen = grasp::firstClearGrasp(pose, styles, gripper, geometry.vision, obstacles);
+    if (!chosen) {
+      ++pick.skipped;
+      continue;
+    }
+    pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles[*chosen])));
+  }
+  return pick;
+}
+
+}  // namespace picksight::app

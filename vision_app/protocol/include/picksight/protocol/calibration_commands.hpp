@@ -1,0 +1,15 @@
+// Robot protocol commands for calibration: CALCAM (camera scale), STORE,
+// DELETE, LIST, COMPUTE and RESIDUALS (robot-camera), docs/PROTOCOL.md.
+#pragma once
+
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+// Registers the commands; `vision` and `calibration` outlive `table`.
+void addCalibrationCommands(CommandTable& table, VisionService& vision,
+                            CellCalibration& calibration);
+
+}  // namespace picksight::app

@@ -1,0 +1,37 @@
+// Robot protocol commands that run the cell: LOCATE (grasp poses in the
+// reply frame), GRASP and GRIPPER (per model), STATUS, and the camera
+// settings passed through to the video server (EXPOSURE, ROI);
+// docs/PROTOCOL.md.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+// What the cell commands share; owned by VisionCell.
+struct CellContext {
+  CellContext(VisionService& v, CellCalibration& c) : vision(v), calibration(c) {}
+  VisionService& vision;
+  CellCalibration& calibration;
+  // LOCATE figures for STATUS.
+  std::atomic<uint64_t> locates{0};
+  std::atomic<uint64_t> last_offered{0};
+  std::atomic<uint64_t> last_skipped{0};  // parts with no free grasp in the last LOCATE
+  std::atomic<uint64_t> skipped_total{0};
+  std::mutex grasp_edits;  // serializes GRASP/GRIPPER read-modify-writes
+};
+
+// The camera feature names EXPOSURE tries, in order: GenICam SFNC, older
+// GenICam cameras, V4L2.
+const std::vector<std::string>& exposureFeatureNames();
+
+// Registers the commands; `context` outlives `table`.
+void addCellCommands(CommandTable& table, CellContext& context);
+
+}  // namespace picksight::app

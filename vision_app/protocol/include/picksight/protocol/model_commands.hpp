@@ -1,0 +1,21 @@
+// Robot protocol commands for part models and blob analysis: LEARN, MODELS,
+// FORGET, BLOBS (docs/PROTOCOL.md).
+#pragma once
+
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+// Registers the commands; `vision` (with its model library) outlives `table`.
+void addModelCommands(CommandTable& table, VisionService& vision);
+
+// The reply fields of one model ("<type> <name> <area> <holes> <symmetry>").
+std::string modelSummary(const vision::PartModel& model);
+// The reply fields of one region's features (see BLOBS).
+std::string blobSummary(const vision::BlobFeatures& blob);
+
+// A model name: 1 to 32 of A-Z a-z 0-9 _ - .
+bool validModelName(std::string_view name);
+
+}  // namespace picksight::app

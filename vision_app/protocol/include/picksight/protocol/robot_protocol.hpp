@@ -1,0 +1,30 @@
+// The robot protocol (docs/PROTOCOL.md): the core commands (PING, VERSION,
+// HELP, FRAME) over a CommandTable that the other features extend (LOCATE
+// and the cell: cell_commands.hpp; VisionCell wires them all).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/cell/vision_service.hpp"
+
+namespace picksight::app {
+
+class RobotProtocol {
+ public:
+  explicit RobotProtocol(VisionService& vision);
+
+  // One request line in, one reply line out. Thread-safe.
+  std::string handle(std::string_view line) const { return table_.dispatch(line); }
+  // For features that add commands; only before serving starts.
+  CommandTable& table() { return table_; }
+
+ private:
+  std::string frame(const Request& request);
+
+  VisionService& vision_;
+  CommandTable table_;
+};
+
+}  // namespace picksight::app

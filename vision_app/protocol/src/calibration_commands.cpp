@@ -1,0 +1,114 @@
+// CALCAM, STORE, DELETE, LIST, COMPUTE, RESIDUALS. Every argument is checked
+// before a frame is taken or a file written.
+#include "picksight/protocol/calibration_commands.hpp"
+
+#include <cmath>
+
+#include "picksight/common/text.hpp"
+
+namespace picksight::app {
+namespace {
+// A disc's area equals that of its equal-moment ellipse; a square's is 4.7%
+// smaller, so 3% tells a disc from the usual wrong targets.
+constexpr double kDiscTolerance = 0.03;
+constexpr double kMaxRadiusMm = 10000;
+
+std::string reply(const Error& e) { return errorReply(e.code, e.message); }
+
+bool looksLikeDisc(const cv::Moments& m) {
+  const double a = m.mu20 / m.m00, b = m.mu02 / m.m00, c = m.mu11 / m.m00;
+  const double det = a * b - c * c;
+  if (!(det > 0)) return false;
+  const double ellipse_area = 4.0 * M_PI * std::sqrt(det);
+  return std::abs(ellipse_area / m.m00 - 1.0) <= kDiscTolerance;
+}
+
+std::string calcam(const Request& r, VisionService& vision, CellCalibration& calibration) {
+  const auto radius = parseNumbers(r.args);
+  if (!radius || radius->size() != 1 || !((*radius)[0] > 0) || (*radius)[0] > kMaxRadiusMm)
+    return errorReply(kBadArguments, "usage: CALCAM <radius_mm> (a number in (0, 10000])");
+  auto target = vision.target();
+  if (!target) return reply(target.error());
+  if (!looksLikeDisc(target->moments))
+    return errorReply(kNotADisc, "the target is not a disc (check the target and the lighting)");
+  auto scale = calibration::scaleFromCircle(target->moments, (*radius)[0]);
+  if (!scale) return errorReply(kNotADisc, scale.error().message);
+  if (auto ok = calibration.setScale(*scale); !ok) return reply(ok.error());
+  return "OK " + formatFixed(scale->mm_per_px_x, 6) + " " + formatFixed(scale->mm_per_px_y, 6);
+}
+
+std::string store(const Request& r, VisionService& vision, CellCalibration& calibration) {
+  const auto robot = parseNumbers(r.args);
+  if (!robot || robot->size() != 2)
+    return errorReply(kBadArguments, "usage: STORE <x> <y> (robot mm)");
+  auto target = vision.target();
+  if (!target) return reply(target.error());
+  const calibration::PointPair pair{calibration.geometry().vision.toMm(target->centroid),
+                                    {(*robot)[0], (*robot)[1]}};
+  auto id = calibration.addPoint(pair);
+  if (!id) return reply(id.error());
+  return "OK " + std::to_string(*id);
+}
+
+std::string list(const Request& r, CellCalibration& calibration) {
+  if (!r.args.empty()) return errorReply(kBadArguments, "LIST takes no arguments");
+  const auto points = calibration.points();
+  std::string out = "OK " + std::to_string(points.size());
+  for (const auto& [id, p] : points) {
+    out += " " + std::to_string(id) + " " + formatFixed(p.vision.x) + " " +
+           formatFixed(p.vision.y) + " " + formatFixed(p.robot.x) + " " + formatFixed(p.robot.y);
+  }
+  return out;
+}
+
+std::optional<calibration::Method> parseMethod(const std::vector<std::string>& args) {
+  if (args.empty()) return calibration::Method::kBest;
+  if (args.size() != 1) return std::nullopt;
+  const std::string m = toUpper(args[0]);
+  if (m == "BEST") return calibration::Method::kBest;
+  if (m == "LSQ") return calibration::Method::kLeastSquares;
+  if (m == "GEOMETRIC") return calibration::Method::kGeometric;
+  return std::nullopt;
+}
+}  // namespace
+
+void addCalibrationCommands(CommandTable& table, VisionService& vision,
+                            CellCalibration& calibration) {
+  table.add("CALCAM", "CALCAM <radius_mm>",
+            [&](const Request& r) { return calcam(r, vision, calibration); });
+  table.add("STORE", "STORE <x> <y>",
+            [&](const Request& r) { return store(r, vision, calibration); });
+  table.add("DELETE", "DELETE <id>", [&](const Request& r) {
+    const auto id = r.args.size() == 1 ? parseInt(r.args[0]) : std::nullopt;
+    if (!id || *id < 0 || *id > 1000000000)
+      return errorReply(kBadArguments, "usage: DELETE <id> (see LIST)");
+    auto ok = calibration.deletePoint(static_cast<int>(*id));
+    return ok ? std::string("OK") : reply(ok.error());
+  });
+  table.add("LIST", "LIST", [&](const Request& r) { return list(r, calibration); });
+  table.add("COMPUTE", "COMPUTE [BEST|LSQ|GEOMETRIC]", [&](const Request& r) {
+    const auto method = parseMethod(r.args);
+    if (!method) return errorReply(kBadArguments, "usage: COMPUTE [BEST|LSQ|GEOMETRIC]");
+    auto result = calibration.compute(*method);
+    if (!result) return reply(result.error());
+    const auto& t = result->transform;
+    return "OK " + formatFixed(t.dx) + " " + formatFixed(t.dy) + " " + formatFixed(t.rz_deg) + " " +
+           formatFixed(result->rms);
+  });
+  table.add("RESIDUALS", "RESIDUALS", [&](const Request& r) {
+    if (!r.args.empty()) return errorReply(kBadArguments, "RESIDUALS takes no arguments");
+    const auto geometry = calibration.geometry();
+    if (!geometry.transform)
+      return errorReply(kNotComputed, "no robot-camera transform yet (see COMPUTE)");
+    const auto points = calibration.points();
+    std::string out = "OK " + std::to_string(points.size());
+    for (const auto& [id, p] : points) {
+      const cv::Point2d d = geometry.transform->apply(p.vision) - p.robot;
+      out += " " + std::to_string(id) + " " + formatFixed(d.x) + " " + formatFixed(d.y) + " " +
+             formatFixed(std::hypot(d.x, d.y));
+    }
+    return out;
+  });
+}
+
+}  // namespace picksight::app

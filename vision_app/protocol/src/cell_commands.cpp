@@ -1,0 +1,239 @@
+// LOCATE with grasps, GRASP, GRIPPER, STATUS, EXPOSURE, ROI.
+#include "picksight/protocol/cell_commands.hpp"
+
+#include <algorithm>
+
+#include "picksight/common/text.hpp"
+#include "picksight/cell/grasp_planner.hpp"
+
+namespace picksight::app {
+namespace {
+std::string reply(const Error& e) { return errorReply(e.code, e.message); }
+
+std::string typeError(const std::string& command, const std::string& arg) {
+  return errorReply(kBadArguments, command + ": type must be an integer in [0, 9999], got '" +
+                                       printable(arg) + "'");
+}
+
+bool modelExists(const VisionService& vision, int type) {
+  if (!vision.models()) return false;
+  const auto models = vision.models()->snapshot();
+  return std::any_of(models->begin(), models->end(),
+                     [&](const vision::PartModel& m) { return m.type == type; });
+}
+
+std::string locate(const Request& r, CellContext& cell) {
+  if (r.args.size() != 1) return errorReply(kBadArguments, "usage: LOCATE <type>");
+  const auto type = parseType(r.args[0]);
+  if (!type) return typeError("LOCATE", r.args[0]);
+  auto outcome = cell.vision.locate(*type);
+  if (!outcome) return reply(outcome.error());
+  const auto grasps =
+      cell.vision.models() ? cell.vision.models()->grasps() : std::make_shared<const GraspMap>();
+  const CellPick pick = pickPoses(*outcome, *grasps, cell.calibration.geometry());
+  ++cell.locates;
+  cell.last_offered = pick.poses.size();
+  cell.last_skipped = pick.skipped;
+  cell.skipped_total += pick.skipped;
+  std::string out = "OK " + std::to_string(pick.poses.size());
+  for (const auto& p : pick.poses)
+    out += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
+  return out;
+}
+
+// GRASP <type> ADD x y rz | CLEAR | LIST, and GRIPPER <type> FINGER x y w h |
+// CLEAR | LIST: one editor, the two lists differ in their item.
+std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
+  const std::string usage = gripper ? "usage: GRIPPER <type> FINGER <x> <y> <w> <h> | CLEAR | LIST"
+                                    : "usage: GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST";
+  if (r.args.size() < 2) return errorReply(kBadArguments, usage);
+  const auto type = parseType(r.args[0]);
+  if (!type) return typeError(gripper ? "GRIPPER" : "GRASP", r.args[0]);
+  const std::string action = toUpper(r.args[1]);
+  const std::string add_word = gripper ? "FINGER" : "ADD";
+  const size_t add_values = gripper ? 4 : 3;
+  std::optional<std::vector<double>> values;
+  if (action == add_word) {
+    values = parseNumbers(r.args, 2);
+    if (!values || values->size() != add_values) return errorReply(kBadArguments, usage);
+  } else if ((action != "CLEAR" && action != "LIST") || r.args.size() != 2) {
+    return errorReply(kBadArguments, usage);
+  }
+  if (!modelExists(cell.vision, *type)) {
+    return errorReply(kUnknownType,
+                      "no model for type " + std::to_string(*type) + " (see MODELS, LEARN)");
+  }
+  ModelLibrary& library = *cell.vision.models();
+  std::lock_guard<std::mutex> lock(cell.grasp_edits);
+  GraspSetup setup = library.graspOf(*type);
+  if (action == "LIST") {
+    std::string out;
+    if (gripper) {
+      out = "OK " + std::to_string(setup.gripper.fingers.size());
+      for (const auto& f : setup.gripper.fingers) {
+        out += " " + formatFixed(f.x_mm) + " " + formatFixed(f.y_mm) + " " +
+               formatFixed(f.width_mm) + " " + formatFixed(f.height_mm);
+      }
+    } else {
+      out = "OK " + std::to_string(setup.styles.size());
+      for (const auto& s : setup.styles)
+        out += " " + formatFixed(s.x_mm) + " " + formatFixed(s.y_mm) + " " + formatFixed(s.rz_deg);
+    }
+    return out;
+  }
+  if (action == "CLEAR") {
+    if (gripper) {
+      setup.gripper.fingers.clear();
+    } else {
+      setup.styles.clear();
+    }
+  } else if (gripper) {
+    const auto& v = *values;
+    setup.gripper.fingers.push_back({v[0], v[1], v[2], v[3]});
+  } else {
+    const auto& v = *values;
+    setup.styles.push_back({v[0], v[1], v[2]});
+  }
+  if (const std::string problem = validateGrasp(setup); !problem.empty())
+    return errorReply(kBadArguments, problem);
+  auto ok = library.setGrasp(*type, setup);
+  if (!ok) {
+    if (ok.error().code == 1) return errorReply(kUnknownType, ok.error().message);
+    return errorReply(kStorageFailed, "cannot store the model: " + ok.error().message);
+  }
+  const size_t count = gripper ? setup.gripper.fingers.size() : setup.styles.size();
+  return "OK " + std::to_string(count);
+}
+
+std::string status(const Request& r, CellContext& cell) {
+  if (!r.args.empty()) return errorReply(kBadArguments, "STATUS takes no arguments");
+  const auto calib = cell.calibration.summary();
+  const auto geometry = cell.calibration.geometry();
+  const auto models =
+      cell.vision.models() ? cell.vision.models()->snapshot() : std::make_shared<const ModelList>();
+  const auto last = cell.vision.lastFrame();
+  std::string out = "OK frame=" + std::string(frameName(geometry.frame()));
+  out += " scale=";
+  out += calib.scale ? formatFixed(calib.scale->mm_per_px_x, 6) + "x" +
+                           formatFixed(calib.scale->mm_per_px_y, 6)
+                     : std::string("none");  // 1 unit per pixel
+  out += " lens=" + std::string(calib.lens ? "1" : "0");
+  out += " points=" + std::to_string(calib.points);
+  if (calib.transform) {
+    out += " transform=" + formatFixed(calib.transform->transform.dx) + "," +
+           formatFixed(calib.transform->transform.dy) + "," +
+           formatFixed(calib.transform->transform.rz_deg) +
+           " rms=" + formatFixed(calib.transform->rms);
+  } else {
+    out += " transform=none";
+  }
+  out += " camera=" + printable(cell.vision.camera(), 64);
+  out += " frames=" + std::to_string(cell.vision.framesReceived());
+  out += " last_frame=" + (last ? std::to_string(last->sequence) : std::string("none"));
+  out += " models=" + std::to_string(models->size());
+  out += " locates=" + std::to_string(cell.locates.load());
+  out += " offered=" + std::to_string(cell.last_offered.load());
+  out += " skipped=" + std::to_string(cell.last_skipped.load());
+  out += " skipped_total=" + std::to_string(cell.skipped_total.load());
+  return out;
+}
+
+std::string exposure(const Request& r, CellContext& cell) {
+  if (r.args.size() > 1) return errorReply(kBadArguments, "usage: EXPOSURE [<value>]");
+  std::optional<double> value;
+  if (!r.args.empty()) {
+    value = parseDouble(r.args[0]);
+    if (!value || !(*value > 0))
+      return errorReply(kBadArguments, "EXPOSURE: value must be a positive number, got '" +
+                                           printable(r.args[0]) + "'");
+  }
+  // The first name the camera knows decides; a camera that knows it but
+  // refuses the value explains why better than the names it does not know.
+  std::string why;
+  for (const auto& name : exposureFeatureNames()) {
+    proto::ControlRequest request;
+    if (value) {
+      auto* set = request.mutable_set_feature();
+      set->set_name(name);
+      set->set_value(formatFixed(*value, 3));
+    } else {
+      request.mutable_get_feature()->set_name(name);
+    }
+    auto answer = cell.vision.control(request);
+    if (answer) {
+      return "OK " + name + " " + printable(answer->feature().feature().value(), 64);
+    }
+    if (answer.error().code == kControlTimeout || answer.error().code == kNoVideoServer)
+      return errorReply(kNoVideoServer, "video server: " + answer.error().message);
+    if (answer.error().code != proto::Error::UNKNOWN_FEATURE || why.empty())
+      why = printable(answer.error().message, 120);
+    if (answer.error().code != proto::Error::UNKNOWN_FEATURE) break;
+  }
+  return errorReply(kCameraRefused, "EXPOSURE: " + why);
+}
+
+std::string roi(const Request& r, CellContext& cell) {
+  const std::string usage = "usage: ROI <x> <y> <width> <height> | ROI FULL | ROI";
+  proto::ControlRequest request;
+  if (r.args.empty()) {
+    request.mutable_describe_camera();
+    auto answer = cell.vision.control(request);
+    if (!answer)
+      return errorReply(kCameraRefused, "ROI: " + printable(answer.error().message, 120));
+    const auto& d = answer->describe_camera();
+    const auto& roi = d.roi();
+    // A zero size is the full sensor.
+    return "OK " + std::to_string(roi.x()) + " " + std::to_string(roi.y()) + " " +
+           std::to_string(roi.width() ? roi.width() : d.sensor_width()) + " " +
+           std::to_string(roi.height() ? roi.height() : d.sensor_height());
+  }
+  auto* set = request.mutable_set_roi();
+  if (r.args.size() == 1 && toUpper(r.args[0]) == "FULL") {
+    set->mutable_roi();  // all zero: the full sensor
+  } else if (r.args.size() == 4) {
+    uint32_t v[4];
+    for (size_t i = 0; i < 4; ++i) {
+      const auto n = parseInt(r.args[i]);
+      if (!n || *n < 0 || *n > 100000 || (i >= 2 && *n == 0))
+        return errorReply(kBadArguments, usage);
+      v[i] = static_cast<uint32_t>(*n);
+    }
+    auto* roi = set->mutable_roi();
+    roi->set_x(v[0]);
+    roi->set_y(v[1]);
+    roi->set_width(v[2]);
+    roi->set_height(v[3]);
+  } else {
+    return errorReply(kBadArguments, usage);
+  }
+  auto answer = cell.vision.control(request);
+  if (!answer) {
+    const bool down =
+        answer.error().code == kControlTimeout || answer.error().code == kNoVideoServer;
+    const int code = down ? kNoVideoServer : kCameraRefused;
+    return errorReply(code, "ROI: " + printable(answer.error().message, 120));
+  }
+  return std::string("OK");
+}
+}  // namespace
+
+const std::vector<std::string>& exposureFeatureNames() {
+  static const std::vector<std::string> names{"ExposureTime", "ExposureTimeAbs",
+                                              "exposure_time_absolute"};
+  return names;
+}
+
+void addCellCommands(CommandTable& table, CellContext& cell) {
+  table.add("LOCATE", "LOCATE <type>", [&cell](const Request& r) { return locate(r, cell); });
+  table.add("GRASP", "GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST",
+            [&cell](const Request& r) { return editGrasp(r, cell, false); });
+  table.add("GRIPPER", "GRIPPER <type> FINGER <x> <y> <w> <h> | CLEAR | LIST",
+            [&cell](const Request& r) { return editGrasp(r, cell, true); });
+  table.add("STATUS", "STATUS", [&cell](const Request& r) { return status(r, cell); });
+  table.add("EXPOSURE", "EXPOSURE [<value>]",
+            [&cell](const Request& r) { return exposure(r, cell); });
+  table.add("ROI", "ROI [<x> <y> <w> <h> | FULL]",
+            [&cell](const Request& r) { return roi(r, cell); });
+}
+
+}  // namespace picksight::app

@@ -1,0 +1,74 @@
+// Robot protocol command table and request parsing.
+#include "picksight/protocol/command_table.hpp"
+
+#include "picksight/common/text.hpp"
+
+namespace picksight::app {
+
+std::string errorReply(int code, const std::string& text) {
+  return "ERROR " + std::to_string(code) + " " + text;
+}
+
+std::optional<int> parseType(std::string_view text) {
+  const auto type = parseInt(text);
+  if (!type || *type < 0 || *type > 9999) return std::nullopt;
+  return static_cast<int>(*type);
+}
+
+std::optional<std::vector<double>> parseNumbers(const std::vector<std::string>& args,
+                                                size_t first) {
+  std::vector<double> out;
+  for (size_t i = first; i < args.size(); ++i) {
+    const auto v = parseDouble(args[i]);
+    if (!v) return std::nullopt;
+    out.push_back(*v);
+  }
+  return out;
+}
+
+std::string printable(std::string_view text, size_t limit) {
+  std::string out;
+  for (char c : text.substr(0, limit)) {
+    out +=
+        (static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f) ? c : '?';
+  }
+  if (text.size() > limit) out += "...";
+  return out;
+}
+
+std::optional<Request> parseRequest(std::string_view line) {
+  const auto fields = splitFields(line, " \t,");
+  if (fields.empty()) return std::nullopt;
+  Request r;
+  r.command = toUpper(fields[0]);
+  for (size_t i = 1; i < fields.size(); ++i) r.args.emplace_back(fields[i]);
+  return r;
+}
+
+void CommandTable::add(const std::string& word, const std::string& usage, Handler handler) {
+  commands_[toUpper(word)] = Entry{usage, std::move(handler)};
+}
+
+std::string CommandTable::dispatch(std::string_view line) const {
+  const auto request = parseRequest(line);
+  if (!request) return errorReply(kEmptyRequest, "empty request");
+  const auto it = commands_.find(request->command);
+  if (it == commands_.end()) {
+    return errorReply(kUnknownCommand,
+                      "unknown command '" + printable(request->command) + "' (try HELP)");
+  }
+  return it->second.handler(*request);
+}
+
+std::string CommandTable::help() const {
+  std::string out = "OK";
+  bool first = true;
+  for (const auto& [word, entry] : commands_) {
+    out += first ? " " : " | ";
+    out += entry.usage;
+    first = false;
+  }
+  return out;
+}
+
+}  // namespace picksight::app

@@ -1,0 +1,30 @@
+// Robot protocol core commands.
+#include "picksight/protocol/robot_protocol.hpp"
+
+#include "picksight/common/text.hpp"
+
+namespace picksight::app {
+namespace {
+constexpr const char* kVersion = "0.1.0";
+}  // namespace
+
+RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
+  table_.add("PING", "PING", [](const Request& r) {
+    return r.args.empty() ? std::string("OK")
+                          : errorReply(kBadArguments, "PING takes no arguments");
+  });
+  table_.add("VERSION", "VERSION", [](const Request&) { return std::string("OK ") + kVersion; });
+  table_.add("HELP", "HELP", [this](const Request&) { return table_.help(); });
+  table_.add("FRAME", "FRAME", [this](const Request& r) { return frame(r); });
+}
+
+std::string RobotProtocol::frame(const Request& request) {
+  if (!request.args.empty()) return errorReply(kBadArguments, "FRAME takes no arguments");
+  const auto f = vision_.lastFrame();
+  if (!f) return errorReply(kNoFrame, "no frame used yet");
+  return "OK " + f->camera + " " + std::to_string(f->sequence) + " " +
+         std::to_string(f->host_timestamp_ns) + " " + std::to_string(f->width) + " " +
+         std::to_string(f->height) + " " + (f->triggered ? "1" : "0");
+}
+
+}  // namespace picksight::app

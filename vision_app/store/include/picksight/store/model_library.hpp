@@ -1,0 +1,55 @@
+// The model library: one file per trained part type under
+// <data dir>/models/, loaded at start, written atomically on every change.
+//
+// Threading: every member is thread-safe. Readers get an immutable snapshot
+// (shared_ptr), so a recognition in progress never sees a half-changed list.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "picksight/common/result.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/store/model_file.hpp"
+
+namespace picksight::app {
+
+using ModelList = std::vector<vision::PartModel>;
+using GraspMap = std::map<int, GraspSetup>;  // by type; a type without grasps may be absent
+
+class ModelLibrary {
+ public:
+  // `directory` is created on the first store if missing.
+  explicit ModelLibrary(std::string directory);
+
+  // Loads every *.yaml file of the directory, replacing what was held. Bad
+  // files are skipped; each gets one message naming the file and its problem.
+  std::vector<std::string> load();
+
+  // Adds or replaces the model of model.type: the file first, then memory.
+  // A replaced model keeps its grasp styles and gripper.
+  Result<void> store(const vision::PartModel& model);
+  // Removes the model of `type` (file and memory); an error (code 1) if there
+  // is none.
+  Result<void> remove(int type);
+  // Replaces the grasp styles and gripper of `type`, written with its model;
+  // an error (code 1) if there is no model of `type`.
+  Result<void> setGrasp(int type, const GraspSetup& grasp);
+
+  std::shared_ptr<const ModelList> snapshot() const;
+  std::shared_ptr<const GraspMap> grasps() const;
+  GraspSetup graspOf(int type) const;
+  const std::string& directory() const { return directory_; }
+  std::string pathOf(int type) const;
+
+ private:
+  const std::string directory_;
+  mutable std::mutex mutex_;  // guards models_ and grasps_, serializes writers
+  std::shared_ptr<const ModelList> models_;
+  std::shared_ptr<const GraspMap> grasps_;
+};
+
+}  // namespace picksight::app

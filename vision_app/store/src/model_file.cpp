@@ -1,0 +1,326 @@
+// Model file (de)serialization with yaml-cpp; every field is checked on load.
+#include "picksight/store/model_file.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+
+namespace picksight::app {
+namespace {
+using vision::PartModel;
+using vision::Primitive;
+using vision::PrimitiveKind;
+
+void point(YAML::Emitter& out, const char* key, cv::Point2d p) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << p.x << p.y
+      << YAML::EndSeq;
+}
+
+void range(YAML::Emitter& out, const char* key, const vision::Range& r) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << r.min << r.max
+      << YAML::EndSeq;
+}
+
+// Reading: a missing or mistyped field throws a message naming the field.
+struct FieldError {
+  std::string what;
+};
+
+const YAML::Node need(const YAML::Node& node, const std::string& key) {
+  if (!node.IsMap() || !node[key]) throw FieldError{"missing field '" + key + "'"};
+  return node[key];
+}
+
+template <typename T>
+T as(const YAML::Node& node, const std::string& key) {
+  const YAML::Node v = need(node, key);
+  try {
+    return v.as<T>();
+  } catch (const YAML::Exception&) {
+    throw FieldError{"field '" + key + "' has the wrong type"};
+  }
+}
+
+cv::Point2d asPoint(const YAML::Node& node, const std::string& key) {
+  const YAML::Node v = need(node, key);
+  if (!v.IsSequence() || v.size() != 2) throw FieldError{"field '" + key + "' must be [x, y]"};
+  try {
+    return {v[0].as<double>(), v[1].as<double>()};
+  } catch (const YAML::Exception&) {
+    throw FieldError{"field '" + key + "' must hold two numbers"};
+  }
+}
+
+vision::Range asRange(const YAML::Node& node, const std::string& key) {
+  const cv::Point2d p = asPoint(node, key);
+  if (!(p.x <= p.y)) throw FieldError{"range '" + key + "' must be [min, max] with min <= max"};
+  return {p.x, p.y};
+}
+}  // namespace
+
+std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);  // doubles read back bit-exact
+  out << YAML::Comment("PickSight part model: see docs/PROTOCOL.md (LEARN)");
+  out << YAML::BeginMap;
+  out << YAML::Key << "format" << YAML::Value << "picksight-part-model";
+  out << YAML::Key << "version" << YAML::Value << kModelFormatVersion;
+  out << YAML::Key << "type" << YAML::Value << m.type;
+  out << YAML::Key << "name" << YAML::Value << m.name;
+  out << YAML::Key << "trained" << YAML::Value << YAML::BeginMap;
+  point(out, "centroid", m.trained_centroid);
+  out << YAML::Key << "angle_deg" << YAML::Value << m.trained_angle_deg;
+  out << YAML::EndMap;
+
+  out << YAML::Key << "body" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "area" << YAML::Value << m.body.area;
+  out << YAML::Key << "area_tolerance" << YAML::Value << m.body.area_tolerance;
+  out << YAML::Key << "holes" << YAML::Value << m.body.holes;
+  out << YAML::Key << "log_hu" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (double h : m.body.log_hu) out << h;
+  out << YAML::EndSeq;
+  out << YAML::Key << "hu_used" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (bool u : m.body.hu_used) out << u;
+  out << YAML::EndSeq;
+  out << YAML::Key << "hu_tolerance" << YAML::Value << m.body.hu_tolerance;
+  out << YAML::Key << "mirror_symmetric" << YAML::Value << m.body.mirror_symmetric;
+  out << YAML::EndMap;
+
+  out << YAML::Key << "orientation" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "order" << YAML::Value << m.orientation_order;
+  out << YAML::Key << "phase_deg" << YAML::Value << m.orientation_phase_deg;
+  out << YAML::Key << "symmetry_order" << YAML::Value << m.symmetry_order;
+  out << YAML::EndMap;
+
+  out << YAML::Key << "boundary" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "conformity_px" << YAML::Value << m.conformity;
+  out << YAML::Key << "edge_tolerance_px" << YAML::Value << m.edge_tolerance;
+  out << YAML::Key << "verify_percent" << YAML::Value << m.verify_percent;
+  out << YAML::Key << "loops" << YAML::Value << YAML::BeginSeq;
+  for (const auto& loop : m.loops) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "hole" << YAML::Value << loop.hole;
+    out << YAML::Key << "weight" << YAML::Value << loop.weight;
+    out << YAML::Key << "primitives" << YAML::Value << YAML::BeginSeq;
+    for (const auto& p : loop.primitives) {
+      out << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "kind" << YAML::Value
+          << (p.kind == PrimitiveKind::kLine ? "line" : "arc");
+      point(out, "start", p.start);
+      point(out, "end", p.end);
+      if (p.kind == PrimitiveKind::kArc) {
+        point(out, "centre", p.centre);
+        out << YAML::Key << "radius" << YAML::Value << p.radius;
+        out << YAML::Key << "sweep_deg" << YAML::Value << p.sweep_deg;
+      }
+      out << YAML::Key << "weight" << YAML::Value << p.weight;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "corners" << YAML::Value << YAML::BeginSeq;
+  for (const auto& c : m.corners) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "class" << YAML::Value << vision::cornerClassName(c.kind);
+    out << YAML::Key << "loop" << YAML::Value << c.loop;
+    out << YAML::Key << "index" << YAML::Value << c.index;
+    point(out, "at", c.at);
+    out << YAML::Key << "direction_in_deg" << YAML::Value << c.direction_in_deg;
+    out << YAML::Key << "direction_out_deg" << YAML::Value << c.direction_out_deg;
+    range(out, "turn_deg", c.turn_deg);
+    out << YAML::Key << "convex" << YAML::Value << c.convex;
+    range(out, "length_in", c.length_in);
+    range(out, "length_out", c.length_out);
+    range(out, "radius_in", c.radius_in);
+    range(out, "radius_out", c.radius_out);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+
+  out << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "styles" << YAML::Value << YAML::BeginSeq;
+  for (const auto& st : grasp.styles) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << st.x_mm
+        << YAML::Key << "y_mm" << YAML::Value << st.y_mm << YAML::Key << "rz_deg" << YAML::Value
+        << st.rz_deg << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "fingers" << YAML::Value << YAML::BeginSeq;
+  for (const auto& f : grasp.gripper.fingers) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << f.x_mm << YAML::Key
+        << "y_mm" << YAML::Value << f.y_mm << YAML::Key << "width_mm" << YAML::Value << f.width_mm
+        << YAML::Key << "height_mm" << YAML::Value << f.height_mm << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+std::string validateGrasp(const GraspSetup& grasp) {
+  // Beyond a few metres a value is a typo, not a gripper.
+  constexpr double kMaxMm = 10000;
+  const auto bad = [](double v, double limit) { return !std::isfinite(v) || std::abs(v) > limit; };
+  if (grasp.styles.size() > kMaxGraspStyles)
+    return "at most " + std::to_string(kMaxGraspStyles) + " grasp styles";
+  if (grasp.gripper.fingers.size() > kMaxFingers)
+    return "at most " + std::to_string(kMaxFingers) + " fingers";
+  for (const auto& s : grasp.styles) {
+    if (bad(s.x_mm, kMaxMm) || bad(s.y_mm, kMaxMm) || bad(s.rz_deg, 360))
+      return "a grasp style needs |x|, |y| <= 10000 mm and |rz| <= 360 deg";
+  }
+  for (const auto& f : grasp.gripper.fingers) {
+    if (bad(f.x_mm, kMaxMm) || bad(f.y_mm, kMaxMm) || bad(f.width_mm, kMaxMm) ||
+        bad(f.height_mm, kMaxMm) || !(f.width_mm > 0) || !(f.height_mm > 0))
+      return "a finger needs |x|, |y| <= 10000 mm and a size in (0, 10000] mm";
+  }
+  return {};
+}
+
+Result<PartModel> modelFromYaml(const std::string& text) {
+  auto record = modelRecordFromYaml(text);
+  if (!record) return record.error();
+  return std::move(record->model);
+}
+
+Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    return makeError(1, "not YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
+  }
+  ModelRecord record;
+  PartModel& m = record.model;
+  try {
+    if (!root.IsMap() || as<std::string>(root, "format") != "picksight-part-model") {
+      return makeError(1, "not a PickSight part model (format: picksight-part-model)");
+    }
+    const int version = as<int>(root, "version");
+    if (version < kOldestModelFormatVersion || version > kModelFormatVersion) {
+      return makeError(1, "format version " + std::to_string(version) +
+                              " (this program reads versions " +
+                              std::to_string(kOldestModelFormatVersion) + " to " +
+                              std::to_string(kModelFormatVersion) + ")");
+    }
+    m.type = as<int>(root, "type");
+    m.name = as<std::string>(root, "name");
+    const YAML::Node trained = need(root, "trained");
+    m.trained_centroid = asPoint(trained, "centroid");
+    m.trained_angle_deg = as<double>(trained, "angle_deg");
+
+    const YAML::Node body = need(root, "body");
+    m.body.area = as<double>(body, "area");
+    m.body.area_tolerance = as<double>(body, "area_tolerance");
+    m.body.holes = as<int>(body, "holes");
+    const auto hu = as<std::vector<double>>(body, "log_hu");
+    const auto used = as<std::vector<bool>>(body, "hu_used");
+    if (hu.size() != 7 || used.size() != 7)
+      throw FieldError{"log_hu and hu_used need 7 values each"};
+    for (size_t i = 0; i < 7; ++i) {
+      m.body.log_hu[i] = hu[i];
+      m.body.hu_used[i] = used[i];
+    }
+    m.body.hu_tolerance = as<double>(body, "hu_tolerance");
+    m.body.mirror_symmetric = as<bool>(body, "mirror_symmetric");
+
+    const YAML::Node orientation = need(root, "orientation");
+    m.orientation_order = as<int>(orientation, "order");
+    m.orientation_phase_deg = as<double>(orientation, "phase_deg");
+    m.symmetry_order = as<int>(orientation, "symmetry_order");
+
+    const YAML::Node boundary = need(root, "boundary");
+    m.conformity = as<double>(boundary, "conformity_px");
+    m.edge_tolerance = as<double>(boundary, "edge_tolerance_px");
+    m.verify_percent = as<double>(boundary, "verify_percent");
+    const YAML::Node loops = need(boundary, "loops");
+    if (!loops.IsSequence()) throw FieldError{"'loops' must be a list"};
+    for (const auto& l : loops) {
+      vision::BoundaryLoop loop;
+      loop.hole = as<bool>(l, "hole");
+      loop.weight = as<double>(l, "weight");
+      const YAML::Node prims = need(l, "primitives");
+      if (!prims.IsSequence()) throw FieldError{"'primitives' must be a list"};
+      for (const auto& p : prims) {
+        Primitive prim;
+        const std::string kind = as<std::string>(p, "kind");
+        if (kind != "line" && kind != "arc")
+          throw FieldError{"primitive kind must be line or arc, got '" + kind + "'"};
+        prim.kind = kind == "line" ? PrimitiveKind::kLine : PrimitiveKind::kArc;
+        prim.start = asPoint(p, "start");
+        prim.end = asPoint(p, "end");
+        if (prim.kind == PrimitiveKind::kArc) {
+          prim.centre = asPoint(p, "centre");
+          prim.radius = as<double>(p, "radius");
+          prim.sweep_deg = as<double>(p, "sweep_deg");
+        }
+        prim.weight = as<double>(p, "weight");
+        loop.primitives.push_back(prim);
+      }
+      m.loops.push_back(std::move(loop));
+    }
+    const YAML::Node corners = need(boundary, "corners");
+    if (!corners.IsSequence()) throw FieldError{"'corners' must be a list"};
+    for (const auto& c : corners) {
+      vision::Corner corner;
+      const std::string kind = as<std::string>(c, "class");
+      bool known = false;
+      for (auto k : {vision::CornerClass::kLineLine, vision::CornerClass::kLineArc,
+                     vision::CornerClass::kArcLine, vision::CornerClass::kArcArc}) {
+        if (kind == vision::cornerClassName(k)) {
+          corner.kind = k;
+          known = true;
+        }
+      }
+      if (!known) throw FieldError{"unknown corner class '" + kind + "'"};
+      corner.loop = as<int>(c, "loop");
+      corner.index = as<int>(c, "index");
+      if (corner.loop < 0 || static_cast<size_t>(corner.loop) >= m.loops.size() ||
+          corner.index < 0 ||
+          static_cast<size_t>(corner.index) >=
+              m.loops[static_cast<size_t>(corner.loop)].primitives.size()) {
+        throw FieldError{"a corner refers to a primitive that does not exist"};
+      }
+      corner.at = asPoint(c, "at");
+      corner.direction_in_deg = as<double>(c, "direction_in_deg");
+      corner.direction_out_deg = as<double>(c, "direction_out_deg");
+      corner.turn_deg = asRange(c, "turn_deg");
+      corner.convex = as<bool>(c, "convex");
+      corner.length_in = asRange(c, "length_in");
+      corner.length_out = asRange(c, "length_out");
+      corner.radius_in = asRange(c, "radius_in");
+      corner.radius_out = asRange(c, "radius_out");
+      m.corners.push_back(corner);
+    }
+    if (version >= 2) {
+      const YAML::Node grasp = need(root, "grasp");
+      const YAML::Node styles = need(grasp, "styles");
+      const YAML::Node fingers = need(grasp, "fingers");
+      if (!styles.IsSequence() || !fingers.IsSequence())
+        throw FieldError{"'grasp.styles' and 'grasp.fingers' must be lists"};
+      for (const auto& st : styles) {
+        record.grasp.styles.push_back(
+            {as<double>(st, "x_mm"), as<double>(st, "y_mm"), as<double>(st, "rz_deg")});
+      }
+      for (const auto& f : fingers) {
+        record.grasp.gripper.fingers.push_back({as<double>(f, "x_mm"), as<double>(f, "y_mm"),
+                                                as<double>(f, "width_mm"),
+                                                as<double>(f, "height_mm")});
+      }
+      const std::string problem = validateGrasp(record.grasp);
+      if (!problem.empty()) throw FieldError{"grasp: " + problem};
+    }
+  } catch (const FieldError& e) {
+    return makeError(1, e.what);
+  } catch (const YAML::Exception& e) {
+    return makeError(1, e.msg);
+  }
+  const std::string problem = vision::validateModel(m);
+  if (!problem.empty()) return makeError(1, problem);
+  vision::prepareModel(m);
+  return record;
+}
+
+}  // namespace picksight::app

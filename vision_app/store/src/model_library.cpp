@@ -1,0 +1,136 @@
+// Model library on disk.
+#include "picksight/store/model_library.hpp"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "picksight/common/atomic_file.hpp"
+#include "picksight/store/model_file.hpp"
+
+namespace picksight::app {
+namespace fs = std::filesystem;
+
+ModelLibrary::ModelLibrary(std::string directory)
+    : directory_(std::move(directory)),
+      models_(std::make_shared<const ModelList>()),
+      grasps_(std::make_shared<const GraspMap>()) {}
+
+std::string ModelLibrary::pathOf(int type) const {
+  return directory_ + "/type_" + std::to_string(type) + ".yaml";
+}
+
+std::vector<std::string> ModelLibrary::load() {
+  std::vector<std::string> problems;
+  auto models = std::make_shared<ModelList>();
+  auto grasps = std::make_shared<GraspMap>();
+  std::error_code ec;
+  std::vector<fs::path> files;
+  if (!fs::exists(directory_, ec)) {
+    ec.clear();  // no model trained yet
+  } else if (fs::is_directory(directory_, ec)) {
+    for (fs::directory_iterator it(directory_, ec), end; !ec && it != end; it.increment(ec)) {
+      if (it->path().extension() == ".yaml") files.push_back(it->path());
+    }
+  }
+  if (ec) problems.push_back(directory_ + ": " + ec.message());
+  std::sort(files.begin(), files.end());
+  for (const auto& path : files) {
+    auto text = readFile(path.string());
+    if (!text) {
+      problems.push_back(path.string() + ": " + text.error().message);
+      continue;
+    }
+    auto record = modelRecordFromYaml(*text);
+    if (!record) {
+      problems.push_back(path.string() + ": " + record.error().message);
+      continue;
+    }
+    auto* model = &record->model;
+    const bool duplicate =
+        std::any_of(models->begin(), models->end(),
+                    [&](const vision::PartModel& m) { return m.type == model->type; });
+    if (duplicate) {
+      problems.push_back(path.string() + ": type " + std::to_string(model->type) +
+                         " is already defined by another file");
+      continue;
+    }
+    (*grasps)[model->type] = record->grasp;
+    models->push_back(std::move(*model));
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  models_ = std::move(models);
+  grasps_ = std::move(grasps);
+  return problems;
+}
+
+Result<void> ModelLibrary::store(const vision::PartModel& model) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::error_code ec;
+  fs::create_directories(directory_, ec);
+  if (ec) return makeError(1, directory_ + ": " + ec.message());
+  const auto kept = grasps_->find(model.type);
+  auto written = writeFileAtomically(
+      pathOf(model.type), modelToYaml(model, kept == grasps_->end() ? GraspSetup{} : kept->second));
+  if (!written) return written;
+  auto models = std::make_shared<ModelList>(*models_);
+  models->erase(std::remove_if(models->begin(), models->end(),
+                               [&](const vision::PartModel& m) { return m.type == model.type; }),
+                models->end());
+  models->push_back(model);
+  std::sort(models->begin(), models->end(),
+            [](const vision::PartModel& a, const vision::PartModel& b) { return a.type < b.type; });
+  models_ = std::move(models);
+  return {};
+}
+
+Result<void> ModelLibrary::remove(int type) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool known = std::any_of(models_->begin(), models_->end(),
+                                 [&](const vision::PartModel& m) { return m.type == type; });
+  if (!known) return makeError(1, "no model for type " + std::to_string(type));
+  std::error_code ec;
+  fs::remove(pathOf(type), ec);
+  if (ec) return makeError(2, pathOf(type) + ": " + ec.message());
+  auto models = std::make_shared<ModelList>(*models_);
+  models->erase(std::remove_if(models->begin(), models->end(),
+                               [&](const vision::PartModel& m) { return m.type == type; }),
+                models->end());
+  models_ = std::move(models);
+  auto grasps = std::make_shared<GraspMap>(*grasps_);
+  grasps->erase(type);
+  grasps_ = std::move(grasps);
+  return {};
+}
+
+Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto model = std::find_if(models_->begin(), models_->end(),
+                                  [&](const vision::PartModel& m) { return m.type == type; });
+  if (model == models_->end()) return makeError(1, "no model for type " + std::to_string(type));
+  const std::string problem = validateGrasp(grasp);
+  if (!problem.empty()) return makeError(3, problem);
+  auto written = writeFileAtomically(pathOf(type), modelToYaml(*model, grasp));
+  if (!written) return makeError(2, written.error().message);
+  auto grasps = std::make_shared<GraspMap>(*grasps_);
+  (*grasps)[type] = grasp;
+  grasps_ = std::move(grasps);
+  return {};
+}
+
+std::shared_ptr<const ModelList> ModelLibrary::snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return models_;
+}
+
+std::shared_ptr<const GraspMap> ModelLibrary::grasps() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return grasps_;
+}
+
+GraspSetup ModelLibrary::graspOf(int type) const {
+  const auto all = grasps();
+  const auto it = all->find(type);
+  return it == all->end() ? GraspSetup{} : it->second;
+}
+
+}  // namespace picksight::app
