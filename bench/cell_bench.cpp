@@ -13,14 +13,14 @@
 #include <vector>
 
 #include "locate_args.hpp"
+#include "picksight/cell/grasp_planner.hpp"
+#include "picksight/common/text.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/store/model_library.hpp"
+#include "picksight/synthetic/scene.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
-#include "picksight/common/text.hpp"
-#include "picksight/synthetic/scene.hpp"
 #include "picksight/vision/part_model.hpp"
-#include "picksight/store/cell_calibration.hpp"
-#include "picksight/cell/grasp_planner.hpp"
-#include "picksight/store/model_library.hpp"
 
 namespace {
 using namespace std::chrono_literals;
@@ -45,8 +45,9 @@ bool prepareDataDir(const std::string& dir) {
   for (const auto& name : kTypes) {
     const picksight::synthetic::SceneRenderer one(scene(400, 400, 1, 1000 + type, {name}));
     const auto trained = picksight::vision::trainModel(one.render(0), type, name);
-    if (!trained.ok || !library.store(trained.model)) {
-      std::fprintf(stderr, "bench: training %s failed: %s\n", name.c_str(), trained.error.c_str());
+    if (!trained || !library.store(*trained)) {
+      std::fprintf(stderr, "bench: training %s failed: %s\n", name.c_str(),
+                   (trained ? "cannot store" : trained.error().message.c_str()));
       return false;
     }
     picksight::app::GraspSetup grasp;

@@ -154,18 +154,18 @@ std::map<std::string, Trained> trainSynthetic(const std::vector<std::string>& ty
     const ps::SceneRenderer scene(
         sceneOptions(400, 400, 1, 1000 + static_cast<uint64_t>(id), {type}));
     auto outcome = pv::trainModel(scene.render(0), id, type);
-    if (!outcome.ok) {
-      std::printf("  training %s failed: %s\n", type.c_str(), outcome.error.c_str());
+    if (!outcome.ok()) {
+      std::printf("  training %s failed: %s\n", type.c_str(), outcome.error().message.c_str());
       continue;
     }
     std::printf(
         "  trained %-15s area %8.1f holes %d order %2d symmetry %5.1f mirror-symmetric %d "
         "primitives %zu corners %zu hu-tol %.2f\n",
-        type.c_str(), outcome.model.body.area, outcome.model.body.holes,
-        outcome.model.orientation_order, outcome.model.symmetryDeg(),
-        outcome.model.body.mirror_symmetric ? 1 : 0, outcome.model.loops[0].primitives.size(),
-        outcome.model.corners.size(), outcome.model.body.hu_tolerance);
-    trained[type] = Trained{outcome.model, scene.truth()[0].angle_deg};
+        type.c_str(), outcome.value().body.area, outcome.value().body.holes,
+        outcome.value().orientation_order, outcome.value().symmetryDeg(),
+        outcome.value().body.mirror_symmetric ? 1 : 0, outcome.value().loops[0].primitives.size(),
+        outcome.value().corners.size(), outcome.value().body.hu_tolerance);
+    trained[type] = Trained{outcome.value(), scene.truth()[0].angle_deg};
     ++id;
   }
   return trained;
@@ -314,16 +314,16 @@ void silhouetteAccuracy(const std::string& data_dir, int scenes) {
     patch.copyTo(canvas(cv::Rect(at, patch.size())));
     auto outcome = pv::trainModel(renderCanvas(canvas, static_cast<uint64_t>(id)), id, s.name);
     ++id;
-    if (!outcome.ok) {
-      std::printf("  training %s failed: %s\n", s.name.c_str(), outcome.error.c_str());
+    if (!outcome.ok()) {
+      std::printf("  training %s failed: %s\n", s.name.c_str(), outcome.error().message.c_str());
       continue;
     }
     std::printf(
         "  trained %-10s area %8.1f holes %d order %2d symmetry %5.1f mirror-symmetric %d\n",
-        s.name.c_str(), outcome.model.body.area, outcome.model.body.holes,
-        outcome.model.orientation_order, outcome.model.symmetryDeg(),
-        outcome.model.body.mirror_symmetric ? 1 : 0);
-    trained[s.name] = Trained{outcome.model, 0.0};
+        s.name.c_str(), outcome.value().body.area, outcome.value().body.holes,
+        outcome.value().orientation_order, outcome.value().symmetryDeg(),
+        outcome.value().body.mirror_symmetric ? 1 : 0);
+    trained[s.name] = Trained{outcome.value(), 0.0};
   }
   const auto models = modelList(trained);
   Tally tally;

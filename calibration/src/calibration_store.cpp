@@ -3,6 +3,8 @@
 // disk does not.
 #include "picksight/calibration/calibration_store.hpp"
 
+#include "picksight/calibration/calibration_errors.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <sys/stat.h>
@@ -122,7 +124,7 @@ Result<void> CalibrationStore::load() {
       loaded.lens_ = lens;
     }
   } catch (const std::exception& e) {
-    return makeError(EINVAL, path_ + ": " + e.what());
+    return makeError(CalibrationErrc::kBadFile, path_ + ": " + e.what());
   }
   *this = std::move(loaded);
   return {};
@@ -138,7 +140,7 @@ Result<int> CalibrationStore::addPoint(const PointPair& pair) {
 }
 
 Result<void> CalibrationStore::deletePoint(int id) {
-  if (!points_.count(id)) return makeError(ENOENT, "no point with id " + std::to_string(id));
+  if (!points_.count(id)) return systemError(ENOENT, "no point with id " + std::to_string(id));
   CalibrationStore next = *this;
   next.points_.erase(id);
   if (auto ok = next.save(); !ok) return ok;

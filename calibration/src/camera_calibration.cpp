@@ -1,6 +1,8 @@
 // Camera scale and lens calibration.
 #include "picksight/calibration/camera_calibration.hpp"
 
+#include "picksight/calibration/calibration_errors.hpp"
+
 #include <opencv2/calib3d.hpp>
 
 #include <cmath>
@@ -8,8 +10,10 @@
 namespace picksight::calibration {
 
 Result<PixelScale> scaleFromCircle(const cv::Moments& m, double radius_mm) {
-  if (!(radius_mm > 0)) return makeError(1, "target radius must be positive");
-  if (m.m00 <= 0 || m.mu20 <= 0 || m.mu02 <= 0) return makeError(1, "target has no area");
+  if (!(radius_mm > 0))
+    return makeError(CalibrationErrc::kBadInput, "target radius must be positive");
+  if (m.m00 <= 0 || m.mu20 <= 0 || m.mu02 <= 0)
+    return makeError(CalibrationErrc::kBadTarget, "target has no area");
   PixelScale s;
   s.mm_per_px_x = radius_mm / (2.0 * std::sqrt(m.mu20 / m.m00));
   s.mm_per_px_y = radius_mm / (2.0 * std::sqrt(m.mu02 / m.m00));
@@ -66,8 +70,9 @@ Result<LensModel> calibrateChessboard(const std::vector<cv::Mat>& views,
     object_points.push_back(board);
   }
   if (image_points.size() < 3) {
-    return makeError(1, "the chessboard was found in " + std::to_string(image_points.size()) +
-                            " views; at least 3 are needed");
+    return makeError(CalibrationErrc::kBadInput, "the chessboard was found in " +
+                                                     std::to_string(image_points.size()) +
+                                                     " views; at least 3 are needed");
   }
   cv::Mat k = cv::Mat::eye(3, 3, CV_64F);
   cv::Mat dist;
@@ -96,9 +101,9 @@ std::string lensModelToYaml(const LensModel& model) {
 Result<LensModel> lensModelFromYaml(const std::string& text) {
   try {
     cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
-    if (!fs.isOpened()) return makeError(1, "not a YAML document");
+    if (!fs.isOpened()) return makeError(CalibrationErrc::kBadFile, "not a YAML document");
     if (static_cast<int>(fs["format_version"]) != 1)
-      return makeError(1, "format_version must be 1");
+      return makeError(CalibrationErrc::kBadFile, "format_version must be 1");
     LensModel m;
     m.image_size =
         cv::Size(static_cast<int>(fs["image_width"]), static_cast<int>(fs["image_height"]));
@@ -107,19 +112,20 @@ Result<LensModel> lensModelFromYaml(const std::string& text) {
     fs["camera_matrix"] >> k;
     fs["distortion_coefficients"] >> d;
     if (k.rows != 3 || k.cols != 3 || k.type() != CV_64F)
-      return makeError(1, "camera_matrix must be 3x3");
+      return makeError(CalibrationErrc::kBadFile, "camera_matrix must be 3x3");
     if (d.total() < 4 || d.total() > 14)
-      return makeError(1, "distortion_coefficients must have 4 to 14 values");
+      return makeError(CalibrationErrc::kBadFile,
+                       "distortion_coefficients must have 4 to 14 values");
     m.camera_matrix = cv::Matx33d(k);
     d.reshape(1, 1).convertTo(d, CV_64F);
     d.copyTo(m.distortion);
     m.rms_reprojection_px = static_cast<double>(fs["rms_reprojection_px"]);
     m.views = static_cast<int>(fs["views"]);
     if (m.image_size.width <= 0 || m.image_size.height <= 0)
-      return makeError(1, "image size missing");
+      return makeError(CalibrationErrc::kBadFile, "image size missing");
     return m;
   } catch (const cv::Exception& e) {
-    return makeError(1, std::string("unreadable lens model: ") + e.what());
+    return makeError(CalibrationErrc::kBadFile, std::string("unreadable lens model: ") + e.what());
   }
 }
 

@@ -10,6 +10,22 @@
 #include <limits>
 
 namespace picksight::calibration {
+
+const char* errorName(CalibrationErrc e) {
+  switch (e) {
+    case CalibrationErrc::kTooFewPoints:
+      return "too few points";
+    case CalibrationErrc::kDegeneratePoints:
+      return "degenerate points";
+    case CalibrationErrc::kBadTarget:
+      return "bad target";
+    case CalibrationErrc::kBadInput:
+      return "bad input";
+    case CalibrationErrc::kBadFile:
+      return "bad file";
+  }
+  return "unknown";
+}
 namespace {
 using picksight::signedDeg;
 constexpr double kDeg = 180.0 / M_PI;
@@ -223,7 +239,7 @@ const char* methodName(Method method) {
 
 Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method method) {
   if (points.size() < 3) {
-    return makeError(kTooFewPoints,
+    return makeError(CalibrationErrc::kTooFewPoints,
                      "need at least 3 points, have " + std::to_string(points.size()));
   }
   // Spread of the vision points along their minor axis.
@@ -235,14 +251,14 @@ Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method
   cv::PCA pca(data, cv::Mat(), cv::PCA::DATA_AS_ROW);
   const double minor = std::sqrt(std::max(0.0, pca.eigenvalues.at<double>(1)));
   if (minor < kMinSpreadMm) {
-    return makeError(kDegeneratePoints,
+    return makeError(CalibrationErrc::kDegeneratePoints,
                      "the points lie (nearly) on one line: spread them over the work area");
   }
   bool mirrored = false;
   const std::vector<bool> use = findInliers(points, &mirrored);
   const int inliers = static_cast<int>(std::count(use.begin(), use.end(), true));
   if (inliers < 3) {
-    return makeError(kTooFewPoints,
+    return makeError(CalibrationErrc::kTooFewPoints,
                      "fewer than 3 points agree with each other: check the stored points");
   }
   // Cluster radius for the geometric method: a few times the noise level,

@@ -29,14 +29,14 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& con
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
     FdGuard file{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644)};
-    if (file.fd < 0) return makeError(errno, errnoText("cannot create", tmp));
+    if (file.fd < 0) return systemError(errno, errnoText("cannot create", tmp));
     const char* p = content.data();
     size_t left = content.size();
     while (left > 0) {
       ssize_t n = ::write(file.fd, p, left);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) {
-        Error e = makeError(errno, errnoText("cannot write", tmp));
+        Error e = systemError(errno, errnoText("cannot write", tmp));
         ::unlink(tmp.c_str());
         return e;
       }
@@ -44,13 +44,13 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& con
       left -= static_cast<size_t>(n);
     }
     if (::fsync(file.fd) != 0) {
-      Error e = makeError(errno, errnoText("cannot sync", tmp));
+      Error e = systemError(errno, errnoText("cannot sync", tmp));
       ::unlink(tmp.c_str());
       return e;
     }
   }
   if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    Error e = makeError(errno, errnoText("cannot rename over", path));
+    Error e = systemError(errno, errnoText("cannot rename over", path));
     ::unlink(tmp.c_str());
     return e;
   }
@@ -66,13 +66,13 @@ Result<std::string> readFile(const std::string& path) {
   // An ifstream opens a directory and reads it as an empty file.
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-    return makeError(EISDIR, "cannot read " + path + ": is a directory");
+    return systemError(EISDIR, "cannot read " + path + ": is a directory");
   }
   std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ENOENT, "cannot open " + path);
+  if (!in) return systemError(ENOENT, "cannot open " + path);
   std::ostringstream out;
   out << in.rdbuf();
-  if (in.bad()) return makeError(EIO, "cannot read " + path);
+  if (in.bad()) return systemError(EIO, "cannot read " + path);
   return out.str();
 }
 

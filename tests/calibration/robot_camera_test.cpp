@@ -131,7 +131,7 @@ TEST_CASE("too few or collinear points are refused with the reason", "[calibrati
   auto two = makePoints(kTruth, 2, 0, 1);
   auto r = calibrate(two);
   REQUIRE_FALSE(r);
-  CHECK(r.error().code == kTooFewPoints);
+  CHECK(r.error().code == CalibrationErrc::kTooFewPoints);
   std::vector<PointPair> line;
   for (int i = 0; i < 6; ++i) {
     const cv::Point2d v(20.0 * i, 10.0 * i);
@@ -139,6 +139,6 @@ TEST_CASE("too few or collinear points are refused with the reason", "[calibrati
   }
   r = calibrate(line);
   REQUIRE_FALSE(r);
-  CHECK(r.error().code == kDegeneratePoints);
+  CHECK(r.error().code == CalibrationErrc::kDegeneratePoints);
   CHECK(r.error().message.find("line") != std::string::npos);
 }

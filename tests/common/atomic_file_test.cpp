@@ -65,7 +65,7 @@ TEST_CASE("writeFileAtomically into a missing directory is an error, not a crash
   const std::string path = (missing / "file.txt").string();
   auto written = picksight::writeFileAtomically(path, "content");
   REQUIRE_FALSE(written);
-  CHECK(written.error().code != 0);
+  CHECK(written.error().code);
   CHECK_THAT(written.error().message, Catch::Contains("no_such_dir"));
   CHECK_FALSE(fs::exists(missing));
   CHECK(namesIn(dir.path()).empty());
@@ -87,7 +87,7 @@ TEST_CASE("readFile of a missing file is an error naming the file", "[common]") 
   const std::string path = (dir.path() / "absent.txt").string();
   auto read = picksight::readFile(path);
   REQUIRE_FALSE(read);
-  CHECK(read.error().code != 0);
+  CHECK(read.error().code == std::errc::no_such_file_or_directory);
   CHECK_THAT(read.error().message, Catch::Contains("absent.txt"));
 }
 

@@ -11,11 +11,11 @@ using picksight::video::makeSource;
 
 namespace {
 
-// The error message of a source string that must fail with kSourceBadConfig.
+// The error message of a source string that must fail with SourceErrc::kBadConfig.
 std::string badConfigMessage(const std::string& uri) {
   auto source = makeSource(uri);
   if (source) return "accepted";
-  CHECK(source.error().code == picksight::video::kSourceBadConfig);
+  CHECK(source.error().code == picksight::video::SourceErrc::kBadConfig);
   return source.error().message;
 }
 

@@ -191,7 +191,7 @@ TEST_CASE("corrupt and truncated MJPEG frames are errors, not crashes", "[video_
     for (auto format : {OutputFormat::kMono8, OutputFormat::kBgr8}) {
       auto out = toOutputFormat(raw, PixelLayout::kMJPEG, format);
       REQUIRE_FALSE(out);
-      CHECK(out.error().code == picksight::video::kSourceBadValue);
+      CHECK(out.error().code == picksight::video::SourceErrc::kBadValue);
       CHECK_THAT(out.error().message, Catch::Contains("MJPEG"));
     }
   }

@@ -323,7 +323,7 @@ TEST_CASE("VideoServer answers a real ControlClient on its bound endpoint", "[vi
 
   auto unknown = client.call(describe("nope"));
   REQUIRE_FALSE(unknown);
-  CHECK(unknown.error().code == proto::Error::UNKNOWN_CAMERA);
+  CHECK(unknown.error().code == picksight::ControlErrc::kUnknownCamera);
   CHECK_THAT(unknown.error().message, Catch::Contains("nope"));
 
   auto first = client.call(trigger("cam1"));
@@ -334,7 +334,7 @@ TEST_CASE("VideoServer answers a real ControlClient on its bound endpoint", "[vi
   CHECK(second->trigger().sequence() == first->trigger().sequence() + 1);
 
   // An empty or undecodable request gets BAD_REQUEST, and the socket goes on.
-  CHECK(client.call(proto::ControlRequest{}).error().code == proto::Error::BAD_REQUEST);
+  CHECK(client.call(proto::ControlRequest{}).error().code == picksight::ControlErrc::kBadRequest);
   {
     zmq::socket_t raw(context, zmq::socket_type::req);
     raw.set(zmq::sockopt::linger, 0);

@@ -42,12 +42,12 @@ std::vector<Match> recognizeScene(const ps::SceneRenderer& s,
 TEST_CASE("training needs exactly one part", "[vision][model]") {
   cv::Mat empty(200, 200, CV_8UC1, cv::Scalar(200));
   auto outcome = trainModel(empty, 1, "x");
-  CHECK_FALSE(outcome.ok);
-  CHECK(outcome.error.find("no part") != std::string::npos);
+  CHECK_FALSE(outcome.ok());
+  CHECK(outcome.error().message.find("no part") != std::string::npos);
   const ps::SceneRenderer two(scene(640, 480, 2, 3, {"rectangle"}));
   outcome = trainModel(two.render(0), 1, "x");
-  CHECK_FALSE(outcome.ok);
-  CHECK(outcome.error.find("2 parts") != std::string::npos);
+  CHECK_FALSE(outcome.ok());
+  CHECK(outcome.error().message.find("2 parts") != std::string::npos);
 }
 
 TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][model]") {
@@ -63,15 +63,15 @@ TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][mo
     const Trained t = train(type, id++);
     CHECK(t.model.symmetryDeg() == deg);
     CHECK(t.model.body.mirror_symmetric == mirror.at(type));
-    CHECK(validateModel(t.model).empty());
+    CHECK(validateModel(t.model));
   }
   // A plain disc turns into itself at any angle.
   cv::Mat grey(300, 300, CV_8UC1, cv::Scalar(200));
   cv::circle(grey, {150, 150}, 60, cv::Scalar(40), cv::FILLED, cv::LINE_AA);
   const auto disc = trainModel(grey, 9, "disc");
-  REQUIRE(disc.ok);
-  CHECK(disc.model.symmetryDeg() == 0);
-  CHECK(disc.model.orientation_order == 0);
+  REQUIRE(disc.ok());
+  CHECK(disc.value().symmetryDeg() == 0);
+  CHECK(disc.value().orientation_order == 0);
 }
 
 TEST_CASE("a hole becomes one arc; a rectangle four lines with convex right-angle corners",
@@ -93,14 +93,14 @@ TEST_CASE("a hole becomes one arc; a rectangle four lines with convex right-angl
   cv::Mat grey(300, 300, CV_8UC1, cv::Scalar(200));
   cv::rectangle(grey, cv::Rect(80, 100, 120, 60), cv::Scalar(40), cv::FILLED);
   const auto rect = trainModel(grey, 2, "rect");
-  REQUIRE(rect.ok);
-  REQUIRE(rect.model.loops.size() == 1);
+  REQUIRE(rect.ok());
+  REQUIRE(rect.value().loops.size() == 1);
   int long_lines = 0;
-  for (const auto& p : rect.model.loops[0].primitives)
+  for (const auto& p : rect.value().loops[0].primitives)
     long_lines += p.kind == PrimitiveKind::kLine && p.length() > 50;
   CHECK(long_lines == 4);
   int right_angles = 0;
-  for (const auto& c : rect.model.corners) {
+  for (const auto& c : rect.value().corners) {
     if (c.kind == CornerClass::kLineLine && c.convex &&
         (c.turn_deg.contains(90) || c.turn_deg.contains(-90))) {
       ++right_angles;

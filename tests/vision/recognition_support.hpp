@@ -26,9 +26,9 @@ struct Trained {
 inline Trained trainOn(const synthetic::SceneOptions& options, int id, const std::string& type) {
   const synthetic::SceneRenderer s(options);
   auto outcome = vision::trainModel(s.render(0), id, type);
-  INFO(type << ": " << outcome.error);
-  REQUIRE(outcome.ok);
-  return {outcome.model, s.truth()[0].angle_deg};
+  INFO(type << ": " << (outcome ? std::string() : outcome.error().message));
+  REQUIRE(outcome.ok());
+  return {outcome.value(), s.truth()[0].angle_deg};
 }
 
 // Every type trained by `train(type, id)` with ids 1, 2, ..., and the

@@ -6,10 +6,10 @@
 #include <fstream>
 
 #include "picksight/common/atomic_file.hpp"
-#include "picksight/synthetic/scene.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/model_file.hpp"
 #include "picksight/store/model_library.hpp"
+#include "picksight/synthetic/scene.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight;
@@ -25,8 +25,8 @@ vision::PartModel trainedModel(const std::string& type, int id) {
   o.types = {type};
   const synthetic::SceneRenderer scene(o);
   auto outcome = vision::trainModel(scene.render(0), id, type);
-  REQUIRE(outcome.ok);
-  return outcome.model;
+  REQUIRE(outcome.ok());
+  return outcome.value();
 }
 
 struct TempDir {

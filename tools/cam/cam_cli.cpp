@@ -22,12 +22,16 @@
 
 namespace picksight::cam {
 
+const char* errorName(CliErrc e) {
+  return e == CliErrc::kUsage ? "usage" : e == CliErrc::kBadReply ? "bad reply" : "save failed";
+}
+
 namespace {
 
 constexpr const char* kProgram = "picksight-cam";
 
 // Usage errors are carried in Result as Error{kExitUsage, message}.
-Error usageError(std::string message) { return makeError(kExitUsage, std::move(message)); }
+Error usageError(std::string message) { return makeError(CliErrc::kUsage, std::move(message)); }
 
 // Shortest decimal text that reads back to `value`, '.' whatever the locale.
 std::string formatShortest(double value) {
@@ -52,8 +56,6 @@ std::string formatReadable(double value) {
 // Codes of the errors that printReply returns; both exit with
 // kExitServerError, but only a reply the CLI cannot use is the server's fault,
 // and only then does the message name the server.
-constexpr int kBadReply = 1;
-constexpr int kSaveFailed = 2;
 
 // Index of FILE in "snap CAM FILE": the request has no field for it, so the
 // command words carry it to the code that writes the frame.
@@ -459,7 +461,7 @@ Result<void> saveSnap(const std::string& camera, const proto::SnapReply& snap,
                       const std::string& file, bool as_json, std::ostream& out) {
   const proto::FrameHeader& h = snap.header();
   if (!frameIsConsistent(h, snap.pixels().size())) {
-    return makeError(kBadReply,
+    return makeError(CliErrc::kBadReply,
                      "inconsistent frame: " + std::to_string(h.width()) + "x" +
                          std::to_string(h.height()) + " " + formatName(h.pixel_format()) +
                          " with stride " + std::to_string(h.stride()) + " needs " +
@@ -478,7 +480,7 @@ Result<void> saveSnap(const std::string& camera, const proto::SnapReply& snap,
   } catch (const cv::Exception& e) {
     reason = e.err;  // what() adds OpenCV's source path and line
   }
-  if (!written) return makeError(kSaveFailed, "could not save '" + file + "': " + reason);
+  if (!written) return makeError(CliErrc::kSaveFailed, "could not save '" + file + "': " + reason);
 
   if (as_json) {
     JsonWriter json;
@@ -692,7 +694,7 @@ Result<void> printReply(const proto::ControlRequest& request, const proto::Contr
                         const CamOptions& options, std::ostream& out) {
   const bool as_json = options.json;
   auto missing = [](const char* what) {
-    return makeError(kBadReply, std::string("unexpected reply: no ") + what);
+    return makeError(CliErrc::kBadReply, std::string("unexpected reply: no ") + what);
   };
   switch (request.request_case()) {
     // An empty list is a legitimate answer, and reading an absent proto3
@@ -1021,20 +1023,20 @@ int runCamCli(const std::vector<std::string>& args, std::ostream& out, std::ostr
   }
   if (!*reply) {
     const Error& error = reply->error();
-    if (error.code == kControlTimeout) {
+    if (error.code == ControlErrc::kNoReply) {
       err << kProgram << ": no answer from " << options->endpoint << " within " << timeout.count()
           << " ms: is picksight-video-server running?\n";
       return kExitTimeout;
     }
     err << kProgram << ": " << command << ": " << error.message << " (server error "
-        << errorCodeName(error.code) << ", code " << error.code << ")\n";
+        << errorCodeName(error.code.value()) << ", code " << error.code.value() << ")\n";
     return kExitServerError;
   }
 
   std::ostringstream text;  // nothing on `out` unless the whole reply printed
   if (auto printed = printReply(*request, reply->value(), *options, text); !printed) {
     err << kProgram << ": " << command << ": " << printed.error().message;
-    if (printed.error().code == kBadReply) err << " from " << options->endpoint;
+    if (printed.error().code == CliErrc::kBadReply) err << " from " << options->endpoint;
     err << '\n';
     return kExitServerError;
   }

@@ -16,6 +16,12 @@
 
 namespace picksight::cam {
 
+// Why the CLI failed on its own side: usage errors (nothing was sent), and
+// replies it could not use or save. Printed and turned into exit codes.
+enum class CliErrc { kUsage = 1, kBadReply, kSaveFailed };
+const char* errorName(CliErrc e);
+PICKSIGHT_ERROR_DOMAIN(CliErrc, "picksight-cam")
+
 // Exit codes, part of the CLI's contract with scripts.
 constexpr int kExitOk = 0;
 constexpr int kExitServerError = 1;  // the server refused, or answered nonsense
@@ -85,3 +91,5 @@ class JsonWriter {
 };
 
 }  // namespace picksight::cam
+
+PICKSIGHT_ERROR_ENUM(picksight::cam::CliErrc)

@@ -3,6 +3,39 @@
 #include "picksight/transport/control_client.hpp"
 
 namespace picksight {
+namespace {
+ControlErrc fromWire(proto::Error::Code code) {
+  // Same numbers; a code this client does not know is the server's problem.
+  const bool known = code >= proto::Error::BAD_REQUEST && code <= proto::Error::BUSY;
+  return known ? static_cast<ControlErrc>(code) : ControlErrc::kInternal;
+}
+}  // namespace
+
+const char* errorName(ControlErrc e) {
+  switch (e) {
+    case ControlErrc::kNoReply:
+      return "no reply";
+    case ControlErrc::kBadRequest:
+      return "bad request";
+    case ControlErrc::kUnknownCamera:
+      return "unknown camera";
+    case ControlErrc::kOutOfRange:
+      return "out of range";
+    case ControlErrc::kNotSupported:
+      return "not supported";
+    case ControlErrc::kCameraUnavailable:
+      return "camera unavailable";
+    case ControlErrc::kInternal:
+      return "internal";
+    case ControlErrc::kUnknownFeature:
+      return "unknown feature";
+    case ControlErrc::kTimeout:
+      return "timeout";
+    case ControlErrc::kBusy:
+      return "busy";
+  }
+  return "unknown";
+}
 
 ControlClient::ControlClient(zmq::context_t& context, std::string endpoint,
                              std::chrono::milliseconds timeout)
@@ -22,20 +55,21 @@ Result<proto::ControlReply> ControlClient::call(const proto::ControlRequest& req
   zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
   if (zmq::poll(&item, 1, timeout_) == 0) {
     reconnect();
-    return makeError(kControlTimeout, "video server at " + endpoint_ + " did not answer within " +
-                                          std::to_string(timeout_.count()) + " ms");
+    return makeError(ControlErrc::kNoReply, "video server at " + endpoint_ +
+                                                " did not answer within " +
+                                                std::to_string(timeout_.count()) + " ms");
   }
   zmq::message_t reply_bytes;
   if (!socket_->recv(reply_bytes)) {
     reconnect();
-    return makeError(kControlTimeout, "no reply from " + endpoint_);
+    return makeError(ControlErrc::kNoReply, "no reply from " + endpoint_);
   }
   proto::ControlReply reply;
   if (!reply.ParseFromArray(reply_bytes.data(), static_cast<int>(reply_bytes.size()))) {
-    return makeError(proto::Error::INTERNAL, "malformed reply from " + endpoint_);
+    return makeError(ControlErrc::kInternal, "malformed reply from " + endpoint_);
   }
   if (reply.has_error() && reply.error().code() != proto::Error::OK) {
-    return makeError(reply.error().code(), reply.error().text());
+    return makeError(fromWire(reply.error().code()), reply.error().text());
   }
   return reply;
 }

@@ -2,19 +2,38 @@
 #include "aravis/aravis_source.hpp"
 #include "dir/dir_source.hpp"
 #include "file/file_source.hpp"
+#include "picksight/sources/source.hpp"
 #include "stream/stream_source.hpp"
 #include "synthetic/synthetic_source.hpp"
 #include "v4l2/v4l2_source.hpp"
-#include "picksight/sources/source.hpp"
 
 namespace picksight::video {
+
+const char* errorName(SourceErrc e) {
+  switch (e) {
+    case SourceErrc::kTimeout:
+      return "timeout";
+    case SourceErrc::kUnavailable:
+      return "unavailable";
+    case SourceErrc::kBadConfig:
+      return "bad config";
+    case SourceErrc::kUnknownFeature:
+      return "unknown feature";
+    case SourceErrc::kBadValue:
+      return "bad value";
+    case SourceErrc::kNotSupported:
+      return "not supported";
+  }
+  return "unknown";
+}
 
 Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
   const size_t colon = uri.find(':');
   if (colon == std::string::npos) {
-    return makeError(kSourceBadConfig, "source '" + uri +
-                                           "' has no scheme (synthetic:, file:<path>, dir:<path>, "
-                                           "v4l2:/dev/videoN, stream:<url>)");
+    return makeError(SourceErrc::kBadConfig,
+                     "source '" + uri +
+                         "' has no scheme (synthetic:, file:<path>, dir:<path>, "
+                         "v4l2:/dev/videoN, stream:<url>)");
   }
   const std::string scheme = uri.substr(0, colon);
   const std::string rest = uri.substr(colon + 1);
@@ -29,7 +48,7 @@ Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
   }
   if (scheme == "file") {
     if (rest.empty())
-      return makeError(kSourceBadConfig, "file: needs a path, as in file:/data/part.png");
+      return makeError(SourceErrc::kBadConfig, "file: needs a path, as in file:/data/part.png");
     return std::unique_ptr<Source>(std::make_unique<FileSource>(rest));
   }
   if (scheme == "v4l2") {
@@ -39,17 +58,18 @@ Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
   }
   if (scheme == "stream") {
     if (rest.empty()) {
-      return makeError(kSourceBadConfig, "stream: needs a URL, as in stream:rtsp://host/path");
+      return makeError(SourceErrc::kBadConfig,
+                       "stream: needs a URL, as in stream:rtsp://host/path");
     }
     return std::unique_ptr<Source>(std::make_unique<StreamSource>(rest));
   }
   if (scheme == "dir") {
     if (rest.empty()) {
-      return makeError(kSourceBadConfig, "dir: needs a directory, as in dir:/data/run1");
+      return makeError(SourceErrc::kBadConfig, "dir: needs a directory, as in dir:/data/run1");
     }
     return std::unique_ptr<Source>(std::make_unique<DirSource>(rest));
   }
-  return makeError(kSourceBadConfig,
+  return makeError(SourceErrc::kBadConfig,
                    "unknown source scheme '" + scheme + "' in '" + uri +
                        "' (known: synthetic:, file:, dir:, v4l2:, stream:, aravis:)");
 }

@@ -6,6 +6,7 @@
 // on their own thread or in the kernel and only hand them to grab(); the
 // conversion work happens here, never on the driver's thread.
 #include "picksight/video_server/camera.hpp"
+#include "picksight/video_server/video_errors.hpp"
 
 #include <algorithm>
 #include <future>
@@ -88,7 +89,7 @@ OutputSettings Camera::output() const {
 }
 
 Result<void> Camera::setMode(AcquisitionMode mode, double fps) {
-  if (fps < 0 || fps > 1000) return makeError(1, "fps must be in (0, 1000]");
+  if (fps < 0 || fps > 1000) return makeError(VideoErrc::kOutOfRange, "fps must be in (0, 1000]");
   {
     std::lock_guard<std::mutex> lock(mutex_);
     mode_ = mode;
@@ -154,7 +155,8 @@ Result<T> Camera::onAcquisitionThread(std::function<Result<T>(Source&, bool open
   }
   wake_.notify_all();
   if (future.wait_for(kCommandTimeout) != std::future_status::ready) {
-    return makeError(kSourceTimeout, "camera " + config_.name + " is busy: no answer within 5 s");
+    return makeError(SourceErrc::kTimeout,
+                     "camera " + config_.name + " is busy: no answer within 5 s");
   }
   return future.get();
 }
@@ -162,21 +164,21 @@ Result<T> Camera::onAcquisitionThread(std::function<Result<T>(Source&, bool open
 Result<std::vector<Feature>> Camera::features() {
   return onAcquisitionThread<std::vector<Feature>>(
       [](Source& s, bool open) -> Result<std::vector<Feature>> {
-        if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+        if (!open) return makeError(SourceErrc::kUnavailable, "camera is not connected");
         return s.features();
       });
 }
 
 Result<Feature> Camera::feature(const std::string& name) {
   return onAcquisitionThread<Feature>([name](Source& s, bool open) -> Result<Feature> {
-    if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+    if (!open) return makeError(SourceErrc::kUnavailable, "camera is not connected");
     return s.feature(name);
   });
 }
 
 Result<Feature> Camera::setFeature(const std::string& name, const std::string& value) {
   return onAcquisitionThread<Feature>([name, value](Source& s, bool open) -> Result<Feature> {
-    if (!open) return makeError(kSourceUnavailable, "camera is not connected");
+    if (!open) return makeError(SourceErrc::kUnavailable, "camera is not connected");
     if (auto ok = s.setFeature(name, value); !ok) return ok.error();
     return s.feature(name);
   });
@@ -333,14 +335,14 @@ void Camera::run() {
       // The sequence number was not used: give it back so a gap means a lost frame.
       if (next_sequence_ == sequence + 1) next_sequence_ = sequence;
       if (triggered) ++pending_triggers_;  // the trigger is still owed a frame
-      if (out.error().code == kSourceTimeout) {
+      if (out.error().code == SourceErrc::kTimeout) {
         // A streaming camera with nothing to deliver yet; not an error.
         if (triggered) ++status_.acquisition_errors;
         continue;
       }
       ++status_.acquisition_errors;
       status_.last_error = out.error().message;
-      if (out.error().code == kSourceUnavailable) {
+      if (out.error().code == SourceErrc::kUnavailable) {
         logWarning("camera ", config_.name, ": ", out.error().message);
         closeSource(lock);
         status_.state = "reconnecting";

@@ -1,5 +1,6 @@
 // ROI, resize and pixel format for published frames.
 #include "picksight/video_server/frame_pipeline.hpp"
+#include "picksight/video_server/video_errors.hpp"
 
 #include "picksight/video_server/pixel_format.hpp"
 
@@ -35,27 +36,31 @@ Result<void> validateOutputSettings(const OutputSettings& s, cv::Size sensor) {
   // side (a uint32 from a control request that did not fit an int) is an error.
   if (s.roi != cv::Rect()) {
     if (s.roi.x < 0 || s.roi.y < 0 || s.roi.width <= 0 || s.roi.height <= 0) {
-      return makeError(1, "roi must have a non-negative offset and a positive size");
+      return makeError(VideoErrc::kOutOfRange,
+                       "roi must have a non-negative offset and a positive size");
     }
     // In 64 bits: x + width may overflow an int, and cv::Rect arithmetic with it.
     const int64_t right = int64_t{s.roi.x} + s.roi.width;
     const int64_t bottom = int64_t{s.roi.y} + s.roi.height;
     if (right > std::numeric_limits<int>::max() || bottom > std::numeric_limits<int>::max() ||
         (sensor.area() > 0 && (right > sensor.width || bottom > sensor.height))) {
-      return makeError(1, "roi " + std::to_string(s.roi.x) + "," + std::to_string(s.roi.y) + " " +
-                              std::to_string(s.roi.width) + "x" + std::to_string(s.roi.height) +
-                              " exceeds the sensor " + std::to_string(sensor.width) + "x" +
-                              std::to_string(sensor.height));
+      return makeError(VideoErrc::kOutOfRange,
+                       "roi " + std::to_string(s.roi.x) + "," + std::to_string(s.roi.y) + " " +
+                           std::to_string(s.roi.width) + "x" + std::to_string(s.roi.height) +
+                           " exceeds the sensor " + std::to_string(sensor.width) + "x" +
+                           std::to_string(sensor.height));
     }
   }
   if ((s.size.width == 0) != (s.size.height == 0)) {
-    return makeError(1, "size needs both a width and a height");
+    return makeError(VideoErrc::kOutOfRange, "size needs both a width and a height");
   }
   if (s.size.width < 0 || s.size.height < 0 || s.size.width > kMaxOutputSide ||
       s.size.height > kMaxOutputSide) {
-    return makeError(1, "size must be between 1 and " + std::to_string(kMaxOutputSide));
+    return makeError(VideoErrc::kOutOfRange,
+                     "size must be between 1 and " + std::to_string(kMaxOutputSide));
   }
-  if (s.scale < 0 || s.scale > 16) return makeError(1, "scale must be in (0, 16]");
+  if (s.scale < 0 || s.scale > 16)
+    return makeError(VideoErrc::kOutOfRange, "scale must be in (0, 16]");
   return {};
 }
 

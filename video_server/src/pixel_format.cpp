@@ -11,7 +11,7 @@ namespace picksight::video {
 namespace {
 
 Error mismatch(PixelLayout layout, const cv::Mat& raw, const char* expected) {
-  return makeError(kSourceBadValue,
+  return makeError(SourceErrc::kBadValue,
                    std::string("buffer does not match layout ") + pixelLayoutName(layout) +
                        ": expected " + expected + ", got " + std::to_string(raw.cols) + "x" +
                        std::to_string(raw.rows) + " of type " + std::to_string(raw.type()));
@@ -67,14 +67,14 @@ Result<cv::Mat> decodeJpeg(const cv::Mat& raw, bool mono) {
     return mismatch(PixelLayout::kMJPEG, raw, "one continuous row of bytes");
   }
   if (!jpegLooksComplete(raw)) {
-    return makeError(kSourceBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
-                                          " bytes): no JPEG start or end marker");
+    return makeError(SourceErrc::kBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
+                                                " bytes): no JPEG start or end marker");
   }
   // Decoding to grey skips the colour planes entirely (libjpeg reads Y only).
   cv::Mat out = cv::imdecode(raw, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
   if (out.empty()) {
-    return makeError(kSourceBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
-                                          " bytes): not decodable");
+    return makeError(SourceErrc::kBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
+                                                " bytes): not decodable");
   }
   return out;
 }
@@ -133,7 +133,7 @@ Result<cv::Mat> convert(const cv::Mat& raw, PixelLayout layout, bool mono) {
     case PixelLayout::kMJPEG:
       return decodeJpeg(raw, mono);
   }
-  return makeError(kSourceNotSupported,
+  return makeError(SourceErrc::kNotSupported,
                    std::string("pixel layout ") + pixelLayoutName(layout) + " is not converted");
 }
 
@@ -173,14 +173,15 @@ const char* pixelLayoutName(PixelLayout layout) {
 
 Result<cv::Mat> toOutputFormat(const cv::Mat& raw, PixelLayout layout, OutputFormat format) {
   if (raw.empty())
-    return makeError(kSourceBadValue, std::string("empty ") + pixelLayoutName(layout) + " frame");
+    return makeError(SourceErrc::kBadValue,
+                     std::string("empty ") + pixelLayoutName(layout) + " frame");
   // The acquisition thread must never see an exception: an OpenCV assertion
   // on a malformed buffer becomes a dropped frame.
   try {
     return convert(raw, layout, format == OutputFormat::kMono8);
   } catch (const cv::Exception& e) {
-    return makeError(kSourceBadValue, std::string("cannot convert ") + pixelLayoutName(layout) +
-                                          " frame: " + e.what());
+    return makeError(SourceErrc::kBadValue, std::string("cannot convert ") +
+                                                pixelLayoutName(layout) + " frame: " + e.what());
   }
 }
 

@@ -3,6 +3,8 @@
 
 #include <stdexcept>
 
+#include "picksight/video_server/control_errors.hpp"
+
 namespace picksight::video {
 namespace {
 proto::AcquisitionMode toProto(AcquisitionMode m) {
@@ -18,23 +20,8 @@ proto::ControlReply errorReply(proto::Error::Code code, const std::string& text)
 
 constexpr std::chrono::milliseconds kSnapTimeout{3000};
 
-// Source error codes to the wire's.
-proto::ControlReply sourceErrorReply(const Error& e) {
-  switch (e.code) {
-    case kSourceUnknownFeature:
-      return errorReply(proto::Error::UNKNOWN_FEATURE, e.message);
-    case kSourceBadValue:
-      return errorReply(proto::Error::OUT_OF_RANGE, e.message);
-    case kSourceUnavailable:
-      return errorReply(proto::Error::CAMERA_UNAVAILABLE, e.message);
-    case kSourceTimeout:
-      return errorReply(proto::Error::TIMEOUT, e.message);
-    case kSourceNotSupported:
-      return errorReply(proto::Error::NOT_SUPPORTED, e.message);
-    default:
-      return errorReply(proto::Error::INTERNAL, e.message);
-  }
-}
+// Driver errors to the wire's, through the server's one table.
+proto::ControlReply sourceErrorReply(const Error& e) { return video::errorReply(e); }
 
 void fillFeature(const Feature& f, proto::Feature* out) {
   out->set_name(f.name);

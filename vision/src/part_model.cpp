@@ -111,24 +111,34 @@ void prepareModel(PartModel& model) {
     model.radius = std::max(model.radius, std::hypot(s.point.x, s.point.y));
 }
 
-TrainOutcome trainModel(const cv::Mat& grey, int type, const std::string& name,
-                        const TrainOptions& options) {
-  TrainOutcome out;
+const char* errorName(PartModelErrc e) {
+  switch (e) {
+    case PartModelErrc::kNotGrey:
+      return "not grey";
+    case PartModelErrc::kNoPart:
+      return "no part";
+    case PartModelErrc::kSeveralParts:
+      return "several parts";
+    case PartModelErrc::kInvalid:
+      return "invalid";
+  }
+  return "unknown";
+}
+
+Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& name,
+                             const TrainOptions& options) {
   if (grey.empty() || grey.type() != CV_8UC1) {
-    out.error = "the training image must be 8-bit grey";
-    return out;
+    return makeError(PartModelErrc::kNotGrey, "the training image must be 8-bit grey");
   }
   const auto regions = findRegions(binarize(grey, options.binarize), options.regions, grey);
-  if (regions.empty()) {
-    out.error = "no part in the image";
-    return out;
-  }
+  if (regions.empty()) return makeError(PartModelErrc::kNoPart, "no part in the image");
   if (regions.size() > 1) {
-    out.error = std::to_string(regions.size()) + " parts in the image, training needs exactly one";
-    return out;
+    return makeError(
+        PartModelErrc::kSeveralParts,
+        std::to_string(regions.size()) + " parts in the image, training needs exactly one");
   }
   const Region& r = regions.front();
-  PartModel& m = out.model;
+  PartModel m;
   m.type = type;
   m.name = name;
   m.trained_centroid = r.centroid;
@@ -228,11 +238,12 @@ TrainOutcome trainModel(const cv::Mat& grey, int type, const std::string& name,
   double worst = 0;
   for (const auto& h : probes) worst = std::max(worst, huDistance(m.body, h));
   m.body.hu_tolerance = std::max(kMinHuTolerance, 3 * worst);
-  out.ok = true;
-  return out;
+  return m;
 }
 
-std::string validateModel(const PartModel& m) {
+namespace {
+// What is wrong with a model; empty when nothing is.
+std::string modelProblem(const PartModel& m) {
   const auto finite = [](double v) { return std::isfinite(v); };
   if (m.type < 0 || m.type > 9999) return "type must be in [0, 9999]";
   if (!finite(m.body.area) || m.body.area <= 0) return "body area must be a positive number";
@@ -274,6 +285,14 @@ std::string validateModel(const PartModel& m) {
     }
   }
   return {};
+}
+
+}  // namespace
+
+Result<void> validateModel(const PartModel& model) {
+  const std::string problem = modelProblem(model);
+  if (problem.empty()) return {};
+  return makeError(PartModelErrc::kInvalid, problem);
 }
 
 }  // namespace picksight::vision

@@ -103,11 +103,11 @@ TEST_CASE("video server describes an Aravis camera and sets its features",
 
   auto refused = client.call(setFeature("GainRaw", "11"));
   REQUIRE_FALSE(refused);
-  CHECK(refused.error().code == proto::Error::OUT_OF_RANGE);
+  CHECK(refused.error().code == ControlErrc::kOutOfRange);
   CHECK_THAT(refused.error().message, Catch::Contains("GainRaw") && Catch::Contains("[0, 10]"));
   auto unknown = client.call(getFeature("Gain"));
   REQUIRE_FALSE(unknown);
-  CHECK(unknown.error().code == proto::Error::UNKNOWN_FEATURE);
+  CHECK(unknown.error().code == ControlErrc::kUnknownFeature);
   CHECK_THAT(unknown.error().message, Catch::Contains("Gain"));
 
   proto::ControlRequest list;

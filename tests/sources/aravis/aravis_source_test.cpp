@@ -33,7 +33,7 @@ std::optional<SourceFrame> nextFrame(Source& source, std::chrono::seconds within
   while (std::chrono::steady_clock::now() < deadline) {
     auto frame = source.grab(200ms);
     if (frame) return std::move(*frame);
-    if (frame.error().code == kSourceUnavailable) FAIL(frame.error().message);
+    if (frame.error().code == SourceErrc::kUnavailable) FAIL(frame.error().message);
     last_error = frame.error().message;
   }
   WARN("no frame: " << last_error);
@@ -80,7 +80,7 @@ TEST_CASE("aravis source reports an absent camera as unavailable, naming it", "[
   REQUIRE(source);
   auto opened = (*source)->open();
   REQUIRE_FALSE(opened);
-  CHECK(opened.error().code == kSourceUnavailable);
+  CHECK(opened.error().code == SourceErrc::kUnavailable);
   CHECK_THAT(opened.error().message, Catch::Contains("No-Such-Camera-42"));
 }
 
@@ -120,7 +120,7 @@ TEST_CASE("aravis source reads and writes GenICam features by type", "[aravis]")
   SECTION("out of range names the feature and the range, and changes nothing") {
     auto refused = source->setFeature("GainRaw", "20");
     REQUIRE_FALSE(refused);
-    CHECK(refused.error().code == kSourceBadValue);
+    CHECK(refused.error().code == SourceErrc::kBadValue);
     CHECK_THAT(refused.error().message, Catch::Contains("GainRaw") && Catch::Contains("[0, 10]"));
     CHECK(mustGet(*source, "GainRaw").value == "3");
     refused = source->setFeature("ExposureTimeAbs", "5");
@@ -131,7 +131,7 @@ TEST_CASE("aravis source reads and writes GenICam features by type", "[aravis]")
   SECTION("a value of the wrong type or not among the choices is refused") {
     auto refused = source->setFeature("GainRaw", "lots");
     REQUIRE_FALSE(refused);
-    CHECK(refused.error().code == kSourceBadValue);
+    CHECK(refused.error().code == SourceErrc::kBadValue);
     refused = source->setFeature("PixelFormat", "Mono99");
     REQUIRE_FALSE(refused);
     CHECK_THAT(refused.error().message, Catch::Contains("Mono99") && Catch::Contains("Mono8"));
@@ -142,11 +142,11 @@ TEST_CASE("aravis source reads and writes GenICam features by type", "[aravis]")
   SECTION("an unknown feature is named") {
     auto unknown = source->feature("Gain");  // the fake camera only has GainRaw
     REQUIRE_FALSE(unknown);
-    CHECK(unknown.error().code == kSourceUnknownFeature);
+    CHECK(unknown.error().code == SourceErrc::kUnknownFeature);
     CHECK_THAT(unknown.error().message, Catch::Contains("'Gain'"));
     auto set = source->setFeature("NoSuchFeature", "1");
     REQUIRE_FALSE(set);
-    CHECK(set.error().code == kSourceUnknownFeature);
+    CHECK(set.error().code == SourceErrc::kUnknownFeature);
   }
   SECTION("the feature list carries types, ranges and current values") {
     const auto all = source->features();
@@ -253,7 +253,7 @@ TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames",
   for (int i = 0; i < 5; ++i) {
     auto none = source->grab(200ms);
     REQUIRE_FALSE(none);
-    CHECK(none.error().code == kSourceTimeout);
+    CHECK(none.error().code == SourceErrc::kTimeout);
   }
   for (int i = 0; i < 3; ++i) {
     // As the Camera does: a triggered frame that arrives incomplete (a
@@ -265,7 +265,7 @@ TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames",
       if (ask) REQUIRE(source->softwareTrigger());
       auto grabbed = source->grab(200ms);
       if (grabbed) frame = std::move(*grabbed);
-      ask = !grabbed && grabbed.error().code == kSourceBadValue;
+      ask = !grabbed && grabbed.error().code == SourceErrc::kBadValue;
     }
     REQUIRE(frame);
     CHECK(isDiagonalRamp(frame->image));
@@ -289,7 +289,7 @@ TEST_CASE("aravis source reports a killed camera as unavailable and reopens it",
   const auto deadline = std::chrono::steady_clock::now() + 60s;
   while (!unavailable && std::chrono::steady_clock::now() < deadline) {
     auto frame = source->grab(200ms);
-    unavailable = !frame && frame.error().code == kSourceUnavailable;
+    unavailable = !frame && frame.error().code == SourceErrc::kUnavailable;
   }
   REQUIRE(unavailable);
   source->close();

@@ -16,10 +16,10 @@
 #include <zmq.hpp>
 #include "temp_dir.hpp"
 
+#include "picksight/sources/source.hpp"
 #include "picksight/tool_support/subprocess.hpp"
 #include "picksight/transport/frame_message.hpp"
 #include "picksight/video_server/pixel_format.hpp"
-#include "picksight/sources/source.hpp"
 
 using namespace std::chrono_literals;
 using namespace picksight::video;
@@ -109,7 +109,7 @@ TEST_CASE("dir: empty, missing or unreadable directories are unavailable", "[vid
   auto source = dirSource(dir.path());
   auto empty = source->open();
   REQUIRE_FALSE(empty);
-  CHECK(empty.error().code == kSourceUnavailable);
+  CHECK(empty.error().code == SourceErrc::kUnavailable);
   std::ofstream(dir.path() / "broken.png") << "no";
   auto unreadable = source->open();
   REQUIRE_FALSE(unreadable);
@@ -122,9 +122,9 @@ TEST_CASE("dir: empty, missing or unreadable directories are unavailable", "[vid
   auto missing = dirSource(dir.path() / "nope");
   auto opened = missing->open();
   REQUIRE_FALSE(opened);
-  CHECK(opened.error().code == kSourceUnavailable);
+  CHECK(opened.error().code == SourceErrc::kUnavailable);
   CHECK_THAT(opened.error().message, Catch::Contains("nope"));
-  CHECK(makeSource("dir:").error().code == kSourceBadConfig);
+  CHECK(makeSource("dir:").error().code == SourceErrc::kBadConfig);
 }
 
 TEST_CASE("picksight-video-server publishes a dir: source's images in order",

@@ -142,27 +142,29 @@ TEST_CASE("FileSource picks up a renamed image of equal size and mtime (new inod
   CHECK(sameImage(grabImage(*source), sceneImage(2)));
 }
 
-TEST_CASE("FileSource of a missing file is kSourceUnavailable naming the path", "[video_server]") {
+TEST_CASE("FileSource of a missing file is SourceErrc::kUnavailable naming the path",
+          "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("absent.png");
   auto source = fileSource(path);
   auto opened = source->open();
   REQUIRE_FALSE(opened);
-  CHECK(opened.error().code == picksight::video::kSourceUnavailable);
+  CHECK(opened.error().code == picksight::video::SourceErrc::kUnavailable);
   CHECK_THAT(opened.error().message, Catch::Contains(path));
   auto grabbed = source->grab(100ms);
   REQUIRE_FALSE(grabbed);
-  CHECK(grabbed.error().code == picksight::video::kSourceUnavailable);
+  CHECK(grabbed.error().code == picksight::video::SourceErrc::kUnavailable);
 }
 
-TEST_CASE("FileSource of a file that is not an image is kSourceUnavailable", "[video_server]") {
+TEST_CASE("FileSource of a file that is not an image is SourceErrc::kUnavailable",
+          "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("garbage.png");
   std::ofstream(path) << "this is not a PNG";
   auto source = fileSource(path);
   auto opened = source->open();
   REQUIRE_FALSE(opened);
-  CHECK(opened.error().code == picksight::video::kSourceUnavailable);
+  CHECK(opened.error().code == picksight::video::SourceErrc::kUnavailable);
 }
 
 TEST_CASE("FileSource keeps the last image while the file is missing or unreadable",

@@ -22,8 +22,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "picksight/video_server/pixel_format.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/video_server/pixel_format.hpp"
 
 using namespace std::chrono_literals;
 using namespace picksight::video;
@@ -135,7 +135,8 @@ Result<SourceFrame> nextFrame(Source& source, std::chrono::seconds limit = 20s) 
   const auto end = std::chrono::steady_clock::now() + limit;
   for (;;) {
     auto frame = source.grab(500ms);
-    if (frame || frame.error().code != kSourceTimeout || std::chrono::steady_clock::now() > end)
+    if (frame || frame.error().code != SourceErrc::kTimeout ||
+        std::chrono::steady_clock::now() > end)
       return frame;
   }
 }
@@ -189,11 +190,11 @@ TEST_CASE("stream: MJPEG over HTTP arrives with its content, is lost and resumes
   Result<SourceFrame> lost = nextFrame(source);
   for (int i = 0; i < 200 && lost; ++i) lost = nextFrame(source);
   REQUIRE_FALSE(lost);
-  CHECK(lost.error().code == kSourceUnavailable);
+  CHECK(lost.error().code == SourceErrc::kUnavailable);
   source.close();
   auto refused = source.open();
   REQUIRE_FALSE(refused);
-  CHECK(refused.error().code == kSourceUnavailable);
+  CHECK(refused.error().code == SourceErrc::kUnavailable);
 
   // Back on the same port: the reopen the camera does with back-off works.
   server.setLevel(200);
@@ -239,6 +240,6 @@ TEST_CASE("stream: a video file plays every frame in order and loops", "[video_s
   REQUIRE(missing);
   auto opened = (*missing)->open();
   REQUIRE_FALSE(opened);
-  CHECK(opened.error().code == kSourceUnavailable);
+  CHECK(opened.error().code == SourceErrc::kUnavailable);
   CHECK_THAT(opened.error().message, Catch::Contains("/nonexistent/clip.avi"));
 }

@@ -14,9 +14,9 @@
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
 
+#include "picksight/sources/source.hpp"
 #include "picksight/video_server/camera.hpp"
 #include "picksight/video_server/pixel_format.hpp"
-#include "picksight/sources/source.hpp"
 #include "simulated_v4l2_device.hpp"
 #include "v4l2/v4l2_source.hpp"
 
@@ -112,7 +112,7 @@ TEST_CASE("v4l2 options: keys, values and errors that name them", "[video_server
   // Through the factory, the same errors.
   auto bad = makeSource("v4l2:/dev/video0?buffers=1");
   REQUIRE_FALSE(bad);
-  CHECK(bad.error().code == kSourceBadConfig);
+  CHECK(bad.error().code == SourceErrc::kBadConfig);
   CHECK_THAT(bad.error().message, Catch::Contains("buffers"));
   CHECK(makeSource("v4l2:/dev/video0?width=640&height=480"));
 }
@@ -184,7 +184,7 @@ TEST_CASE("v4l2 prefers MJPEG where only it reaches the rate, and honours format
     Rig rig("?format=uyvy");
     auto opened = rig.source->open();
     REQUIRE_FALSE(opened);
-    CHECK(opened.error().code == kSourceBadConfig);
+    CHECK(opened.error().code == SourceErrc::kBadConfig);
     CHECK_THAT(opened.error().message, Catch::Contains("UYVY") && Catch::Contains("YUYV, MJPG"));
     CHECK(rig.sim->state().open_fds == 0);  // a failed open releases the device
   }
@@ -206,7 +206,7 @@ TEST_CASE("v4l2 retries EINTR and spurious wakeups, drops error-flagged frames",
   rig.sim->setPaused(true);
   auto none = rig.source->grab(50ms);
   REQUIRE_FALSE(none);
-  CHECK(none.error().code == kSourceTimeout);
+  CHECK(none.error().code == SourceErrc::kTimeout);
 }
 
 TEST_CASE("v4l2 close stops streaming, unmaps and closes", "[video_server][v4l2]") {
@@ -235,14 +235,14 @@ TEST_CASE("v4l2 device that disappears is unavailable and everything is released
     rig.sim->unplug(poll_fails);
     auto lost = rig.source->grab(2s);
     REQUIRE_FALSE(lost);
-    CHECK(lost.error().code == kSourceUnavailable);
+    CHECK(lost.error().code == SourceErrc::kUnavailable);
     CHECK_THAT(lost.error().message, Catch::Contains("/dev/video0"));
     rig.source->close();
     CHECK(rig.sim->state().mapped == 0);
     CHECK(rig.sim->state().open_fds == 0);
     auto reopened = rig.source->open();
     REQUIRE_FALSE(reopened);
-    CHECK(reopened.error().code == kSourceUnavailable);
+    CHECK(reopened.error().code == SourceErrc::kUnavailable);
     rig.sim->replug();
     REQUIRE(rig.source->open());
     grabOk(*rig.source);
@@ -301,7 +301,7 @@ TEST_CASE("v4l2 controls are typed features named from their labels", "[video_se
   CHECK(rig.source->feature("gain")->value == "100");
   auto out_of_range = rig.source->setFeature("gain", "300");
   REQUIRE_FALSE(out_of_range);
-  CHECK(out_of_range.error().code == kSourceBadValue);
+  CHECK(out_of_range.error().code == SourceErrc::kBadValue);
   CHECK_THAT(out_of_range.error().message, Catch::Contains("gain") && Catch::Contains("[0, 255]"));
   CHECK(rig.sim->controlValue(V4L2_CID_GAIN) == 100);
   CHECK_THAT(rig.source->setFeature("brightness", "bright").error().message,
@@ -316,9 +316,9 @@ TEST_CASE("v4l2 controls are typed features named from their labels", "[video_se
 
   auto unknown = rig.source->setFeature("zoom", "2");
   REQUIRE_FALSE(unknown);
-  CHECK(unknown.error().code == kSourceUnknownFeature);
+  CHECK(unknown.error().code == SourceErrc::kUnknownFeature);
   CHECK_THAT(unknown.error().message, Catch::Contains("zoom"));
-  CHECK(rig.source->feature("zoom").error().code == kSourceUnknownFeature);
+  CHECK(rig.source->feature("zoom").error().code == SourceErrc::kUnknownFeature);
 
   // Exposure is inactive under automatic exposure: the error says why.
   auto inactive = rig.source->setFeature("exposure_time_absolute", "500");

@@ -45,9 +45,9 @@ Result<LineClient> LineClient::connect(const std::string& host, uint16_t port,
   addrinfo* found = nullptr;
   const std::string service = std::to_string(port);
   if (int rc = ::getaddrinfo(host.c_str(), service.c_str(), &hints, &found); rc != 0) {
-    return makeError(rc, "cannot resolve " + host + ": " + gai_strerror(rc));
+    return systemError(EHOSTUNREACH, "cannot resolve " + host + ": " + gai_strerror(rc));
   }
-  Error last = makeError(ECONNREFUSED, "cannot connect to " + host + ":" + service);
+  Error last = systemError(ECONNREFUSED, "cannot connect to " + host + ":" + service);
   for (addrinfo* a = found; a != nullptr; a = a->ai_next) {
     int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
     if (fd < 0) continue;
@@ -70,7 +70,7 @@ Result<LineClient> LineClient::connect(const std::string& host, uint16_t port,
       ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
       return LineClient(fd);
     }
-    last = makeError(errno, "cannot connect to " + host + ":" + service + ": " + strerror(errno));
+    last = systemError(errno, "cannot connect to " + host + ":" + service + ": " + strerror(errno));
     ::close(fd);
   }
   ::freeaddrinfo(found);
@@ -78,7 +78,7 @@ Result<LineClient> LineClient::connect(const std::string& host, uint16_t port,
 }
 
 Result<void> LineClient::sendRaw(const std::string& bytes) {
-  if (fd_ < 0) return makeError(ENOTCONN, "not connected");
+  if (fd_ < 0) return systemError(ENOTCONN, "not connected");
   size_t sent = 0;
   while (sent < bytes.size()) {
     const ssize_t n = ::send(fd_, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
@@ -88,14 +88,14 @@ Result<void> LineClient::sendRaw(const std::string& bytes) {
       ::poll(&p, 1, 1000);
       continue;
     }
-    if (n <= 0) return makeError(errno, std::string("send: ") + strerror(errno));
+    if (n <= 0) return systemError(errno, std::string("send: ") + strerror(errno));
     sent += static_cast<size_t>(n);
   }
   return {};
 }
 
 Result<std::string> LineClient::readLine(std::chrono::milliseconds timeout) {
-  if (fd_ < 0) return makeError(ENOTCONN, "not connected");
+  if (fd_ < 0) return systemError(ENOTCONN, "not connected");
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     const size_t nl = buffer_.find('\n');
@@ -107,16 +107,16 @@ Result<std::string> LineClient::readLine(std::chrono::milliseconds timeout) {
     }
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) return makeError(ETIMEDOUT, "no reply in time");
+    if (left.count() <= 0) return systemError(ETIMEDOUT, "no reply in time");
     pollfd p{fd_, POLLIN, 0};
     const int r = ::poll(&p, 1, static_cast<int>(left.count()));
     if (r < 0 && errno == EINTR) continue;
-    if (r == 0) return makeError(ETIMEDOUT, "no reply in time");
+    if (r == 0) return systemError(ETIMEDOUT, "no reply in time");
     char chunk[4096];
     const ssize_t n = ::recv(fd_, chunk, sizeof(chunk), 0);
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-    if (n == 0) return makeError(ECONNRESET, "connection closed by server");
-    if (n < 0) return makeError(errno, std::string("recv: ") + strerror(errno));
+    if (n == 0) return systemError(ECONNRESET, "connection closed by server");
+    if (n < 0) return systemError(errno, std::string("recv: ") + strerror(errno));
     buffer_.append(chunk, static_cast<size_t>(n));
   }
 }

@@ -113,7 +113,7 @@ AravisSource::AravisSource(std::string device_id) : device_id_(std::move(device_
 AravisSource::~AravisSource() { close(); }
 
 Error AravisSource::lost(const std::string& why) const {
-  return makeError(kSourceUnavailable, label() + ": " + why);
+  return makeError(SourceErrc::kUnavailable, label() + ": " + why);
 }
 
 Result<void> AravisSource::open() {
@@ -251,7 +251,7 @@ Result<void> AravisSource::configureAcquisition(AcquisitionMode mode, double fps
   if (mode == AcquisitionMode::kFreeRun) {
     arv_camera_clear_triggers(camera_.get(), error.out());
     if (error)
-      return makeError(kSourceNotSupported,
+      return makeError(SourceErrc::kNotSupported,
                        label() + ": cannot leave trigger mode: " + error.message());
     const bool has_rate = arv_camera_is_frame_rate_available(camera_.get(), error.out());
     if (has_rate && fps > 0) {
@@ -265,12 +265,12 @@ Result<void> AravisSource::configureAcquisition(AcquisitionMode mode, double fps
     }
   } else {
     if (!arv_camera_is_software_trigger_supported(camera_.get(), error.out())) {
-      return makeError(kSourceNotSupported, label() + ": the camera has no software trigger");
+      return makeError(SourceErrc::kNotSupported, label() + ": the camera has no software trigger");
     }
     // TriggerSelector FrameStart, TriggerMode On, TriggerSource Software.
     arv_camera_set_trigger(camera_.get(), "Software", error.out());
     if (error)
-      return makeError(kSourceNotSupported,
+      return makeError(SourceErrc::kNotSupported,
                        label() + ": cannot set software trigger: " + error.message());
   }
   mode_ = mode;
@@ -289,7 +289,7 @@ Result<void> AravisSource::softwareTrigger() {
   arv_camera_software_trigger(camera_.get(), error.out());
   if (error) {
     if (auto alive = checkDevice(); !alive) return alive;
-    return makeError(kSourceNotSupported,
+    return makeError(SourceErrc::kNotSupported,
                      label() + ": software trigger failed: " + error.message());
   }
   triggers_in_flight_ = 1;
@@ -322,7 +322,7 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
       if (auto alive = checkDevice(); !alive) return alive.error();
       last_alive_ = Clock::now();
     }
-    return makeError(kSourceTimeout,
+    return makeError(SourceErrc::kTimeout,
                      label() + ": no frame within " + std::to_string(timeout.count()) + " ms");
   }
   last_alive_ = Clock::now();
@@ -332,8 +332,8 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
   if (status != ARV_BUFFER_STATUS_SUCCESS) {
     const uint64_t id = arv_buffer_get_frame_id(buffer.get());
     arv_stream_push_buffer(stream_.get(), buffer.release());
-    return makeError(kSourceBadValue, label() + ": frame " + std::to_string(id) +
-                                          " incomplete: " + statusName(status));
+    return makeError(SourceErrc::kBadValue, label() + ": frame " + std::to_string(id) +
+                                                " incomplete: " + statusName(status));
   }
   const ArvPixelFormat format = arv_buffer_get_image_pixel_format(buffer.get());
   const auto layout = layoutOf(format);
@@ -341,7 +341,7 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
     arv_stream_push_buffer(stream_.get(), buffer.release());
     char hex[16];
     g_snprintf(hex, sizeof hex, "0x%08x", static_cast<unsigned>(format));
-    return makeError(kSourceNotSupported,
+    return makeError(SourceErrc::kNotSupported,
                      label() + ": pixel format " + hex +
                          " is not supported (set PixelFormat to Mono8/10/12/16, "
                          "Bayer**8, RGB8, BGR8, YUV422)");
@@ -359,9 +359,9 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
       size < stride * static_cast<size_t>(height - 1) +
                  static_cast<size_t>(width) * layout->bytes_per_pixel) {
     arv_stream_push_buffer(stream_.get(), buffer.release());
-    return makeError(kSourceBadValue, label() + ": frame smaller than its " +
-                                          std::to_string(width) + "x" + std::to_string(height) +
-                                          " header says");
+    return makeError(SourceErrc::kBadValue, label() + ": frame smaller than its " +
+                                                std::to_string(width) + "x" +
+                                                std::to_string(height) + " header says");
   }
 
   SourceFrame frame;
@@ -395,7 +395,7 @@ Result<void> AravisSource::setFeature(const std::string& name, const std::string
     // startAcquisition() remakes the pool if the payload size changed.
     if (auto started = startAcquisition(); !started) return started;
   }
-  if (!set && set.error().code == kSourceBadValue) {
+  if (!set && set.error().code == SourceErrc::kBadValue) {
     if (auto alive = checkDevice(); !alive) return alive;
   }
   return set;

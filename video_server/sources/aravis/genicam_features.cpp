@@ -28,7 +28,7 @@ std::string rangeText(double min, double max) {
 }
 
 Error badValue(const std::string& name, const std::string& why) {
-  return makeError(kSourceBadValue, "feature '" + name + "': " + why);
+  return makeError(SourceErrc::kBadValue, "feature '" + name + "': " + why);
 }
 
 // GenICam writes that the device refuses come back as a GError; the device's
@@ -44,7 +44,7 @@ Result<ArvGcFeatureNode*> GenicamFeatures::node(const std::string& name) const {
   ArvGcNode* found = arv_device_get_feature(device_, name.c_str());
   // Categories are features in GenICam's tree but carry no value.
   if (found == nullptr || !ARV_IS_GC_FEATURE_NODE(found) || ARV_IS_GC_CATEGORY(found)) {
-    return makeError(kSourceUnknownFeature,
+    return makeError(SourceErrc::kUnknownFeature,
                      "unknown feature '" + name + "': the camera has no such GenICam feature");
   }
   return ARV_GC_FEATURE_NODE(found);

@@ -73,10 +73,10 @@ SourceInfo DirSource::info() const {
 Result<void> DirSource::refreshListing() {
   struct stat st {};
   if (::stat(path_.c_str(), &st) != 0) {
-    return makeError(kSourceUnavailable, "dir:" + path_ + ": " + std::strerror(errno));
+    return makeError(SourceErrc::kUnavailable, "dir:" + path_ + ": " + std::strerror(errno));
   }
   if (!S_ISDIR(st.st_mode))
-    return makeError(kSourceUnavailable, "dir:" + path_ + ": not a directory");
+    return makeError(SourceErrc::kUnavailable, "dir:" + path_ + ": not a directory");
   // Adding, removing or renaming an entry changes the directory's mtime;
   // rewriting a file in place does not, but every grab reads its file afresh.
   if (listed_ && !racy_ && st.st_mtim.tv_sec == listed_mtime_.tv_sec &&
@@ -93,7 +93,7 @@ Result<void> DirSource::refreshListing() {
     if (!it->is_regular_file(type_ec)) continue;
     names.push_back(name);
   }
-  if (ec) return makeError(kSourceUnavailable, "dir:" + path_ + ": " + ec.message());
+  if (ec) return makeError(SourceErrc::kUnavailable, "dir:" + path_ + ": " + ec.message());
   // Plain byte order: recordings use zero-padded numbers, which sort right.
   std::sort(names.begin(), names.end());
   names_ = std::move(names);
@@ -112,7 +112,7 @@ Result<void> DirSource::refreshListing() {
 
 Result<SourceFrame> DirSource::grab(std::chrono::milliseconds /*timeout*/) {
   if (auto r = refreshListing(); !r) return r.error();
-  if (names_.empty()) return makeError(kSourceUnavailable, "dir:" + path_ + ": no files");
+  if (names_.empty()) return makeError(SourceErrc::kUnavailable, "dir:" + path_ + ": no files");
   // Start after the last name served, wrapping: at most one pass over the
   // listing, so a directory of unreadable files is an error, not a hang.
   const size_t start = static_cast<size_t>(
@@ -135,8 +135,8 @@ Result<SourceFrame> DirSource::grab(std::chrono::milliseconds /*timeout*/) {
     warned_.erase(name);  // rewritten into a good image: warn again if it breaks again
     return toFrame(std::move(image));
   }
-  return makeError(kSourceUnavailable, "dir:" + path_ + ": no readable image among " +
-                                           std::to_string(names_.size()) + " files");
+  return makeError(SourceErrc::kUnavailable, "dir:" + path_ + ": no readable image among " +
+                                                 std::to_string(names_.size()) + " files");
 }
 
 }  // namespace picksight::video

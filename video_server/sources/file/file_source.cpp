@@ -54,7 +54,7 @@ Result<void> FileSource::refresh() {
   struct stat st {};
   if (::stat(path_.c_str(), &st) != 0) {
     if (!image_.empty()) return {};  // keep serving the last image while the file is being replaced
-    return makeError(kSourceUnavailable, "file:" + path_ + ": " + std::strerror(errno));
+    return makeError(SourceErrc::kUnavailable, "file:" + path_ + ": " + std::strerror(errno));
   }
   if (!image_.empty() && st.st_ino == inode_ && st.st_size == size_ &&
       st.st_mtim.tv_sec == mtime_.tv_sec && st.st_mtim.tv_nsec == mtime_.tv_nsec) {
@@ -65,7 +65,7 @@ Result<void> FileSource::refresh() {
     // A half-written file reads as garbage: keep the previous image and try
     // again on the next frame.
     if (!image_.empty()) return {};
-    return makeError(kSourceUnavailable, "file:" + path_ + ": not a readable image");
+    return makeError(SourceErrc::kUnavailable, "file:" + path_ + ": not a readable image");
   }
   image_ = toEightBit(loaded);
   inode_ = st.st_ino;

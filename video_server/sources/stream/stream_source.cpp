@@ -26,10 +26,10 @@ Result<void> StreamSource::open() {
   try {
     capture->open(url_, cv::CAP_FFMPEG, params);
   } catch (const cv::Exception& e) {
-    return makeError(kSourceUnavailable, "stream:" + url_ + ": " + e.what());
+    return makeError(SourceErrc::kUnavailable, "stream:" + url_ + ": " + e.what());
   }
   if (!capture->isOpened())
-    return makeError(kSourceUnavailable, "stream:" + url_ + ": cannot open");
+    return makeError(SourceErrc::kUnavailable, "stream:" + url_ + ": cannot open");
   width_ = static_cast<int>(capture->get(cv::CAP_PROP_FRAME_WIDTH));
   height_ = static_cast<int>(capture->get(cv::CAP_PROP_FRAME_HEIGHT));
   {
@@ -108,7 +108,8 @@ void StreamSource::readLoop() {
 
 Result<SourceFrame> StreamSource::grab(std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (!reader_.joinable()) return makeError(kSourceUnavailable, "stream:" + url_ + ": not open");
+  if (!reader_.joinable())
+    return makeError(SourceErrc::kUnavailable, "stream:" + url_ + ": not open");
   frame_ready_.wait_for(lock, timeout, [this] { return has_frame_ || ended_; });
   if (has_frame_) {
     SourceFrame frame;
@@ -119,9 +120,9 @@ Result<SourceFrame> StreamSource::grab(std::chrono::milliseconds timeout) {
     frame.layout = frame.image.channels() == 1 ? PixelLayout::kMono8 : PixelLayout::kBGR8;
     return frame;
   }
-  if (ended_) return makeError(kSourceUnavailable, "stream:" + url_ + ": " + end_reason_);
-  return makeError(kSourceTimeout, "stream:" + url_ + ": no frame within " +
-                                       std::to_string(timeout.count()) + " ms");
+  if (ended_) return makeError(SourceErrc::kUnavailable, "stream:" + url_ + ": " + end_reason_);
+  return makeError(SourceErrc::kTimeout, "stream:" + url_ + ": no frame within " +
+                                             std::to_string(timeout.count()) + " ms");
 }
 
 }  // namespace picksight::video

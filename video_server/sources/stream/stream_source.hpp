@@ -28,13 +28,13 @@ class StreamSource : public Source {
   StreamSource(const StreamSource&) = delete;
   StreamSource& operator=(const StreamSource&) = delete;
 
-  // Connects (FFmpeg open timeout 5 s); a failure is kSourceUnavailable.
+  // Connects (FFmpeg open timeout 5 s); a failure is SourceErrc::kUnavailable.
   Result<void> open() override;
   // Stops the reader; may wait for a read in progress (at most the 5 s read timeout).
   void close() override;
   SourceInfo info() const override;
-  // The newest frame not yet returned; kSourceTimeout when none came in
-  // time; kSourceUnavailable once the stream ended or broke (the camera
+  // The newest frame not yet returned; SourceErrc::kTimeout when none came in
+  // time; SourceErrc::kUnavailable once the stream ended or broke (the camera
   // then reopens it with back-off). A local file (a path, no "scheme://")
   // loops instead of ending.
   Result<SourceFrame> grab(std::chrono::milliseconds timeout) override;

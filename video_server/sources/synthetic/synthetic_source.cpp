@@ -13,14 +13,14 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
   for (auto field : splitFields(text, ",?&")) {
     const size_t eq = field.find('=');
     if (eq == std::string_view::npos) {
-      return makeError(kSourceBadConfig,
+      return makeError(SourceErrc::kBadConfig,
                        "synthetic: expected key=value, got '" + std::string(field) + "'");
     }
     const std::string key(field.substr(0, eq));
     const std::string_view value = field.substr(eq + 1);
     const auto bad = [&](const std::string& what) {
-      return makeError(kSourceBadConfig, "synthetic: " + key + " must be " + what + ", got '" +
-                                             std::string(value) + "'");
+      return makeError(SourceErrc::kBadConfig, "synthetic: " + key + " must be " + what +
+                                                   ", got '" + std::string(value) + "'");
     };
     const auto integer = parseInt(value);
     const auto number = parseDouble(value);
@@ -63,7 +63,7 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
       if (!integer || *integer < 0) return bad("a non-negative integer");
       o.scene_every = static_cast<uint64_t>(*integer);
     } else {
-      return makeError(kSourceBadConfig,
+      return makeError(SourceErrc::kBadConfig,
                        "synthetic: unknown key '" + key +
                            "' (known: width, height, parts, seed, noise, size, light, types, "
                            "touching, blur, scene_every)");
@@ -91,7 +91,7 @@ SourceInfo SyntheticSource::info() const {
 }
 
 Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/) {
-  if (!renderer_) return makeError(kSourceUnavailable, "synthetic source not open");
+  if (!renderer_) return makeError(SourceErrc::kUnavailable, "synthetic source not open");
   if (options_.scene_every > 0) {
     const uint64_t layout = frame_index_ / options_.scene_every;
     if (layout != layout_) {

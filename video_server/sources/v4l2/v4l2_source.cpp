@@ -121,7 +121,7 @@ Result<V4l2Options> parseV4l2Options(const std::string& text) {
   const size_t q = text.find('?');
   o.path = text.substr(0, q);
   if (o.path.empty())
-    return makeError(kSourceBadConfig, "v4l2: needs a device, as in v4l2:/dev/video0");
+    return makeError(SourceErrc::kBadConfig, "v4l2: needs a device, as in v4l2:/dev/video0");
   std::string query = q == std::string::npos ? "" : text.substr(q + 1);
   size_t pos = 0;
   while (pos < query.size()) {
@@ -136,16 +136,17 @@ Result<V4l2Options> parseV4l2Options(const std::string& text) {
     if (key == "width" || key == "height" || key == "buffers") {
       const bool buffers = key == "buffers";
       if (!parseInt(value, n) || n < (buffers ? 2 : 1) || n > (buffers ? 32 : 16384)) {
-        return makeError(kSourceBadConfig, "v4l2: " + key + " must be " +
-                                               (buffers ? "2..32" : "1..16384") + ", got '" +
-                                               value + "'");
+        return makeError(SourceErrc::kBadConfig, "v4l2: " + key + " must be " +
+                                                     (buffers ? "2..32" : "1..16384") + ", got '" +
+                                                     value + "'");
       }
       (key == "width" ? o.width : key == "height" ? o.height : o.buffers) = static_cast<int>(n);
     } else if (key == "fps") {
       char* end = nullptr;
       o.fps = std::strtod(value.c_str(), &end);
       if (value.empty() || *end != '\0' || !(o.fps > 0 && o.fps <= 1000)) {
-        return makeError(kSourceBadConfig, "v4l2: fps must be in (0, 1000], got '" + value + "'");
+        return makeError(SourceErrc::kBadConfig,
+                         "v4l2: fps must be in (0, 1000], got '" + value + "'");
       }
     } else if (key == "format") {
       std::string lower;
@@ -158,16 +159,17 @@ Result<V4l2Options> parseV4l2Options(const std::string& text) {
         known += std::string(known.empty() ? "" : ", ") + f.option;
       }
       if (o.fourcc == 0) {
-        return makeError(kSourceBadConfig,
+        return makeError(SourceErrc::kBadConfig,
                          "v4l2: unknown format '" + value + "' (known: " + known + ")");
       }
     } else {
-      return makeError(kSourceBadConfig, "v4l2: unknown option '" + key +
-                                             "' (known: width, height, format, fps, buffers)");
+      return makeError(
+          SourceErrc::kBadConfig,
+          "v4l2: unknown option '" + key + "' (known: width, height, format, fps, buffers)");
     }
   }
   if ((o.width == 0) != (o.height == 0)) {
-    return makeError(kSourceBadConfig, "v4l2: width and height go together");
+    return makeError(SourceErrc::kBadConfig, "v4l2: width and height go together");
   }
   return o;
 }
@@ -191,7 +193,7 @@ Error V4l2Source::deviceError(const std::string& what, bool streaming) {
   // While streaming every failure means reopening; before, a request the
   // device refuses (EINVAL) is a configuration it will always refuse.
   const bool lost = streaming || deviceLost(err) || err == EBUSY || err == ENOENT || err == EACCES;
-  return makeError(lost ? kSourceUnavailable : kSourceBadConfig,
+  return makeError(lost ? SourceErrc::kUnavailable : SourceErrc::kBadConfig,
                    "v4l2:" + options_.path + ": " + what + ": " + std::strerror(err));
 }
 
@@ -220,8 +222,9 @@ Result<void> V4l2Source::openDevice() {
       (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
   if (!(caps & V4L2_CAP_VIDEO_CAPTURE) || !(caps & V4L2_CAP_STREAMING)) {
     // A UVC camera also registers a metadata node (often /dev/video1).
-    return makeError(kSourceBadConfig, "v4l2:" + options_.path + " (" + kernelString(cap.card) +
-                                           ") is not a streaming video capture device");
+    return makeError(SourceErrc::kBadConfig, "v4l2:" + options_.path + " (" +
+                                                 kernelString(cap.card) +
+                                                 ") is not a streaming video capture device");
   }
   card_ = kernelString(cap.card);
   driver_ = kernelString(cap.driver);
@@ -310,7 +313,7 @@ Result<void> V4l2Source::chooseFormat() {
   if (candidates.empty()) {
     std::string offered;
     for (const auto& f : formats_) offered += (offered.empty() ? "" : ", ") + f;
-    return makeError(kSourceBadConfig,
+    return makeError(SourceErrc::kBadConfig,
                      "v4l2:" + options_.path + ": " +
                          (options_.fourcc ? "format " + fourccName(options_.fourcc) + " not offered"
                                           : std::string("no usable format")) +
@@ -336,9 +339,9 @@ Result<void> V4l2Source::chooseFormat() {
   // The driver may adjust everything: use what it set, never what we asked.
   const FormatInfo* info = formatInfo(fmt.fmt.pix.pixelformat);
   if (!info) {
-    return makeError(kSourceBadConfig, "v4l2:" + options_.path + ": driver set format " +
-                                           fourccName(fmt.fmt.pix.pixelformat) +
-                                           ", which is not supported");
+    return makeError(SourceErrc::kBadConfig, "v4l2:" + options_.path + ": driver set format " +
+                                                 fourccName(fmt.fmt.pix.pixelformat) +
+                                                 ", which is not supported");
   }
   format_ = fmt.fmt.pix;
   layout_ = info->layout;
@@ -374,8 +377,9 @@ Result<void> V4l2Source::startStreaming() {
     // The driver decides the count; with fewer than two, one buffer is
     // always being copied while the device has nowhere to write.
     if (req.count < 2) {
-      return makeError(kSourceUnavailable, "v4l2:" + options_.path + ": driver granted " +
-                                               std::to_string(req.count) + " buffers, need 2");
+      return makeError(SourceErrc::kUnavailable, "v4l2:" + options_.path + ": driver granted " +
+                                                     std::to_string(req.count) +
+                                                     " buffers, need 2");
     }
     for (uint32_t i = 0; i < req.count; ++i) {
       v4l2_buffer buf{};
@@ -482,7 +486,7 @@ void V4l2Source::drainReadyBuffers() {
 }
 
 Result<void> V4l2Source::softwareTrigger() {
-  if (!fd_) return makeError(kSourceUnavailable, "v4l2:" + options_.path + ": not open");
+  if (!fd_) return makeError(SourceErrc::kUnavailable, "v4l2:" + options_.path + ": not open");
   // The camera asks again after a grab timed out: the first trigger still
   // stands, and frames since then are its answer.
   if (trigger_pending_) return {};
@@ -498,7 +502,7 @@ Result<void> V4l2Source::softwareTrigger() {
 Result<SourceFrame> V4l2Source::grab(std::chrono::milliseconds timeout) {
   using Clock = std::chrono::steady_clock;
   if (!fd_ || !streaming_)
-    return makeError(kSourceUnavailable, "v4l2:" + options_.path + ": not open");
+    return makeError(SourceErrc::kUnavailable, "v4l2:" + options_.path + ": not open");
   const auto deadline = Clock::now() + timeout;
   for (;;) {
     const auto left =
@@ -510,8 +514,8 @@ Result<SourceFrame> V4l2Source::grab(std::chrono::milliseconds timeout) {
       return deviceError("poll", true);
     }
     if (ready == 0) {
-      return makeError(kSourceTimeout, "v4l2:" + options_.path + ": no frame within " +
-                                           std::to_string(timeout.count()) + " ms");
+      return makeError(SourceErrc::kTimeout, "v4l2:" + options_.path + ": no frame within " +
+                                                 std::to_string(timeout.count()) + " ms");
     }
     v4l2_buffer buf{};
     buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -682,23 +686,23 @@ std::vector<Feature> V4l2Source::features() {
 }
 
 Result<Feature> V4l2Source::feature(const std::string& name) {
-  if (!fd_) return makeError(kSourceUnavailable, "v4l2:" + options_.path + ": not open");
+  if (!fd_) return makeError(SourceErrc::kUnavailable, "v4l2:" + options_.path + ": not open");
   const auto q = findControl(name);
   if (!q)
-    return makeError(kSourceUnknownFeature,
+    return makeError(SourceErrc::kUnknownFeature,
                      "unknown feature '" + name + "' (not a control of " + card_ + ")");
   return describeControl(*q);
 }
 
 Result<void> V4l2Source::setFeature(const std::string& name, const std::string& text) {
-  if (!fd_) return makeError(kSourceUnavailable, "v4l2:" + options_.path + ": not open");
+  if (!fd_) return makeError(SourceErrc::kUnavailable, "v4l2:" + options_.path + ": not open");
   const auto found = findControl(name);
   if (!found)
-    return makeError(kSourceUnknownFeature,
+    return makeError(SourceErrc::kUnknownFeature,
                      "unknown feature '" + name + "' (not a control of " + card_ + ")");
   const v4l2_queryctrl& q = *found;
   if (q.flags & V4L2_CTRL_FLAG_READ_ONLY)
-    return makeError(kSourceBadValue, "feature '" + name + "' is read-only");
+    return makeError(SourceErrc::kBadValue, "feature '" + name + "' is read-only");
 
   long long value = 0;
   switch (q.type) {
@@ -711,23 +715,24 @@ Result<void> V4l2Source::setFeature(const std::string& name, const std::string& 
       } else if (text == "false" || text == "0" || text == "off") {
         value = 0;
       } else {
-        return makeError(kSourceBadValue,
+        return makeError(SourceErrc::kBadValue,
                          "feature '" + name + "' is a boolean (true/false), got '" + text + "'");
       }
       break;
     case V4L2_CTRL_TYPE_INTEGER:
       if (!parseInt(text, value)) {
-        return makeError(kSourceBadValue, "feature '" + name + "' is an integer " + range(q) +
-                                              ", got '" + text + "'");
+        return makeError(SourceErrc::kBadValue, "feature '" + name + "' is an integer " + range(q) +
+                                                    ", got '" + text + "'");
       }
       if (value < q.minimum || value > q.maximum) {
-        return makeError(kSourceBadValue,
+        return makeError(SourceErrc::kBadValue,
                          "feature '" + name + "' value " + text + " out of range " + range(q));
       }
       if (q.step > 1 && (value - q.minimum) % q.step != 0) {
-        return makeError(kSourceBadValue, "feature '" + name + "' value " + text + " is not " +
-                                              std::to_string(q.minimum) + " plus a multiple of " +
-                                              std::to_string(q.step) + " in " + range(q));
+        return makeError(SourceErrc::kBadValue, "feature '" + name + "' value " + text +
+                                                    " is not " + std::to_string(q.minimum) +
+                                                    " plus a multiple of " +
+                                                    std::to_string(q.step) + " in " + range(q));
       }
       break;
     default: {  // menus: a choice by its name, or by its index
@@ -743,8 +748,8 @@ Result<void> V4l2Source::setFeature(const std::string& name, const std::string& 
       if (!matched) {
         std::string choices;
         for (const auto& c : menu) choices += (choices.empty() ? "" : ", ") + c.second;
-        return makeError(kSourceBadValue, "feature '" + name + "' has no choice '" + text +
-                                              "' (choices: " + choices + ")");
+        return makeError(SourceErrc::kBadValue, "feature '" + name + "' has no choice '" + text +
+                                                    "' (choices: " + choices + ")");
       }
       break;
     }
@@ -755,11 +760,11 @@ Result<void> V4l2Source::setFeature(const std::string& name, const std::string& 
   if (xioctl(VIDIOC_S_CTRL, &c) < 0) {
     const int err = errno;
     if (err == ERANGE || err == EINVAL) {
-      return makeError(kSourceBadValue,
+      return makeError(SourceErrc::kBadValue,
                        "feature '" + name + "' refused " + text + " (range " + range(q) + ")");
     }
     if (err == EACCES || err == EBUSY) {
-      return makeError(kSourceBadValue,
+      return makeError(SourceErrc::kBadValue,
                        "feature '" + name + "' cannot be set now: " + std::strerror(err) +
                            " (inactive under an automatic mode, e.g. exposure needs "
                            "auto_exposure on manual)");

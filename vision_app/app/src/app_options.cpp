@@ -34,7 +34,8 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
       if (help) *help = true;
       return o;
     }
-    if (i + 1 >= args.size()) return makeError(2, a + ": missing value or unknown option");
+    if (i + 1 >= args.size())
+      return makeError(OptionsErrc::kBadOption, a + ": missing value or unknown option");
     const std::string& v = args[++i];
     if (a == "--frames") {
       o.frames_endpoint = v;
@@ -49,7 +50,8 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
     } else if (a == "--robot-port") {
       auto p = parseInt(v);
       if (!p || *p < 0 || *p > 65535)
-        return makeError(2, "--robot-port: must be in [0, 65535], got '" + v + "'");
+        return makeError(OptionsErrc::kBadOption,
+                         "--robot-port: must be in [0, 65535], got '" + v + "'");
       o.robot.port = static_cast<uint16_t>(*p);
     } else if (a == "--threshold") {
       if (v == "adaptive") {
@@ -59,29 +61,35 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
       } else if (v.rfind("fixed:", 0) == 0) {
         auto level = parseInt(v.substr(6));
         if (!level || *level < 0 || *level > 255) {
-          return makeError(2, "--threshold: fixed level must be in [0, 255], got '" + v + "'");
+          return makeError(OptionsErrc::kBadOption,
+                           "--threshold: fixed level must be in [0, 255], got '" + v + "'");
         }
         o.vision.binarize.method = vision::ThresholdMethod::kFixed;
         o.vision.binarize.fixed_threshold = static_cast<int>(*level);
       } else {
-        return makeError(2, "--threshold: must be adaptive, otsu or fixed:LEVEL, got '" + v + "'");
+        return makeError(OptionsErrc::kBadOption,
+                         "--threshold: must be adaptive, otsu or fixed:LEVEL, got '" + v + "'");
       }
     } else if (a == "--polarity") {
       if (v != "dark" && v != "light")
-        return makeError(2, "--polarity: must be dark or light, got '" + v + "'");
+        return makeError(OptionsErrc::kBadOption,
+                         "--polarity: must be dark or light, got '" + v + "'");
       o.vision.binarize.polarity =
           v == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
     } else if (a == "--window") {
       auto w = parseInt(v);
       if (!w || *w < 8 || *w > 16384)
-        return makeError(2, "--window: must be in [8, 16384], got '" + v + "'");
+        return makeError(OptionsErrc::kBadOption,
+                         "--window: must be in [8, 16384], got '" + v + "'");
       o.vision.binarize.adaptive_window = static_cast<int>(*w);
     } else if (a == "--min-area") {
       auto m = parseDouble(v);
-      if (!m || *m < 1) return makeError(2, "--min-area: must be a number >= 1, got '" + v + "'");
+      if (!m || *m < 1)
+        return makeError(OptionsErrc::kBadOption,
+                         "--min-area: must be a number >= 1, got '" + v + "'");
       o.vision.regions.min_area = *m;
     } else {
-      return makeError(2, "unknown option '" + a + "'");
+      return makeError(OptionsErrc::kBadOption, "unknown option '" + a + "'");
     }
   }
   return o;

@@ -7,14 +7,14 @@
 #include <ostream>
 
 #include "picksight/calibration/camera_calibration.hpp"
-#include "picksight/common/text.hpp"
-#include "picksight/vision_app/app_options.hpp"
-#include "picksight/store/cell_calibration.hpp"
 #include "picksight/cell/grasp_planner.hpp"
+#include "picksight/cell/vision_service.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/protocol/model_commands.hpp"
+#include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
-#include "picksight/cell/vision_service.hpp"
+#include "picksight/vision_app/app_options.hpp"
 
 namespace picksight::app {
 
@@ -87,7 +87,7 @@ int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   auto lens = calibration::calibrateChessboard(views, board, &skipped);
   for (int i : skipped) err << "picksight-vision lens: no board in view " << i + 1 << "\n";
   if (!lens) {
-    out << errorReply(kBadArguments, lens.error().message) << "\n";
+    out << errorReply(ProtocolErrc::kBadArguments, lens.error().message) << "\n";
     return 1;
   }
   std::error_code ec;
@@ -96,7 +96,7 @@ int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostrea
   auto loaded = store.load();
   auto saved = loaded ? store.setLens(*lens) : Result<void>(loaded.error());
   if (!saved) {
-    out << errorReply(kCalibrationStorage, saved.error().message) << "\n";
+    out << errorReply(CellCalibrationErrc::kCalibrationStorage, saved.error().message) << "\n";
     return 1;
   }
   const auto& k = lens->camera_matrix;
@@ -161,7 +161,9 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   for (const auto& path : images) {
     const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (grey.empty()) {
-      out << errorReply(kBadArguments, "cannot read image '" + printable(path, 200) + "'") << "\n";
+      out << errorReply(ProtocolErrc::kBadArguments,
+                        "cannot read image '" + printable(path, 200) + "'")
+          << "\n";
       status = 1;
       continue;
     }
@@ -174,20 +176,20 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       vision::TrainOptions train;
       train.binarize = options->vision.binarize;
       train.regions = options->vision.regions;
-      const auto outcome = vision::trainModel(grey, type, name, train);
-      if (!outcome.ok) {
-        const bool none = outcome.error.rfind("no part", 0) == 0;
-        out << errorReply(none ? kNoPartToLearn : kSeveralParts, outcome.error) << "\n";
+      const auto trained = vision::trainModel(grey, type, name, train);
+      if (!trained) {
+        out << errorReply(trained.error()) << "\n";
         return 1;
       }
-      auto stored = library.store(outcome.model);
+      auto stored = library.store(*trained);
       if (!stored) {
-        out << errorReply(kStorageFailed, "cannot store the model: " + stored.error().message)
+        out << errorReply(VisionErrc::kStorageFailed,
+                          "cannot store the model: " + stored.error().message)
             << "\n";
         return 1;
       }
-      out << "OK " << modelSummary(outcome.model) << " "
-          << (outcome.model.body.mirror_symmetric ? "1" : "0") << "\n";
+      out << "OK " << modelSummary(*trained) << " " << (trained->body.mirror_symmetric ? "1" : "0")
+          << "\n";
     } else if (command == "locate") {
       // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
       LocateOutcome outcome;

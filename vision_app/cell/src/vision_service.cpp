@@ -11,6 +11,22 @@
 
 namespace picksight::app {
 
+const char* errorName(VisionErrc e) {
+  switch (e) {
+    case VisionErrc::kNoTarget:
+      return "no target";
+    case VisionErrc::kSeveralTargets:
+      return "several targets";
+    case VisionErrc::kNotADisc:
+      return "not a disc";
+    case VisionErrc::kUnknownType:
+      return "unknown type";
+    case VisionErrc::kStorageFailed:
+      return "storage failed";
+  }
+  return "unknown";
+}
+
 cv::Point2d FrameMapping::toSensor(cv::Point2d p) const {
   // Pixel centres are at integer coordinates in both frames.
   return {roi_x + (p.x + 0.5) / scale_x - 0.5, roi_y + (p.y + 0.5) / scale_y - 0.5};
@@ -112,9 +128,9 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& map
                                     const VisionOptions& options) {
   const auto regions =
       vision::findRegions(vision::binarize(grey, options.binarize), options.regions, grey);
-  if (regions.empty()) return makeError(kNoTarget, "no target found");
+  if (regions.empty()) return makeError(VisionErrc::kNoTarget, "no target found");
   if (regions.size() > 1) {
-    return makeError(kSeveralTargets,
+    return makeError(VisionErrc::kSeveralTargets,
                      "more than one target found (" + std::to_string(regions.size()) + " regions)");
   }
   const vision::Region& r = regions.front();
@@ -159,7 +175,8 @@ Result<LocateOutcome> VisionService::locate(int type) {
     bool known = false;
     for (const auto& m : *models) known = known || m.type == type;
     if (!known)
-      return makeError(kUnknownType, "no model for type " + std::to_string(type) + " (see MODELS)");
+      return makeError(VisionErrc::kUnknownType,
+                       "no model for type " + std::to_string(type) + " (see MODELS)");
   }
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
@@ -173,22 +190,20 @@ Result<LocateOutcome> VisionService::locate(int type) {
 }
 
 Result<vision::PartModel> VisionService::learn(int type, const std::string& name) {
-  if (!models_) return makeError(kStorageFailed, "no model library");
+  if (!models_) return makeError(VisionErrc::kStorageFailed, "no model library");
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
   vision::TrainOptions train;
   train.binarize = options_.binarize;
   train.regions = options_.regions;
-  const auto outcome = vision::trainModel(greyImage(**frame), type, name, train);
-  if (!outcome.ok) {
-    const bool none = outcome.error.rfind("no part", 0) == 0;
-    return makeError(none ? kNoPartToLearn : kSeveralParts, outcome.error);
-  }
-  auto stored = models_->store(outcome.model);
+  auto trained = vision::trainModel(greyImage(**frame), type, name, train);
+  if (!trained) return trained.error();
+  auto stored = models_->store(*trained);
   if (!stored)
-    return makeError(kStorageFailed, "cannot store the model: " + stored.error().message);
-  return outcome.model;
+    return makeError(VisionErrc::kStorageFailed,
+                     "cannot store the model: " + stored.error().message);
+  return trained;
 }
 
 Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {

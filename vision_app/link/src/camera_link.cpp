@@ -7,6 +7,18 @@
 
 namespace picksight::app {
 
+const char* errorName(CameraErrc e) {
+  switch (e) {
+    case CameraErrc::kNoFrame:
+      return "no frame";
+    case CameraErrc::kNoVideoServer:
+      return "no video server";
+    case CameraErrc::kCameraRefused:
+      return "camera refused";
+  }
+  return "unknown";
+}
+
 VideoServerCamera::VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
                                      const std::string& control_endpoint, std::string camera,
                                      std::chrono::milliseconds frame_timeout)
@@ -25,13 +37,14 @@ Result<std::shared_ptr<const ReceivedFrame>> VideoServerCamera::freshFrame() {
   for (;;) {
     const auto now = std::chrono::steady_clock::now();
     if (now >= deadline) {
-      return makeError(kNoFrame, "no frame from camera " + camera_ + " within " +
-                                     std::to_string(frame_timeout_.count()) + " ms");
+      return makeError(CameraErrc::kNoFrame, "no frame from camera " + camera_ + " within " +
+                                                 std::to_string(frame_timeout_.count()) + " ms");
     }
     proto::ControlRequest request;
     request.mutable_trigger();
     auto reply = control(request);
-    if (!reply) return makeError(kNoVideoServer, "video server: " + reply.error().message);
+    if (!reply)
+      return makeError(CameraErrc::kNoVideoServer, "video server: " + reply.error().message);
     const auto wait = std::min<std::chrono::milliseconds>(
         kRetrigger, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now));
     auto frame = feed_.waitFor(reply->trigger().sequence(), requested_ns, wait);
@@ -94,12 +107,13 @@ void StillCamera::setImage(const cv::Mat& image) {
 Result<std::shared_ptr<const ReceivedFrame>> StillCamera::freshFrame() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (image_.empty() || (image_.type() != CV_8UC1 && image_.type() != CV_8UC3))
-    return makeError(kNoFrame, "no image for camera " + camera_);
+    return makeError(CameraErrc::kNoFrame, "no image for camera " + camera_);
   return frameFromImage(image_, camera_, ++sequence_);
 }
 
 Result<proto::ControlReply> StillCamera::control(proto::ControlRequest) {
-  return makeError(kNoVideoServer, "camera " + camera_ + " is a still image: no settings");
+  return makeError(CameraErrc::kNoVideoServer,
+                   "camera " + camera_ + " is a still image: no settings");
 }
 
 uint64_t StillCamera::framesReceived() const {
@@ -108,11 +122,11 @@ uint64_t StillCamera::framesReceived() const {
 }
 
 Result<std::shared_ptr<const ReceivedFrame>> NoCamera::freshFrame() {
-  return makeError(kNoFrame, "no camera");
+  return makeError(CameraErrc::kNoFrame, "no camera");
 }
 
 Result<proto::ControlReply> NoCamera::control(proto::ControlRequest) {
-  return makeError(kNoVideoServer, "no video server");
+  return makeError(CameraErrc::kNoVideoServer, "no video server");
 }
 
 }  // namespace picksight::app

@@ -13,7 +13,7 @@ namespace {
 constexpr double kDiscTolerance = 0.03;
 constexpr double kMaxRadiusMm = 10000;
 
-std::string reply(const Error& e) { return errorReply(e.code, e.message); }
+std::string reply(const Error& e) { return errorReply(e); }
 
 bool looksLikeDisc(const cv::Moments& m) {
   const double a = m.mu20 / m.m00, b = m.mu02 / m.m00, c = m.mu11 / m.m00;
@@ -26,13 +26,15 @@ bool looksLikeDisc(const cv::Moments& m) {
 std::string calcam(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const auto radius = parseNumbers(r.args);
   if (!radius || radius->size() != 1 || !((*radius)[0] > 0) || (*radius)[0] > kMaxRadiusMm)
-    return errorReply(kBadArguments, "usage: CALCAM <radius_mm> (a number in (0, 10000])");
+    return errorReply(ProtocolErrc::kBadArguments,
+                      "usage: CALCAM <radius_mm> (a number in (0, 10000])");
   auto target = vision.target();
   if (!target) return reply(target.error());
   if (!looksLikeDisc(target->moments))
-    return errorReply(kNotADisc, "the target is not a disc (check the target and the lighting)");
+    return errorReply(VisionErrc::kNotADisc,
+                      "the target is not a disc (check the target and the lighting)");
   auto scale = calibration::scaleFromCircle(target->moments, (*radius)[0]);
-  if (!scale) return errorReply(kNotADisc, scale.error().message);
+  if (!scale) return errorReply(VisionErrc::kNotADisc, scale.error().message);
   if (auto ok = calibration.setScale(*scale); !ok) return reply(ok.error());
   return "OK " + formatFixed(scale->mm_per_px_x, 6) + " " + formatFixed(scale->mm_per_px_y, 6);
 }
@@ -40,7 +42,7 @@ std::string calcam(const Request& r, VisionService& vision, CellCalibration& cal
 std::string store(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const auto robot = parseNumbers(r.args);
   if (!robot || robot->size() != 2)
-    return errorReply(kBadArguments, "usage: STORE <x> <y> (robot mm)");
+    return errorReply(ProtocolErrc::kBadArguments, "usage: STORE <x> <y> (robot mm)");
   auto target = vision.target();
   if (!target) return reply(target.error());
   const calibration::PointPair pair{calibration.geometry().vision.toMm(target->centroid),
@@ -51,7 +53,7 @@ std::string store(const Request& r, VisionService& vision, CellCalibration& cali
 }
 
 std::string list(const Request& r, CellCalibration& calibration) {
-  if (!r.args.empty()) return errorReply(kBadArguments, "LIST takes no arguments");
+  if (!r.args.empty()) return errorReply(ProtocolErrc::kBadArguments, "LIST takes no arguments");
   const auto points = calibration.points();
   std::string out = "OK " + std::to_string(points.size());
   for (const auto& [id, p] : points) {
@@ -81,14 +83,15 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
   table.add("DELETE", "DELETE <id>", [&](const Request& r) {
     const auto id = r.args.size() == 1 ? parseInt(r.args[0]) : std::nullopt;
     if (!id || *id < 0 || *id > 1000000000)
-      return errorReply(kBadArguments, "usage: DELETE <id> (see LIST)");
+      return errorReply(ProtocolErrc::kBadArguments, "usage: DELETE <id> (see LIST)");
     auto ok = calibration.deletePoint(static_cast<int>(*id));
     return ok ? std::string("OK") : reply(ok.error());
   });
   table.add("LIST", "LIST", [&](const Request& r) { return list(r, calibration); });
   table.add("COMPUTE", "COMPUTE [BEST|LSQ|GEOMETRIC]", [&](const Request& r) {
     const auto method = parseMethod(r.args);
-    if (!method) return errorReply(kBadArguments, "usage: COMPUTE [BEST|LSQ|GEOMETRIC]");
+    if (!method)
+      return errorReply(ProtocolErrc::kBadArguments, "usage: COMPUTE [BEST|LSQ|GEOMETRIC]");
     auto result = calibration.compute(*method);
     if (!result) return reply(result.error());
     const auto& t = result->transform;
@@ -96,10 +99,12 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
            formatFixed(result->rms);
   });
   table.add("RESIDUALS", "RESIDUALS", [&](const Request& r) {
-    if (!r.args.empty()) return errorReply(kBadArguments, "RESIDUALS takes no arguments");
+    if (!r.args.empty())
+      return errorReply(ProtocolErrc::kBadArguments, "RESIDUALS takes no arguments");
     const auto geometry = calibration.geometry();
     if (!geometry.transform)
-      return errorReply(kNotComputed, "no robot-camera transform yet (see COMPUTE)");
+      return errorReply(CellCalibrationErrc::kNotComputed,
+                        "no robot-camera transform yet (see COMPUTE)");
     const auto points = calibration.points();
     std::string out = "OK " + std::to_string(points.size());
     for (const auto& [id, p] : points) {

@@ -3,16 +3,17 @@
 
 #include <algorithm>
 
-#include "picksight/common/text.hpp"
 #include "picksight/cell/grasp_planner.hpp"
+#include "picksight/common/text.hpp"
 
 namespace picksight::app {
 namespace {
-std::string reply(const Error& e) { return errorReply(e.code, e.message); }
+std::string reply(const Error& e) { return errorReply(e); }
 
 std::string typeError(const std::string& command, const std::string& arg) {
-  return errorReply(kBadArguments, command + ": type must be an integer in [0, 9999], got '" +
-                                       printable(arg) + "'");
+  return errorReply(
+      ProtocolErrc::kBadArguments,
+      command + ": type must be an integer in [0, 9999], got '" + printable(arg) + "'");
 }
 
 bool modelExists(const VisionService& vision, int type) {
@@ -23,7 +24,7 @@ bool modelExists(const VisionService& vision, int type) {
 }
 
 std::string locate(const Request& r, CellContext& cell) {
-  if (r.args.size() != 1) return errorReply(kBadArguments, "usage: LOCATE <type>");
+  if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: LOCATE <type>");
   const auto type = parseType(r.args[0]);
   if (!type) return typeError("LOCATE", r.args[0]);
   auto outcome = cell.vision.locate(*type);
@@ -46,7 +47,7 @@ std::string locate(const Request& r, CellContext& cell) {
 std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
   const std::string usage = gripper ? "usage: GRIPPER <type> FINGER <x> <y> <w> <h> | CLEAR | LIST"
                                     : "usage: GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST";
-  if (r.args.size() < 2) return errorReply(kBadArguments, usage);
+  if (r.args.size() < 2) return errorReply(ProtocolErrc::kBadArguments, usage);
   const auto type = parseType(r.args[0]);
   if (!type) return typeError(gripper ? "GRIPPER" : "GRASP", r.args[0]);
   const std::string action = toUpper(r.args[1]);
@@ -55,12 +56,13 @@ std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
   std::optional<std::vector<double>> values;
   if (action == add_word) {
     values = parseNumbers(r.args, 2);
-    if (!values || values->size() != add_values) return errorReply(kBadArguments, usage);
+    if (!values || values->size() != add_values)
+      return errorReply(ProtocolErrc::kBadArguments, usage);
   } else if ((action != "CLEAR" && action != "LIST") || r.args.size() != 2) {
-    return errorReply(kBadArguments, usage);
+    return errorReply(ProtocolErrc::kBadArguments, usage);
   }
   if (!modelExists(cell.vision, *type)) {
-    return errorReply(kUnknownType,
+    return errorReply(VisionErrc::kUnknownType,
                       "no model for type " + std::to_string(*type) + " (see MODELS, LEARN)");
   }
   ModelLibrary& library = *cell.vision.models();
@@ -94,19 +96,20 @@ std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
     const auto& v = *values;
     setup.styles.push_back({v[0], v[1], v[2]});
   }
-  if (const std::string problem = validateGrasp(setup); !problem.empty())
-    return errorReply(kBadArguments, problem);
+  if (auto valid = validateGrasp(setup); !valid)
+    return errorReply(ProtocolErrc::kBadArguments, valid.error().message);
   auto ok = library.setGrasp(*type, setup);
   if (!ok) {
-    if (ok.error().code == 1) return errorReply(kUnknownType, ok.error().message);
-    return errorReply(kStorageFailed, "cannot store the model: " + ok.error().message);
+    if (ok.error().code == ModelErrc::kUnknownType)
+      return errorReply(VisionErrc::kUnknownType, ok.error().message);
+    return errorReply(VisionErrc::kStorageFailed, "cannot store the model: " + ok.error().message);
   }
   const size_t count = gripper ? setup.gripper.fingers.size() : setup.styles.size();
   return "OK " + std::to_string(count);
 }
 
 std::string status(const Request& r, CellContext& cell) {
-  if (!r.args.empty()) return errorReply(kBadArguments, "STATUS takes no arguments");
+  if (!r.args.empty()) return errorReply(ProtocolErrc::kBadArguments, "STATUS takes no arguments");
   const auto calib = cell.calibration.summary();
   const auto geometry = cell.calibration.geometry();
   const auto models =
@@ -139,13 +142,15 @@ std::string status(const Request& r, CellContext& cell) {
 }
 
 std::string exposure(const Request& r, CellContext& cell) {
-  if (r.args.size() > 1) return errorReply(kBadArguments, "usage: EXPOSURE [<value>]");
+  if (r.args.size() > 1)
+    return errorReply(ProtocolErrc::kBadArguments, "usage: EXPOSURE [<value>]");
   std::optional<double> value;
   if (!r.args.empty()) {
     value = parseDouble(r.args[0]);
     if (!value || !(*value > 0))
-      return errorReply(kBadArguments, "EXPOSURE: value must be a positive number, got '" +
-                                           printable(r.args[0]) + "'");
+      return errorReply(
+          ProtocolErrc::kBadArguments,
+          "EXPOSURE: value must be a positive number, got '" + printable(r.args[0]) + "'");
   }
   // The first name the camera knows decides; a camera that knows it but
   // refuses the value explains why better than the names it does not know.
@@ -163,13 +168,14 @@ std::string exposure(const Request& r, CellContext& cell) {
     if (answer) {
       return "OK " + name + " " + printable(answer->feature().feature().value(), 64);
     }
-    if (answer.error().code == kControlTimeout || answer.error().code == kNoVideoServer)
-      return errorReply(kNoVideoServer, "video server: " + answer.error().message);
-    if (answer.error().code != proto::Error::UNKNOWN_FEATURE || why.empty())
+    if (answer.error().code == ControlErrc::kNoReply ||
+        answer.error().code == CameraErrc::kNoVideoServer)
+      return errorReply(CameraErrc::kNoVideoServer, "video server: " + answer.error().message);
+    if (answer.error().code != ControlErrc::kUnknownFeature || why.empty())
       why = printable(answer.error().message, 120);
-    if (answer.error().code != proto::Error::UNKNOWN_FEATURE) break;
+    if (answer.error().code != ControlErrc::kUnknownFeature) break;
   }
-  return errorReply(kCameraRefused, "EXPOSURE: " + why);
+  return errorReply(CameraErrc::kCameraRefused, "EXPOSURE: " + why);
 }
 
 std::string roi(const Request& r, CellContext& cell) {
@@ -179,7 +185,8 @@ std::string roi(const Request& r, CellContext& cell) {
     request.mutable_describe_camera();
     auto answer = cell.vision.control(request);
     if (!answer)
-      return errorReply(kCameraRefused, "ROI: " + printable(answer.error().message, 120));
+      return errorReply(CameraErrc::kCameraRefused,
+                        "ROI: " + printable(answer.error().message, 120));
     const auto& d = answer->describe_camera();
     const auto& roi = d.roi();
     // A zero size is the full sensor.
@@ -195,7 +202,7 @@ std::string roi(const Request& r, CellContext& cell) {
     for (size_t i = 0; i < 4; ++i) {
       const auto n = parseInt(r.args[i]);
       if (!n || *n < 0 || *n > 100000 || (i >= 2 && *n == 0))
-        return errorReply(kBadArguments, usage);
+        return errorReply(ProtocolErrc::kBadArguments, usage);
       v[i] = static_cast<uint32_t>(*n);
     }
     auto* roi = set->mutable_roi();
@@ -204,13 +211,13 @@ std::string roi(const Request& r, CellContext& cell) {
     roi->set_width(v[2]);
     roi->set_height(v[3]);
   } else {
-    return errorReply(kBadArguments, usage);
+    return errorReply(ProtocolErrc::kBadArguments, usage);
   }
   auto answer = cell.vision.control(request);
   if (!answer) {
-    const bool down =
-        answer.error().code == kControlTimeout || answer.error().code == kNoVideoServer;
-    const int code = down ? kNoVideoServer : kCameraRefused;
+    const bool down = answer.error().code == ControlErrc::kNoReply ||
+                      answer.error().code == CameraErrc::kNoVideoServer;
+    const CameraErrc code = down ? CameraErrc::kNoVideoServer : CameraErrc::kCameraRefused;
     return errorReply(code, "ROI: " + printable(answer.error().message, 120));
   }
   return std::string("OK");

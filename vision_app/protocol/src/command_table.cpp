@@ -2,11 +2,30 @@
 #include "picksight/protocol/command_table.hpp"
 
 #include "picksight/common/text.hpp"
+#include "picksight/protocol/robot_errors.hpp"
 
 namespace picksight::app {
 
-std::string errorReply(int code, const std::string& text) {
-  return "ERROR " + std::to_string(code) + " " + text;
+const char* errorName(ProtocolErrc e) {
+  switch (e) {
+    case ProtocolErrc::kUnknownCommand:
+      return "unknown command";
+    case ProtocolErrc::kBadArguments:
+      return "bad arguments";
+    case ProtocolErrc::kRequestTooLong:
+      return "request too long";
+    case ProtocolErrc::kTooManyConnections:
+      return "too many connections";
+    case ProtocolErrc::kEmptyRequest:
+      return "empty request";
+    case ProtocolErrc::kInternalError:
+      return "internal error";
+  }
+  return "unknown";
+}
+
+std::string errorReply(const Error& error) {
+  return "ERROR " + std::to_string(robotErrorCode(error.code)) + " " + error.message;
 }
 
 std::optional<int> parseType(std::string_view text) {
@@ -51,10 +70,10 @@ void CommandTable::add(const std::string& word, const std::string& usage, Handle
 
 std::string CommandTable::dispatch(std::string_view line) const {
   const auto request = parseRequest(line);
-  if (!request) return errorReply(kEmptyRequest, "empty request");
+  if (!request) return errorReply(ProtocolErrc::kEmptyRequest, "empty request");
   const auto it = commands_.find(request->command);
   if (it == commands_.end()) {
-    return errorReply(kUnknownCommand,
+    return errorReply(ProtocolErrc::kUnknownCommand,
                       "unknown command '" + printable(request->command) + "' (try HELP)");
   }
   return it->second.handler(*request);

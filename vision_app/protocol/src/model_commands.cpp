@@ -35,23 +35,26 @@ std::string blobSummary(const vision::BlobFeatures& b) {
 void addModelCommands(CommandTable& table, VisionService& vision) {
   table.add("LEARN", "LEARN <type> [name]", [&vision](const Request& r) {
     if (r.args.empty() || r.args.size() > 2)
-      return errorReply(kBadArguments, "usage: LEARN <type> [name]");
+      return errorReply(ProtocolErrc::kBadArguments, "usage: LEARN <type> [name]");
     const auto type = parseType(r.args[0]);
     if (!type) {
-      return errorReply(kBadArguments, "LEARN: type must be an integer in [0, 9999], got '" +
-                                           printable(r.args[0]) + "'");
+      return errorReply(
+          ProtocolErrc::kBadArguments,
+          "LEARN: type must be an integer in [0, 9999], got '" + printable(r.args[0]) + "'");
     }
     const std::string name = r.args.size() > 1 ? r.args[1] : "type" + std::to_string(*type);
     if (!validModelName(name)) {
-      return errorReply(kBadArguments, "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" +
-                                           printable(name) + "'");
+      return errorReply(
+          ProtocolErrc::kBadArguments,
+          "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" + printable(name) + "'");
     }
     auto model = vision.learn(*type, name);
-    if (!model) return errorReply(model.error().code, model.error().message);
+    if (!model) return errorReply(model.error());
     return "OK " + modelSummary(*model) + " " + (model->body.mirror_symmetric ? "1" : "0");
   });
   table.add("MODELS", "MODELS", [&vision](const Request& r) {
-    if (!r.args.empty()) return errorReply(kBadArguments, "MODELS takes no arguments");
+    if (!r.args.empty())
+      return errorReply(ProtocolErrc::kBadArguments, "MODELS takes no arguments");
     const auto models =
         vision.models() ? vision.models()->snapshot() : std::make_shared<const ModelList>();
     std::string reply = "OK " + std::to_string(models->size());
@@ -59,25 +62,28 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
     return reply;
   });
   table.add("FORGET", "FORGET <type>", [&vision](const Request& r) {
-    if (r.args.size() != 1) return errorReply(kBadArguments, "usage: FORGET <type>");
+    if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: FORGET <type>");
     const auto type = parseType(r.args[0]);
     if (!type) {
-      return errorReply(kBadArguments, "FORGET: type must be an integer in [0, 9999], got '" +
-                                           printable(r.args[0]) + "'");
+      return errorReply(
+          ProtocolErrc::kBadArguments,
+          "FORGET: type must be an integer in [0, 9999], got '" + printable(r.args[0]) + "'");
     }
     if (!vision.models())
-      return errorReply(kUnknownType, "no model for type " + std::to_string(*type));
+      return errorReply(VisionErrc::kUnknownType, "no model for type " + std::to_string(*type));
     auto removed = vision.models()->remove(*type);
     if (!removed) {
-      return errorReply(removed.error().code == 1 ? kUnknownType : kStorageFailed,
+      return errorReply(removed.error().code == ModelErrc::kUnknownType
+                            ? VisionErrc::kUnknownType
+                            : VisionErrc::kStorageFailed,
                         removed.error().message);
     }
     return std::string("OK");
   });
   table.add("BLOBS", "BLOBS", [&vision](const Request& r) {
-    if (!r.args.empty()) return errorReply(kBadArguments, "BLOBS takes no arguments");
+    if (!r.args.empty()) return errorReply(ProtocolErrc::kBadArguments, "BLOBS takes no arguments");
     auto blobs = vision.blobs();
-    if (!blobs) return errorReply(blobs.error().code, blobs.error().message);
+    if (!blobs) return errorReply(blobs.error());
     std::string reply = "OK " + std::to_string(blobs->size());
     for (const auto& b : *blobs) reply += " " + blobSummary(b);
     return reply;

@@ -11,7 +11,7 @@ constexpr const char* kVersion = "0.1.0";
 RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
   table_.add("PING", "PING", [](const Request& r) {
     return r.args.empty() ? std::string("OK")
-                          : errorReply(kBadArguments, "PING takes no arguments");
+                          : errorReply(ProtocolErrc::kBadArguments, "PING takes no arguments");
   });
   table_.add("VERSION", "VERSION", [](const Request&) { return std::string("OK ") + kVersion; });
   table_.add("HELP", "HELP", [this](const Request&) { return table_.help(); });
@@ -19,9 +19,10 @@ RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
 }
 
 std::string RobotProtocol::frame(const Request& request) {
-  if (!request.args.empty()) return errorReply(kBadArguments, "FRAME takes no arguments");
+  if (!request.args.empty())
+    return errorReply(ProtocolErrc::kBadArguments, "FRAME takes no arguments");
   const auto f = vision_.lastFrame();
-  if (!f) return errorReply(kNoFrame, "no frame used yet");
+  if (!f) return errorReply(CameraErrc::kNoFrame, "no frame used yet");
   return "OK " + f->camera + " " + std::to_string(f->sequence) + " " +
          std::to_string(f->host_timestamp_ns) + " " + std::to_string(f->width) + " " +
          std::to_string(f->height) + " " + (f->triggered ? "1" : "0");

@@ -4,9 +4,22 @@
 #include <vector>
 
 namespace picksight::app {
+
+const char* errorName(CellCalibrationErrc e) {
+  switch (e) {
+    case CellCalibrationErrc::kNoSuchPoint:
+      return "no such point";
+    case CellCalibrationErrc::kCalibrationStorage:
+      return "calibration storage";
+    case CellCalibrationErrc::kNotComputed:
+      return "not computed";
+  }
+  return "unknown";
+}
 namespace {
 Error storageError(const Error& e) {
-  return makeError(kCalibrationStorage, "cannot write the calibration: " + e.message);
+  return makeError(CellCalibrationErrc::kCalibrationStorage,
+                   "cannot write the calibration: " + e.message);
 }
 }  // namespace
 
@@ -43,8 +56,9 @@ Result<void> CellCalibration::load() {
 }
 
 Error CellCalibration::blocked() const {
-  return makeError(kCalibrationStorage, "the calibration file is damaged, nothing is changed: " +
-                                            damaged_.substr(0, 200));
+  return makeError(
+      CellCalibrationErrc::kCalibrationStorage,
+      "the calibration file is damaged, nothing is changed: " + damaged_.substr(0, 200));
 }
 
 CellGeometry CellCalibration::geometry() const {
@@ -93,7 +107,8 @@ Result<void> CellCalibration::deletePoint(int id) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!damaged_.empty()) return blocked();
   if (!store_.points().count(id))
-    return makeError(kNoSuchPoint, "no point with id " + std::to_string(id) + " (see LIST)");
+    return makeError(CellCalibrationErrc::kNoSuchPoint,
+                     "no point with id " + std::to_string(id) + " (see LIST)");
   auto ok = store_.deletePoint(id);
   if (!ok) return storageError(ok.error());
   return {};
@@ -105,11 +120,7 @@ Result<calibration::CalibrationResult> CellCalibration::compute(calibration::Met
   std::vector<calibration::PointPair> pairs;
   for (const auto& [id, pair] : store_.points()) pairs.push_back(pair);
   auto result = calibration::calibrate(pairs, method);
-  if (!result) {
-    const int code =
-        result.error().code == calibration::kTooFewPoints ? kTooFewPoints : kDegeneratePoints;
-    return makeError(code, result.error().message);
-  }
+  if (!result) return result.error();
   auto ok = store_.setTransform(*result);
   if (!ok) return storageError(ok.error());
   return result;

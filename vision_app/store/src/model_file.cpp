@@ -6,6 +6,20 @@
 #include <cmath>
 
 namespace picksight::app {
+
+const char* errorName(ModelErrc e) {
+  switch (e) {
+    case ModelErrc::kUnknownType:
+      return "unknown type";
+    case ModelErrc::kStorage:
+      return "storage";
+    case ModelErrc::kInvalidModel:
+      return "invalid model";
+    case ModelErrc::kBadFile:
+      return "bad file";
+  }
+  return "unknown";
+}
 namespace {
 using vision::PartModel;
 using vision::Primitive;
@@ -159,7 +173,9 @@ std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   return std::string(out.c_str()) + "\n";
 }
 
-std::string validateGrasp(const GraspSetup& grasp) {
+namespace {
+// What is wrong with a grasp set-up; empty when nothing is.
+std::string graspProblem(const GraspSetup& grasp) {
   // Beyond a few metres a value is a typo, not a gripper.
   constexpr double kMaxMm = 10000;
   const auto bad = [](double v, double limit) { return !std::isfinite(v) || std::abs(v) > limit; };
@@ -178,6 +194,13 @@ std::string validateGrasp(const GraspSetup& grasp) {
   }
   return {};
 }
+}  // namespace
+
+Result<void> validateGrasp(const GraspSetup& grasp) {
+  const std::string problem = graspProblem(grasp);
+  if (problem.empty()) return {};
+  return makeError(ModelErrc::kInvalidModel, problem);
+}
 
 Result<PartModel> modelFromYaml(const std::string& text) {
   auto record = modelRecordFromYaml(text);
@@ -190,20 +213,22 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    return makeError(1, "not YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
+    return makeError(ModelErrc::kBadFile,
+                     "not YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }
   ModelRecord record;
   PartModel& m = record.model;
   try {
     if (!root.IsMap() || as<std::string>(root, "format") != "picksight-part-model") {
-      return makeError(1, "not a PickSight part model (format: picksight-part-model)");
+      return makeError(ModelErrc::kBadFile,
+                       "not a PickSight part model (format: picksight-part-model)");
     }
     const int version = as<int>(root, "version");
     if (version < kOldestModelFormatVersion || version > kModelFormatVersion) {
-      return makeError(1, "format version " + std::to_string(version) +
-                              " (this program reads versions " +
-                              std::to_string(kOldestModelFormatVersion) + " to " +
-                              std::to_string(kModelFormatVersion) + ")");
+      return makeError(ModelErrc::kBadFile, "format version " + std::to_string(version) +
+                                                " (this program reads versions " +
+                                                std::to_string(kOldestModelFormatVersion) + " to " +
+                                                std::to_string(kModelFormatVersion) + ")");
     }
     m.type = as<int>(root, "type");
     m.name = as<std::string>(root, "name");
@@ -309,16 +334,16 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
                                                 as<double>(f, "width_mm"),
                                                 as<double>(f, "height_mm")});
       }
-      const std::string problem = validateGrasp(record.grasp);
-      if (!problem.empty()) throw FieldError{"grasp: " + problem};
+      if (auto valid = validateGrasp(record.grasp); !valid)
+        throw FieldError{"grasp: " + valid.error().message};
     }
   } catch (const FieldError& e) {
-    return makeError(1, e.what);
+    return makeError(ModelErrc::kBadFile, e.what);
   } catch (const YAML::Exception& e) {
-    return makeError(1, e.msg);
+    return makeError(ModelErrc::kBadFile, e.msg);
   }
-  const std::string problem = vision::validateModel(m);
-  if (!problem.empty()) return makeError(1, problem);
+  if (auto valid = vision::validateModel(m); !valid)
+    return makeError(ModelErrc::kBadFile, valid.error().message);
   vision::prepareModel(m);
   return record;
 }

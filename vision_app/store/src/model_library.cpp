@@ -67,7 +67,7 @@ Result<void> ModelLibrary::store(const vision::PartModel& model) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
   fs::create_directories(directory_, ec);
-  if (ec) return makeError(1, directory_ + ": " + ec.message());
+  if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   const auto kept = grasps_->find(model.type);
   auto written = writeFileAtomically(
       pathOf(model.type), modelToYaml(model, kept == grasps_->end() ? GraspSetup{} : kept->second));
@@ -87,10 +87,11 @@ Result<void> ModelLibrary::remove(int type) {
   std::lock_guard<std::mutex> lock(mutex_);
   const bool known = std::any_of(models_->begin(), models_->end(),
                                  [&](const vision::PartModel& m) { return m.type == type; });
-  if (!known) return makeError(1, "no model for type " + std::to_string(type));
+  if (!known)
+    return makeError(ModelErrc::kUnknownType, "no model for type " + std::to_string(type));
   std::error_code ec;
   fs::remove(pathOf(type), ec);
-  if (ec) return makeError(2, pathOf(type) + ": " + ec.message());
+  if (ec) return makeError(ModelErrc::kStorage, pathOf(type) + ": " + ec.message());
   auto models = std::make_shared<ModelList>(*models_);
   models->erase(std::remove_if(models->begin(), models->end(),
                                [&](const vision::PartModel& m) { return m.type == type; }),
@@ -106,11 +107,11 @@ Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto model = std::find_if(models_->begin(), models_->end(),
                                   [&](const vision::PartModel& m) { return m.type == type; });
-  if (model == models_->end()) return makeError(1, "no model for type " + std::to_string(type));
-  const std::string problem = validateGrasp(grasp);
-  if (!problem.empty()) return makeError(3, problem);
+  if (model == models_->end())
+    return makeError(ModelErrc::kUnknownType, "no model for type " + std::to_string(type));
+  if (auto valid = validateGrasp(grasp); !valid) return valid.error();
   auto written = writeFileAtomically(pathOf(type), modelToYaml(*model, grasp));
-  if (!written) return makeError(2, written.error().message);
+  if (!written) return makeError(ModelErrc::kStorage, written.error().message);
   auto grasps = std::make_shared<GraspMap>(*grasps_);
   (*grasps)[type] = grasp;
   grasps_ = std::move(grasps);

@@ -18,6 +18,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "picksight/calibration/calibration_errors.hpp"
 #include "picksight/common/result.hpp"
 
 namespace picksight::calibration {
@@ -54,12 +55,6 @@ struct CalibrationResult {
   double rms = 0;                         // over inliers, mm
   std::vector<Residual> residuals;        // one per input point, same order
   int inliers = 0;
-};
-
-// Error codes of calibrate().
-enum CalibrationError : int {
-  kTooFewPoints = 1,
-  kDegeneratePoints = 2,
 };
 
 // Estimates the transform. kBest runs both estimators on the same inliers

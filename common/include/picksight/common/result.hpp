@@ -1,6 +1,7 @@
 // Result<T>: the value of an operation that can fail for reasons the caller
-// must handle (a timeout, a lost camera, a bad request). Exceptions are kept
-// for start-up and programmer errors.
+// must handle (a timeout, a lost camera, a bad request), or the typed Error
+// (error.hpp) that says why. Exceptions are kept for start-up and programmer
+// errors, and never cross a C callback or leave a thread loop.
 #pragma once
 
 #include <cassert>
@@ -8,12 +9,9 @@
 #include <utility>
 #include <variant>
 
-namespace picksight {
+#include "picksight/common/error.hpp"
 
-struct Error {
-  int code = 0;
-  std::string message;
-};
+namespace picksight {
 
 template <typename T>
 class [[nodiscard]] Result {
@@ -68,7 +66,5 @@ class [[nodiscard]] Result<void> {
   Error error_;
   bool ok_ = true;
 };
-
-inline Error makeError(int code, std::string message) { return Error{code, std::move(message)}; }
 
 }  // namespace picksight

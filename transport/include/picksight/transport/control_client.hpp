@@ -13,9 +13,23 @@
 
 namespace picksight {
 
-// Error codes of ControlClient results: the server's proto::Error codes, plus
-// this one for a server that did not answer.
-constexpr int kControlTimeout = 1000;
+// Why a control call failed: the server's answer, its wire code decoded
+// (the values are proto::Error::Code's, so a tool can print the wire code),
+// or no answer at all.
+enum class ControlErrc {
+  kBadRequest = 1,
+  kUnknownCamera = 2,
+  kOutOfRange = 3,
+  kNotSupported = 4,
+  kCameraUnavailable = 5,
+  kInternal = 6,
+  kUnknownFeature = 7,
+  kTimeout = 8,     // the server waited in vain (e.g. for a frame)
+  kBusy = 9,        // the server has too much slow work pending
+  kNoReply = 1000,  // the server did not answer in time
+};
+const char* errorName(ControlErrc e);
+PICKSIGHT_ERROR_DOMAIN(ControlErrc, "control")
 
 class ControlClient {
  public:
@@ -23,7 +37,7 @@ class ControlClient {
                 std::chrono::milliseconds timeout = std::chrono::milliseconds(2000));
 
   // Sends `request`; the reply when the server answered with code OK, else an
-  // Error carrying the server's code and text (or kControlTimeout).
+  // Error carrying the server's code and text (or kNoReply).
   Result<proto::ControlReply> call(const proto::ControlRequest& request);
 
   const std::string& endpoint() const { return endpoint_; }
@@ -38,3 +52,5 @@ class ControlClient {
 };
 
 }  // namespace picksight
+
+PICKSIGHT_ERROR_ENUM(picksight::ControlErrc)

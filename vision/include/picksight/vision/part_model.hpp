@@ -8,6 +8,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "picksight/common/result.hpp"
+
 #include "picksight/vision/binarize.hpp"
 #include "picksight/vision/blob_features.hpp"
 #include "picksight/vision/boundary_model.hpp"
@@ -73,24 +75,30 @@ struct TrainOptions {
   double area_tolerance = 0.1;
 };
 
-struct TrainOutcome {
-  bool ok = false;
-  std::string error;  // when !ok: why (no part, several parts...)
-  PartModel model;
+// Why a model could not be trained, or is not valid.
+enum class PartModelErrc {
+  kNotGrey = 1,   // the training image is not 8-bit grey
+  kNoPart,        // no part in the training image
+  kSeveralParts,  // more than one part in the training image
+  kInvalid,       // a model's values are out of range or inconsistent
 };
+const char* errorName(PartModelErrc e);
+PICKSIGHT_ERROR_DOMAIN(PartModelErrc, "part model")
 
 // Trains from a grey image holding exactly one part.
-TrainOutcome trainModel(const cv::Mat& grey, int type, const std::string& name,
-                        const TrainOptions& options = {});
+Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& name,
+                             const TrainOptions& options = {});
 
 // Fills the derived members; call after training or loading.
 void prepareModel(PartModel& model);
 
-// Checks a model's values (finite, in range, consistent); empty when valid,
-// else what is wrong.
-std::string validateModel(const PartModel& model);
+// Checks a model's values (finite, in range, consistent); kInvalid says
+// what is wrong.
+Result<void> validateModel(const PartModel& model);
 
 // Sum |H_i(a) - H_i(b)| over the invariants the model uses.
 double huDistance(const BodyModel& body, const HuArray& log_hu);
 
 }  // namespace picksight::vision
+
+PICKSIGHT_ERROR_ENUM(picksight::vision::PartModelErrc)

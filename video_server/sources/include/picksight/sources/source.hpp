@@ -87,15 +87,18 @@ struct SourceInfo {
   std::vector<std::string> formats;  // formats the device delivers
 };
 
-// Error codes of source results.
-enum SourceError : int {
-  kSourceTimeout = 1,      // no frame in time; try again
-  kSourceUnavailable = 2,  // device gone or not openable; reopen with back-off
-  kSourceBadConfig = 3,    // the source string is wrong; retrying will not help
-  kSourceUnknownFeature = 4,
-  kSourceBadValue = 5,  // feature value out of range or of the wrong type
-  kSourceNotSupported = 6,
+// Why a source call failed: the camera thread decides from it whether to
+// retry, reopen or give up.
+enum class SourceErrc {
+  kTimeout = 1,     // no frame in time; try again
+  kUnavailable,     // device gone or not openable; reopen with back-off
+  kBadConfig,       // the source string is wrong; retrying will not help
+  kUnknownFeature,  // no feature of that name
+  kBadValue,        // feature value out of range or of the wrong type
+  kNotSupported,    // the device cannot do that
 };
+const char* errorName(SourceErrc e);
+PICKSIGHT_ERROR_DOMAIN(SourceErrc, "source")
 
 class Source {
  public:
@@ -108,7 +111,7 @@ class Source {
   virtual SourceInfo info() const = 0;
   // Produces one frame. Sources that render or read on demand (synthetic,
   // file) make it now; the caller paces them. Streaming sources return the
-  // next frame the device delivers, or kSourceTimeout.
+  // next frame the device delivers, or SourceErrc::kTimeout.
   virtual Result<SourceFrame> grab(std::chrono::milliseconds timeout) = 0;
 
   // --- Acquisition. Defaults suit on-demand sources.
@@ -125,10 +128,10 @@ class Source {
   // range; errors name the feature and, for a range, the range.
   virtual std::vector<Feature> features() { return {}; }
   virtual Result<Feature> feature(const std::string& name) {
-    return makeError(kSourceUnknownFeature, "unknown feature '" + name + "'");
+    return makeError(SourceErrc::kUnknownFeature, "unknown feature '" + name + "'");
   }
   virtual Result<void> setFeature(const std::string& name, const std::string& /*value*/) {
-    return makeError(kSourceUnknownFeature, "unknown feature '" + name + "'");
+    return makeError(SourceErrc::kUnknownFeature, "unknown feature '" + name + "'");
   }
 };
 
@@ -137,3 +140,5 @@ class Source {
 Result<std::unique_ptr<Source>> makeSource(const std::string& uri);
 
 }  // namespace picksight::video
+
+PICKSIGHT_ERROR_ENUM(picksight::video::SourceErrc)

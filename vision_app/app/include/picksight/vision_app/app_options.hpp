@@ -4,11 +4,16 @@
 #include <string>
 #include <vector>
 
+#include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
-#include "picksight/cell/vision_service.hpp"
 
 namespace picksight::app {
+
+// A command-line option picksight-vision cannot use; the message names it.
+enum class OptionsErrc { kBadOption = 1 };
+inline const char* errorName(OptionsErrc) { return "bad option"; }
+PICKSIGHT_ERROR_DOMAIN(OptionsErrc, "options")
 
 struct AppOptions {
   std::string frames_endpoint = "tcp://127.0.0.1:5555";
@@ -24,3 +29,5 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
 std::string appUsage();
 
 }  // namespace picksight::app
+
+PICKSIGHT_ERROR_ENUM(picksight::app::OptionsErrc)

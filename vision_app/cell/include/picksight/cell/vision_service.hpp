@@ -16,28 +16,27 @@
 
 #include <zmq.hpp>
 
+#include "picksight/camera_link/camera_link.hpp"
 #include "picksight/common/result.hpp"
+#include "picksight/store/model_library.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/vision/binarize.hpp"
 #include "picksight/vision/blob_features.hpp"
 #include "picksight/vision/part_model.hpp"
 #include "picksight/vision/regions.hpp"
-#include "picksight/camera_link/camera_link.hpp"
-#include "picksight/store/model_library.hpp"
 
 namespace picksight::app {
 
-// Error codes of VisionService results; they are also the robot protocol's.
-// (kNoFrame, kNoVideoServer and kCameraRefused come from the camera link.)
-enum VisionError : int {
-  kNoTarget = 1,        // STORE, CALCAM: no target in the frame
-  kSeveralTargets = 2,  // STORE, CALCAM: more than one
-  kNotADisc = 3,        // CALCAM: the target is not a disc
-  kNoPartToLearn = 30,  // LEARN: no part in the frame
-  kSeveralParts = 31,   // LEARN: more than one part in the frame
-  kUnknownType = 32,    // no model for that type
-  kStorageFailed = 33,  // a model file could not be written or removed
+// Why a vision request failed (besides the camera link's CameraErrc).
+enum class VisionErrc {
+  kNoTarget = 1,    // STORE, CALCAM: no target in the frame
+  kSeveralTargets,  // STORE, CALCAM: more than one
+  kNotADisc,        // CALCAM: the target is not a disc
+  kUnknownType,     // no model for that type
+  kStorageFailed,   // a model file could not be written or removed
 };
+const char* errorName(VisionErrc e);
+PICKSIGHT_ERROR_DOMAIN(VisionErrc, "vision")
 
 struct LocatedPart {
   double x = 0;  // sensor pixels
@@ -139,7 +138,7 @@ class VisionService {
   void stop();
 
   // The parts of `type` in a frame taken after this call (every region when
-  // no model exists; kUnknownType when models exist but none of `type`).
+  // no model exists; VisionErrc::kUnknownType when models exist but none of `type`).
   Result<LocateOutcome> locate(int type);
   // Trains type `type` from the single part in a fresh frame and stores it.
   Result<vision::PartModel> learn(int type, const std::string& name);
@@ -169,3 +168,5 @@ class VisionService {
 };
 
 }  // namespace picksight::app
+
+PICKSIGHT_ERROR_ENUM(picksight::app::VisionErrc)

@@ -18,19 +18,21 @@
 #include <zmq.hpp>
 
 #include "picksight.pb.h"
+#include "picksight/camera_link/frame_feed.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/transport/frame_message.hpp"
-#include "picksight/camera_link/frame_feed.hpp"
 
 namespace picksight::app {
 
-// Error codes of camera links; they are also the robot protocol's.
-enum CameraError : int {
-  kNoFrame = 20,        // no fresh frame in time
-  kNoVideoServer = 21,  // the video server did not answer or refused
-  kCameraRefused = 22,  // the camera refused a setting
+// Why a camera link failed.
+enum class CameraErrc {
+  kNoFrame = 1,    // no fresh frame in time
+  kNoVideoServer,  // the video server did not answer or refused
+  kCameraRefused,  // the camera refused a setting
 };
+const char* errorName(CameraErrc e);
+PICKSIGHT_ERROR_DOMAIN(CameraErrc, "camera link")
 
 class CameraLink {
  public:
@@ -84,8 +86,8 @@ class StillCamera : public CameraLink {
   uint64_t sequence_ = 0;
 };
 
-// No camera: every frame request fails at once with kNoFrame and every
-// control request with kNoVideoServer.
+// No camera: every frame request fails at once with CameraErrc::kNoFrame and every
+// control request with CameraErrc::kNoVideoServer.
 class NoCamera : public CameraLink {
  public:
   Result<std::shared_ptr<const ReceivedFrame>> freshFrame() override;
@@ -103,3 +105,5 @@ std::shared_ptr<const ReceivedFrame> frameFromImage(const cv::Mat& image, const 
                                                     uint64_t sequence);
 
 }  // namespace picksight::app
+
+PICKSIGHT_ERROR_ENUM(picksight::app::CameraErrc)

@@ -10,17 +10,21 @@
 #include <string_view>
 #include <vector>
 
+#include "picksight/common/result.hpp"
+
 namespace picksight::app {
 
-// Protocol error codes shared by every command (ERROR <code> <text>).
-enum ProtocolError : int {
-  kUnknownCommand = 10,
-  kBadArguments = 11,
-  kRequestTooLong = 12,      // sent by RobotServer
-  kTooManyConnections = 13,  // sent by RobotServer
-  kEmptyRequest = 14,
-  kInternalError = 99,
+// Failures of the protocol itself, shared by every command.
+enum class ProtocolErrc {
+  kUnknownCommand = 1,
+  kBadArguments,
+  kRequestTooLong,      // sent by RobotServer
+  kTooManyConnections,  // sent by RobotServer
+  kEmptyRequest,
+  kInternalError,
 };
+const char* errorName(ProtocolErrc e);
+PICKSIGHT_ERROR_DOMAIN(ProtocolErrc, "robot protocol")
 
 // A parsed request: the command word upper-cased and its arguments, split
 // on spaces, tabs or commas.
@@ -32,7 +36,13 @@ struct Request {
 // Nullopt for an empty or blank line.
 std::optional<Request> parseRequest(std::string_view line);
 
-std::string errorReply(int code, const std::string& text);
+// "ERROR <code> <text>", the code from the protocol's one table
+// (robot_errors.hpp).
+std::string errorReply(const Error& error);
+template <typename E>
+std::string errorReply(E code, const std::string& text) {
+  return errorReply(makeError(code, text));
+}
 // A part type argument: an integer in [0, 9999].
 std::optional<int> parseType(std::string_view text);
 // Every argument from `first` on as a finite number; nullopt if one is not.
@@ -62,3 +72,5 @@ class CommandTable {
 };
 
 }  // namespace picksight::app
+
+PICKSIGHT_ERROR_ENUM(picksight::app::ProtocolErrc)

@@ -19,14 +19,15 @@
 
 namespace picksight::app {
 
-// Error codes of calibration requests; they are also the robot protocol's.
-enum CalibrationError : int {
-  kNoSuchPoint = 40,         // DELETE: no point with that id
-  kTooFewPoints = 41,        // COMPUTE: fewer than 3 usable points
-  kDegeneratePoints = 42,    // COMPUTE: points on one line, or too close
-  kCalibrationStorage = 43,  // calibration.yaml could not be written
-  kNotComputed = 44,         // no robot-camera transform yet
+// Why a change to the cell's calibration failed. (COMPUTE's own failures
+// are calibration::CalibrationErrc, passed on as they are.)
+enum class CellCalibrationErrc {
+  kNoSuchPoint = 1,     // DELETE: no point with that id
+  kCalibrationStorage,  // calibration.yaml could not be written, or is damaged
+  kNotComputed,         // no robot-camera transform yet
 };
+const char* errorName(CellCalibrationErrc e);
+PICKSIGHT_ERROR_DOMAIN(CellCalibrationErrc, "cell calibration")
 
 // The frame LOCATE replies in: the vision frame in sensor pixels (no
 // CALCAM), in millimetres (CALCAM, no COMPUTE), or the robot frame.
@@ -55,7 +56,7 @@ class CellCalibration {
   explicit CellCalibration(std::string path);
 
   // Reads the file if it exists. A damaged file is an error, and is left
-  // alone: every change is then refused (kCalibrationStorage) rather than
+  // alone: every change is then refused (CellCalibrationErrc::kCalibrationStorage) rather than
   // overwrite what an integrator may still repair.
   Result<void> load();
 
@@ -63,11 +64,11 @@ class CellCalibration {
   CalibrationSummary summary() const;
   std::map<int, calibration::PointPair> points() const;
 
-  // Each change is written before it takes effect (kCalibrationStorage).
+  // Each change is written before it takes effect (CellCalibrationErrc::kCalibrationStorage).
   Result<void> setScale(const calibration::PixelScale& scale);
   Result<void> setLens(const calibration::LensModel& lens);
   Result<int> addPoint(const calibration::PointPair& pair);
-  Result<void> deletePoint(int id);  // kNoSuchPoint names the id
+  Result<void> deletePoint(int id);  // CellCalibrationErrc::kNoSuchPoint names the id
   // Fits the transform to the stored points and stores it.
   Result<calibration::CalibrationResult> compute(
       calibration::Method method = calibration::Method::kBest);
@@ -83,3 +84,5 @@ class CellCalibration {
 };
 
 }  // namespace picksight::app
+
+PICKSIGHT_ERROR_ENUM(picksight::app::CellCalibrationErrc)

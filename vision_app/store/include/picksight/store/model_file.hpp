@@ -12,6 +12,16 @@
 
 namespace picksight::app {
 
+// Why a model could not be read, stored or removed.
+enum class ModelErrc {
+  kUnknownType = 1,  // no model of that type
+  kStorage,          // the file or its directory could not be written or removed
+  kInvalidModel,     // the model breaks a rule (tolerances, weights, grasps...)
+  kBadFile,          // the file is not a readable part model
+};
+const char* errorName(ModelErrc e);
+PICKSIGHT_ERROR_DOMAIN(ModelErrc, "model")
+
 // Version 2 added the grasp section; version 1 files are still read (no
 // grasp styles, no fingers).
 constexpr int kModelFormatVersion = 2;
@@ -40,8 +50,10 @@ std::string modelToYaml(const vision::PartModel& model, const GraspSetup& grasp 
 Result<ModelRecord> modelRecordFromYaml(const std::string& text);
 Result<vision::PartModel> modelFromYaml(const std::string& text);
 
-// Checks grasp values (finite, in range, within the limits); empty when
-// valid, else what is wrong.
-std::string validateGrasp(const GraspSetup& grasp);
+// Checks grasp values (finite, in range, within the limits);
+// ModelErrc::kInvalidModel says what is wrong.
+Result<void> validateGrasp(const GraspSetup& grasp);
 
 }  // namespace picksight::app
+
+PICKSIGHT_ERROR_ENUM(picksight::app::ModelErrc)

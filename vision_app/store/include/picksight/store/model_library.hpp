@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "picksight/common/result.hpp"
-#include "picksight/vision/part_model.hpp"
 #include "picksight/store/model_file.hpp"
+#include "picksight/vision/part_model.hpp"
 
 namespace picksight::app {
 
@@ -32,11 +32,11 @@ class ModelLibrary {
   // Adds or replaces the model of model.type: the file first, then memory.
   // A replaced model keeps its grasp styles and gripper.
   Result<void> store(const vision::PartModel& model);
-  // Removes the model of `type` (file and memory); an error (code 1) if there
-  // is none.
+  // Removes the model of `type` (file and memory); ModelErrc::kUnknownType
+  // if there is none.
   Result<void> remove(int type);
   // Replaces the grasp styles and gripper of `type`, written with its model;
-  // an error (code 1) if there is no model of `type`.
+  // ModelErrc::kUnknownType if there is no model of `type`.
   Result<void> setGrasp(int type, const GraspSetup& grasp);
 
   std::shared_ptr<const ModelList> snapshot() const;

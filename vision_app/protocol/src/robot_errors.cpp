@@ -1,0 +1,63 @@
+// Errors to robot ERROR codes: the protocol's one table.
+#include "picksight/protocol/robot_errors.hpp"
+
+#include <array>
+#include <utility>
+
+#include "picksight/calibration/robot_camera.hpp"
+#include "picksight/camera_link/camera_link.hpp"
+#include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/store/model_library.hpp"
+#include "picksight/transport/control_client.hpp"
+
+namespace picksight::app {
+namespace {
+
+using calibration::CalibrationErrc;
+
+constexpr int kInternal = 99;
+
+const std::array<std::pair<std::error_code, int>, 27> kTable = {{
+    {VisionErrc::kNoTarget, 1},
+    {VisionErrc::kSeveralTargets, 2},
+    {VisionErrc::kNotADisc, 3},
+    {ProtocolErrc::kUnknownCommand, 10},
+    {ProtocolErrc::kBadArguments, 11},
+    {ProtocolErrc::kRequestTooLong, 12},
+    {ProtocolErrc::kTooManyConnections, 13},
+    {ProtocolErrc::kEmptyRequest, 14},
+    {CameraErrc::kNoFrame, 20},
+    {CameraErrc::kNoVideoServer, 21},
+    {ControlErrc::kNoReply, 21},
+    {CameraErrc::kCameraRefused, 22},
+    {vision::PartModelErrc::kNoPart, 30},
+    {vision::PartModelErrc::kSeveralParts, 31},
+    {VisionErrc::kUnknownType, 32},
+    {ModelErrc::kUnknownType, 32},
+    {VisionErrc::kStorageFailed, 33},
+    {ModelErrc::kStorage, 33},
+    {CellCalibrationErrc::kNoSuchPoint, 40},
+    {CalibrationErrc::kTooFewPoints, 41},
+    {CalibrationErrc::kDegeneratePoints, 42},
+    {CalibrationErrc::kBadTarget, 3},
+    {CalibrationErrc::kBadInput, 11},
+    {CellCalibrationErrc::kCalibrationStorage, 43},
+    {CalibrationErrc::kBadFile, 43},
+    {CellCalibrationErrc::kNotComputed, 44},
+    {ProtocolErrc::kInternalError, kInternal},
+}};
+
+}  // namespace
+
+int robotErrorCode(const std::error_code& code) {
+  for (const auto& [known, robot] : kTable) {
+    if (known == code) return robot;
+  }
+  // Any other answer of the video server: the camera refused.
+  if (code.category() == make_error_code(ControlErrc::kInternal).category()) return 22;
+  return kInternal;
+}
+
+}  // namespace picksight::app
