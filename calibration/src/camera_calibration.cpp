@@ -7,6 +7,8 @@
 
 #include <cmath>
 
+#include "picksight/common/angles.hpp"
+
 namespace picksight::calibration {
 
 Result<PixelScale> scaleFromCircle(const cv::Moments& m, double radius_mm) {
@@ -21,9 +23,9 @@ Result<PixelScale> scaleFromCircle(const cv::Moments& m, double radius_mm) {
   // only counts once the ellipse is measurably elongated.
   const double spread = std::hypot(m.mu20 - m.mu02, 2 * m.mu11) / (m.mu20 + m.mu02);
   if (spread > 1e-3) {
-    double axis = 0.5 * std::atan2(2 * m.mu11, m.mu20 - m.mu02) * 180.0 / M_PI;
-    axis = std::fmod(axis + 180.0, 90.0);
-    s.skew_deg = std::min(axis, 90.0 - axis);
+    const double axis = 0.5 * std::atan2(2 * m.mu11, m.mu20 - m.mu02) * 180.0 / M_PI;
+    // How far the axis leans from the nearest image axis.
+    s.skew_deg = picksight::angleDiffDeg(axis, 0.0, 90.0);
   }
   return s;
 }

@@ -1,5 +1,5 @@
 // Robot-camera calibration: least-squares (Kabsch in 2D) and geometric
-// (circle intersections, SPEC section 3) estimators behind least median of
+// (circle intersections) estimators behind least median of
 // squares outlier rejection.
 #include "picksight/calibration/robot_camera.hpp"
 
@@ -27,8 +27,8 @@ const char* errorName(CalibrationErrc e) {
   return "unknown";
 }
 namespace {
+using picksight::kDegPerRad;
 using picksight::signedDeg;
-constexpr double kDeg = 180.0 / M_PI;
 // Points closer together than this (mm) along their spread's minor axis are
 // taken as lying on one line: rotation and handedness are then unobservable.
 constexpr double kMinSpreadMm = 1.0;
@@ -77,7 +77,7 @@ RigidTransform leastSquares(const std::vector<PointPair>& pts, const std::vector
   const double theta = std::atan2(sxy - syx, sxx + syy);
   RigidTransform t;
   t.mirrored = mirrored;
-  t.rz_deg = signedDeg(theta * kDeg);
+  t.rz_deg = signedDeg(theta * kDegPerRad);
   const double c = std::cos(theta), s = std::sin(theta);
   t.dx = cr_mean.x - (c * cv_mean.x - s * cv_mean.y);
   t.dy = cr_mean.y - (s * cv_mean.x + c * cv_mean.y);
@@ -149,7 +149,7 @@ RigidTransform geometric(const std::vector<PointPair>& pts, const std::vector<bo
   }
   RigidTransform t;
   t.mirrored = mirrored;
-  t.rz_deg = signedDeg(std::atan2(sy, sx) * kDeg);
+  t.rz_deg = signedDeg(std::atan2(sy, sx) * kDegPerRad);
   t.dx = origin.x;
   t.dy = origin.y;
   return t;
@@ -215,14 +215,12 @@ CalibrationResult evaluate(const RigidTransform& t, Method method,
 
 cv::Point2d RigidTransform::apply(cv::Point2d vision) const {
   const cv::Point2d v = mirror(vision, mirrored);
-  const double a = rz_deg / kDeg;
+  const double a = rz_deg / kDegPerRad;
   return {dx + std::cos(a) * v.x - std::sin(a) * v.y, dy + std::sin(a) * v.x + std::cos(a) * v.y};
 }
 
 double RigidTransform::applyToAngleDeg(double vision_deg) const {
-  double d = (mirrored ? -vision_deg : vision_deg) + rz_deg;
-  d = std::fmod(d, 360.0);
-  return d < 0 ? d + 360.0 : d;
+  return picksight::normalizeDeg((mirrored ? -vision_deg : vision_deg) + rz_deg);
 }
 
 const char* methodName(Method method) {

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "picksight/common/angles.hpp"
+
 namespace picksight::calibration {
 
 VisionFrame::VisionFrame(PixelScale scale, std::optional<LensModel> lens)
@@ -17,11 +19,7 @@ cv::Point2d VisionFrame::toPixels(cv::Point2d mm) const {
   return {mm.x / scale_.mm_per_px_x, -mm.y / scale_.mm_per_px_y};
 }
 
-double VisionFrame::angleToVision(double image_deg) {
-  double d = std::fmod(-image_deg, 360.0);
-  if (d < 0) d += 360.0;
-  return d >= 360.0 ? 0.0 : d;
-}
+double VisionFrame::angleToVision(double image_deg) { return picksight::normalizeDeg(-image_deg); }
 
 double VisionFrame::angleToImage(double vision_deg) { return angleToVision(vision_deg); }
 

@@ -5,22 +5,21 @@
 
 #include <cmath>
 
+#include "picksight/common/angles.hpp"
+
 namespace picksight::grasp {
 namespace {
-constexpr double kRad = M_PI / 180.0;
 constexpr int kShift = 4;  // sub-pixel bits for fillPoly
 
 cv::Point2d rotate(cv::Point2d p, double deg) {
-  const double c = std::cos(deg * kRad), s = std::sin(deg * kRad);
+  const double c = std::cos(deg * kRadPerDeg), s = std::sin(deg * kRadPerDeg);
   return {c * p.x - s * p.y, s * p.x + c * p.y};
 }
 }  // namespace
 
 Pose gripperPose(const Pose& part, const GraspStyle& style) {
   const cv::Point2d offset = rotate({style.x_mm, style.y_mm}, part.rz_deg);
-  double rz = std::fmod(part.rz_deg + style.rz_deg, 360.0);
-  if (rz < 0) rz += 360.0;
-  return {part.x + offset.x, part.y + offset.y, rz};
+  return {part.x + offset.x, part.y + offset.y, normalizeDeg(part.rz_deg + style.rz_deg)};
 }
 
 std::vector<std::vector<cv::Point2d>> fingerPolygons(const Pose& gripper, const Gripper& fingers,

@@ -1,11 +1,16 @@
-// Pins angle differences modulo a part's symmetry period and normalization to [0, 360).
+// Pins angle differences modulo a part's symmetry period and the wraps into
+// [0, period), [0, 360) and (-180, 180], edge cases included.
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
 
 #include "picksight/common/angles.hpp"
 
 using Catch::Detail::Approx;
 using picksight::angleDiffDeg;
 using picksight::normalizeDeg;
+using picksight::signedDeg;
+using picksight::wrapDeg;
 
 TEST_CASE("angleDiffDeg wraps around 360", "[common]") {
   CHECK(angleDiffDeg(359, 1) == Approx(2));
@@ -44,4 +49,58 @@ TEST_CASE("normalizeDeg maps into 0 up to but excluding 360", "[common]") {
   const double tiny = normalizeDeg(-1e-20);
   CHECK(tiny >= 0.0);
   CHECK(tiny < 360.0);
+}
+
+TEST_CASE("normalizeDeg never returns negative zero", "[common]") {
+  CHECK_FALSE(std::signbit(normalizeDeg(-0.0)));
+  CHECK_FALSE(std::signbit(normalizeDeg(-360.0)));
+  CHECK_FALSE(std::signbit(normalizeDeg(-720.0)));
+}
+
+TEST_CASE("wrapDeg maps into 0 up to but excluding the period", "[common]") {
+  CHECK(wrapDeg(190, 180) == Approx(10));
+  CHECK(wrapDeg(-10, 180) == Approx(170));
+  CHECK(wrapDeg(180, 180) == 0.0);
+  CHECK(wrapDeg(-180, 180) == 0.0);
+  CHECK(wrapDeg(95, 90) == Approx(5));
+  CHECK(wrapDeg(359.5, 120) == Approx(119.5));
+  CHECK(wrapDeg(725, 360) == Approx(5));
+  const double tiny = wrapDeg(-1e-20, 90);
+  CHECK(tiny >= 0.0);
+  CHECK(tiny < 90.0);
+  CHECK_FALSE(std::signbit(wrapDeg(-0.0, 180)));
+}
+
+TEST_CASE("wrapDeg with period 0 or not a number means no angle", "[common]") {
+  CHECK(wrapDeg(123, 0) == 0.0);
+  CHECK(wrapDeg(-5, -90) == 0.0);
+  CHECK(wrapDeg(45, std::numeric_limits<double>::quiet_NaN()) == 0.0);
+}
+
+TEST_CASE("wrapDeg of a non-negative angle is fmod", "[common]") {
+  for (double deg : {0.0, 0.1, 59.999, 60.0, 119.5, 359.9, 1000.25})
+    CHECK(wrapDeg(deg, 60) == std::fmod(deg, 60.0));
+}
+
+TEST_CASE("signedDeg maps into minus 180 excluded up to 180", "[common]") {
+  CHECK(signedDeg(0) == 0.0);
+  CHECK(signedDeg(180) == Approx(180));
+  CHECK(signedDeg(-180) == Approx(180));
+  CHECK(signedDeg(190) == Approx(-170));
+  CHECK(signedDeg(-190) == Approx(170));
+  CHECK(signedDeg(540) == Approx(180));
+  CHECK(signedDeg(359) == Approx(-1));
+  CHECK(signedDeg(-359) == Approx(1));
+  CHECK(signedDeg(720) == 0.0);
+}
+
+TEST_CASE("angleDiffDeg is symmetric and at most half the period", "[common]") {
+  for (double a = -400; a <= 400; a += 37.5)
+    for (double b = -400; b <= 400; b += 41.25)
+      for (double period : {360.0, 180.0, 90.0, 120.0}) {
+        const double d = angleDiffDeg(a, b, period);
+        CHECK(d >= 0.0);
+        CHECK(d <= period / 2 + 1e-9);
+        CHECK(d == angleDiffDeg(b, a, period));
+      }
 }

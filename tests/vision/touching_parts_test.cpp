@@ -102,7 +102,7 @@ TEST_CASE("the edge fit moves a pose a few pixels off onto the part", "[vision][
   REQUIRE(regions.size() == 1);
   const ps::PartTruth& truth = s.truth()[0];
   const double angle = truth.angle_deg - t.truth_angle;
-  const Pose start{{truth.x + 1.5, truth.y - 1.0}, angle + 2.0, false};
+  const ImagePose start{{truth.x + 1.5, truth.y - 1.0}, angle + 2.0, false};
   const EdgeFit fit = refinePoseOnEdges(t.model, regions[0], start);
   REQUIRE(fit.ok);
   CHECK(std::hypot(fit.pose.centre.x - truth.x, fit.pose.centre.y - truth.y) < 0.05);

@@ -9,6 +9,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "picksight/common/angles.hpp"
+
 namespace picksight::vision {
 
 HuArray huInvariants(const cv::Moments& m) {
@@ -64,9 +66,7 @@ std::vector<double> radialSignature(const std::vector<cv::Point>& outer, cv::Poi
   for (const auto& p : outer) {
     const double dx = p.x - centroid.x;
     const double dy = p.y - centroid.y;
-    double a = std::atan2(dy, dx) * 180.0 / M_PI - start_deg + 0.5 * step;
-    a = std::fmod(a, 360.0);
-    if (a < 0) a += 360.0;
+    const double a = normalizeDeg(std::atan2(dy, dx) * 180.0 / M_PI - start_deg + 0.5 * step);
     const size_t bin = std::min(static_cast<size_t>(a / step), r.size() - 1);
     r[bin] = std::max(r[bin], std::hypot(dx, dy));
   }

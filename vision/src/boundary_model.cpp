@@ -12,12 +12,12 @@
 
 namespace picksight::vision {
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 // An arc whose radius exceeds this many times the loop's extent is a line.
 constexpr double kMaxRadiusFactor = 4.0;
 
-double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kDeg; }
+double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kRadPerDeg; }
 
+using picksight::kRadPerDeg;
 using picksight::signedDeg;
 
 cv::Point2d unit(cv::Point2d v) {
@@ -120,12 +120,12 @@ Primitive makeLine(cv::Point2d a, cv::Point2d b) {
 
 double Primitive::length() const {
   if (kind == PrimitiveKind::kLine) return std::hypot(end.x - start.x, end.y - start.y);
-  return std::abs(sweep_deg) * kDeg * radius;
+  return std::abs(sweep_deg) * kRadPerDeg * radius;
 }
 
 cv::Point2d Primitive::pointAt(double t) const {
   if (kind == PrimitiveKind::kLine) return start + (end - start) * t;
-  const double a = angleOf(start - centre) * kDeg + t * sweep_deg * kDeg;
+  const double a = angleOf(start - centre) * kRadPerDeg + t * sweep_deg * kRadPerDeg;
   return centre + cv::Point2d(std::cos(a), std::sin(a)) * radius;
 }
 
@@ -306,7 +306,7 @@ std::vector<Corner> findCorners(const std::vector<BoundaryLoop>& loops, double c
       const double turn = signedDeg(c.direction_out_deg - c.direction_in_deg);
       // Turn ranges widen for short edges, whose directions are less sure.
       const double slack =
-          8.0 + std::atan2(2 * conformity, std::min(a.length(), b.length())) / kDeg;
+          8.0 + std::atan2(2 * conformity, std::min(a.length(), b.length())) / kRadPerDeg;
       c.turn_deg = {turn - slack, turn + slack};
       c.convex = (turn >= 0) == (winding >= 0);
       const double tol = 2 * conformity;
@@ -398,8 +398,8 @@ namespace {
 template <typename F>
 void forPlaced(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
                const EdgeDistance& edges, bool mirrored, F&& f) {
-  const double c = std::cos(angle_deg * kDeg);
-  const double s = std::sin(angle_deg * kDeg);
+  const double c = std::cos(angle_deg * kRadPerDeg);
+  const double s = std::sin(angle_deg * kRadPerDeg);
   const double flip = mirrored ? -1.0 : 1.0;
   for (const auto& sample : samples) {
     const double x = sample.point.x;

@@ -8,17 +8,12 @@
 #include <cmath>
 #include <memory>
 
+#include "picksight/common/angles.hpp"
 #include "picksight/vision/blob_features.hpp"
 #include "picksight/vision/touching_parts.hpp"
 
 namespace picksight::vision {
 namespace {
-
-double normalizeDeg(double deg) {
-  double d = std::fmod(deg, 360.0);
-  if (d < 0) d += 360.0;
-  return d >= 360.0 ? 0.0 : d;
-}
 
 // Phase of the region's complex moment of order k, degrees.
 double regionPhaseDeg(const Region& region, int k) {
@@ -133,7 +128,7 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
     best.score = direct.score;
     best.centroid = r.centroid;
     best.symmetry_deg = model->symmetryDeg();
-    best.angle_deg = best.symmetry_deg > 0 ? std::fmod(direct.angle_deg, best.symmetry_deg) : 0.0;
+    best.angle_deg = wrapDeg(direct.angle_deg, best.symmetry_deg);
     best.body_distance = distance;
   }
   if (best.model) return {best};

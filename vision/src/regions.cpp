@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "picksight/common/angles.hpp"
+
 namespace picksight::vision {
 
 double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
@@ -26,9 +28,7 @@ double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
   }
   double deg = theta * 180.0 / M_PI;
   if (backward > forward) deg += 180.0;
-  deg = std::fmod(deg, 360.0);
-  if (deg < 0) deg += 360.0;
-  return deg;
+  return normalizeDeg(deg);
 }
 
 namespace {

@@ -13,7 +13,6 @@
 
 namespace picksight::vision {
 namespace {
-constexpr double kDeg = M_PI / 180.0;
 // A corner turning less than this has no reliable direction (a line running
 // tangentially into an arc, a wobble of the fit).
 constexpr double kMinCornerTurnDeg = 30;
@@ -41,15 +40,13 @@ constexpr double kMaxOutside = 0.06;
 // Edge samples this close to a primitive's end see the neighbouring edge.
 constexpr double kCornerClearancePx = 2.0;
 
-double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kDeg; }
+double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kRadPerDeg; }
 
+using picksight::angleDiffDeg;
+using picksight::kRadPerDeg;
+using picksight::normalizeDeg;
 using picksight::signedDeg;
-
-double normalizeDeg(double deg) {
-  double d = std::fmod(deg, 360.0);
-  if (d < 0) d += 360.0;
-  return d >= 360.0 ? 0.0 : d;
-}
+using picksight::wrapDeg;
 
 cv::Point2d rotate(cv::Point2d p, double c, double s) {
   return {c * p.x - s * p.y, s * p.x + c * p.y};
@@ -145,7 +142,7 @@ cv::Point2d awayNormal(const Primitive& p, double t, bool left_interior, bool ho
   if (p.kind == PrimitiveKind::kLine) {
     tangent = (p.end - p.start) / std::max(p.length(), 1e-9);
   } else {
-    const double a = angleOf(p.start - p.centre) * kDeg + t * p.sweep_deg * kDeg;
+    const double a = angleOf(p.start - p.centre) * kRadPerDeg + t * p.sweep_deg * kRadPerDeg;
     const cv::Point2d r(std::cos(a), std::sin(a));
     tangent = p.sweep_deg >= 0 ? cv::Point2d(-r.y, r.x) : cv::Point2d(r.y, -r.x);
   }
@@ -234,27 +231,25 @@ std::vector<BoundarySample> sparseSamples(const std::vector<BoundarySample>& all
 
 struct Candidate {
   const PartModel* model = nullptr;
-  Pose pose;
+  ImagePose pose;
   double score = 0;
   double rms = 0;
 };
 
-bool samePose(const PartModel& m, const Pose& a, const Pose& b, double px, double deg) {
+bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double px, double deg) {
   if (a.mirrored != b.mirrored) return false;
   if (std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) > px) return false;
-  const double period = m.symmetryDeg();
-  if (period <= 0) return true;
-  double d = std::fmod(std::abs(a.angle_deg - b.angle_deg), period);
-  return std::min(d, period - d) <= deg;
+  // A period of 0 (any turn looks the same): the angles always agree.
+  return angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
 }
 
 // The model's loops placed at a pose, as polygons in canvas coordinates:
 // filled together, the holes stay empty.
-std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Pose& pose,
+std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose,
                                                   cv::Point origin) {
   std::vector<std::vector<cv::Point>> polys;
-  const double c = std::cos(pose.angle_deg * kDeg);
-  const double s = std::sin(pose.angle_deg * kDeg);
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
   const double flip = pose.mirrored ? -1.0 : 1.0;
   for (const auto& loop : m.loops) {
     std::vector<cv::Point> poly;
@@ -283,11 +278,11 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double f = mirrored ? -1.0 : 1.0;
   const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle) {
-    const double c = std::cos(angle * kDeg);
-    const double s = std::sin(angle * kDeg);
+    const double c = std::cos(angle * kRadPerDeg);
+    const double s = std::sin(angle * kRadPerDeg);
     const cv::Point2d centre = image_point - rotate({model_point.x, f * model_point.y}, c, s);
     const double score = verifyScore(sparse, centre, angle, edges, model.edge_tolerance, mirrored);
-    return Candidate{&model, Pose{centre, normalizeDeg(angle), mirrored}, score, 0};
+    return Candidate{&model, ImagePose{centre, normalizeDeg(angle), mirrored}, score, 0};
   };
   for (const auto& mc : corners) {
     for (const auto& ic : image_corners) {
@@ -299,7 +294,7 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
   }
   // An arc fixes where its centre goes; the rotation about it is scanned,
   // keeping the local maxima of the screening score.
-  const double step = kScanStepPx / std::max(model.radius, 1.0) / kDeg;
+  const double step = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   const int steps = static_cast<int>(std::ceil(360.0 / step));
   std::vector<Candidate> scan(static_cast<size_t>(steps));
   for (const auto& ma : arcs) {
@@ -318,7 +313,7 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
 }
 }  // namespace
 
-EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Pose& start,
+EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
                           double search_px, int iterations) {
   const auto samples = edgeSamples(model, 1.0);
   const Coverage cov(region);
@@ -334,8 +329,8 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Po
   // The last pass only measures: residuals and inliers at the final pose.
   for (int it = 0; it <= iterations; ++it) {
     const bool measure_only = it == iterations;
-    const double c = std::cos(fit.pose.angle_deg * kDeg);
-    const double s = std::sin(fit.pose.angle_deg * kDeg);
+    const double c = std::cos(fit.pose.angle_deg * kRadPerDeg);
+    const double s = std::sin(fit.pose.angle_deg * kRadPerDeg);
     const double step = window > 2.0 ? 0.5 : 0.25;
     cv::Matx44d a = cv::Matx44d::zeros();
     cv::Vec4d b(0, 0, 0, 0);
@@ -364,7 +359,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Po
     cv::Vec4d x;
     if (!cv::solve(a, b, x, cv::DECOMP_CHOLESKY)) return fit;
     fit.pose.centre += cv::Point2d(x[0], x[1]);
-    fit.pose.angle_deg = normalizeDeg(fit.pose.angle_deg + x[2] / kDeg);
+    fit.pose.angle_deg = normalizeDeg(fit.pose.angle_deg + x[2] / kRadPerDeg);
     offset = x[3];
     // Narrow the search as the pose settles; outliers (the other part's
     // edges near a contact) fall outside the gate.
@@ -471,11 +466,11 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       propose(*m, mirrored, image_corners, image_arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-      std::vector<Pose> tried;
+      std::vector<ImagePose> tried;
       std::vector<Candidate> refined;
       for (const auto& p : proposed) {
         if (static_cast<int>(tried.size()) >= kMaxRefinedPerModel) break;
-        const auto near = [&](const Pose& q) { return samePose(*m, p.pose, q, 2.0, 3.0); };
+        const auto near = [&](const ImagePose& q) { return samePose(*m, p.pose, q, 2.0, 3.0); };
         if (std::any_of(tried.begin(), tried.end(), near)) continue;
         tried.push_back(p.pose);
         const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
@@ -533,8 +528,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     match.score = c.score;
     match.centroid = c.pose.centre;
     match.symmetry_deg = m.symmetryDeg();
-    match.angle_deg =
-        match.symmetry_deg > 0 ? std::fmod(c.pose.angle_deg, match.symmetry_deg) : 0.0;
+    match.angle_deg = wrapDeg(c.pose.angle_deg, match.symmetry_deg);
     match.touching = true;
     found.push_back(match);
   }

@@ -8,9 +8,9 @@
 #include <cstring>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <system_error>
 
+#include "eight_bit_image.hpp"
 #include "picksight/common/log.hpp"
 
 namespace picksight::video {
@@ -26,12 +26,7 @@ SourceFrame toFrame(cv::Mat image) {
     frame.layout = PixelLayout::kMono16;
     return frame;
   }
-  if (image.depth() == CV_16U) {
-    image.convertTo(image, CV_8U, 1.0 / 257.0);
-  } else if (image.depth() != CV_8U) {
-    cv::normalize(image, image, 0, 255, cv::NORM_MINMAX, CV_8U);
-  }
-  if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+  image = toEightBit(image);
   frame.layout = image.channels() == 3 ? PixelLayout::kBGR8 : PixelLayout::kMono8;
   frame.image = std::move(image);
   return frame;

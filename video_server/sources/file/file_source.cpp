@@ -6,28 +6,10 @@
 #include <cerrno>
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+
+#include "eight_bit_image.hpp"
 
 namespace picksight::video {
-namespace {
-// Any depth/channel layout imread gives, to 8-bit mono or BGR.
-cv::Mat toEightBit(const cv::Mat& in) {
-  cv::Mat eight;
-  if (in.depth() == CV_16U) {
-    in.convertTo(eight, CV_8U, 1.0 / 257.0);
-  } else if (in.depth() != CV_8U) {
-    cv::normalize(in, eight, 0, 255, cv::NORM_MINMAX, CV_8U);
-  } else {
-    eight = in;
-  }
-  if (eight.channels() == 4) {
-    cv::Mat bgr;
-    cv::cvtColor(eight, bgr, cv::COLOR_BGRA2BGR);
-    return bgr;
-  }
-  return eight;
-}
-}  // namespace
 
 FileSource::FileSource(std::string path) : path_(std::move(path)) {}
 

@@ -7,6 +7,8 @@
 #include <sys/types.h>
 
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 namespace picksight::video {
@@ -25,6 +27,13 @@ class V4l2Device {
   virtual int munmap(void* address, size_t length) = 0;
   virtual int poll(pollfd* fds, nfds_t count, int timeout_ms) = 0;
 };
+
+// A fixed-size, maybe unterminated kernel string.
+template <size_t N>
+std::string kernelString(const uint8_t (&bytes)[N]) {
+  const auto* chars = reinterpret_cast<const char*>(bytes);
+  return std::string(chars, strnlen(chars, N));
+}
 
 // A device file descriptor, closed through its device. Move-only.
 class V4l2Fd {

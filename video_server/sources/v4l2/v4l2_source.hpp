@@ -1,5 +1,7 @@
 // The V4L2 camera: USB webcams and capture cards through libv4l2, mmap
-// streaming, with the device's controls exposed as features.
+// streaming, with the device's controls exposed as features. Its members are
+// defined in v4l2_source.cpp (open, close, rate), v4l2_format_negotiation.cpp,
+// v4l2_streaming.cpp and v4l2_controls.cpp.
 #pragma once
 
 #include <linux/videodev2.h>
@@ -13,28 +15,9 @@
 
 #include "picksight/sources/source.hpp"
 #include "v4l2_device.hpp"
+#include "v4l2_options.hpp"
 
 namespace picksight::video {
-
-// What "v4l2:" asks for: "/dev/video0?width=1280&height=720&format=mjpeg&fps=30&buffers=4".
-// width and height (both or neither): the frame size; the nearest the device
-// offers when it has not this one. format: yuyv, mjpeg, uyvy, grey, y16,
-// rgb24, bgr24 or a Bayer order (rggb, grbg, bggr, gbrg); without it YUYV,
-// else MJPEG, is chosen at that size, MJPEG first when only it reaches the
-// requested fps. fps: the initial frame rate, which the camera's own
-// frame-rate setting then overrides only when it changes at run time.
-// buffers: mmap buffers to request (2..32, default 4; the driver may grant another count).
-struct V4l2Options {
-  std::string path;
-  int width = 0;
-  int height = 0;
-  uint32_t fourcc = 0;  // 0 = choose
-  double fps = 0;       // 0 = the camera's setting
-  int buffers = 4;
-};
-
-// The error names the key or value that is wrong.
-Result<V4l2Options> parseV4l2Options(const std::string& text);
 
 // Threading: called from the camera's acquisition thread only. The kernel
 // fills the buffers; grab() only copies one out and queues it straight back.
@@ -73,6 +56,7 @@ class V4l2Source : public Source {
   int xioctl(unsigned long request, void* arg);
   // errno after a failed call, as a source error.
   Error deviceError(const std::string& what, bool streaming = false);
+  Error notOpen() const;
   // The rate to run at: a run-time change, else the URI's, else the camera's default.
   double desiredFps() const;
   Result<void> openDevice();

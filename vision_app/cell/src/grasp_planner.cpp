@@ -7,19 +7,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "picksight/common/angles.hpp"
+
 namespace picksight::app {
 namespace {
 // Footprint margin (frame pixels) around a placed model: covers its
 // anti-aliased edge and a small pose error, so that a part never blocks
 // its own grasp.
 constexpr int kFootprintMargin = 3;
-
-double normalizeDeg(double deg, double period) {
-  if (!(period > 0)) return 0;
-  double d = std::fmod(deg, period);
-  if (d < 0) d += period;
-  return d >= period ? 0.0 : d;
-}
 
 const vision::PartModel* modelOf(const LocateScene& scene, int type) {
   if (!scene.models || type < 0) return nullptr;
@@ -110,7 +105,7 @@ grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
 grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision) {
   const cv::Point2d at = vision.toMm({part.x, part.y});
   // The vision frame flips y: an image rotation turns the other way.
-  const double rz = part.type >= 0 ? normalizeDeg(-part.angle_deg, part.symmetry_deg)
+  const double rz = part.type >= 0 ? wrapDeg(-part.angle_deg, part.symmetry_deg)
                                    : calibration::VisionFrame::angleToVision(part.angle_deg);
   return {at.x, at.y, rz};
 }

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "picksight/common/angles.hpp"
+
 #include "picksight/vision/recognizer.hpp"
 
 namespace picksight::app {
@@ -35,9 +37,7 @@ cv::Point2d FrameMapping::toSensor(cv::Point2d p) const {
 double FrameMapping::directionToSensor(double deg) const {
   // A direction scales like a displacement: undo an anisotropic resize.
   const double a = deg * M_PI / 180.0;
-  double out = std::atan2(std::sin(a) / scale_y, std::cos(a) / scale_x) * 180.0 / M_PI;
-  if (out < 0) out += 360.0;
-  return out >= 360.0 ? 0.0 : out;
+  return normalizeDeg(std::atan2(std::sin(a) / scale_y, std::cos(a) / scale_x) * 180.0 / M_PI);
 }
 
 cv::Mat greyImage(const ReceivedFrame& frame) {

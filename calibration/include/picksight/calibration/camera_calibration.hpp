@@ -1,5 +1,5 @@
 // Camera calibration: the pixel scale in millimetres from a circular target
-// of known radius (SPEC section 3), and optionally a full lens model
+// of known radius, and optionally a full lens model
 // (intrinsics and distortion) from chessboard views, used to undistort
 // located points.
 #pragma once

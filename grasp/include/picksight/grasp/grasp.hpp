@@ -1,4 +1,4 @@
-// Grasp selection with gripper clearance (SPEC section 3): each part model
+// Grasp selection with gripper clearance: each part model
 // has grasp styles (where the gripper goes, in the part's own frame) and a
 // gripper fingerprint (the finger rectangles in the gripper's frame). A grasp
 // is offered only if its fingers cover no other part; the first free style

@@ -20,7 +20,7 @@ namespace picksight::synthetic {
 // A part's silhouette in its own frame: loops[0] is the outer boundary, the
 // others are holes. Canonical frame: the area centroid is the origin, the axis
 // of least second moment is +x, and +x points to the side where the part
-// reaches farther from the centroid along that axis (SPEC section 3).
+// reaches farther from the centroid along that axis.
 struct Shape {
   std::vector<std::vector<cv::Point2d>> loops;
 };

@@ -1,4 +1,4 @@
-// Blob analysis: the features of one region (SPEC section 3), for unknown
+// Blob analysis: the features of one region, for unknown
 // regions and as the body part of trained part models.
 #pragma once
 
@@ -24,7 +24,7 @@ struct BlobFeatures {
   double eccentricity = 0;
   cv::Rect bbox;
   cv::Point2d centroid;
-  double angle_deg = 0;  // orientation, SPEC section 3 (see Region)
+  double angle_deg = 0;  // orientation, as Region::angle_deg
   // Raw moments about the image origin (pixel centres at integer
   // coordinates), central and normalized central moments.
   cv::Moments moments;

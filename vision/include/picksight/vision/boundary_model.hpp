@@ -1,6 +1,6 @@
 // Boundary models: a region's contours (outer and holes) as straight lines and
 // circular arcs within a conformity tolerance, the corners between them, and
-// the verification of a pose against the edges of an image (SPEC section 3).
+// the verification of a pose against the edges of an image.
 #pragma once
 
 #include <vector>

@@ -1,5 +1,5 @@
 // Part models (prototypes) trained from an image of one part: body features
-// with tolerances, a boundary model, and the part's symmetries (SPEC section 3).
+// with tolerances, a boundary model, and the part's symmetries.
 #pragma once
 
 #include <array>

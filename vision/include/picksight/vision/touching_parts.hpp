@@ -13,9 +13,10 @@
 
 namespace picksight::vision {
 
-// Where a model lies in the image: model point m lands at
+// Where a model lies in the image, in pixels (not grasp::Pose, which is in
+// millimetres in the vision frame): model point m lands at
 // centre + R(angle) (m.x, s m.y), s = -1 for the mirror image of the model.
-struct Pose {
+struct ImagePose {
   cv::Point2d centre;
   double angle_deg = 0;
   bool mirrored = false;
@@ -23,7 +24,7 @@ struct Pose {
 
 struct EdgeFit {
   bool ok = false;
-  Pose pose;
+  ImagePose pose;
   double rms_px = 0;           // of the inlier edge points about the fitted boundary
   double inlier_fraction = 0;  // of the model's edge samples (weighted) found on an edge
 };
@@ -35,7 +36,7 @@ struct EdgeFit {
 // to pixel centres lies inside the true edge. Edge points with no clean
 // crossing (where the part touches another) are left out. `search_px`: how
 // far along the normals an edge is looked for in the first iteration.
-EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Pose& start,
+EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
                           double search_px = 4.0, int iterations = 6);
 
 // Moves each primitive of `loops` (model frame: image point minus `origin`)

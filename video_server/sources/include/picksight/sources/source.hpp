@@ -1,6 +1,6 @@
-// The camera source interface: every driver (synthetic, file, and later
-// aravis, v4l2, stream, dir) implements it in its own folder under sources/,
-// and SourceFactory builds one from its source string.
+// The camera source interface: every driver (synthetic, file, dir, stream,
+// v4l2, aravis) implements it in its own folder under sources/, and
+// makeSource (source_factory.cpp) builds one from its source string.
 //
 // Threading: a Source is owned by one Camera and called from that camera's
 // acquisition thread only, except where a method says otherwise.

@@ -1,14 +1,14 @@
 // From located parts to the poses a robot picks at: each part's pose in the
 // vision frame, its first grasp style whose fingers cover no other part
-// (SPEC section 3, Grasping), then the reply frame (robot once computed).
+// (see grasp/grasp.hpp), then the reply frame (robot once computed).
 #pragma once
 
 #include <vector>
 
+#include "picksight/cell/vision_service.hpp"
 #include "picksight/grasp/grasp.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
-#include "picksight/cell/vision_service.hpp"
 
 namespace picksight::app {
 
