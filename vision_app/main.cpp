@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iostream>
 
+#include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/log.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"

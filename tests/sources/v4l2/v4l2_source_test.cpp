@@ -14,9 +14,9 @@
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
 
+#include "picksight/sources/source.hpp"
 #include "picksight/video_server/camera.hpp"
 #include "picksight/video_server/pixel_format.hpp"
-#include "picksight/sources/source.hpp"
 #include "simulated_v4l2_device.hpp"
 #include "v4l2/v4l2_source.hpp"
 
@@ -65,9 +65,9 @@ Feature findFeature(const std::vector<Feature>& features, const std::string& nam
 
 class CollectingSink : public FrameSink {
  public:
-  void publish(PublishedFrame frame) override {
+  void publish(picksight::Frame frame) override {
     std::lock_guard<std::mutex> lock(mutex_);
-    frames_.push_back(frame.sequence);
+    frames_.push_back(frame.info.sequence);
   }
   size_t count() const {
     std::lock_guard<std::mutex> lock(mutex_);

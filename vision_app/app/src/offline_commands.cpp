@@ -7,14 +7,14 @@
 #include <ostream>
 
 #include "picksight/calibration/camera_calibration.hpp"
-#include "picksight/common/text.hpp"
-#include "picksight/vision_app/app_options.hpp"
-#include "picksight/store/cell_calibration.hpp"
 #include "picksight/cell/grasp_planner.hpp"
+#include "picksight/cell/vision_service.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/protocol/model_commands.hpp"
+#include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
-#include "picksight/cell/vision_service.hpp"
+#include "picksight/vision_app/app_options.hpp"
 
 namespace picksight::app {
 
@@ -190,15 +190,9 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
           << (outcome.model.body.mirror_symmetric ? "1" : "0") << "\n";
     } else if (command == "locate") {
       // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
-      LocateOutcome outcome;
-      outcome.scene.models = library.snapshot();
-      outcome.parts = locateInImage(grey, FrameMapping{}, options->vision, *outcome.scene.models,
-                                    type, &outcome.scene);
-      const CellPick pick = pickPoses(outcome, *library.grasps(), calibration.geometry());
-      std::string line = "OK " + std::to_string(pick.poses.size());
-      for (const auto& p : pick.poses)
-        line += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
-      out << line << "\n";
+      const LocateOutcome outcome =
+          locateInFrame(frameFromImage(grey, path, 1), options->vision, library.snapshot(), type);
+      out << locateReply(pickPoses(outcome, *library.grasps(), calibration.geometry())) << "\n";
     } else {
       const auto blobs = blobsInImage(grey, options->vision);
       std::string line = "OK " + std::to_string(blobs.size());
