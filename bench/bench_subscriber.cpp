@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
       if (received == 0) first_ns = now;
       last_ns = now;
       ++received;
-      latency_ms.push_back(static_cast<double>(now - f->header.host_timestamp_ns()) / 1e6);
+      latency_ms.push_back(static_cast<double>(now - f->info.host_timestamp_ns) / 1e6);
     }
     lost = sub.framesLost();
   }

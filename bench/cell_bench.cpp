@@ -82,16 +82,13 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
   picksight::app::CellCalibration calibration(data_dir + "/calibration.yaml");
   if (!library.load().empty() || !calibration.load()) return {};
   const picksight::synthetic::SceneRenderer renderer(scene(width, height, parts, 5, kTypes));
-  const cv::Mat grey = renderer.render(1);
+  const picksight::Frame frame = picksight::frameFromImage(renderer.render(1), "cam0", 1);
   const auto geometry = calibration.geometry();
   std::vector<double> recognition, grasps;
   for (int i = 0; i < 100; ++i) {
-    picksight::app::LocateOutcome outcome;
-    outcome.scene.models = library.snapshot();
     const int type = 1 + i % static_cast<int>(kTypes.size());
     auto t0 = Clock::now();
-    outcome.parts =
-        picksight::app::locateInImage(grey, {}, {}, *outcome.scene.models, type, &outcome.scene);
+    const auto outcome = picksight::app::locateInFrame(frame, {}, library.snapshot(), type);
     recognition.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     t0 = Clock::now();
     const auto pick = picksight::app::pickPoses(outcome, *library.grasps(), geometry);

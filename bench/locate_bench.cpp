@@ -17,9 +17,9 @@
 #include <zmq.hpp>
 
 #include "locate_args.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
-#include "picksight/common/text.hpp"
 #include "picksight/transport/frame_message.hpp"
 #include "picksight/vision/binarize.hpp"
 #include "picksight/vision/regions.hpp"
@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
   while (images.size() < 20) {
     auto f = watcher.receive(200ms);
     if (!f) break;
-    images.push_back(f->image().clone());
+    images.push_back(f->image.clone());
   }
   vision.terminate();
   server.terminate();

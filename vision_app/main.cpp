@@ -7,10 +7,11 @@
 #include <cstring>
 #include <iostream>
 
+#include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/log.hpp"
+#include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
-#include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 int main(int argc, char** argv) {

@@ -57,27 +57,27 @@ TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
     INFO("reply: " << *reply);
     const auto poses = imagePoses(*reply);
     const UsedFrame used = usedFrame(robot);
-    auto frame = receiveUntil(
-        watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == used.sequence; });
+    auto frame =
+        receiveUntil(watcher, [&](const Frame& f) { return f.info.sequence == used.sequence; });
     REQUIRE(frame);
-    const auto& truth = frame->header.truth();
+    const auto& truth = frame->truth;
     REQUIRE(truth.size() == 8);
     CHECK(poses.size() == static_cast<size_t>(truth.size()));
     for (const auto& t : truth) {
       double best = std::numeric_limits<double>::max();
       const Pose* match = nullptr;
       for (const auto& p : poses) {
-        const double d = std::hypot(p.x - t.x(), p.y - t.y());
+        const double d = std::hypot(p.x - t.x, p.y - t.y);
         if (d < best) {
           best = d;
           match = &p;
         }
       }
       REQUIRE(match);
-      INFO(t.type() << " at " << t.x() << ", " << t.y() << " angle " << t.angle_deg());
+      INFO(t.type << " at " << t.x << ", " << t.y << " angle " << t.angle_deg);
       // Replies carry 3 decimals: 0.0005 of rounding on top of the error.
       CHECK(best < 0.1);
-      const double angle_error = angleDiffDeg(match->rz, t.angle_deg(), t.symmetry_deg());
+      const double angle_error = angleDiffDeg(match->rz, t.angle_deg, t.symmetry_deg);
       CHECK(angle_error < 0.5);
       worst_position = std::max(worst_position, best);
       worst_angle = std::max(worst_angle, angle_error);
@@ -153,11 +153,10 @@ TEST_CASE("LEARN a part, then LOCATE finds it turned from the trained pose",
   std::this_thread::sleep_for(300ms);
   auto robot = vision.connect();
   const auto truthOf = [&](uint64_t sequence) {
-    auto frame = receiveUntil(
-        watcher, [&](const ReceivedFrame& f) { return f.header.sequence() == sequence; });
+    auto frame = receiveUntil(watcher, [&](const Frame& f) { return f.info.sequence == sequence; });
     REQUIRE(frame);
-    REQUIRE(frame->header.truth().size() == 1);
-    return frame->header.truth(0);
+    REQUIRE(frame->truth.size() == 1);
+    return frame->truth[0];
   };
 
   CHECK(*robot.request("MODELS", 5s) == "OK 0");
@@ -177,8 +176,8 @@ TEST_CASE("LEARN a part, then LOCATE finds it turned from the trained pose",
     const auto poses = imagePoses(*reply);
     const auto truth = truthOf(usedFrame(robot).sequence);
     REQUIRE(poses.size() == 1);
-    CHECK(std::hypot(poses[0].x - truth.x(), poses[0].y - truth.y()) < 0.1);
-    CHECK(angleDiffDeg(poses[0].rz, truth.angle_deg() - trained.angle_deg()) < 0.3);
+    CHECK(std::hypot(poses[0].x - truth.x, poses[0].y - truth.y) < 0.1);
+    CHECK(angleDiffDeg(poses[0].rz, truth.angle_deg - trained.angle_deg) < 0.3);
   }
   // Another type is not trained: refused, no frame taken.
   reply = robot.request("LOCATE 2", 5s);

@@ -29,39 +29,39 @@ TEST_CASE("ROI and resize change both the pixels and the header", "[e2e][video]"
       {"--source", "cam0=synthetic:width=800,height=600,parts=5,noise=0", "--fps", "20"});
   zmq::context_t context;
   FrameSubscriber sub(context, server.frames, "cam0", 4);
-  auto full = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 800; });
+  auto full = receiveUntil(sub, [](const Frame& f) { return f.info.width == 800; });
   REQUIRE(full);
-  CHECK(full->header.roi_x() == 0);
-  CHECK(full->header.scale_x() == 1.0);
-  const cv::Mat sensor = full->image().clone();
+  CHECK(full->mapping.roi_x == 0);
+  CHECK(full->mapping.scale_x == 1.0);
+  const cv::Mat sensor = full->image.clone();
 
   REQUIRE(cam(server, {"roi", "cam0", "100", "50", "400", "300"}).exit_code == 0);
-  auto cropped = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 400; });
+  auto cropped = receiveUntil(sub, [](const Frame& f) { return f.info.width == 400; });
   REQUIRE(cropped);
-  CHECK(cropped->header.height() == 300);
-  CHECK(cropped->header.roi_x() == 100);
-  CHECK(cropped->header.roi_y() == 50);
-  CHECK(cropped->header.scale_x() == 1.0);
-  CHECK(cv::countNonZero(cropped->image() != sensor(cv::Rect(100, 50, 400, 300))) == 0);
+  CHECK(cropped->info.height == 300);
+  CHECK(cropped->mapping.roi_x == 100);
+  CHECK(cropped->mapping.roi_y == 50);
+  CHECK(cropped->mapping.scale_x == 1.0);
+  CHECK(cv::countNonZero(cropped->image != sensor(cv::Rect(100, 50, 400, 300))) == 0);
 
   REQUIRE(cam(server, {"size", "cam0", "200", "150"}).exit_code == 0);
-  auto resized = receiveUntil(sub, [](const ReceivedFrame& f) { return f.header.width() == 200; });
+  auto resized = receiveUntil(sub, [](const Frame& f) { return f.info.width == 200; });
   REQUIRE(resized);
-  CHECK(resized->header.height() == 150);
-  CHECK(resized->header.roi_x() == 100);
-  CHECK(resized->header.scale_x() == Approx(0.5));
-  CHECK(resized->header.scale_y() == Approx(0.5));
+  CHECK(resized->info.height == 150);
+  CHECK(resized->mapping.roi_x == 100);
+  CHECK(resized->mapping.scale_x == Approx(0.5));
+  CHECK(resized->mapping.scale_y == Approx(0.5));
   cv::Mat expected;
   cv::resize(sensor(cv::Rect(100, 50, 400, 300)), expected, cv::Size(200, 150), 0, 0,
              cv::INTER_AREA);
-  CHECK(cv::norm(resized->image(), expected, cv::NORM_INF) <= 1);
+  CHECK(cv::norm(resized->image, expected, cv::NORM_INF) <= 1);
 
   // Out of range is refused with the reason, and changes nothing.
   const auto refused = cam(server, {"roi", "cam0", "700", "0", "400", "300"});
   CHECK(refused.exit_code == 1);
-  auto still = receiveUntil(sub, [](const ReceivedFrame&) { return true; });
+  auto still = receiveUntil(sub, [](const Frame&) { return true; });
   REQUIRE(still);
-  CHECK(still->header.width() == 200);
+  CHECK(still->info.width == 200);
 }
 
 TEST_CASE("two subscribers receive the same sequence numbers", "[e2e][video]") {
@@ -76,13 +76,13 @@ TEST_CASE("two subscribers receive the same sequence numbers", "[e2e][video]") {
   auto first_b = b.receive(5s);
   REQUIRE(first_a);
   REQUIRE(first_b);
-  const uint64_t start = std::max(first_a->header.sequence(), first_b->header.sequence()) + 1;
+  const uint64_t start = std::max(first_a->info.sequence, first_b->info.sequence) + 1;
   auto collect = [&](FrameSubscriber& s) {
     std::vector<uint64_t> seqs;
     while (seqs.size() < 20) {
       auto f = s.receive(5s);
       if (!f) break;
-      if (f->header.sequence() >= start) seqs.push_back(f->header.sequence());
+      if (f->info.sequence >= start) seqs.push_back(f->info.sequence);
     }
     return seqs;
   };
@@ -112,9 +112,9 @@ TEST_CASE("a software trigger's frame carries the sequence its reply named", "[e
     REQUIRE(seq);
     auto frame = sub.receive(5s);
     REQUIRE(frame);
-    CHECK(static_cast<long long>(frame->header.sequence()) == *seq);
-    CHECK(frame->header.triggered());
-    CHECK(frame->header.host_timestamp_ns() > before);
+    CHECK(static_cast<long long>(frame->info.sequence) == *seq);
+    CHECK(frame->info.triggered);
+    CHECK(frame->info.host_timestamp_ns > before);
   }
 }
 

@@ -70,9 +70,8 @@ CommandResult run(const std::vector<std::string>& argv) {
   return r;
 }
 
-std::optional<ReceivedFrame> receiveUntil(FrameSubscriber& subscriber,
-                                          const std::function<bool(const ReceivedFrame&)>& accept,
-                                          int tries) {
+std::optional<Frame> receiveUntil(FrameSubscriber& subscriber,
+                                  const std::function<bool(const Frame&)>& accept, int tries) {
   for (int i = 0; i < tries; ++i) {
     auto f = subscriber.receive(2s);
     if (f && accept(*f)) return f;

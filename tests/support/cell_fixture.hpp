@@ -49,9 +49,8 @@ struct CommandResult {
 CommandResult run(const std::vector<std::string>& argv);
 
 // Receives frames until one satisfies `accept` or `tries` frames went by.
-std::optional<ReceivedFrame> receiveUntil(FrameSubscriber& subscriber,
-                                          const std::function<bool(const ReceivedFrame&)>& accept,
-                                          int tries = 100);
+std::optional<Frame> receiveUntil(FrameSubscriber& subscriber,
+                                  const std::function<bool(const Frame&)>& accept, int tries = 100);
 
 // The reply "OK n x y rz ..." as (x, y, rz) triples; REQUIREs the format.
 struct Pose {

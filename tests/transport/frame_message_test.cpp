@@ -1,6 +1,6 @@
-// Pins the frame wire format: header/payload consistency, the zero-copy image
-// view, and a FrameSubscriber that returns only well-formed frames of exactly
-// its camera and counts the malformed ones.
+// Pins the frame wire format: header/payload consistency, the zero-copy
+// decode, the encoder and decoder agreeing, and a FrameSubscriber that returns
+// only well-formed frames of exactly its camera and counts the malformed ones.
 #include <chrono>
 #include <cstring>
 #include <string>
@@ -13,8 +13,8 @@
 
 using namespace std::chrono_literals;
 namespace proto = picksight::proto;
+using picksight::Frame;
 using picksight::FrameSubscriber;
-using picksight::ReceivedFrame;
 
 namespace {
 
@@ -67,10 +67,10 @@ void waitForSubscription(zmq::socket_t& pub, FrameSubscriber& sub, const std::st
 }
 
 // The next frame that is not a probe.
-std::optional<ReceivedFrame> receiveNonProbe(FrameSubscriber& sub) {
+std::optional<Frame> receiveNonProbe(FrameSubscriber& sub) {
   for (;;) {
     auto frame = sub.receive(kTimeout);
-    if (!frame || frame->header.sequence() < kProbeBase) return frame;
+    if (!frame || frame->info.sequence < kProbeBase) return frame;
   }
 }
 
@@ -108,27 +108,116 @@ TEST_CASE("frameIsConsistent checks format, sizes, stride and payload length", "
   CHECK_FALSE(frameIsConsistent(flat, 12));
 }
 
-TEST_CASE("ReceivedFrame image is a view on the pixel bytes with the stride", "[common]") {
-  ReceivedFrame frame;
-  frame.header = monoHeader("cam", 1, 3, 2, 4);
-  const std::string bytes = pattern(8);
-  frame.pixels = zmq::message_t(bytes.data(), bytes.size());
-  const cv::Mat image = frame.image();
+TEST_CASE("decodeFrame image is a view on the pixel bytes with the stride", "[common]") {
+  // Trailing bytes make the message large enough that ZeroMQ keeps its bytes
+  // outside the message_t object (small ones move with it).
+  const std::string bytes = pattern(64);
+  zmq::message_t mono_pixels(bytes.data(), bytes.size());
+  const void* mono_data = mono_pixels.data();
+  const auto frame = picksight::decodeFrame(monoHeader("cam", 1, 3, 2, 4), std::move(mono_pixels));
+  REQUIRE(frame);
+  const cv::Mat image = frame->image;
   REQUIRE(image.type() == CV_8UC1);
   REQUIRE(image.cols == 3);
   REQUIRE(image.rows == 2);
   CHECK(image.step[0] == 4);
-  CHECK(image.data == frame.pixels.data());
+  CHECK(image.data == mono_data);
   CHECK(image.at<uint8_t>(1, 2) == static_cast<uint8_t>(bytes[1 * 4 + 2]));
 
-  ReceivedFrame colour;
-  colour.header = monoHeader("cam", 1, 2, 2, 6);
-  colour.header.set_pixel_format(proto::BGR8);
+  auto colour_header = monoHeader("cam", 1, 2, 2, 6);
+  colour_header.set_pixel_format(proto::BGR8);
   const std::string bgr = pattern(12);
-  colour.pixels = zmq::message_t(bgr.data(), bgr.size());
-  const cv::Mat c = colour.image();
+  const auto colour = picksight::decodeFrame(colour_header, zmq::message_t(bgr.data(), bgr.size()));
+  REQUIRE(colour);
+  const cv::Mat c = colour->image;
   REQUIRE(c.type() == CV_8UC3);
   CHECK(c.at<cv::Vec3b>(1, 1)[2] == static_cast<uint8_t>(bgr[6 + 3 + 2]));
+}
+
+TEST_CASE("decodeFrame refuses an inconsistent header and fills the mapping", "[common]") {
+  const std::string bytes = pattern(12);
+  CHECK_FALSE(
+      picksight::decodeFrame(monoHeader("cam", 1, 4, 3, 4), zmq::message_t(bytes.data(), 11)));
+  auto h = monoHeader("cam", 9, 4, 3, 4);
+  h.set_roi_x(10);
+  h.set_roi_y(20);
+  h.set_scale_x(0.5);
+  h.set_scale_y(0);  // left out by the sender: no resize
+  h.set_triggered(true);
+  h.set_host_timestamp_ns(123);
+  auto* t = h.add_truth();
+  t->set_type("disc");
+  t->set_x(1.5);
+  t->set_symmetry_deg(0);
+  const auto frame = picksight::decodeFrame(h, zmq::message_t(bytes.data(), bytes.size()));
+  REQUIRE(frame);
+  CHECK(frame->mapping.roi_x == 10);
+  CHECK(frame->mapping.roi_y == 20);
+  CHECK(frame->mapping.scale_x == 0.5);
+  CHECK(frame->mapping.scale_y == 1.0);
+  CHECK(frame->info.camera == "cam");
+  CHECK(frame->info.sequence == 9);
+  CHECK(frame->info.width == 4);
+  CHECK(frame->info.height == 3);
+  CHECK(frame->info.triggered);
+  CHECK(frame->info.host_timestamp_ns == 123);
+  REQUIRE(frame->truth.size() == 1);
+  CHECK(frame->truth[0].type == "disc");
+  CHECK(frame->truth[0].x == 1.5);
+  CHECK(frame->truth[0].symmetry_deg == 0);
+}
+
+TEST_CASE("A frame survives encoding and decoding and outlives its sender's image", "[common]") {
+  zmq::context_t context;
+  zmq::socket_t pub(context, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  pub.bind("tcp://127.0.0.1:*");
+  FrameSubscriber sub(context, pub.get(zmq::sockopt::last_endpoint), "cam1", 64);
+  waitForSubscription(pub, sub, "cam1");
+
+  Frame sent;
+  cv::Mat sensor(40, 60, CV_8UC3);
+  cv::randu(sensor, 0, 255);
+  sent.image = sensor(cv::Rect(5, 7, 30, 20));  // a view: not continuous
+  sent.mapping = {100, 50, 0.5, 0.25};
+  sent.info.camera = "cam1";
+  sent.info.sequence = 3;
+  sent.info.device_timestamp_ns = 11;
+  sent.info.host_timestamp_ns = 22;
+  sent.info.triggered = true;
+  sent.truth.push_back({"ring", 1, 2, 30, 180, 400});
+  const cv::Mat expected = sent.image.clone();
+  picksight::sendFrame(pub, sent);
+  sent = Frame{};
+  sensor.release();
+
+  const auto got = receiveNonProbe(sub);
+  REQUIRE(got);
+  CHECK(got->info.camera == "cam1");
+  CHECK(got->info.sequence == 3);
+  CHECK(got->info.device_timestamp_ns == 11);
+  CHECK(got->info.host_timestamp_ns == 22);
+  CHECK(got->info.triggered);
+  CHECK(got->info.received_ns > 0);
+  CHECK(got->info.width == 30);
+  CHECK(got->info.height == 20);
+  CHECK(got->mapping.roi_x == 100);
+  CHECK(got->mapping.roi_y == 50);
+  CHECK(got->mapping.scale_x == 0.5);
+  CHECK(got->mapping.scale_y == 0.25);
+  REQUIRE(got->truth.size() == 1);
+  CHECK(got->truth[0].type == "ring");
+  CHECK(got->truth[0].angle_deg == 30);
+  CHECK(got->truth[0].symmetry_deg == 180);
+  CHECK(got->truth[0].area_px == 400);
+  REQUIRE(got->image.type() == CV_8UC3);
+  CHECK(cv::norm(got->image, expected, cv::NORM_INF) == 0);
+
+  // The image stays valid as long as a copy of the frame holds its owner.
+  const cv::Mat view = got->image;
+  const auto owner = got->owner;
+  CHECK(owner != nullptr);
+  CHECK(cv::norm(view, expected, cv::NORM_INF) == 0);
 }
 
 TEST_CASE("FrameSubscriber returns only well-formed frames of its camera", "[common]") {
@@ -168,19 +257,19 @@ TEST_CASE("FrameSubscriber returns only well-formed frames of its camera", "[com
 
   auto frame = receiveNonProbe(sub);
   REQUIRE(frame);
-  CHECK(frame->header.camera() == "cam1");
-  CHECK(frame->header.sequence() == 1);
-  CHECK(frame->header.width() == 5);
-  CHECK(frame->header.height() == 4);
-  CHECK(frame->received_ns > 0);
-  REQUIRE(frame->pixels.size() == good_pixels.size());
-  CHECK(std::memcmp(frame->pixels.data(), good_pixels.data(), good_pixels.size()) == 0);
-  CHECK(frame->image().at<uint8_t>(3, 4) == static_cast<uint8_t>(good_pixels[3 * 6 + 4]));
+  CHECK(frame->info.camera == "cam1");
+  CHECK(frame->info.sequence == 1);
+  CHECK(frame->info.width == 5);
+  CHECK(frame->info.height == 4);
+  CHECK(frame->info.received_ns > 0);
+  REQUIRE(frame->image.step[0] * static_cast<size_t>(frame->image.rows) == good_pixels.size());
+  CHECK(std::memcmp(frame->image.data, good_pixels.data(), good_pixels.size()) == 0);
+  CHECK(frame->image.at<uint8_t>(3, 4) == static_cast<uint8_t>(good_pixels[3 * 6 + 4]));
 
   auto marker = receiveNonProbe(sub);
   REQUIRE(marker);
-  CHECK(marker->header.camera() == "cam1");
-  CHECK(marker->header.sequence() == 2);
+  CHECK(marker->info.camera == "cam1");
+  CHECK(marker->info.sequence == 2);
   CHECK(sub.malformedMessages() - malformed_before == 5);
   CHECK_FALSE(sub.receive(50ms));
 }
@@ -198,7 +287,7 @@ TEST_CASE("FrameSubscriber with an empty camera name receives every camera", "[c
   for (const char* camera : {"cam1", "cam10", "other"}) {
     auto frame = receiveNonProbe(sub);
     REQUIRE(frame);
-    CHECK(frame->header.camera() == camera);
+    CHECK(frame->info.camera == camera);
   }
   CHECK(sub.malformedMessages() == 0);
 }

@@ -23,11 +23,11 @@
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
+using picksight::Frame;
 using picksight::video::AcquisitionMode;
 using picksight::video::Camera;
 using picksight::video::CameraConfig;
 using picksight::video::OutputSettings;
-using picksight::video::PublishedFrame;
 
 namespace {
 
@@ -38,7 +38,7 @@ const std::string kSource = "synthetic:width=160,height=120,parts=2,size=30,seed
 // Collects published frames; tests wait on it.
 class CollectingSink : public picksight::video::FrameSink {
  public:
-  void publish(PublishedFrame frame) override {
+  void publish(Frame frame) override {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       frames_.push_back(std::move(frame));
@@ -46,7 +46,7 @@ class CollectingSink : public picksight::video::FrameSink {
     changed_.notify_all();
   }
 
-  std::vector<PublishedFrame> frames() const {
+  std::vector<Frame> frames() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return frames_;
   }
@@ -55,19 +55,19 @@ class CollectingSink : public picksight::video::FrameSink {
     return frames_.size();
   }
   // Waits until `done(frames)` holds; false on timeout.
-  bool waitUntil(const std::function<bool(const std::vector<PublishedFrame>&)>& done,
+  bool waitUntil(const std::function<bool(const std::vector<Frame>&)>& done,
                  std::chrono::milliseconds timeout = kTimeout) {
     std::unique_lock<std::mutex> lock(mutex_);
     return changed_.wait_for(lock, timeout, [&] { return done(frames_); });
   }
   bool waitForCount(size_t n) {
-    return waitUntil([n](const std::vector<PublishedFrame>& f) { return f.size() >= n; });
+    return waitUntil([n](const std::vector<Frame>& f) { return f.size() >= n; });
   }
 
  private:
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::vector<PublishedFrame> frames_;
+  std::vector<Frame> frames_;
 };
 
 CameraConfig config(AcquisitionMode mode, double fps = 10, const std::string& uri = kSource) {
@@ -101,9 +101,9 @@ bool waitForState(const Camera& camera, const std::string& state) {
 
 using picksight::test::TempDir;
 
-uint64_t maxSequence(const std::vector<PublishedFrame>& frames) {
+uint64_t maxSequence(const std::vector<Frame>& frames) {
   uint64_t m = 0;
-  for (const auto& f : frames) m = std::max(m, f.sequence);
+  for (const auto& f : frames) m = std::max(m, f.info.sequence);
   return m;
 }
 
@@ -140,19 +140,19 @@ TEST_CASE("Camera trigger tickets are consecutive and each gives exactly one fra
   const auto frames = sink.frames();
   REQUIRE(frames.size() == tickets.size());
   for (size_t i = 0; i < frames.size(); ++i) {
-    CHECK(frames[i].sequence == tickets[i]);
-    CHECK(frames[i].triggered);
-    CHECK(frames[i].camera == "cam1");
-    CHECK(frames[i].output.image.size() == cv::Size(160, 120));
+    CHECK(frames[i].info.sequence == tickets[i]);
+    CHECK(frames[i].info.triggered);
+    CHECK(frames[i].info.camera == "cam1");
+    CHECK(frames[i].image.size() == cv::Size(160, 120));
     CHECK(frames[i].truth.size() == 2);
-    CHECK(frames[i].host_timestamp_ns > 0);
+    CHECK(frames[i].info.host_timestamp_ns > 0);
   }
 
   // A later trigger continues the numbering.
   const auto next = camera->trigger();
   CHECK(next.sequence == tickets.back() + 1);
   REQUIRE(sink.waitForCount(tickets.size() + 1));
-  CHECK(sink.frames().back().sequence == next.sequence);
+  CHECK(sink.frames().back().info.sequence == next.sequence);
   // The status is updated beside the hand-over to the sink, not before it.
   REQUIRE(waitForStatus(*camera, [&](const picksight::video::CameraStatus& s) {
     return s.frames_acquired >= tickets.size() + 1;
@@ -168,8 +168,9 @@ TEST_CASE("Camera in free-run publishes increasing sequences untriggered", "[vid
   REQUIRE(sink.waitForCount(5));
   camera->stop();
   const auto frames = sink.frames();
-  for (size_t i = 1; i < frames.size(); ++i) CHECK(frames[i].sequence > frames[i - 1].sequence);
-  for (const auto& f : frames) CHECK_FALSE(f.triggered);
+  for (size_t i = 1; i < frames.size(); ++i)
+    CHECK(frames[i].info.sequence > frames[i - 1].info.sequence);
+  for (const auto& f : frames) CHECK_FALSE(f.info.triggered);
   CHECK(camera->status().state == "stopped");
 }
 
@@ -185,7 +186,7 @@ TEST_CASE("Camera free-run trigger ticket follows every published frame", "[vide
     CHECK(ticket.sequence > published);
     // ... and a frame with that sequence does come.
     CHECK(sink.waitUntil(
-        [&](const std::vector<PublishedFrame>& f) { return maxSequence(f) >= ticket.sequence; }));
+        [&](const std::vector<Frame>& f) { return maxSequence(f) >= ticket.sequence; }));
   }
 }
 
@@ -196,8 +197,9 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   REQUIRE(waitForState(*camera, "streaming"));
   camera->trigger();
   REQUIRE(sink.waitForCount(1));
-  CHECK(sink.frames()[0].output.image.size() == cv::Size(160, 120));
-  CHECK(sink.frames()[0].output.roi_offset == cv::Point(0, 0));
+  CHECK(sink.frames()[0].image.size() == cv::Size(160, 120));
+  CHECK(cv::Point2d(sink.frames()[0].mapping.roi_x, sink.frames()[0].mapping.roi_y) ==
+        cv::Point2d(0, 0));
 
   OutputSettings roi;
   roi.roi = cv::Rect(10, 20, 64, 48);
@@ -206,8 +208,8 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   camera->trigger();
   REQUIRE(sink.waitForCount(2));
   const auto cropped = sink.frames()[1];
-  CHECK(cropped.output.image.size() == cv::Size(64, 48));
-  CHECK(cropped.output.roi_offset == cv::Point(10, 20));
+  CHECK(cropped.image.size() == cv::Size(64, 48));
+  CHECK(cv::Point2d(cropped.mapping.roi_x, cropped.mapping.roi_y) == cv::Point2d(10, 20));
 
   OutputSettings scaled = roi;
   scaled.scale = 0.5;
@@ -216,9 +218,9 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   camera->trigger();
   REQUIRE(sink.waitForCount(3));
   const auto small = sink.frames()[2];
-  CHECK(small.output.image.size() == cv::Size(32, 24));
-  CHECK(small.output.image.type() == CV_8UC3);
-  CHECK(small.output.scale_x == 0.5);
+  CHECK(small.image.size() == cv::Size(32, 24));
+  CHECK(small.image.type() == CV_8UC3);
+  CHECK(small.mapping.scale_x == 0.5);
   // Ground truth stays in sensor pixels.
   CHECK(small.truth.size() == 2);
 }
@@ -255,13 +257,13 @@ TEST_CASE("Camera setMode switches between free-run and trigger", "[video_server
   const auto ticket = camera->trigger();
   CHECK(ticket.triggered);
   REQUIRE(sink.waitForCount(settled + 1));
-  CHECK(sink.frames().back().sequence == ticket.sequence);
-  CHECK(sink.frames().back().triggered);
+  CHECK(sink.frames().back().info.sequence == ticket.sequence);
+  CHECK(sink.frames().back().info.triggered);
 
   REQUIRE(camera->setMode(AcquisitionMode::kFreeRun, 40));
   CHECK(camera->status().fps_setting == 40);
   REQUIRE(sink.waitForCount(settled + 4));
-  CHECK_FALSE(sink.frames().back().triggered);
+  CHECK_FALSE(sink.frames().back().info.triggered);
 
   CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, -1));
   CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, 5000));
@@ -284,6 +286,6 @@ TEST_CASE("Camera retries a source that is missing and streams once it appears",
   camera->stop();
   const auto frames = sink.frames();
   REQUIRE_FALSE(frames.empty());
-  CHECK(frames[0].output.image.size() == cv::Size(40, 30));
-  CHECK(frames[0].output.image.at<uint8_t>(0, 0) == 99);
+  CHECK(frames[0].image.size() == cv::Size(40, 30));
+  CHECK(frames[0].image.at<uint8_t>(0, 0) == 99);
 }

@@ -95,30 +95,30 @@ void waitForSubscription(picksight::ControlClient& control, picksight::FrameSubs
 }
 
 // The cam1 frame with exactly this sequence (earlier ones are skipped).
-std::optional<picksight::ReceivedFrame> receiveSequence(picksight::FrameSubscriber& sub,
-                                                        uint64_t sequence) {
+std::optional<picksight::Frame> receiveSequence(picksight::FrameSubscriber& sub,
+                                                uint64_t sequence) {
   const auto deadline = std::chrono::steady_clock::now() + kTimeout;
   while (std::chrono::steady_clock::now() < deadline) {
     auto frame = sub.receive(1000ms);
-    if (frame && frame->header.sequence() >= sequence) {
-      if (frame->header.sequence() == sequence) return frame;
+    if (frame && frame->info.sequence >= sequence) {
+      if (frame->info.sequence == sequence) return frame;
       return std::nullopt;
     }
   }
   return std::nullopt;
 }
 
-void checkConsistent(const picksight::ReceivedFrame& f) {
-  const auto& h = f.header;
-  const int bpp = h.pixel_format() == proto::BGR8 ? 3 : 1;
-  CHECK((h.pixel_format() == proto::MONO8 || h.pixel_format() == proto::BGR8));
-  CHECK(h.stride() >= h.width() * bpp);
-  CHECK(f.pixels.size() == size_t{h.stride()} * h.height());
-  const cv::Mat image = f.image();
-  CHECK(image.cols == static_cast<int>(h.width()));
-  CHECK(image.rows == static_cast<int>(h.height()));
+void checkConsistent(const picksight::Frame& f) {
+  const cv::Mat& image = f.image;
+  const int bpp = image.type() == CV_8UC3 ? 3 : 1;
+  CHECK((image.type() == CV_8UC1 || image.type() == CV_8UC3));
+  CHECK(image.step[0] >= f.info.width * bpp);
+  // Published dense: the decoded view spans rows of exactly the stride.
+  CHECK(image.isContinuous());
+  CHECK(image.cols == static_cast<int>(f.info.width));
+  CHECK(image.rows == static_cast<int>(f.info.height));
   CHECK(image.channels() == bpp);
-  CHECK(h.host_timestamp_ns() > 0);
+  CHECK(f.info.host_timestamp_ns > 0);
 }
 
 }  // namespace
@@ -363,23 +363,24 @@ TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", 
     REQUIRE(ticket);
     auto frame = receiveSequence(sub, ticket->trigger().sequence());
     REQUIRE(frame);
-    const auto& h = frame->header;
-    CHECK(h.camera() == "cam1");
-    CHECK(h.width() == 320);
-    CHECK(h.height() == 240);
-    CHECK(h.stride() == 320);
-    CHECK(h.pixel_format() == proto::MONO8);
-    CHECK(h.roi_x() == 0);
-    CHECK(h.roi_y() == 0);
-    CHECK(h.scale_x() == 1.0);
-    CHECK(h.scale_y() == 1.0);
-    CHECK(h.triggered());
-    REQUIRE(h.truth_size() == 3);
-    for (const auto& t : h.truth()) {
-      CHECK_FALSE(t.type().empty());
-      CHECK(t.area_px() > 0);
-      CHECK(t.x() > 0);
-      CHECK(t.x() < 320);
+    const auto& h = frame->info;
+    const auto& m = frame->mapping;
+    CHECK(h.camera == "cam1");
+    CHECK(h.width == 320);
+    CHECK(h.height == 240);
+    CHECK(frame->image.step[0] == 320);
+    CHECK(frame->image.type() == CV_8UC1);
+    CHECK(m.roi_x == 0);
+    CHECK(m.roi_y == 0);
+    CHECK(m.scale_x == 1.0);
+    CHECK(m.scale_y == 1.0);
+    CHECK(h.triggered);
+    REQUIRE(frame->truth.size() == 3);
+    for (const auto& t : frame->truth) {
+      CHECK_FALSE(t.type.empty());
+      CHECK(t.area_px > 0);
+      CHECK(t.x > 0);
+      CHECK(t.x < 320);
     }
     checkConsistent(*frame);
   }
@@ -399,17 +400,18 @@ TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", 
     REQUIRE(ticket);
     auto frame = receiveSequence(sub, ticket->trigger().sequence());
     REQUIRE(frame);
-    const auto& h = frame->header;
-    CHECK(h.width() == 100);
-    CHECK(h.height() == 50);
-    CHECK(h.stride() == 300);
-    CHECK(h.pixel_format() == proto::BGR8);
-    CHECK(h.roi_x() == 10);
-    CHECK(h.roi_y() == 20);
-    CHECK(h.scale_x() == 0.5);
-    CHECK(h.scale_y() == 0.5);
+    const auto& h = frame->info;
+    const auto& m = frame->mapping;
+    CHECK(h.width == 100);
+    CHECK(h.height == 50);
+    CHECK(frame->image.step[0] == 300);
+    CHECK(frame->image.type() == CV_8UC3);
+    CHECK(m.roi_x == 10);
+    CHECK(m.roi_y == 20);
+    CHECK(m.scale_x == 0.5);
+    CHECK(m.scale_y == 0.5);
     // Truth stays in sensor pixels, whatever the output transform.
-    CHECK(h.truth_size() == 3);
+    CHECK(frame->truth.size() == 3);
     checkConsistent(*frame);
   }
 
@@ -420,7 +422,7 @@ TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", 
     REQUIRE(ticket);
     auto frame = receiveSequence(sub, ticket->trigger().sequence());
     REQUIRE(frame);
-    CHECK(frame->header.camera() == "cam1");
+    CHECK(frame->info.camera == "cam1");
   }
   CHECK(sub.malformedMessages() == 0);
 }
@@ -436,13 +438,13 @@ TEST_CASE("VideoServer frames of a free-running camera arrive in order", "[video
   while (received < 5 && std::chrono::steady_clock::now() < deadline) {
     auto frame = sub.receive(1000ms);
     if (!frame) continue;
-    CHECK(frame->header.camera() == "cam10");
-    CHECK(frame->header.sequence() > previous);
-    CHECK_FALSE(frame->header.triggered());
-    CHECK(frame->header.width() == 160);
-    CHECK(frame->header.truth_size() == 1);
+    CHECK(frame->info.camera == "cam10");
+    CHECK(frame->info.sequence > previous);
+    CHECK_FALSE(frame->info.triggered);
+    CHECK(frame->info.width == 160);
+    CHECK(frame->truth.size() == 1);
     checkConsistent(*frame);
-    previous = frame->header.sequence();
+    previous = frame->info.sequence;
     ++received;
   }
   CHECK(received == 5);

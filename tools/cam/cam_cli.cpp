@@ -470,13 +470,11 @@ Result<void> saveSnap(const std::string& camera, const proto::SnapReply& snap,
   }
   // Decoded as a subscriber decodes a published frame, so that the file holds
   // what a vision app would have seen. The copy is one frame, once.
-  ReceivedFrame frame;
-  frame.header = h;
-  frame.pixels = zmq::message_t(snap.pixels().data(), snap.pixels().size());
+  const auto frame = decodeFrame(h, zmq::message_t(snap.pixels().data(), snap.pixels().size()));
   bool written = false;
   std::string reason = "cannot write the file (does its directory exist, is it writable?)";
   try {
-    written = cv::imwrite(file, frame.image());
+    written = cv::imwrite(file, frame->image);
   } catch (const cv::Exception& e) {
     reason = e.err;  // what() adds OpenCV's source path and line
   }

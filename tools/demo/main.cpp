@@ -14,9 +14,9 @@
 #include <zmq.hpp>
 
 #include "picksight/common/angles.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
-#include "picksight/common/text.hpp"
 #include "picksight/transport/frame_message.hpp"
 
 namespace {
@@ -125,10 +125,10 @@ int main(int argc, char** argv) {
     // Find the frame LOCATE used among the watched ones, by sequence number.
     const auto fields = used ? picksight::splitFields(*used, " ") : std::vector<std::string_view>{};
     const auto seq = fields.size() >= 3 ? picksight::parseInt(fields[2]) : std::nullopt;
-    std::optional<picksight::ReceivedFrame> frame;
+    std::optional<picksight::Frame> frame;
     for (int tries = 0; tries < 50 && seq; ++tries) {
       auto f = watcher.receive(200ms);
-      if (f && static_cast<long long>(f->header.sequence()) == *seq) {
+      if (f && static_cast<long long>(f->info.sequence) == *seq) {
         frame = std::move(f);
         break;
       }
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
     }
     std::printf("  %-16s %9s %9s %8s | %9s %9s %8s | %7s %7s\n", "truth type", "x", "y", "rz",
                 "found x", "y", "rz", "d px", "d deg");
-    for (const auto& t : frame->header.truth()) {
+    for (const auto& t : frame->truth) {
       double best = std::numeric_limits<double>::max();
       double fx = 0, fy = 0, fr = 0;
       for (size_t i = 2; i + 2 < words.size(); i += 3) {
@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
         // counter-clockwise); the truth is in image axes.
         const double x = picksight::parseDouble(words[i]).value_or(0);
         const double y = -picksight::parseDouble(words[i + 1]).value_or(0);
-        const double d = std::hypot(x - t.x(), y - t.y());
+        const double d = std::hypot(x - t.x, y - t.y);
         if (d < best) {
           best = d;
           fx = x;
@@ -157,11 +157,11 @@ int main(int argc, char** argv) {
         }
       }
       const std::string angle_err =
-          t.symmetry_deg() > 0
-              ? formatFixed(picksight::angleDiffDeg(fr, t.angle_deg(), t.symmetry_deg()), 3)
+          t.symmetry_deg > 0
+              ? formatFixed(picksight::angleDiffDeg(fr, t.angle_deg, t.symmetry_deg), 3)
               : std::string("any");
-      std::printf("  %-16s %9.3f %9.3f %8.3f | %9.3f %9.3f %8.3f | %7.3f %7s\n", t.type().c_str(),
-                  t.x(), t.y(), t.angle_deg(), fx, fy, fr, best, angle_err.c_str());
+      std::printf("  %-16s %9.3f %9.3f %8.3f | %9.3f %9.3f %8.3f | %7.3f %7s\n", t.type.c_str(),
+                  t.x, t.y, t.angle_deg, fx, fy, fr, best, angle_err.c_str());
     }
   }
   robot->close();

@@ -1,9 +1,70 @@
-// Frame wire format decoding.
+// The frame codec: Frame to wire message and back, and the subscriber.
 #include "picksight/transport/frame_message.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <utility>
 
 #include "picksight/common/clock.hpp"
 
 namespace picksight {
+namespace {
+
+// What ZeroMQ holds while it sends a frame's pixels without copying them.
+struct SentPixels {
+  cv::Mat image;
+  std::shared_ptr<const void> owner;
+};
+
+// ZeroMQ calls this from its I/O thread when the last subscriber has been
+// sent the pixels.
+void releasePixels(void* /*data*/, void* hint) { delete static_cast<SentPixels*>(hint); }
+
+// The header of `f` sent with the pixels of `img` (its image, or a dense copy).
+proto::FrameHeader headerOf(const Frame& f, const cv::Mat& img) {
+  proto::FrameHeader h;
+  h.set_camera(f.info.camera);
+  h.set_sequence(f.info.sequence);
+  h.set_device_timestamp_ns(f.info.device_timestamp_ns);
+  h.set_host_timestamp_ns(f.info.host_timestamp_ns);
+  h.set_width(static_cast<uint32_t>(img.cols));
+  h.set_height(static_cast<uint32_t>(img.rows));
+  h.set_stride(static_cast<uint32_t>(img.step[0]));
+  h.set_pixel_format(img.channels() == 3 ? proto::BGR8 : proto::MONO8);
+  h.set_roi_x(static_cast<uint32_t>(f.mapping.roi_x));
+  h.set_roi_y(static_cast<uint32_t>(f.mapping.roi_y));
+  h.set_scale_x(f.mapping.scale_x);
+  h.set_scale_y(f.mapping.scale_y);
+  h.set_triggered(f.info.triggered);
+  for (const auto& t : f.truth) {
+    auto* p = h.add_truth();
+    p->set_type(t.type);
+    p->set_x(t.x);
+    p->set_y(t.y);
+    p->set_angle_deg(t.angle_deg);
+    p->set_symmetry_deg(t.symmetry_deg);
+    p->set_area_px(t.area_px);
+  }
+  return h;
+}
+
+}  // namespace
+
+proto::FrameHeader frameHeaderOf(const Frame& frame) { return headerOf(frame, frame.image); }
+
+void sendFrame(zmq::socket_t& socket, const Frame& frame) {
+  // The payload is rows of `stride` bytes, the last one included: a view
+  // into a larger image is copied to a dense one first.
+  auto* held =
+      new SentPixels{frame.image.isContinuous() ? frame.image : frame.image.clone(), frame.owner};
+  const std::string header = headerOf(frame, held->image).SerializeAsString();
+  zmq::message_t pixels(held->image.data, held->image.total() * held->image.elemSize(),
+                        releasePixels, held);
+  // PUB never blocks: a subscriber whose pipe is full simply misses the message.
+  socket.send(zmq::buffer(frame.info.camera), zmq::send_flags::sndmore);
+  socket.send(zmq::buffer(header), zmq::send_flags::sndmore);
+  socket.send(pixels, zmq::send_flags::none);
+}
 
 int bytesPerPixel(proto::PixelFormat format) {
   switch (format) {
@@ -25,10 +86,34 @@ bool frameIsConsistent(const proto::FrameHeader& header, size_t payload_size) {
   return static_cast<uint64_t>(header.stride()) * header.height() <= payload_size;
 }
 
-cv::Mat ReceivedFrame::image() const {
-  const int type = header.pixel_format() == proto::BGR8 ? CV_8UC3 : CV_8UC1;
-  return cv::Mat(static_cast<int>(header.height()), static_cast<int>(header.width()), type,
-                 const_cast<void*>(pixels.data()), header.stride());
+std::optional<Frame> decodeFrame(const proto::FrameHeader& h, zmq::message_t pixels) {
+  if (!frameIsConsistent(h, pixels.size())) return std::nullopt;
+  auto bytes = std::make_shared<zmq::message_t>(std::move(pixels));
+  Frame frame;
+  const int type = h.pixel_format() == proto::BGR8 ? CV_8UC3 : CV_8UC1;
+  // Nobody writes into a frame: the const_cast only satisfies cv::Mat.
+  frame.image =
+      cv::Mat(static_cast<int>(h.height()), static_cast<int>(h.width()), type,
+              const_cast<void*>(static_cast<const zmq::message_t&>(*bytes).data()), h.stride());
+  frame.owner = std::move(bytes);
+  frame.mapping.roi_x = h.roi_x();
+  frame.mapping.roi_y = h.roi_y();
+  // A sender that leaves the scale out means no resize.
+  frame.mapping.scale_x = h.scale_x() > 0 ? h.scale_x() : 1.0;
+  frame.mapping.scale_y = h.scale_y() > 0 ? h.scale_y() : 1.0;
+  frame.info.camera = h.camera();
+  frame.info.sequence = h.sequence();
+  frame.info.device_timestamp_ns = h.device_timestamp_ns();
+  frame.info.host_timestamp_ns = h.host_timestamp_ns();
+  frame.info.width = h.width();
+  frame.info.height = h.height();
+  frame.info.triggered = h.triggered();
+  frame.truth.reserve(static_cast<size_t>(h.truth_size()));
+  for (const auto& t : h.truth()) {
+    frame.truth.push_back(
+        TruthPart{t.type(), t.x(), t.y(), t.angle_deg(), t.symmetry_deg(), t.area_px()});
+  }
+  return frame;
 }
 
 FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& endpoint,
@@ -41,7 +126,7 @@ FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& end
   socket_.connect(endpoint);
 }
 
-std::optional<ReceivedFrame> FrameSubscriber::receive(std::chrono::milliseconds timeout) {
+std::optional<Frame> FrameSubscriber::receive(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -53,7 +138,7 @@ std::optional<ReceivedFrame> FrameSubscriber::receive(std::chrono::milliseconds 
     }
     zmq::message_t topic;
     zmq::message_t header_bytes;
-    ReceivedFrame frame;
+    zmq::message_t pixels;
     if (!socket_.recv(topic, zmq::recv_flags::dontwait)) continue;
     // Read every part of the message, whatever it looks like, so the next
     // receive starts on a message boundary.
@@ -64,21 +149,25 @@ std::optional<ReceivedFrame> FrameSubscriber::receive(std::chrono::milliseconds 
       if (!socket_.recv(part)) break;
       more = part.more();
       if (parts == 1) header_bytes = std::move(part);
-      if (parts == 2) frame.pixels = std::move(part);
+      if (parts == 2) pixels = std::move(part);
       ++parts;
     }
     // Subscriptions match prefixes: "cam1" also receives "cam10".
     if (!camera_.empty() && topic.to_string_view() != camera_) continue;
-    if (parts != 3 ||
-        !frame.header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size())) ||
-        !frameIsConsistent(frame.header, frame.pixels.size())) {
+    proto::FrameHeader header;
+    std::optional<Frame> frame;
+    if (parts == 3 &&
+        header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size()))) {
+      frame = decodeFrame(header, std::move(pixels));
+    }
+    if (!frame) {
       ++malformed_;
       continue;
     }
-    frame.received_ns = monotonicNs();
+    frame->info.received_ns = monotonicNs();
     ++received_;
-    const uint64_t seq = frame.header.sequence();
-    auto [last, first] = last_sequence_.try_emplace(frame.header.camera(), seq);
+    const uint64_t seq = frame->info.sequence;
+    auto [last, first] = last_sequence_.try_emplace(frame->info.camera, seq);
     if (!first) {
       if (seq > last->second + 1) lost_ += seq - last->second - 1;
       last->second = seq;

@@ -128,10 +128,9 @@ TriggerTicket Camera::trigger() {
   return ticket;
 }
 
-std::optional<PublishedFrame> Camera::waitForFrame(uint64_t sequence,
-                                                   std::chrono::milliseconds timeout) {
+std::optional<Frame> Camera::waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
-  const auto ready = [&] { return last_frame_ && last_frame_->sequence >= sequence; };
+  const auto ready = [&] { return last_frame_ && last_frame_->info.sequence >= sequence; };
   frame_published_.wait_for(lock, timeout, ready);
   if (!ready()) return std::nullopt;
   return last_frame_;
@@ -355,13 +354,17 @@ void Camera::run() {
     }
 
     trigger_sent_.reset();
-    PublishedFrame frame;
-    frame.camera = config_.name;
-    frame.sequence = sequence;
-    frame.device_timestamp_ns = grabbed->device_timestamp_ns;
-    frame.host_timestamp_ns = host_ns;
-    frame.triggered = triggered;
-    frame.output = std::move(*out);
+    Frame frame;
+    frame.image = std::move(out->image);
+    frame.mapping = {static_cast<double>(out->roi_offset.x), static_cast<double>(out->roi_offset.y),
+                     out->scale_x, out->scale_y};
+    frame.info.camera = config_.name;
+    frame.info.sequence = sequence;
+    frame.info.device_timestamp_ns = grabbed->device_timestamp_ns;
+    frame.info.host_timestamp_ns = host_ns;
+    frame.info.width = static_cast<uint32_t>(frame.image.cols);
+    frame.info.height = static_cast<uint32_t>(frame.image.rows);
+    frame.info.triggered = triggered;
     frame.truth = std::move(grabbed->truth);
     // Statistics first, then the hand-over: a subscriber must never hold a
     // frame that `stats` does not count yet.

@@ -1,4 +1,4 @@
-// Frame publisher thread and its zero-copy send.
+// Frame publisher thread: queues frames from the cameras, sends them with the codec.
 #include "picksight/video_server/frame_publisher.hpp"
 
 #include <zmq.h>
@@ -6,46 +6,12 @@
 #include <atomic>
 #include <cstring>
 
-#include "picksight.pb.h"
 #include "picksight/common/log.hpp"
 
 namespace picksight::video {
 namespace {
 std::atomic<int> g_monitor_id{0};
-
-// ZeroMQ calls this from its I/O thread when the last subscriber has been
-// sent the pixels; the cv::Mat keeps the buffer alive until then.
-void releaseMat(void* /*data*/, void* hint) { delete static_cast<cv::Mat*>(hint); }
-
 }  // namespace
-
-proto::FrameHeader frameHeaderOf(const PublishedFrame& f) {
-  proto::FrameHeader h;
-  h.set_camera(f.camera);
-  h.set_sequence(f.sequence);
-  h.set_device_timestamp_ns(f.device_timestamp_ns);
-  h.set_host_timestamp_ns(f.host_timestamp_ns);
-  const cv::Mat& img = f.output.image;
-  h.set_width(static_cast<uint32_t>(img.cols));
-  h.set_height(static_cast<uint32_t>(img.rows));
-  h.set_stride(static_cast<uint32_t>(img.step[0]));
-  h.set_pixel_format(img.channels() == 3 ? proto::BGR8 : proto::MONO8);
-  h.set_roi_x(static_cast<uint32_t>(f.output.roi_offset.x));
-  h.set_roi_y(static_cast<uint32_t>(f.output.roi_offset.y));
-  h.set_scale_x(f.output.scale_x);
-  h.set_scale_y(f.output.scale_y);
-  h.set_triggered(f.triggered);
-  for (const auto& t : f.truth) {
-    auto* p = h.add_truth();
-    p->set_type(t.type);
-    p->set_x(t.x);
-    p->set_y(t.y);
-    p->set_angle_deg(t.angle_deg);
-    p->set_symmetry_deg(t.symmetry_deg);
-    p->set_area_px(t.area_px);
-  }
-  return h;
-}
 
 FramePublisher::FramePublisher(zmq::context_t& context, const std::string& endpoint,
                                size_t queue_limit, int subscriber_queue)
@@ -83,11 +49,11 @@ void FramePublisher::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-void FramePublisher::publish(PublishedFrame frame) {
+void FramePublisher::publish(Frame frame) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (queue_.size() >= queue_limit_) {
-      ++counters_[queue_.front().camera].dropped;
+      ++counters_[queue_.front().info.camera].dropped;
       queue_.pop_front();
     }
     queue_.push_back(std::move(frame));
@@ -99,16 +65,6 @@ PublisherCounters FramePublisher::counters(const std::string& camera) const {
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = counters_.find(camera);
   return it == counters_.end() ? PublisherCounters{} : it->second;
-}
-
-void FramePublisher::send(PublishedFrame& frame) {
-  const std::string header = frameHeaderOf(frame).SerializeAsString();
-  cv::Mat* owner = new cv::Mat(frame.output.image);
-  zmq::message_t pixels(owner->data, owner->total() * owner->elemSize(), releaseMat, owner);
-  // PUB never blocks: a subscriber whose pipe is full simply misses the message.
-  socket_.send(zmq::buffer(frame.camera), zmq::send_flags::sndmore);
-  socket_.send(zmq::buffer(header), zmq::send_flags::sndmore);
-  socket_.send(pixels, zmq::send_flags::none);
 }
 
 void FramePublisher::pollMonitor() {
@@ -130,16 +86,16 @@ void FramePublisher::run() {
     wake_.wait_for(lock, std::chrono::milliseconds(100),
                    [this] { return stop_ || !queue_.empty(); });
     while (!queue_.empty() && !stop_) {
-      PublishedFrame frame = std::move(queue_.front());
+      Frame frame = std::move(queue_.front());
       queue_.pop_front();
       lock.unlock();
       try {
-        send(frame);
+        sendFrame(socket_, frame);
       } catch (const zmq::error_t& e) {
         logError("publisher: send failed: ", e.what());
       }
       lock.lock();
-      ++counters_[frame.camera].published;
+      ++counters_[frame.info.camera].published;
     }
     lock.unlock();
     pollMonitor();

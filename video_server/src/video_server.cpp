@@ -280,7 +280,7 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
       }
       auto* snap = reply.mutable_snap();
       *snap->mutable_header() = frameHeaderOf(*frame);
-      const cv::Mat& img = frame->output.image;
+      const cv::Mat& img = frame->image;
       snap->set_pixels(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize());
       return reply;
     }

@@ -149,10 +149,10 @@ TEST_CASE("picksight-video-server publishes a dir: source's images in order",
   for (int tries = 0; tries < 200 && received < 3 * kImages; ++tries) {
     auto frame = subscriber.receive(5s);
     REQUIRE(frame);
-    const cv::Mat image = frame->image();
+    const cv::Mat image = frame->image;
     REQUIRE(image.size() == cv::Size(64, 48));
-    const int image_index = static_cast<int>((frame->header.sequence() - 1) % kImages);
-    INFO("sequence " << frame->header.sequence());
+    const int image_index = static_cast<int>((frame->info.sequence - 1) % kImages);
+    INFO("sequence " << frame->info.sequence);
     CHECK(std::abs(cv::mean(image)[0] - (40 + 50 * image_index)) < 1);
     distinct_mask |= 1 << image_index;
     ++received;

@@ -65,9 +65,9 @@ Feature findFeature(const std::vector<Feature>& features, const std::string& nam
 
 class CollectingSink : public FrameSink {
  public:
-  void publish(PublishedFrame frame) override {
+  void publish(picksight::Frame frame) override {
     std::lock_guard<std::mutex> lock(mutex_);
-    frames_.push_back(frame.sequence);
+    frames_.push_back(frame.info.sequence);
   }
   size_t count() const {
     std::lock_guard<std::mutex> lock(mutex_);

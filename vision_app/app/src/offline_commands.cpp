@@ -192,15 +192,9 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
           << "\n";
     } else if (command == "locate") {
       // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
-      LocateOutcome outcome;
-      outcome.scene.models = library.snapshot();
-      outcome.parts = locateInImage(grey, FrameMapping{}, options->vision, *outcome.scene.models,
-                                    type, &outcome.scene);
-      const CellPick pick = pickPoses(outcome, *library.grasps(), calibration.geometry());
-      std::string line = "OK " + std::to_string(pick.poses.size());
-      for (const auto& p : pick.poses)
-        line += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
-      out << line << "\n";
+      const LocateOutcome outcome =
+          locateInFrame(frameFromImage(grey, path, 1), options->vision, library.snapshot(), type);
+      out << locateReply(pickPoses(outcome, *library.grasps(), calibration.geometry())) << "\n";
     } else {
       const auto blobs = blobsInImage(grey, options->vision);
       std::string line = "OK " + std::to_string(blobs.size());

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "picksight/common/angles.hpp"
+#include "picksight/common/text.hpp"
 
 namespace picksight::app {
 namespace {
@@ -21,12 +22,6 @@ const vision::PartModel* modelOf(const LocateScene& scene, int type) {
   for (const auto& m : *scene.models)
     if (m.type == type) return &m;
   return nullptr;
-}
-
-// Sensor pixels to frame (mask) pixels: the inverse of FrameMapping::toSensor.
-cv::Matx23d sensorToFrame(const FrameMapping& m) {
-  return {m.scale_x, 0,         (0.5 - m.roi_x) * m.scale_x - 0.5,
-          0,         m.scale_y, (0.5 - m.roi_y) * m.scale_y - 0.5};
 }
 
 cv::Point2d apply(const cv::Matx23d& a, cv::Point2d p) {
@@ -63,7 +58,7 @@ std::vector<std::vector<cv::Point>> placedFootprint(const vision::PartModel& mod
 // without the part's own pixels.
 grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
                               const std::vector<std::vector<cv::Point2d>>& finger_polys) {
-  const cv::Matx23d to_frame = sensorToFrame(scene.mapping);
+  const cv::Matx23d to_frame = scene.mapping.sensorToFrame();
   std::vector<cv::Point2f> corners;
   for (const auto& poly : finger_polys)
     for (const auto& p : poly) corners.emplace_back(apply(to_frame, p));
@@ -87,7 +82,7 @@ grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
   // A region of one part's area is that part alone; a larger one holds
   // touching parts, and only this part's placed footprint is its own.
   const vision::PartModel* model = modelOf(scene, part.type);
-  const double frame_area = part.area * scene.mapping.scale_x * scene.mapping.scale_y;
+  const double frame_area = scene.mapping.areaToFrame(part.area);
   if (model && region.area > model->body.area * (1 + 2 * model->body.area_tolerance) &&
       frame_area > 0) {
     const cv::Point2d centre = apply(to_frame, {part.x, part.y});
@@ -141,6 +136,13 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
     pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles[*chosen])));
   }
   return pick;
+}
+
+std::string locateReply(const CellPick& pick) {
+  std::string out = "OK " + std::to_string(pick.poses.size());
+  for (const auto& p : pick.poses)
+    out += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
+  return out;
 }
 
 }  // namespace picksight::app

@@ -4,11 +4,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include <algorithm>
-#include <cmath>
-
-#include "picksight/common/angles.hpp"
-
 #include "picksight/vision/recognizer.hpp"
 
 namespace picksight::app {
@@ -29,38 +24,14 @@ const char* errorName(VisionErrc e) {
   return "unknown";
 }
 
-cv::Point2d FrameMapping::toSensor(cv::Point2d p) const {
-  // Pixel centres are at integer coordinates in both frames.
-  return {roi_x + (p.x + 0.5) / scale_x - 0.5, roi_y + (p.y + 0.5) / scale_y - 0.5};
-}
-
-double FrameMapping::directionToSensor(double deg) const {
-  // A direction scales like a displacement: undo an anisotropic resize.
-  const double a = deg * M_PI / 180.0;
-  return normalizeDeg(std::atan2(std::sin(a) / scale_y, std::cos(a) / scale_x) * 180.0 / M_PI);
-}
-
-cv::Mat greyImage(const ReceivedFrame& frame) {
-  cv::Mat grey = frame.image();
-  if (grey.channels() == 3) {
-    cv::Mat converted;
-    cv::cvtColor(grey, converted, cv::COLOR_BGR2GRAY);
-    grey = converted;
-  }
+cv::Mat greyImage(const Frame& frame) {
+  if (frame.image.channels() != 3) return frame.image;
+  cv::Mat grey;
+  cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
   return grey;
 }
 
-FrameMapping frameMapping(const ReceivedFrame& frame) {
-  const auto& h = frame.header;
-  FrameMapping m;
-  m.roi_x = h.roi_x();
-  m.roi_y = h.roi_y();
-  m.scale_x = h.scale_x() > 0 ? h.scale_x() : 1.0;
-  m.scale_y = h.scale_y() > 0 ? h.scale_y() : 1.0;
-  return m;
-}
-
-std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
+std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
                                        int type, LocateScene* scene) {
   LocateScene local;
@@ -69,7 +40,6 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& 
   s.regions = vision::findRegions(s.mask, options.regions, grey);
   s.mapping = mapping;
   const auto& regions = s.regions;
-  const double area_scale = 1.0 / (mapping.scale_x * mapping.scale_y);
   std::vector<LocatedPart> parts;
   if (models.empty()) {
     parts.reserve(regions.size());
@@ -81,7 +51,7 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& 
       p.x = s.x;
       p.y = s.y;
       p.angle_deg = mapping.directionToSensor(r.angle_deg);
-      p.area = r.area * area_scale;
+      p.area = mapping.areaToSensor(r.area);
       p.holes = r.holes;
       parts.push_back(p);
     }
@@ -98,7 +68,7 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& 
     p.x = s.x;
     p.y = s.y;
     p.angle_deg = match.angle_deg;
-    p.area = regions[match.region].area * area_scale;
+    p.area = mapping.areaToSensor(regions[match.region].area);
     p.holes = regions[match.region].holes;
     p.type = match.model->type;
     p.score = match.score;
@@ -109,8 +79,14 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& 
   return parts;
 }
 
-std::vector<LocatedPart> locateParts(const ReceivedFrame& frame, const VisionOptions& options) {
-  return locateInImage(greyImage(frame), frameMapping(frame), options, {}, -1);
+LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
+                            std::shared_ptr<const ModelList> models, int type) {
+  LocateOutcome outcome;
+  outcome.frame = frame.info;
+  outcome.scene.models = models ? std::move(models) : std::make_shared<const ModelList>();
+  outcome.parts = locateInImage(greyImage(frame), frame.mapping, options, *outcome.scene.models,
+                                type, &outcome.scene);
+  return outcome;
 }
 
 std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const VisionOptions& options) {
@@ -124,7 +100,7 @@ std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const Vision
   return out;
 }
 
-Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& mapping,
+Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                     const VisionOptions& options) {
   const auto regions =
       vision::findRegions(vision::binarize(grey, options.binarize), options.regions, grey);
@@ -136,12 +112,7 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& map
   const vision::Region& r = regions.front();
   TargetOutcome t;
   t.centroid = mapping.toSensor(r.centroid);
-  // Moments in frame pixels to sensor pixels: x lengths grow by 1/scale_x.
-  const double sx = mapping.scale_x, sy = mapping.scale_y;
-  t.moments.m00 = r.moments.m00 / (sx * sy);
-  t.moments.mu20 = r.moments.mu20 / (sx * sx * sx * sy);
-  t.moments.mu02 = r.moments.mu02 / (sx * sy * sy * sy);
-  t.moments.mu11 = r.moments.mu11 / (sx * sx * sy * sy);
+  t.moments = mapping.momentsToSensor(r.moments);
   return t;
 }
 
@@ -149,24 +120,13 @@ VisionService::VisionService(std::unique_ptr<CameraLink> camera, VisionOptions o
                              ModelLibrary* models)
     : camera_(std::move(camera)), options_(std::move(options)), models_(models) {}
 
-VisionService::VisionService(zmq::context_t& context, const std::string& frames_endpoint,
-                             const std::string& control_endpoint, std::string camera,
-                             VisionOptions options, ModelLibrary* models)
-    : VisionService(std::make_unique<VideoServerCamera>(context, frames_endpoint, control_endpoint,
-                                                        std::move(camera), options.frame_timeout),
-                    options, models) {}
-
 void VisionService::start() { camera_->start(); }
 void VisionService::stop() { camera_->stop(); }
 
-Result<std::shared_ptr<const ReceivedFrame>> VisionService::freshFrame() {
+Result<std::shared_ptr<const Frame>> VisionService::freshFrame() {
   auto fresh = camera_->freshFrame();
-  if (!fresh) return fresh.error();
-  const auto frame = *fresh;
-  const auto& h = frame->header;
-  last_frame_ = FrameInfo{h.camera(), h.sequence(), h.host_timestamp_ns(),
-                          h.width(),  h.height(),   h.triggered()};
-  return frame;
+  if (fresh) last_frame_ = (*fresh)->info;
+  return fresh;
 }
 
 Result<LocateOutcome> VisionService::locate(int type) {
@@ -181,12 +141,7 @@ Result<LocateOutcome> VisionService::locate(int type) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  LocateOutcome outcome;
-  outcome.frame = *last_frame_;
-  outcome.parts = locateInImage(greyImage(**frame), frameMapping(**frame), options_, *models, type,
-                                &outcome.scene);
-  outcome.scene.models = models;
-  return outcome;
+  return locateInFrame(**frame, options_, models, type);
 }
 
 Result<vision::PartModel> VisionService::learn(int type, const std::string& name) {
@@ -210,18 +165,14 @@ Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  const FrameMapping mapping = frameMapping(**frame);
+  const SensorMapping& mapping = (*frame)->mapping;
   auto features = blobsInImage(greyImage(**frame), options_);
-  const double linear = 1.0 / std::sqrt(mapping.scale_x * mapping.scale_y);
   for (auto& f : features) {
     f.centroid = mapping.toSensor(f.centroid);
     f.angle_deg = mapping.directionToSensor(f.angle_deg);
-    f.area *= linear * linear;
-    f.perimeter *= linear;
-    const cv::Point2d tl = mapping.toSensor(cv::Point2d(f.bbox.x, f.bbox.y));
-    f.bbox = cv::Rect(static_cast<int>(std::lround(tl.x)), static_cast<int>(std::lround(tl.y)),
-                      static_cast<int>(std::lround(f.bbox.width / mapping.scale_x)),
-                      static_cast<int>(std::lround(f.bbox.height / mapping.scale_y)));
+    f.area = mapping.areaToSensor(f.area);
+    f.perimeter = mapping.lengthToSensor(f.perimeter);
+    f.bbox = mapping.boxToSensor(f.bbox);
   }
   return features;
 }
@@ -230,14 +181,9 @@ Result<TargetOutcome> VisionService::target() {
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  auto outcome = targetInImage(greyImage(**frame), frameMapping(**frame), options_);
+  auto outcome = targetInImage(greyImage(**frame), (*frame)->mapping, options_);
   if (outcome) outcome->frame = *last_frame_;
   return outcome;
-}
-
-Result<proto::ControlReply> VisionService::control(const proto::ControlRequest& request) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return camera_->control(request);
 }
 
 std::optional<FrameInfo> VisionService::lastFrame() const {

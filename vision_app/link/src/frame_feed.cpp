@@ -29,7 +29,7 @@ void FrameFeed::run() {
     while (!stop_) {
       auto frame = subscriber.receive(std::chrono::milliseconds(100));
       if (!frame) continue;
-      auto shared = std::make_shared<const ReceivedFrame>(std::move(*frame));
+      auto shared = std::make_shared<const Frame>(std::move(*frame));
       {
         std::lock_guard<std::mutex> lock(mutex_);
         latest_ = std::move(shared);
@@ -42,16 +42,16 @@ void FrameFeed::run() {
   }
 }
 
-std::shared_ptr<const ReceivedFrame> FrameFeed::latest() const {
+std::shared_ptr<const Frame> FrameFeed::latest() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return latest_;
 }
 
-std::shared_ptr<const ReceivedFrame> FrameFeed::waitFor(uint64_t sequence, uint64_t after_ns,
-                                                        std::chrono::milliseconds timeout) {
+std::shared_ptr<const Frame> FrameFeed::waitFor(uint64_t sequence, uint64_t after_ns,
+                                                std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto fresh = [&] {
-    return latest_ && latest_->header.sequence() >= sequence && latest_->received_ns >= after_ns;
+    return latest_ && latest_->info.sequence >= sequence && latest_->info.received_ns >= after_ns;
   };
   arrived_.wait_for(lock, timeout, fresh);
   return fresh() ? latest_ : nullptr;

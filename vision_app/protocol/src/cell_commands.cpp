@@ -36,10 +36,7 @@ std::string locate(const Request& r, CellContext& cell) {
   cell.last_offered = pick.poses.size();
   cell.last_skipped = pick.skipped;
   cell.skipped_total += pick.skipped;
-  std::string out = "OK " + std::to_string(pick.poses.size());
-  for (const auto& p : pick.poses)
-    out += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
-  return out;
+  return locateReply(pick);
 }
 
 // GRASP <type> ADD x y rz | CLEAR | LIST, and GRIPPER <type> FINGER x y w h |
@@ -156,68 +153,48 @@ std::string exposure(const Request& r, CellContext& cell) {
   // refuses the value explains why better than the names it does not know.
   std::string why;
   for (const auto& name : exposureFeatureNames()) {
-    proto::ControlRequest request;
-    if (value) {
-      auto* set = request.mutable_set_feature();
-      set->set_name(name);
-      set->set_value(formatFixed(*value, 3));
-    } else {
-      request.mutable_get_feature()->set_name(name);
-    }
-    auto answer = cell.vision.control(request);
-    if (answer) {
-      return "OK " + name + " " + printable(answer->feature().feature().value(), 64);
-    }
-    if (answer.error().code == ControlErrc::kNoReply ||
-        answer.error().code == CameraErrc::kNoVideoServer)
+    auto answer = cell.vision.withCamera([&](CameraLink& camera) {
+      return value ? camera.setFeature(name, formatFixed(*value, 3)) : camera.feature(name);
+    });
+    if (answer) return "OK " + name + " " + printable(*answer, 64);
+    const std::error_code code = answer.error().code;
+    if (code == CameraErrc::kNoVideoServer)
       return errorReply(CameraErrc::kNoVideoServer, "video server: " + answer.error().message);
-    if (answer.error().code != ControlErrc::kUnknownFeature || why.empty())
+    if (code != CameraErrc::kUnknownFeature || why.empty())
       why = printable(answer.error().message, 120);
-    if (answer.error().code != ControlErrc::kUnknownFeature) break;
+    if (code != CameraErrc::kUnknownFeature) break;
   }
   return errorReply(CameraErrc::kCameraRefused, "EXPOSURE: " + why);
 }
 
 std::string roi(const Request& r, CellContext& cell) {
   const std::string usage = "usage: ROI <x> <y> <width> <height> | ROI FULL | ROI";
-  proto::ControlRequest request;
   if (r.args.empty()) {
-    request.mutable_describe_camera();
-    auto answer = cell.vision.control(request);
+    auto answer = cell.vision.withCamera([](CameraLink& camera) { return camera.roi(); });
     if (!answer)
       return errorReply(CameraErrc::kCameraRefused,
                         "ROI: " + printable(answer.error().message, 120));
-    const auto& d = answer->describe_camera();
-    const auto& roi = d.roi();
-    // A zero size is the full sensor.
-    return "OK " + std::to_string(roi.x()) + " " + std::to_string(roi.y()) + " " +
-           std::to_string(roi.width() ? roi.width() : d.sensor_width()) + " " +
-           std::to_string(roi.height() ? roi.height() : d.sensor_height());
+    return "OK " + std::to_string(answer->x) + " " + std::to_string(answer->y) + " " +
+           std::to_string(answer->width) + " " + std::to_string(answer->height);
   }
-  auto* set = request.mutable_set_roi();
-  if (r.args.size() == 1 && toUpper(r.args[0]) == "FULL") {
-    set->mutable_roi();  // all zero: the full sensor
-  } else if (r.args.size() == 4) {
-    uint32_t v[4];
+  cv::Rect wanted;  // empty: the full sensor
+  if (r.args.size() == 4) {
+    int v[4];
     for (size_t i = 0; i < 4; ++i) {
       const auto n = parseInt(r.args[i]);
       if (!n || *n < 0 || *n > 100000 || (i >= 2 && *n == 0))
         return errorReply(ProtocolErrc::kBadArguments, usage);
-      v[i] = static_cast<uint32_t>(*n);
+      v[i] = static_cast<int>(*n);
     }
-    auto* roi = set->mutable_roi();
-    roi->set_x(v[0]);
-    roi->set_y(v[1]);
-    roi->set_width(v[2]);
-    roi->set_height(v[3]);
-  } else {
+    wanted = cv::Rect(v[0], v[1], v[2], v[3]);
+  } else if (r.args.size() != 1 || toUpper(r.args[0]) != "FULL") {
     return errorReply(ProtocolErrc::kBadArguments, usage);
   }
-  auto answer = cell.vision.control(request);
+  auto answer = cell.vision.withCamera([&](CameraLink& camera) { return camera.setRoi(wanted); });
   if (!answer) {
-    const bool down = answer.error().code == ControlErrc::kNoReply ||
-                      answer.error().code == CameraErrc::kNoVideoServer;
-    const CameraErrc code = down ? CameraErrc::kNoVideoServer : CameraErrc::kCameraRefused;
+    const CameraErrc code = answer.error().code == CameraErrc::kNoVideoServer
+                                ? CameraErrc::kNoVideoServer
+                                : CameraErrc::kCameraRefused;
     return errorReply(code, "ROI: " + printable(answer.error().message, 120));
   }
   return std::string("OK");

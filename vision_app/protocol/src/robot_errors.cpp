@@ -19,7 +19,7 @@ using calibration::CalibrationErrc;
 
 constexpr int kInternal = 99;
 
-const std::array<std::pair<std::error_code, int>, 27> kTable = {{
+const std::array<std::pair<std::error_code, int>, 28> kTable = {{
     {VisionErrc::kNoTarget, 1},
     {VisionErrc::kSeveralTargets, 2},
     {VisionErrc::kNotADisc, 3},
@@ -32,6 +32,7 @@ const std::array<std::pair<std::error_code, int>, 27> kTable = {{
     {CameraErrc::kNoVideoServer, 21},
     {ControlErrc::kNoReply, 21},
     {CameraErrc::kCameraRefused, 22},
+    {CameraErrc::kUnknownFeature, 22},
     {vision::PartModelErrc::kNoPart, 30},
     {vision::PartModelErrc::kSeveralParts, 31},
     {VisionErrc::kUnknownType, 32},

@@ -1,5 +1,8 @@
-// The frame wire format: a 3-part ZeroMQ message (topic = camera name,
-// serialized FrameHeader, pixel bytes), and a subscriber that receives it.
+// The frame codec: a Frame on the wire is a 3-part ZeroMQ message (topic =
+// camera name, serialized FrameHeader, pixel bytes); the encoder and the
+// decoder live side by side here, with the subscriber that receives frames.
+// Protobuf and ZeroMQ types stop at this library: everything past the
+// decoder is a Frame.
 #pragma once
 
 #include <chrono>
@@ -8,31 +11,36 @@
 #include <optional>
 #include <string>
 
-#include <opencv2/core.hpp>
 #include <zmq.hpp>
 
 #include "picksight.pb.h"
+#include "picksight/common/frame.hpp"
 
 namespace picksight {
 
-// One received frame. Owns its pixel bytes; image() is a view on them.
-struct ReceivedFrame {
-  proto::FrameHeader header;
-  zmq::message_t pixels;
-  // Local CLOCK_MONOTONIC time the frame was received: tells a frame that
-  // arrived after a request from an older one, whatever the sender's clock.
-  uint64_t received_ns = 0;
+// ------------------------------------------------------------------ encoder
 
-  // A cv::Mat header over the pixel bytes (CV_8UC1 or CV_8UC3), no copy;
-  // valid while this ReceivedFrame lives.
-  cv::Mat image() const;
-};
+// The wire header of a frame (its width, height, stride and pixel format are
+// the image's).
+proto::FrameHeader frameHeaderOf(const Frame& frame);
+
+// Sends `frame` as one message (topic = its camera) without copying the
+// pixels of a continuous image: ZeroMQ holds a reference to them until the
+// last subscriber was sent them. Throws zmq::error_t like socket sends.
+void sendFrame(zmq::socket_t& socket, const Frame& frame);
+
+// ------------------------------------------------------------------ decoder
 
 // Bytes per pixel of a wire pixel format (0 for unknown).
 int bytesPerPixel(proto::PixelFormat format);
 
 // Checks that a header and a payload describe a consistent image.
 bool frameIsConsistent(const proto::FrameHeader& header, size_t payload_size);
+
+// The frame a header and its pixel bytes describe, or nullopt when they are
+// not consistent. No copy: the frame's image is a view on `pixels`, which
+// the frame's owner keeps alive. received_ns is left for the caller to stamp.
+std::optional<Frame> decodeFrame(const proto::FrameHeader& header, zmq::message_t pixels);
 
 // Subscribes to the frames of one camera (or all cameras with an empty name).
 // Owned and used by one thread, like the ZeroMQ socket inside it.
@@ -43,9 +51,10 @@ class FrameSubscriber {
   FrameSubscriber(zmq::context_t& context, const std::string& endpoint, const std::string& camera,
                   int queue_frames = 4);
 
-  // The next frame, or nullopt on timeout. Malformed messages are skipped and
-  // counted, never returned.
-  std::optional<ReceivedFrame> receive(std::chrono::milliseconds timeout);
+  // The next frame, decoded and stamped with its local receive time, or
+  // nullopt on timeout. Malformed messages are skipped and counted, never
+  // returned.
+  std::optional<Frame> receive(std::chrono::milliseconds timeout);
 
   uint64_t malformedMessages() const { return malformed_; }
   // Frames this subscriber missed: gaps in each camera's sequence numbers

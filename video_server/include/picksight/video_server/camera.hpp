@@ -18,8 +18,9 @@
 #include <utility>
 #include <vector>
 
-#include "picksight/video_server/frame_pipeline.hpp"
+#include "picksight/common/frame.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/video_server/frame_pipeline.hpp"
 
 namespace picksight::video {
 
@@ -34,23 +35,13 @@ struct CameraConfig {
   std::vector<std::pair<std::string, std::string>> features;
 };
 
-// A frame ready to publish.
-struct PublishedFrame {
-  std::string camera;
-  uint64_t sequence = 0;
-  uint64_t device_timestamp_ns = 0;
-  uint64_t host_timestamp_ns = 0;
-  bool triggered = false;
-  OutputFrame output;
-  std::vector<TruthPart> truth;
-};
-
-// Where a camera's frames go. publish() must not block: the acquisition thread
+// Where a camera's frames go: Frames whose image the camera made for them
+// alone (continuous, owned). publish() must not block: the acquisition thread
 // calls it and a slow consumer must never slow the camera.
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  virtual void publish(PublishedFrame frame) = 0;
+  virtual void publish(Frame frame) = 0;
 };
 
 struct TriggerTicket {
@@ -106,7 +97,7 @@ class Camera {
 
   // The last published frame with a sequence of at least `sequence`, waiting
   // up to `timeout` for it; nullopt on timeout.
-  std::optional<PublishedFrame> waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout);
+  std::optional<Frame> waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout);
 
   // Feature access runs on the acquisition thread, between grabs, so the
   // source is only ever called from one thread.
@@ -141,7 +132,7 @@ class Camera {
   bool open_requested_ = true;
   bool reconfigure_ = true;  // acquisition settings changed since the source last heard
   std::deque<Command> commands_;
-  std::optional<PublishedFrame> last_frame_;
+  std::optional<Frame> last_frame_;
   cv::Size frame_size_;  // of the frames the device delivers (sensor pixels)
   bool ever_opened_ = false;
   std::chrono::milliseconds backoff_{100};

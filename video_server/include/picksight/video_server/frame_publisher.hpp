@@ -1,6 +1,6 @@
 // Publishes camera frames on a ZeroMQ PUB socket, one topic per camera, as
-// 3-part messages (topic, FrameHeader, pixels) with the pixels sent without
-// copying.
+// 3-part messages (the frame codec's sendFrame: topic, FrameHeader, pixels
+// sent without copying).
 //
 // Threading: the PUB socket belongs to the publisher thread. publish() may be
 // called from any camera thread; it only queues. Slow subscribers lose frames
@@ -18,13 +18,10 @@
 
 #include <zmq.hpp>
 
-#include "picksight.pb.h"
+#include "picksight/transport/frame_message.hpp"
 #include "picksight/video_server/camera.hpp"
 
 namespace picksight::video {
-
-// The wire header of a frame.
-proto::FrameHeader frameHeaderOf(const PublishedFrame& frame);
 
 struct PublisherCounters {
   uint64_t published = 0;
@@ -44,14 +41,13 @@ class FramePublisher : public FrameSink {
 
   void start();
   void stop();
-  void publish(PublishedFrame frame) override;
+  void publish(Frame frame) override;
 
   PublisherCounters counters(const std::string& camera) const;
   int subscribers() const { return subscribers_.load(); }
 
  private:
   void run();
-  void send(PublishedFrame& frame);
   void pollMonitor();
 
   zmq::socket_t socket_;   // publisher thread only (after start)
@@ -63,7 +59,7 @@ class FramePublisher : public FrameSink {
 
   mutable std::mutex mutex_;  // guards the fields below
   std::condition_variable wake_;
-  std::deque<PublishedFrame> queue_;
+  std::deque<Frame> queue_;
   std::map<std::string, PublisherCounters> counters_;
   bool stop_ = false;
 };

@@ -14,6 +14,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "picksight/common/frame.hpp"
 #include "picksight/common/result.hpp"
 
 namespace picksight::video {
@@ -58,15 +59,9 @@ struct Feature {
   bool writable = true;
 };
 
-// Ground truth of one part in a frame, in sensor pixels (synthetic sources).
-struct TruthPart {
-  std::string type;
-  double x = 0;
-  double y = 0;
-  double angle_deg = 0;       // [0, 360), image axes (x right, y down)
-  double symmetry_deg = 360;  // period of the measurable angle; 0 = none
-  double area_px = 0;
-};
+// Ground truth of one part in a frame, in sensor pixels (synthetic sources):
+// the frame's own type, carried unchanged to subscribers.
+using picksight::TruthPart;
 
 struct SourceFrame {
   // The frame at sensor resolution, laid out as `layout` says. May share

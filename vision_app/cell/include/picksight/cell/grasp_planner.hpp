@@ -3,6 +3,7 @@
 // (see grasp/grasp.hpp), then the reply frame (robot once computed).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "picksight/cell/vision_service.hpp"
@@ -29,5 +30,8 @@ grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::Vi
 // grasp styles is grasped at its own pose, checked against the fingers.
 CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
                    const CellGeometry& geometry);
+
+// The LOCATE reply a robot reads: "OK <n>" then x y rz of each pose.
+std::string locateReply(const CellPick& pick);
 
 }  // namespace picksight::app

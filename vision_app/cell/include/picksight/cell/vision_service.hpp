@@ -14,12 +14,10 @@
 #include <string>
 #include <vector>
 
-#include <zmq.hpp>
-
 #include "picksight/camera_link/camera_link.hpp"
+#include "picksight/common/frame.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/store/model_library.hpp"
-#include "picksight/transport/control_client.hpp"
 #include "picksight/vision/binarize.hpp"
 #include "picksight/vision/blob_features.hpp"
 #include "picksight/vision/part_model.hpp"
@@ -27,7 +25,8 @@
 
 namespace picksight::app {
 
-// Why a vision request failed (besides the camera link's CameraErrc).
+// Why a vision request failed (besides the camera link's CameraErrc and
+// training's vision::PartModelErrc).
 enum class VisionErrc {
   kNoTarget = 1,    // STORE, CALCAM: no target in the frame
   kSeveralTargets,  // STORE, CALCAM: more than one
@@ -52,31 +51,12 @@ struct LocatedPart {
   int region = -1;            // index into the scene's regions
 };
 
-// Where a frame's pixels lie on the sensor (ROI offset and resize).
-struct FrameMapping {
-  double roi_x = 0;
-  double roi_y = 0;
-  double scale_x = 1;
-  double scale_y = 1;
-  cv::Point2d toSensor(cv::Point2d p) const;
-  double directionToSensor(double deg) const;
-};
-
-struct FrameInfo {
-  std::string camera;
-  uint64_t sequence = 0;
-  uint64_t host_timestamp_ns = 0;
-  uint32_t width = 0;
-  uint32_t height = 0;
-  bool triggered = false;
-};
-
 // What a location saw beyond the parts: the binary mask and the regions
 // (frame pixels), for grasp clearance.
 struct LocateScene {
   cv::Mat mask;  // CV_8UC1, non-zero = part
   std::vector<vision::Region> regions;
-  FrameMapping mapping;
+  SensorMapping mapping;
   std::shared_ptr<const ModelList> models;  // the models the parts refer to
 };
 
@@ -101,24 +81,26 @@ struct VisionOptions {
   std::chrono::milliseconds frame_timeout{3000};
 };
 
-// Finds the parts in one frame and maps them to sensor pixels through the
-// frame header's ROI offset and scale: every region, largest first.
-std::vector<LocatedPart> locateParts(const ReceivedFrame& frame, const VisionOptions& options);
+// The frame's image as 8-bit grey: the image itself, or a converted copy.
+cv::Mat greyImage(const Frame& frame);
 
-// The frame as 8-bit grey (converted from colour if needed) and its mapping.
-cv::Mat greyImage(const ReceivedFrame& frame);
-FrameMapping frameMapping(const ReceivedFrame& frame);
+// LOCATE on one frame, as the robot server, the offline tool and the
+// benchmarks run it: the parts of `type` (-1: all types) recognized with
+// `models` (every region when there are none), with the scene kept for
+// grasp selection. The outcome's frame info is the frame's.
+LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
+                            std::shared_ptr<const ModelList> models, int type);
 
 // Finds parts in a grey image: with `models` non-empty, the recognized parts
 // of type `type` (-1: all types), best first; with none, every region,
 // largest first.
 // With `scene`, also keeps the mask and regions there.
-std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const FrameMapping& mapping,
+std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
                                        int type, LocateScene* scene = nullptr);
 
 // The single region of a grey image as a calibration target.
-Result<TargetOutcome> targetInImage(const cv::Mat& grey, const FrameMapping& mapping,
+Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                     const VisionOptions& options);
 
 // Blob features of every region of a grey image (skeleton left out).
@@ -128,10 +110,6 @@ class VisionService {
  public:
   // `models` (borrowed, may be null: no recognition) outlives the service.
   VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
-                ModelLibrary* models = nullptr);
-  // With a VideoServerCamera.
-  VisionService(zmq::context_t& context, const std::string& frames_endpoint,
-                const std::string& control_endpoint, std::string camera, VisionOptions options,
                 ModelLibrary* models = nullptr);
 
   void start();
@@ -146,8 +124,13 @@ class VisionService {
   Result<std::vector<vision::BlobFeatures>> blobs();
   // The single calibration target in a fresh frame.
   Result<TargetOutcome> target();
-  // A camera setting passed to the video server.
-  Result<proto::ControlReply> control(const proto::ControlRequest& request);
+  // Runs `fn(CameraLink&)` between requests (camera settings: they share
+  // the link's control socket with the triggers) and returns its result.
+  template <typename Fn>
+  auto withCamera(Fn&& fn) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return fn(*camera_);
+  }
   uint64_t framesReceived() const { return camera_->framesReceived(); }
   ModelLibrary* models() const { return models_; }
   // The frame the last request worked on.
@@ -157,7 +140,7 @@ class VisionService {
 
  private:
   // Call with mutex_ held.
-  Result<std::shared_ptr<const ReceivedFrame>> freshFrame();
+  Result<std::shared_ptr<const Frame>> freshFrame();
 
   const std::unique_ptr<CameraLink> camera_;
   const VisionOptions options_;

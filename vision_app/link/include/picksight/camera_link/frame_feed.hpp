@@ -1,5 +1,5 @@
 // The vision app's view of one camera: a thread that receives its frames and
-// keeps the newest, so a request can wait for a frame taken after it.
+// keeps the newest, decoded, so a request can wait for a frame taken after it.
 #pragma once
 
 #include <atomic>
@@ -28,9 +28,9 @@ class FrameFeed {
   // received after `after_ns` (CLOCK_MONOTONIC), waiting for it up to
   // `timeout`; nullptr on timeout. The receive time guards against a video
   // server that restarted and counts sequences from 1 again.
-  std::shared_ptr<const ReceivedFrame> waitFor(uint64_t sequence, uint64_t after_ns,
-                                               std::chrono::milliseconds timeout);
-  std::shared_ptr<const ReceivedFrame> latest() const;
+  std::shared_ptr<const Frame> waitFor(uint64_t sequence, uint64_t after_ns,
+                                       std::chrono::milliseconds timeout);
+  std::shared_ptr<const Frame> latest() const;
   uint64_t framesReceived() const { return received_.load(); }
 
  private:
@@ -45,7 +45,7 @@ class FrameFeed {
 
   mutable std::mutex mutex_;  // guards latest_
   std::condition_variable arrived_;
-  std::shared_ptr<const ReceivedFrame> latest_;
+  std::shared_ptr<const Frame> latest_;
 };
 
 }  // namespace picksight::app

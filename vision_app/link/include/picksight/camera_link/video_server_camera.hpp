@@ -1,0 +1,46 @@
+// The camera link to a video server: a software trigger (or the next
+// free-run frame) on the control socket, the frame from a subscriber thread;
+// camera settings as control requests. The only part of the vision app that
+// speaks the video server's protocol.
+//
+// Threading: as CameraLink; the control socket is used by the caller's
+// thread (VisionService serializes), the frames by the feed's thread.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include <zmq.hpp>
+
+#include "picksight/camera_link/camera_link.hpp"
+#include "picksight/camera_link/frame_feed.hpp"
+#include "picksight/transport/control_client.hpp"
+
+namespace picksight::app {
+
+class VideoServerCamera : public CameraLink {
+ public:
+  VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
+                    const std::string& control_endpoint, std::string camera,
+                    std::chrono::milliseconds frame_timeout);
+  void start() override { feed_.start(); }
+  void stop() override { feed_.stop(); }
+  Result<std::shared_ptr<const Frame>> freshFrame() override;
+  Result<std::string> feature(const std::string& name) override;
+  Result<std::string> setFeature(const std::string& name, const std::string& value) override;
+  Result<cv::Rect> roi() override;
+  Result<void> setRoi(const cv::Rect& roi) override;
+  uint64_t framesReceived() const override { return feed_.framesReceived(); }
+  const std::string& camera() const override { return camera_; }
+
+ private:
+  // One request to the video server, its errors as CameraError codes.
+  Result<proto::ControlReply> call(const proto::ControlRequest& request);
+
+  const std::string camera_;
+  const std::chrono::milliseconds frame_timeout_;
+  FrameFeed feed_;
+  ControlClient control_;
+};
+
+}  // namespace picksight::app
