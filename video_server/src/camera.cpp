@@ -6,6 +6,7 @@
 // on their own thread or in the kernel and only hand them to grab(); the
 // conversion work happens here, never on the driver's thread.
 #include "picksight/video_server/camera.hpp"
+
 #include "picksight/video_server/video_errors.hpp"
 
 #include <algorithm>
@@ -246,146 +247,168 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
 }
 
 void Camera::run() {
-  using Clock = std::chrono::steady_clock;
-  auto next_due = Clock::now();
-  uint64_t last_frame_ns = 0;
+  next_due_ = Clock::now();
+  last_frame_ns_ = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
     runCommands(lock);
     if (!open_requested_) {
-      closeSource(lock);
-      status_.state = "closed";
-      wake_.wait(lock, [this] { return stop_ || open_requested_ || !commands_.empty(); });
+      waitWhileClosed(lock);
       continue;
     }
     if (!ensureOpen(lock)) continue;
-
-    if (reconfigure_) {
-      reconfigure_ = false;
-      const AcquisitionMode mode = mode_;
-      const double fps = fps_;
-      lock.unlock();
-      const Result<void> configured = source_->configureAcquisition(mode, fps);
-      lock.lock();
-      if (!configured) {
-        status_.last_error = configured.error().message;
-        logWarning("camera ", config_.name, ": ", configured.error().message);
-      }
-      next_due = Clock::now();
-    }
+    if (reconfigure_) applyAcquisitionSettings(lock);
     const bool streams = source_->streams();
+    const std::optional<bool> triggered = waitForTurn(lock, streams);
+    if (!triggered) continue;  // woken for something else
 
-    // Wait for the next frame's turn: a trigger, or the free-run period
-    // (sources that stream pace themselves).
-    bool triggered = false;
-    if (mode_ == AcquisitionMode::kTrigger) {
-      wake_.wait(lock, [this] {
-        return stop_ || pending_triggers_ > 0 || mode_ != AcquisitionMode::kTrigger ||
-               reconfigure_ || !open_requested_ || !commands_.empty();
-      });
-      if (stop_ || pending_triggers_ == 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
-          !open_requested_) {
-        continue;
-      }
-      triggered = true;
-      --pending_triggers_;
-    } else if (!streams) {
-      const auto period = std::chrono::duration_cast<Clock::duration>(
-          std::chrono::duration<double>(1.0 / std::max(fps_, 1e-3)));
-      wake_.wait_until(lock, next_due, [&] {
-        return stop_ || reconfigure_ || mode_ != AcquisitionMode::kFreeRun || !open_requested_ ||
-               !commands_.empty();
-      });
-      if (Clock::now() < next_due) continue;  // woken for something else
-      // Behind by more than a period (a slow grab): restart the cadence
-      // rather than bursting to catch up.
-      next_due = std::max(next_due + period, Clock::now());
-    }
     const uint64_t sequence = next_sequence_++;
     const OutputSettings output = output_;
     lock.unlock();
-
-    // A streaming camera may take longer than one grab slice to deliver a
-    // triggered frame: trigger once, then keep waiting, and only trigger
-    // again if the frame never came (a lost trigger packet).
-    const auto now = Clock::now();
-    const bool retrigger = !trigger_sent_ || now - *trigger_sent_ > kTriggerPatience;
-    Result<void> asked;
-    if (triggered && retrigger) {
-      asked = source_->softwareTrigger();
-      trigger_sent_ = now;
-    }
-    Result<SourceFrame> grabbed =
-        asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
-              : Result<SourceFrame>(asked.error());
-    const uint64_t host_ns = realtimeNs();
-    // Standardize, then ROI and resize; the standardized size is the size of
-    // the frames the device delivers.
-    Result<cv::Mat> standard = grabbed
-                                   ? toOutputFormat(grabbed->image, grabbed->layout, output.format)
-                                   : Result<cv::Mat>(grabbed.error());
-    Result<OutputFrame> out =
-        standard ? Result<OutputFrame>(applyOutputSettings(
-                       *standard, output, standard->datastart != grabbed->image.datastart))
-                 : Result<OutputFrame>(standard.error());
-
-    if (!out) {
-      lock.lock();
-      // The sequence number was not used: give it back so a gap means a lost frame.
-      if (next_sequence_ == sequence + 1) next_sequence_ = sequence;
-      if (triggered) ++pending_triggers_;  // the trigger is still owed a frame
-      if (out.error().code == SourceErrc::kTimeout) {
-        // A streaming camera with nothing to deliver yet; not an error.
-        if (triggered) ++status_.acquisition_errors;
-        continue;
-      }
-      ++status_.acquisition_errors;
-      status_.last_error = out.error().message;
-      if (out.error().code == SourceErrc::kUnavailable) {
-        logWarning("camera ", config_.name, ": ", out.error().message);
-        closeSource(lock);
-        status_.state = "reconnecting";
-        waitBackoff(lock);
-      } else {
-        // A bad frame (a corrupt buffer): drop it and go on.
-        logWarning("camera ", config_.name, ": frame dropped: ", out.error().message);
-      }
+    Grab grab = grabAndConvert(*triggered, streams, output);
+    lock.lock();
+    if (!grab.out) {
+      handleGrabFailure(lock, sequence, *triggered, grab.out.error());
       continue;
     }
-
-    trigger_sent_.reset();
-    Frame frame;
-    frame.image = std::move(out->image);
-    frame.mapping = {static_cast<double>(out->roi_offset.x), static_cast<double>(out->roi_offset.y),
-                     out->scale_x, out->scale_y};
-    frame.info.camera = config_.name;
-    frame.info.sequence = sequence;
-    frame.info.device_timestamp_ns = grabbed->device_timestamp_ns;
-    frame.info.host_timestamp_ns = host_ns;
-    frame.info.width = static_cast<uint32_t>(frame.image.cols);
-    frame.info.height = static_cast<uint32_t>(frame.image.rows);
-    frame.info.triggered = triggered;
-    frame.truth = std::move(grabbed->truth);
-    // Statistics first, then the hand-over: a subscriber must never hold a
-    // frame that `stats` does not count yet.
-    lock.lock();
-    frame_size_ = standard->size();
-    last_frame_ = frame;
-    ++status_.frames_acquired;
-    status_.last_sequence = sequence;
-    if (last_frame_ns != 0) {
-      // Exponential average of the instantaneous rate: smooth, and follows a
-      // rate change within a few frames.
-      const double rate = 1e9 / static_cast<double>(std::max<uint64_t>(1, host_ns - last_frame_ns));
-      status_.fps_measured =
-          status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
-    }
-    last_frame_ns = host_ns;
-    lock.unlock();
-    sink_.publish(std::move(frame));
-    lock.lock();
-    frame_published_.notify_all();
+    publish(lock, sequence, *triggered, std::move(grab));
   }
+}
+
+void Camera::waitWhileClosed(std::unique_lock<std::mutex>& lock) {
+  closeSource(lock);
+  status_.state = "closed";
+  wake_.wait(lock, [this] { return stop_ || open_requested_ || !commands_.empty(); });
+}
+
+void Camera::applyAcquisitionSettings(std::unique_lock<std::mutex>& lock) {
+  reconfigure_ = false;
+  const AcquisitionMode mode = mode_;
+  const double fps = fps_;
+  lock.unlock();
+  const Result<void> configured = source_->configureAcquisition(mode, fps);
+  lock.lock();
+  if (!configured) {
+    status_.last_error = configured.error().message;
+    logWarning("camera ", config_.name, ": ", configured.error().message);
+  }
+  next_due_ = Clock::now();
+}
+
+std::optional<bool> Camera::waitForTurn(std::unique_lock<std::mutex>& lock, bool streams) {
+  // A trigger, or the free-run period (sources that stream pace themselves).
+  if (mode_ == AcquisitionMode::kTrigger) {
+    wake_.wait(lock, [this] {
+      return stop_ || pending_triggers_ > 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
+             !open_requested_ || !commands_.empty();
+    });
+    if (stop_ || pending_triggers_ == 0 || mode_ != AcquisitionMode::kTrigger || reconfigure_ ||
+        !open_requested_) {
+      return std::nullopt;
+    }
+    --pending_triggers_;
+    return true;
+  }
+  if (streams) return false;
+  const auto period = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / std::max(fps_, 1e-3)));
+  wake_.wait_until(lock, next_due_, [&] {
+    return stop_ || reconfigure_ || mode_ != AcquisitionMode::kFreeRun || !open_requested_ ||
+           !commands_.empty();
+  });
+  if (Clock::now() < next_due_) return std::nullopt;
+  // Behind by more than a period (a slow grab): restart the cadence rather
+  // than bursting to catch up.
+  next_due_ = std::max(next_due_ + period, Clock::now());
+  return false;
+}
+
+Camera::Grab Camera::grabAndConvert(bool triggered, bool streams, const OutputSettings& output) {
+  // A streaming camera may take longer than one grab slice to deliver a
+  // triggered frame: trigger once, then keep waiting, and only trigger
+  // again if the frame never came (a lost trigger packet).
+  const auto now = Clock::now();
+  const bool retrigger = !trigger_sent_ || now - *trigger_sent_ > kTriggerPatience;
+  Result<void> asked;
+  if (triggered && retrigger) {
+    asked = source_->softwareTrigger();
+    trigger_sent_ = now;
+  }
+  Grab grab;
+  grab.grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
+                       : Result<SourceFrame>(asked.error());
+  grab.host_ns = realtimeNs();
+  // Standardize, then ROI and resize; the standardized size is the size of
+  // the frames the device delivers.
+  const Result<SourceFrame>& grabbed = grab.grabbed;
+  Result<cv::Mat> standard = grabbed
+                                 ? toOutputFormat(grabbed->image, grabbed->layout, output.format)
+                                 : Result<cv::Mat>(grabbed.error());
+  if (standard) grab.delivered = standard->size();
+  grab.out = standard ? Result<OutputFrame>(applyOutputSettings(
+                            *standard, output, standard->datastart != grabbed->image.datastart))
+                      : Result<OutputFrame>(standard.error());
+  return grab;
+}
+
+void Camera::handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequence,
+                               bool triggered, const Error& error) {
+  // The sequence number was not used: give it back so a gap means a lost frame.
+  if (next_sequence_ == sequence + 1) next_sequence_ = sequence;
+  if (triggered) ++pending_triggers_;  // the trigger is still owed a frame
+  if (error.code == SourceErrc::kTimeout) {
+    // A streaming camera with nothing to deliver yet; not an error.
+    if (triggered) ++status_.acquisition_errors;
+    return;
+  }
+  ++status_.acquisition_errors;
+  status_.last_error = error.message;
+  if (error.code == SourceErrc::kUnavailable) {
+    logWarning("camera ", config_.name, ": ", error.message);
+    closeSource(lock);
+    status_.state = "reconnecting";
+    waitBackoff(lock);
+  } else {
+    // A bad frame (a corrupt buffer): drop it and go on.
+    logWarning("camera ", config_.name, ": frame dropped: ", error.message);
+  }
+}
+
+void Camera::publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool triggered,
+                     Grab grab) {
+  trigger_sent_.reset();
+  Frame frame;
+  const OutputFrame& out = *grab.out;
+  frame.image = out.image;
+  frame.mapping = {static_cast<double>(out.roi_offset.x), static_cast<double>(out.roi_offset.y),
+                   out.scale_x, out.scale_y};
+  frame.info.camera = config_.name;
+  frame.info.sequence = sequence;
+  frame.info.device_timestamp_ns = grab.grabbed->device_timestamp_ns;
+  frame.info.host_timestamp_ns = grab.host_ns;
+  frame.info.width = static_cast<uint32_t>(frame.image.cols);
+  frame.info.height = static_cast<uint32_t>(frame.image.rows);
+  frame.info.triggered = triggered;
+  frame.truth = std::move(grab.grabbed->truth);
+  // Statistics first, then the hand-over: a subscriber must never hold a
+  // frame that `stats` does not count yet.
+  frame_size_ = grab.delivered;
+  last_frame_ = frame;
+  ++status_.frames_acquired;
+  status_.last_sequence = sequence;
+  if (last_frame_ns_ != 0) {
+    // Exponential average of the instantaneous rate: smooth, and follows a
+    // rate change within a few frames.
+    const double rate =
+        1e9 / static_cast<double>(std::max<uint64_t>(1, grab.host_ns - last_frame_ns_));
+    status_.fps_measured =
+        status_.fps_measured == 0 ? rate : 0.9 * status_.fps_measured + 0.1 * rate;
+  }
+  last_frame_ns_ = grab.host_ns;
+  lock.unlock();
+  sink_.publish(std::move(frame));
+  lock.lock();
+  frame_published_.notify_all();
 }
 
 }  // namespace picksight::video

@@ -25,6 +25,10 @@ const char* errorName(VideoErrc e) {
       return "not supported";
     case VideoErrc::kBusy:
       return "busy";
+    case VideoErrc::kBadRequest:
+      return "bad request";
+    case VideoErrc::kInternal:
+      return "internal";
   }
   return "unknown";
 }
@@ -32,7 +36,7 @@ const char* errorName(VideoErrc e) {
 namespace {
 using Wire = proto::Error;
 
-const std::array<std::pair<std::error_code, Wire::Code>, 14> kTable = {{
+const std::array<std::pair<std::error_code, Wire::Code>, 16> kTable = {{
     {SourceErrc::kTimeout, Wire::TIMEOUT},
     {SourceErrc::kUnavailable, Wire::CAMERA_UNAVAILABLE},
     {SourceErrc::kBadConfig, Wire::BAD_REQUEST},
@@ -46,6 +50,8 @@ const std::array<std::pair<std::error_code, Wire::Code>, 14> kTable = {{
     {VideoErrc::kNoFrame, Wire::TIMEOUT},
     {VideoErrc::kNotSupported, Wire::NOT_SUPPORTED},
     {VideoErrc::kBusy, Wire::BUSY},
+    {VideoErrc::kBadRequest, Wire::BAD_REQUEST},
+    {VideoErrc::kInternal, Wire::INTERNAL},
     {std::error_code(), Wire::OK},
 }};
 }  // namespace

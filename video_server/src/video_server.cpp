@@ -1,9 +1,13 @@
-// Video server wiring and control request handling.
+// Video server wiring and control request handling: handle() only
+// dispatches, one function per request kind answers.
 #include "picksight/video_server/video_server.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "picksight/video_server/control_errors.hpp"
+#include "picksight/video_server/control_request.hpp"
+#include "picksight/video_server/video_errors.hpp"
 
 namespace picksight::video {
 namespace {
@@ -11,17 +15,7 @@ proto::AcquisitionMode toProto(AcquisitionMode m) {
   return m == AcquisitionMode::kTrigger ? proto::TRIGGER : proto::FREERUN;
 }
 
-proto::ControlReply errorReply(proto::Error::Code code, const std::string& text) {
-  proto::ControlReply reply;
-  reply.mutable_error()->set_code(code);
-  reply.mutable_error()->set_text(text);
-  return reply;
-}
-
 constexpr std::chrono::milliseconds kSnapTimeout{3000};
-
-// Driver errors to the wire's, through the server's one table.
-proto::ControlReply sourceErrorReply(const Error& e) { return video::errorReply(e); }
 
 void fillFeature(const Feature& f, proto::Feature* out) {
   out->set_name(f.name);
@@ -43,9 +37,154 @@ void fillSummary(const CameraStatus& s, proto::CameraSummary* out) {
   out->set_state(s.state);
   out->set_mode(toProto(s.mode));
 }
+proto::ControlReply okReply() {
+  proto::ControlReply reply;
+  reply.mutable_error()->set_code(proto::Error::OK);
+  return reply;
+}
+
+// The ROI in sensor pixels and the output size the current settings give.
+std::pair<cv::Rect, cv::Size> outputGeometry(const CameraStatus& s) {
+  const cv::Rect roi = s.output.roi.empty()
+                           ? cv::Rect(0, 0, s.info.sensor_width, s.info.sensor_height)
+                           : s.output.roi;
+  cv::Size out = s.output.size;
+  if (out.empty()) {
+    const double scale = s.output.scale > 0 ? s.output.scale : 1.0;
+    out = cv::Size(static_cast<int>(std::lround(roi.width * scale)),
+                   static_cast<int>(std::lround(roi.height * scale)));
+  }
+  return {roi, out};
+}
+
+proto::ControlReply describeCamera(Camera& camera) {
+  const CameraStatus s = camera.status();
+  proto::ControlReply reply = okReply();
+  auto* d = reply.mutable_describe_camera();
+  fillSummary(s, d->mutable_summary());
+  d->set_vendor(s.info.vendor);
+  d->set_model(s.info.model);
+  d->set_serial(s.info.serial);
+  d->set_sensor_width(static_cast<uint32_t>(s.info.sensor_width));
+  d->set_sensor_height(static_cast<uint32_t>(s.info.sensor_height));
+  const auto [roi, out] = outputGeometry(s);
+  d->mutable_roi()->set_x(static_cast<uint32_t>(roi.x));
+  d->mutable_roi()->set_y(static_cast<uint32_t>(roi.y));
+  d->mutable_roi()->set_width(static_cast<uint32_t>(roi.width));
+  d->mutable_roi()->set_height(static_cast<uint32_t>(roi.height));
+  d->set_output_width(static_cast<uint32_t>(out.width));
+  d->set_output_height(static_cast<uint32_t>(out.height));
+  d->set_pixel_format(s.output.format == OutputFormat::kBgr8 ? proto::BGR8 : proto::MONO8);
+  d->set_fps(s.fps_setting);
+  for (const auto& f : s.info.formats) d->add_source_formats(f);
+  return reply;
+}
+
+// Applies `change` to the camera's output settings; a rejected setting is
+// OUT_OF_RANGE and leaves the camera as it was.
+proto::ControlReply changeOutput(Camera& camera,
+                                 const std::function<void(OutputSettings&)>& change) {
+  OutputSettings o = camera.output();
+  change(o);
+  if (auto ok = camera.setOutput(o); !ok) {
+    return errorReply(ok.error());
+  }
+  return okReply();
+}
+
+proto::ControlReply setRoi(Camera& camera, const proto::SetRoiRequest& request) {
+  return changeOutput(camera, [&r = request.roi()](OutputSettings& o) {
+    o.roi = cv::Rect(static_cast<int>(r.x()), static_cast<int>(r.y()), static_cast<int>(r.width()),
+                     static_cast<int>(r.height()));
+    if (r.width() == 0 && r.height() == 0) o.roi = cv::Rect();  // back to the full sensor
+  });
+}
+
+proto::ControlReply setSize(Camera& camera, const proto::SetSizeRequest& request) {
+  return changeOutput(camera, [&request](OutputSettings& o) {
+    o.size = cv::Size(static_cast<int>(request.width()), static_cast<int>(request.height()));
+    o.scale = request.scale();
+  });
+}
+
+proto::ControlReply setFormat(Camera& camera, const proto::SetFormatRequest& request) {
+  const auto f = request.pixel_format();
+  if (f != proto::MONO8 && f != proto::BGR8) {
+    return errorReply(makeError(VideoErrc::kOutOfRange, "pixel format must be mono8 or bgr8"));
+  }
+  return changeOutput(camera, [f](OutputSettings& o) {
+    o.format = f == proto::BGR8 ? OutputFormat::kBgr8 : OutputFormat::kMono8;
+  });
+}
+
+proto::ControlReply setMode(Camera& camera, const proto::SetModeRequest& request) {
+  if (request.mode() != proto::FREERUN && request.mode() != proto::TRIGGER) {
+    return errorReply(makeError(VideoErrc::kOutOfRange, "mode must be freerun or trigger"));
+  }
+  const AcquisitionMode mode =
+      request.mode() == proto::TRIGGER ? AcquisitionMode::kTrigger : AcquisitionMode::kFreeRun;
+  if (auto ok = camera.setMode(mode, request.fps()); !ok) {
+    return errorReply(ok.error());
+  }
+  return okReply();
+}
+
+proto::ControlReply trigger(Camera& camera) {
+  const TriggerTicket t = camera.trigger();
+  proto::ControlReply reply = okReply();
+  reply.mutable_trigger()->set_sequence(t.sequence);
+  reply.mutable_trigger()->set_triggered(t.triggered);
+  return reply;
+}
+
+proto::ControlReply listFeatures(Camera& camera) {
+  auto features = camera.features();
+  if (!features) return errorReply(features.error());
+  proto::ControlReply reply = okReply();
+  auto* list = reply.mutable_list_features();
+  for (const auto& f : *features) fillFeature(f, list->add_features());
+  return reply;
+}
+
+// The feature as it now is, or the source's error.
+proto::ControlReply featureReply(const Result<Feature>& f) {
+  if (!f) return errorReply(f.error());
+  proto::ControlReply reply = okReply();
+  fillFeature(*f, reply.mutable_feature()->mutable_feature());
+  return reply;
+}
+
+proto::ControlReply setOpen(Camera& camera, bool open) {
+  camera.setOpen(open);
+  return okReply();
+}
+
+proto::ControlReply snap(Camera& camera) {
+  const std::string& name = camera.name();
+  if (!camera.status().open_requested) {
+    return errorReply(makeError(VideoErrc::kCameraClosed, "camera '" + name + "' is closed"));
+  }
+  const TriggerTicket t = camera.trigger();
+  auto frame = camera.waitForFrame(t.sequence, kSnapTimeout);
+  if (!frame) {
+    return errorReply(makeError(VideoErrc::kNoFrame, "no frame from camera '" + name + "' within " +
+                                                         std::to_string(kSnapTimeout.count()) +
+                                                         " ms"));
+  }
+  proto::ControlReply reply = okReply();
+  auto* out = reply.mutable_snap();
+  *out->mutable_header() = frameHeaderOf(*frame);
+  const cv::Mat& img = frame->image;
+  out->set_pixels(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize());
+  return reply;
+}
+
+proto::ControlReply notSupported() {
+  return errorReply(makeError(VideoErrc::kNotSupported, "request not supported by this server"));
+}
 }  // namespace
 
-VideoServer::VideoServer(const ServerConfig& config) {
+VideoServer::VideoServer(const ServerConfig& config, const SourceFactory& make_source) {
   // zmq::error_t alone ("Address already in use") would not say which endpoint.
   try {
     publisher_ = std::make_unique<FramePublisher>(context_, config.frames_endpoint);
@@ -53,7 +192,7 @@ VideoServer::VideoServer(const ServerConfig& config) {
     throw std::runtime_error("frames endpoint " + config.frames_endpoint + ": " + e.what());
   }
   for (const auto& c : config.cameras) {
-    auto source = makeSource(c.uri);
+    auto source = make_source(c.uri);
     if (!source) throw std::runtime_error("camera " + c.name + ": " + source.error().message);
     cameras_.push_back(std::make_unique<Camera>(c, std::move(*source), *publisher_));
   }
@@ -87,205 +226,78 @@ Camera* VideoServer::find(const std::string& name) {
   return nullptr;
 }
 
+proto::ControlReply VideoServer::listCameras() {
+  proto::ControlReply reply = okReply();
+  auto* list = reply.mutable_list_cameras();
+  for (auto& c : cameras_) fillSummary(c->status(), list->add_cameras());
+  return reply;
+}
+
+proto::ControlReply VideoServer::statistics(const proto::StatisticsRequest& request) {
+  const std::string& only = request.camera();
+  if (!only.empty() && !find(only)) {
+    return errorReply(makeError(VideoErrc::kUnknownCamera, "unknown camera '" + only + "'"));
+  }
+  proto::ControlReply reply = okReply();
+  auto* stats = reply.mutable_statistics();
+  stats->set_subscribers(static_cast<uint32_t>(publisher_->subscribers()));
+  for (auto& c : cameras_) {
+    if (!only.empty() && c->name() != only) continue;
+    const CameraStatus s = c->status();
+    const PublisherCounters counters = publisher_->counters(s.name);
+    auto* cs = stats->add_cameras();
+    cs->set_camera(s.name);
+    cs->set_frames_acquired(s.frames_acquired);
+    cs->set_frames_published(counters.published);
+    cs->set_frames_dropped(counters.dropped);
+    cs->set_acquisition_errors(s.acquisition_errors);
+    cs->set_reconnects(s.reconnects);
+    cs->set_fps(s.fps_measured);
+    cs->set_last_sequence(s.last_sequence);
+  }
+  return reply;
+}
+
 proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
   using R = proto::ControlRequest;
-  proto::ControlReply reply;
-  reply.mutable_error()->set_code(proto::Error::OK);
-
-  if (request.request_case() == R::kListCameras) {
-    auto* list = reply.mutable_list_cameras();
-    for (auto& c : cameras_) fillSummary(c->status(), list->add_cameras());
-    return reply;
-  }
-  if (request.request_case() == R::kStatistics) {
-    auto* stats = reply.mutable_statistics();
-    stats->set_subscribers(static_cast<uint32_t>(publisher_->subscribers()));
-    const std::string& only = request.statistics().camera();
-    if (!only.empty() && !find(only))
-      return errorReply(proto::Error::UNKNOWN_CAMERA, "unknown camera '" + only + "'");
-    for (auto& c : cameras_) {
-      if (!only.empty() && c->name() != only) continue;
-      const CameraStatus s = c->status();
-      const PublisherCounters counters = publisher_->counters(s.name);
-      auto* cs = stats->add_cameras();
-      cs->set_camera(s.name);
-      cs->set_frames_acquired(s.frames_acquired);
-      cs->set_frames_published(counters.published);
-      cs->set_frames_dropped(counters.dropped);
-      cs->set_acquisition_errors(s.acquisition_errors);
-      cs->set_reconnects(s.reconnects);
-      cs->set_fps(s.fps_measured);
-      cs->set_last_sequence(s.last_sequence);
-    }
-    return reply;
-  }
+  if (request.request_case() == R::kListCameras) return listCameras();
+  if (request.request_case() == R::kStatistics) return statistics(request.statistics());
 
   // Every other request names one camera.
-  std::string name;
-  switch (request.request_case()) {
-    case R::kDescribeCamera:
-      name = request.describe_camera().camera();
-      break;
-    case R::kSetRoi:
-      name = request.set_roi().camera();
-      break;
-    case R::kSetSize:
-      name = request.set_size().camera();
-      break;
-    case R::kSetMode:
-      name = request.set_mode().camera();
-      break;
-    case R::kSetFormat:
-      name = request.set_format().camera();
-      break;
-    case R::kTrigger:
-      name = request.trigger().camera();
-      break;
-    case R::kListFeatures:
-      name = request.list_features().camera();
-      break;
-    case R::kGetFeature:
-      name = request.get_feature().camera();
-      break;
-    case R::kSetFeature:
-      name = request.set_feature().camera();
-      break;
-    case R::kOpenStream:
-      name = request.open_stream().camera();
-      break;
-    case R::kCloseStream:
-      name = request.close_stream().camera();
-      break;
-    case R::kSnap:
-      name = request.snap().camera();
-      break;
-    default:
-      return errorReply(proto::Error::NOT_SUPPORTED, "request not supported by this server");
-  }
-  Camera* camera = find(name);
-  if (!camera) return errorReply(proto::Error::UNKNOWN_CAMERA, "unknown camera '" + name + "'");
+  const std::optional<std::string> name = requestCamera(request);
+  if (!name) return notSupported();
+  Camera* camera = find(*name);
+  if (!camera)
+    return errorReply(makeError(VideoErrc::kUnknownCamera, "unknown camera '" + *name + "'"));
 
   switch (request.request_case()) {
-    case R::kDescribeCamera: {
-      const CameraStatus s = camera->status();
-      auto* d = reply.mutable_describe_camera();
-      fillSummary(s, d->mutable_summary());
-      d->set_vendor(s.info.vendor);
-      d->set_model(s.info.model);
-      d->set_serial(s.info.serial);
-      d->set_sensor_width(static_cast<uint32_t>(s.info.sensor_width));
-      d->set_sensor_height(static_cast<uint32_t>(s.info.sensor_height));
-      const cv::Rect roi = s.output.roi.empty()
-                               ? cv::Rect(0, 0, s.info.sensor_width, s.info.sensor_height)
-                               : s.output.roi;
-      d->mutable_roi()->set_x(static_cast<uint32_t>(roi.x));
-      d->mutable_roi()->set_y(static_cast<uint32_t>(roi.y));
-      d->mutable_roi()->set_width(static_cast<uint32_t>(roi.width));
-      d->mutable_roi()->set_height(static_cast<uint32_t>(roi.height));
-      cv::Size out = s.output.size;
-      if (out.empty()) {
-        const double scale = s.output.scale > 0 ? s.output.scale : 1.0;
-        out = cv::Size(static_cast<int>(std::lround(roi.width * scale)),
-                       static_cast<int>(std::lround(roi.height * scale)));
-      }
-      d->set_output_width(static_cast<uint32_t>(out.width));
-      d->set_output_height(static_cast<uint32_t>(out.height));
-      d->set_pixel_format(s.output.format == OutputFormat::kBgr8 ? proto::BGR8 : proto::MONO8);
-      d->set_fps(s.fps_setting);
-      for (const auto& f : s.info.formats) d->add_source_formats(f);
-      return reply;
-    }
-    case R::kSetRoi: {
-      OutputSettings o = camera->output();
-      const auto& r = request.set_roi().roi();
-      o.roi = cv::Rect(static_cast<int>(r.x()), static_cast<int>(r.y()),
-                       static_cast<int>(r.width()), static_cast<int>(r.height()));
-      if (r.width() == 0 && r.height() == 0) o.roi = cv::Rect();  // back to the full sensor
-      if (auto ok = camera->setOutput(o); !ok)
-        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
-      return reply;
-    }
-    case R::kSetSize: {
-      OutputSettings o = camera->output();
-      const auto& s = request.set_size();
-      o.size = cv::Size(static_cast<int>(s.width()), static_cast<int>(s.height()));
-      o.scale = s.scale();
-      if (auto ok = camera->setOutput(o); !ok)
-        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
-      return reply;
-    }
-    case R::kSetFormat: {
-      OutputSettings o = camera->output();
-      const auto f = request.set_format().pixel_format();
-      if (f != proto::MONO8 && f != proto::BGR8) {
-        return errorReply(proto::Error::OUT_OF_RANGE, "pixel format must be mono8 or bgr8");
-      }
-      o.format = f == proto::BGR8 ? OutputFormat::kBgr8 : OutputFormat::kMono8;
-      if (auto ok = camera->setOutput(o); !ok)
-        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
-      return reply;
-    }
-    case R::kSetMode: {
-      const auto& m = request.set_mode();
-      if (m.mode() != proto::FREERUN && m.mode() != proto::TRIGGER) {
-        return errorReply(proto::Error::OUT_OF_RANGE, "mode must be freerun or trigger");
-      }
-      const AcquisitionMode mode =
-          m.mode() == proto::TRIGGER ? AcquisitionMode::kTrigger : AcquisitionMode::kFreeRun;
-      if (auto ok = camera->setMode(mode, m.fps()); !ok)
-        return errorReply(proto::Error::OUT_OF_RANGE, ok.error().message);
-      return reply;
-    }
-    case R::kTrigger: {
-      const TriggerTicket t = camera->trigger();
-      reply.mutable_trigger()->set_sequence(t.sequence);
-      reply.mutable_trigger()->set_triggered(t.triggered);
-      return reply;
-    }
-    case R::kListFeatures: {
-      auto features = camera->features();
-      if (!features) return sourceErrorReply(features.error());
-      auto* list = reply.mutable_list_features();
-      for (const auto& f : *features) fillFeature(f, list->add_features());
-      return reply;
-    }
-    case R::kGetFeature: {
-      auto f = camera->feature(request.get_feature().name());
-      if (!f) return sourceErrorReply(f.error());
-      fillFeature(*f, reply.mutable_feature()->mutable_feature());
-      return reply;
-    }
-    case R::kSetFeature: {
-      const auto& set = request.set_feature();
-      auto f = camera->setFeature(set.name(), set.value());
-      if (!f) return sourceErrorReply(f.error());
-      fillFeature(*f, reply.mutable_feature()->mutable_feature());
-      return reply;
-    }
+    case R::kDescribeCamera:
+      return describeCamera(*camera);
+    case R::kSetRoi:
+      return setRoi(*camera, request.set_roi());
+    case R::kSetSize:
+      return setSize(*camera, request.set_size());
+    case R::kSetFormat:
+      return setFormat(*camera, request.set_format());
+    case R::kSetMode:
+      return setMode(*camera, request.set_mode());
+    case R::kTrigger:
+      return trigger(*camera);
+    case R::kListFeatures:
+      return listFeatures(*camera);
+    case R::kGetFeature:
+      return featureReply(camera->feature(request.get_feature().name()));
+    case R::kSetFeature:
+      return featureReply(
+          camera->setFeature(request.set_feature().name(), request.set_feature().value()));
     case R::kOpenStream:
-      camera->setOpen(true);
-      return reply;
+      return setOpen(*camera, true);
     case R::kCloseStream:
-      camera->setOpen(false);
-      return reply;
-    case R::kSnap: {
-      if (!camera->status().open_requested) {
-        return errorReply(proto::Error::CAMERA_UNAVAILABLE, "camera '" + name + "' is closed");
-      }
-      const TriggerTicket t = camera->trigger();
-      auto frame = camera->waitForFrame(t.sequence, kSnapTimeout);
-      if (!frame) {
-        return errorReply(proto::Error::TIMEOUT, "no frame from camera '" + name + "' within " +
-                                                     std::to_string(kSnapTimeout.count()) + " ms");
-      }
-      auto* snap = reply.mutable_snap();
-      *snap->mutable_header() = frameHeaderOf(*frame);
-      const cv::Mat& img = frame->image;
-      snap->set_pixels(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize());
-      return reply;
-    }
+      return setOpen(*camera, false);
+    case R::kSnap:
+      return snap(*camera);
     default:
-      return errorReply(proto::Error::NOT_SUPPORTED, "request not supported by this server");
+      return notSupported();
   }
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -107,8 +108,29 @@ class Camera {
 
  private:
   using Command = std::function<void()>;
+  using Clock = std::chrono::steady_clock;
 
+  // One grab, standardized and with the output settings applied.
+  struct Grab {
+    Result<SourceFrame> grabbed = Error{};
+    Result<OutputFrame> out = Error{};
+    cv::Size delivered;  // of the standardized frame: what the device sends
+    uint64_t host_ns = 0;
+  };
+
+  // The acquisition loop and its steps; the steps called with `lock` return
+  // with it held.
   void run();
+  void waitWhileClosed(std::unique_lock<std::mutex>& lock);
+  void applyAcquisitionSettings(std::unique_lock<std::mutex>& lock);
+  // Waits for the next frame's turn: whether it was triggered, or nullopt
+  // when woken for something else (stop, a command, a setting).
+  std::optional<bool> waitForTurn(std::unique_lock<std::mutex>& lock, bool streams);
+  // Called without the lock.
+  Grab grabAndConvert(bool triggered, bool streams, const OutputSettings& output);
+  void handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool triggered,
+                         const Error& error);
+  void publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool triggered, Grab grab);
   bool ensureOpen(std::unique_lock<std::mutex>& lock);
   void closeSource(std::unique_lock<std::mutex>& lock);
   void waitBackoff(std::unique_lock<std::mutex>& lock);
@@ -122,7 +144,9 @@ class Camera {
   FrameSink& sink_;
   std::thread thread_;
   // When the pending software trigger was sent (acquisition thread only).
-  std::optional<std::chrono::steady_clock::time_point> trigger_sent_;
+  std::optional<Clock::time_point> trigger_sent_;
+  Clock::time_point next_due_;  // of the next free-run frame (acquisition thread only)
+  uint64_t last_frame_ns_ = 0;  // host time of the last frame (acquisition thread only)
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable wake_;

@@ -15,6 +15,8 @@ enum class VideoErrc {
   kNoFrame,         // no frame in time
   kNotSupported,    // a request this server does not serve
   kBusy,            // too much slow work pending; ask again later
+  kBadRequest,      // a control message that does not decode, or asks nothing
+  kInternal,        // a handler failed unexpectedly (a bug; logged)
 };
 const char* errorName(VideoErrc e);
 PICKSIGHT_ERROR_DOMAIN(VideoErrc, "video")

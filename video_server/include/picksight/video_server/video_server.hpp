@@ -1,7 +1,9 @@
 // The video server: cameras, the frame publisher and the control socket,
-// wired together. Its handle() answers control requests.
+// wired together. Its handle() answers control requests, one small function
+// per request kind.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,9 +20,12 @@ namespace picksight::video {
 
 class VideoServer {
  public:
-  // Builds every source and binds both sockets; throws std::runtime_error
+  using SourceFactory = std::function<Result<std::unique_ptr<Source>>(const std::string& uri)>;
+
+  // Builds every source (with `make_source`, the driver factory unless a
+  // test brings its own) and binds both sockets; throws std::runtime_error
   // with a message naming the camera or endpoint when that fails.
-  explicit VideoServer(const ServerConfig& config);
+  explicit VideoServer(const ServerConfig& config, const SourceFactory& make_source = makeSource);
   ~VideoServer();
 
   void start();
@@ -29,11 +34,16 @@ class VideoServer {
   const std::string& framesEndpoint() const { return publisher_->boundEndpoint(); }
   const std::string& controlEndpoint() const { return control_->boundEndpoint(); }
 
-  // Answers one control request (called on the control thread).
+  // Answers one control request. Called concurrently from the control
+  // socket thread and its workers (see control_server.hpp): it only reads
+  // cameras_ and publisher_, fixed after construction, and Camera and
+  // FramePublisher are safe from any thread.
   proto::ControlReply handle(const proto::ControlRequest& request);
 
  private:
   Camera* find(const std::string& name);
+  proto::ControlReply listCameras();
+  proto::ControlReply statistics(const proto::StatisticsRequest& request);
 
   zmq::context_t context_;
   std::unique_ptr<FramePublisher> publisher_;
