@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -13,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cam_cli.hpp"
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::cam {
@@ -131,11 +131,6 @@ Error missingArguments(const std::string& command) {
                     commandSynopsis(command));
 }
 
-// A CLI11 validator whose message is `what` (it names the option itself).
-CLI::Validator checked(std::function<std::string(const std::string&)> check, const char* name) {
-  return CLI::Validator([check](std::string& value) { return check(value); }, name);
-}
-
 }  // namespace
 
 const std::string& CamCommand::arg(const std::string& name) const {
@@ -172,24 +167,20 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
   app.add_option("--control", options.endpoint,
                  std::string("the server's control socket (default ") + kDefaultEndpoint + ")")
       ->type_name("ENDPOINT")
-      ->check(checked(
-          [](const std::string& v) {
-            return v.empty() ? std::string("ENDPOINT must not be empty") : std::string();
-          },
-          "ENDPOINT"));
+      ->check(checkValue([](const std::string& v) {
+        return v.empty() ? std::string("ENDPOINT must not be empty") : std::string();
+      }));
   long long timeout_ms = kDefaultTimeout.count();
   app.add_option("--timeout", timeout_ms,
                  "how long to wait for an answer (default " +
                      std::to_string(kDefaultTimeout.count()) + ";\nsnap waits at least " +
                      std::to_string(kSnapMinTimeout.count()) + ")")
       ->type_name("MS")
-      ->check(checked(
-          [](const std::string& v) {
-            const std::optional<long long> ms = parseInt(v);
-            if (ms && *ms > 0 && *ms <= std::numeric_limits<int>::max()) return std::string();
-            return "MS must be a positive integer, got '" + v + "'";
-          },
-          "MS"));
+      ->check(checkValue([](const std::string& v) {
+        const std::optional<long long> ms = parseInt(v);
+        if (ms && *ms > 0 && *ms <= std::numeric_limits<int>::max()) return std::string();
+        return "MS must be a positive integer, got '" + v + "'";
+      }));
   app.add_flag("--json", options.json, "print one JSON object on stdout, for scripts");
 
   // Storage for the positionals, one map per command; std::map nodes stay
