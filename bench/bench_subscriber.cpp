@@ -13,6 +13,7 @@
 #include <zmq.hpp>
 
 #include "picksight/common/clock.hpp"
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/transport/frame_message.hpp"
 
@@ -21,19 +22,19 @@ int main(int argc, char** argv) {
   std::string camera = "cam0";
   double seconds = 5;
   bool bare = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--bare") {
-      bare = true;
-    } else if (i + 1 < argc && a == "--frames") {
-      endpoint = argv[++i];
-    } else if (i + 1 < argc && a == "--camera") {
-      camera = argv[++i];
-    } else if (i + 1 < argc && a == "--seconds") {
-      seconds = picksight::parseDouble(argv[++i]).value_or(5);
-    }
-  }
-  if (endpoint.empty()) return 2;
+  CLI::App app("Receives frames for a while; prints what it got, lost and how late.",
+               "picksight-bench-subscriber");
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--frames", endpoint, "the frame PUB endpoint")->type_name("E")->required();
+  app.add_option("--camera", camera, "camera to subscribe to")
+      ->type_name("C")
+      ->capture_default_str();
+  app.add_option("--seconds", seconds, "how long to receive")
+      ->type_name("S")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_flag("--bare", bare, "read the benchmark's plain ZeroMQ messages");
+  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
   zmq::context_t context;
   std::vector<double> latency_ms;
   uint64_t received = 0;

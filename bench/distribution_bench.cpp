@@ -15,8 +15,9 @@
 #include <zmq.hpp>
 
 #include "picksight/common/clock.hpp"
-#include "picksight/tool_support/subprocess.hpp"
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
+#include "picksight/tool_support/subprocess.hpp"
 
 namespace {
 using namespace std::chrono_literals;
@@ -99,8 +100,14 @@ void row(const char* what, int n, const Summary& s) {
 
 int main(int argc, char** argv) {
   double seconds = 5;
-  if (argc == 3 && std::string(argv[1]) == "--seconds")
-    seconds = picksight::parseDouble(argv[2]).value_or(5);
+  CLI::App app("Frame distribution benchmark: PickSight against bare ZeroMQ.",
+               "picksight-bench-distribution");
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--seconds", seconds, "length of each run")
+      ->type_name("S")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
   const std::string dir = binDir();
   std::printf("Distribution benchmark: 1920x1080 mono8 at 60 fps, %.0f s per run, TCP loopback\n",
               seconds);

@@ -3,8 +3,10 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <string>
 
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::bench {
@@ -16,18 +18,25 @@ struct LocateArgs {
   int parts = 20;
 };
 
-// --requests N --width N --height N --parts N, over the given defaults;
-// parsing stops at the first value that is not a positive integer.
+// --requests N --width N --height N --parts N (positive integers), over the
+// given defaults. --help, or a bad option, prints the help and exits: the
+// callers are benchmark mains with nothing to clean up yet.
 inline LocateArgs parseLocateArgs(int argc, char** argv, LocateArgs a) {
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string name = argv[i];
-    const auto v = parseInt(argv[i + 1]);
-    if (!v || *v <= 0) break;
-    if (name == "--requests") a.requests = static_cast<int>(*v);
-    if (name == "--width") a.width = static_cast<int>(*v);
-    if (name == "--height") a.height = static_cast<int>(*v);
-    if (name == "--parts") a.parts = static_cast<int>(*v);
-  }
+  CLI::App app("LOCATE benchmark against the real processes.", argc > 0 ? argv[0] : "bench");
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--requests", a.requests, "LOCATE requests to time")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--width", a.width, "image width")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--height", a.height, "image height")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--parts", a.parts, "parts in the scene")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  if (auto exit_code = parseMainArgs(app, argc, argv)) std::exit(*exit_code);
   return a;
 }
 

@@ -11,7 +11,7 @@ PACKAGES=(
   libclang-rt-14-dev
   # core libraries
   libopencv-dev libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
-  libyaml-cpp-dev
+  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   # camera drivers: GigE/USB3 Vision (and the fake camera used by tests), V4L2
   # (libusb-1.0-0-dev: aravis-0.8.pc requires it, but libaravis-dev does not pull it in)
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli libv4l-dev

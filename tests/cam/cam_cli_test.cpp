@@ -22,6 +22,7 @@
 
 #include "cam_cli.hpp"
 #include "picksight.pb.h"
+#include "reply_printer.hpp"
 
 namespace {
 
@@ -319,7 +320,7 @@ TEST_CASE("info prints key: value lines, or JSON with escaped strings", "[cam]")
                      R"("mode":"trigger","vendor":"Basler","model":"acA1920-40gm \"rev\\2\"",)"
                      R"("serial":"12345","sensor_width":1920,"sensor_height":1200,)"
                      R"("roi":{"x":100,"y":50,"width":800,"height":600},"output_width":400,)"
-                     R"("output_height":300,"pixel_format":"mono8","fps":40,)"
+                     R"("output_height":300,"pixel_format":"mono8","fps":40.0,)"
                      R"("source_formats":["Mono8","Mono12"]})"
                      "\n");
   }
@@ -607,26 +608,28 @@ TEST_CASE("no server: exit 3 naming the endpoint and the timeout", "[cam]") {
 }
 
 TEST_CASE("JSON strings are escaped", "[cam]") {
-  using picksight::cam::escapeJson;
-  CHECK(escapeJson("plain") == "plain");
-  CHECK(escapeJson("a\"b\\c") == "a\\\"b\\\\c");
-  CHECK(escapeJson("line\nnext\ttab\r") == "line\\nnext\\ttab\\r");
-  CHECK(escapeJson(std::string("\x01\x1f", 2)) == "\\u0001\\u001f");
-  CHECK(escapeJson(std::string("nul\0x", 5)) == "nul\\u0000x");
-  CHECK(escapeJson("caf\xc3\xa9") == "caf\xc3\xa9");  // UTF-8 passes through
+  using picksight::cam::toJson;
+  CHECK(toJson("plain") == "\"plain\"");
+  CHECK(toJson("a\"b\\c") == "\"a\\\"b\\\\c\"");
+  CHECK(toJson("line\nnext\ttab\r") == "\"line\\nnext\\ttab\\r\"");
+  CHECK(toJson(std::string("\x01\x1f", 2)) == "\"\\u0001\\u001f\"");
+  CHECK(toJson(std::string("nul\0x", 5)) == "\"nul\\u0000x\"");
+  CHECK(toJson("caf\xc3\xa9") == "\"caf\xc3\xa9\"");  // UTF-8 passes through
+  // Invalid UTF-8 (a camera's vendor string) must not make the output unreadable.
+  CHECK(toJson("bad\xff") == "\"bad\xef\xbf\xbd\"");
 }
 
-TEST_CASE("JsonWriter places commas and writes numbers JSON can read", "[cam]") {
-  picksight::cam::JsonWriter json;
-  json.beginObject();
-  json.key("a").beginArray().uinteger(1).real(2.5).boolean(false).string("x").endArray();
-  json.key("empty").beginObject().endObject();
-  json.key("nan").real(std::numeric_limits<double>::quiet_NaN());
-  json.key("big").uinteger(std::numeric_limits<std::uint64_t>::max());
-  json.key("k\"ey").beginArray().beginObject().endObject().beginObject().endObject().endArray();
-  json.endObject();
-  CHECK(json.str() == R"({"a":[1,2.5,false,"x"],"empty":{},"nan":null,"big":18446744073709551615,)"
-                      R"("k\"ey":[{},{}]})");
+TEST_CASE("toJson keeps key order and writes numbers JSON can read", "[cam]") {
+  using picksight::cam::Json;
+  Json json = Json::object();
+  json["a"] = Json::array({1, 2.5, false, "x"});
+  json["empty"] = Json::object();
+  json["nan"] = std::numeric_limits<double>::quiet_NaN();
+  json["big"] = std::numeric_limits<std::uint64_t>::max();
+  json["k\"ey"] = Json::array({Json::object(), Json::object()});
+  CHECK(picksight::cam::toJson(json) ==
+        R"({"a":[1,2.5,false,"x"],"empty":{},"nan":null,"big":18446744073709551615,)"
+        R"("k\"ey":[{},{}]})");
 }
 
 TEST_CASE("features prints names, types, values, ranges, units and access", "[cam]") {
@@ -688,10 +691,10 @@ TEST_CASE("features as JSON: every field of every feature", "[cam]") {
   const Run run = runAt(context, server, {"--json", "features", "cam0"});
   CHECK(run.code == 0);
   CHECK(run.out == R"({"camera":"cam0","features":[{"name":"ExposureTimeAbs","type":"float",)"
-                   R"("value":"20000","has_range":true,"min":10,"max":1e+06,"increment":0,)"
+                   R"("value":"20000","has_range":true,"min":10.0,"max":1000000.0,"increment":0.0,)"
                    R"("choices":[],"unit":"us","description":"Exposure time","writable":true},)"
                    R"({"name":"TriggerMode","type":"enumeration","value":"Off","has_range":false,)"
-                   R"("min":0,"max":0,"increment":0,"choices":["Off","On"],"unit":"",)"
+                   R"("min":0.0,"max":0.0,"increment":0.0,"choices":["Off","On"],"unit":"",)"
                    R"("description":"","writable":true}]})"
                    "\n");
 }
@@ -717,7 +720,7 @@ TEST_CASE("get prints the bare value, or the whole feature as JSON", "[cam]") {
     const Run run = runAt(context, server, {"--json", "get", "cam0", "ExposureTimeAbs"});
     CHECK(run.code == 0);
     CHECK(run.out == R"({"name":"ExposureTimeAbs","type":"float","value":"20000",)"
-                     R"("has_range":true,"min":10,"max":1e+06,"increment":0,"choices":[],)"
+                     R"("has_range":true,"min":10.0,"max":1000000.0,"increment":0.0,"choices":[],)"
                      R"("unit":"us","description":"Exposure time","writable":true})"
                      "\n");
   }

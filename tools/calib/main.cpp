@@ -7,40 +7,28 @@
 #include <string>
 
 #include "picksight/calibration/robot_camera.hpp"
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 
-namespace {
 using namespace picksight;
-
-int usage() {
-  std::cerr << "usage: picksight-calib --csv FILE [--method best|geometric|lsq]\n"
-               "  FILE: a header line, then robot_x,robot_y,vision_x,vision_y per point (mm)\n";
-  return 2;
-}
-}  // namespace
 
 int main(int argc, char** argv) {
   std::string path;
-  calibration::Method method = calibration::Method::kBest;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--csv" && i + 1 < argc) {
-      path = argv[++i];
-    } else if (a == "--method" && i + 1 < argc) {
-      const std::string m = argv[++i];
-      if (m == "geometric")
-        method = calibration::Method::kGeometric;
-      else if (m == "lsq")
-        method = calibration::Method::kLeastSquares;
-      else if (m == "best")
-        method = calibration::Method::kBest;
-      else
-        return usage();
-    } else {
-      return usage();
-    }
-  }
-  if (path.empty()) return usage();
+  std::string method_name = "best";
+  CLI::App app("Robot-camera calibration from a CSV of point pairs.", "picksight-calib");
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--csv", path,
+                 "a header line, then robot_x,robot_y,vision_x,vision_y per point (mm)")
+      ->type_name("FILE")
+      ->required();
+  app.add_option("--method", method_name, "how to fit the transform")
+      ->type_name("best|geometric|lsq")
+      ->check(CLI::IsMember({"best", "geometric", "lsq"}))
+      ->capture_default_str();
+  if (auto exit_code = parseMainArgs(app, argc, argv)) return *exit_code;
+  const calibration::Method method = method_name == "geometric" ? calibration::Method::kGeometric
+                                     : method_name == "lsq"     ? calibration::Method::kLeastSquares
+                                                                : calibration::Method::kBest;
   std::ifstream in(path);
   if (!in) {
     std::cerr << "picksight-calib: cannot read " << path << "\n";

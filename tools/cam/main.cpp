@@ -1,5 +1,5 @@
 // picksight-cam entry point: everything but the process boundary lives in
-// cam_cli.cpp, where the tests can reach it.
+// the picksight_camcli library, where the tests can reach it.
 #include <iostream>
 #include <string>
 #include <vector>

@@ -14,6 +14,7 @@
 #include <zmq.hpp>
 
 #include "picksight/common/angles.hpp"
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
@@ -31,11 +32,6 @@ std::string binDir() {
   return p.substr(0, p.find_last_of('/'));
 }
 
-int usage() {
-  std::cerr
-      << "usage: picksight-demo [--requests N] [--parts N] [--width W] [--height H] [--seed S]\n";
-  return 2;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,24 +40,30 @@ int main(int argc, char** argv) {
   int width = 1280;
   int height = 960;
   long long seed = 1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h" || i + 1 >= argc) return usage();
-    auto v = picksight::parseInt(argv[++i]);
-    if (!v || *v < 0) return usage();
-    if (a == "--requests")
-      requests = static_cast<int>(*v);
-    else if (a == "--parts")
-      parts = static_cast<int>(*v);
-    else if (a == "--width")
-      width = static_cast<int>(*v);
-    else if (a == "--height")
-      height = static_cast<int>(*v);
-    else if (a == "--seed")
-      seed = *v;
-    else
-      return usage();
-  }
+  CLI::App app("Quick-start demo: a synthetic camera, the vision app and a robot's requests.",
+               "picksight-demo");
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--requests", requests, "LOCATE requests to send")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--parts", parts, "parts in the synthetic scene")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--width", width, "image width")
+      ->type_name("W")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--height", height, "image height")
+      ->type_name("H")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--seed", seed, "scene seed")
+      ->type_name("S")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
 
   const std::string dir = binDir();
   char data_dir[] = "/tmp/picksight-demo-XXXXXX";

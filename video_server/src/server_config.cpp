@@ -1,13 +1,14 @@
-// Command-line and YAML configuration of the video server.
+// Command-line (CLI11) and YAML configuration of the video server.
 #include "picksight/video_server/server_config.hpp"
-#include "picksight/video_server/video_errors.hpp"
 
 #include <yaml-cpp/yaml.h>
 
 #include <optional>
 #include <set>
 
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
+#include "picksight/video_server/video_errors.hpp"
 
 namespace picksight::video {
 namespace {
@@ -169,88 +170,115 @@ Result<ServerConfig> loadServerConfig(const std::string& path) {
   return config;
 }
 
+namespace {
+
+// The command line before it is applied to the configuration.
+struct ServerArgs {
+  std::string config_file;
+  std::vector<std::string> sources;
+  std::string frames;
+  std::string control;
+  std::string mode;
+  std::string fps;
+};
+
+// Declares the options on `app`, bound to `a`; both parseServerArgs and
+// serverUsage use it, so the help lists exactly what is parsed.
+void defineServerOptions(CLI::App& app, ServerArgs& a) {
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--config", a.config_file,
+                 "YAML file with frames, control and cameras (see deploy/examples)")
+      ->type_name("FILE");
+  app.add_option("--source", a.sources, "a camera (default: cam0=synthetic:), repeatable")
+      ->type_name("NAME=URI")
+      ->check(checkValue([](const std::string& v) {
+        const size_t eq = v.find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == v.size()) {
+          return "expected NAME=URI, got '" + v + "'";
+        }
+        return std::string();
+      }));
+  app.add_option("--frames", a.frames, "frame PUB endpoint (default tcp://*:5555)")
+      ->type_name("ENDPOINT");
+  app.add_option("--control", a.control, "control REP endpoint (default tcp://*:5556)")
+      ->type_name("ENDPOINT");
+  app.add_option("--mode", a.mode, "acquisition mode of the --source cameras (default freerun)")
+      ->type_name("freerun|trigger")
+      ->check(checkValue([](const std::string& v) {
+        auto m = parseMode(v);
+        return m ? std::string() : m.error().message;
+      }));
+  app.add_option("--fps", a.fps, "free-run frame rate of the --source cameras (default 10)")
+      ->type_name("F")
+      ->check(checkValue([](const std::string& v) {
+        auto f = parseFps(v);
+        return f ? std::string() : f.error().message;
+      }));
+  app.footer(
+      "Sources (URI):\n"
+      "  aravis:<device-id>        GigE Vision / USB3 Vision (empty id: first found)\n"
+      "  v4l2:/dev/videoN[?width=W&height=H&format=yuyv|mjpeg&fps=F]\n"
+      "  stream:<url>              RTSP, HTTP MJPEG, any file FFmpeg reads\n"
+      "  file:<path>               one image, re-read when it changes\n"
+      "  dir:<path>                images in name order, looping\n"
+      "  synthetic:[key=value,...] generated scene with ground truth\n"
+      "    (width, height, parts, seed, noise, size, light, types, scene_every)\n"
+      "\n"
+      "On start it prints 'frames <endpoint>' and 'control <endpoint>' on stdout.");
+}
+
+CLI::App serverApp() {
+  return CLI::App("Publishes camera frames over ZeroMQ and serves camera configuration.",
+                  "picksight-video-server");
+}
+
+}  // namespace
+
 std::string serverUsage() {
-  return "usage: picksight-video-server [--config FILE] [--source NAME=URI ...]\n"
-         "         [--frames ENDPOINT] [--control ENDPOINT] [--mode freerun|trigger] [--fps F]\n"
-         "\n"
-         "  --source NAME=URI  a camera (default: cam0=synthetic:), one of\n"
-         "                       aravis:<device-id>       GigE Vision / USB3 Vision (empty id: "
-         "first found)\n"
-         "                       v4l2:/dev/videoN[?width=W&height=H&format=yuyv|mjpeg&fps=F]\n"
-         "                       stream:<url>             RTSP, HTTP MJPEG, any file FFmpeg reads\n"
-         "                       file:<path>              one image, re-read when it changes\n"
-         "                       dir:<path>               images in name order, looping\n"
-         "                       synthetic:[key=value,...] generated scene with ground truth\n"
-         "                         (width, height, parts, seed, noise, size, light, types, "
-         "scene_every)\n"
-         "  --frames E         frame PUB endpoint (default tcp://*:5555)\n"
-         "  --control E        control REP endpoint (default tcp://*:5556)\n"
-         "  --mode M           acquisition mode of the --source cameras (default freerun)\n"
-         "  --fps F            free-run frame rate of the --source cameras (default 10)\n"
-         "  --config FILE      YAML file with frames, control and cameras (see deploy/examples)\n"
-         "\n"
-         "On start it prints 'frames <endpoint>' and 'control <endpoint>' on stdout.\n";
+  CLI::App app = serverApp();
+  ServerArgs unused;
+  defineServerOptions(app, unused);
+  return app.help();
 }
 
 Result<ServerConfig> parseServerArgs(const std::vector<std::string>& args, bool* help) {
+  CLI::App app = serverApp();
+  ServerArgs a;
+  defineServerOptions(app, a);
+  bool wants_help = false;
+  if (auto ok = parseArgs(app, args, &wants_help, VideoErrc::kBadConfig); !ok) return ok.error();
+  if (help) *help = wants_help;
   ServerConfig config;
-  std::vector<CameraConfig> cli_cameras;
+  if (wants_help) return config;
+  // The file first: options given next to --config override what it says.
+  if (!a.config_file.empty()) {
+    auto loaded = loadServerConfig(a.config_file);
+    if (!loaded) return loaded.error();
+    config = std::move(*loaded);
+  }
   std::optional<AcquisitionMode> mode;
   std::optional<double> fps;
-  std::optional<std::string> frames;
-  std::optional<std::string> control;
-  if (help) *help = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      if (help) *help = true;
-      return config;
-    }
-    if (i + 1 >= args.size())
-      return makeError(VideoErrc::kBadConfig, a + ": missing value or unknown option");
-    const std::string& v = args[++i];
-    if (a == "--config") {
-      auto loaded = loadServerConfig(v);
-      if (!loaded) return loaded.error();
-      config = std::move(*loaded);
-    } else if (a == "--source") {
-      const size_t eq = v.find('=');
-      if (eq == std::string::npos || eq == 0 || eq + 1 == v.size()) {
-        return makeError(VideoErrc::kBadConfig, "--source: expected NAME=URI, got '" + v + "'");
-      }
-      CameraConfig c;
-      c.name = v.substr(0, eq);
-      c.uri = v.substr(eq + 1);
-      cli_cameras.push_back(c);
-    } else if (a == "--frames") {
-      frames = v;
-    } else if (a == "--control") {
-      control = v;
-    } else if (a == "--mode") {
-      auto m = parseMode(v);
-      if (!m) return makeError(VideoErrc::kBadConfig, "--mode: " + m.error().message);
-      mode = *m;
-    } else if (a == "--fps") {
-      auto f = parseFps(v);
-      if (!f) return makeError(VideoErrc::kBadConfig, "--fps: " + f.error().message);
-      fps = *f;
-    } else {
-      return makeError(VideoErrc::kBadConfig, "unknown option '" + a + "'");
-    }
-  }
-  for (auto& c : cli_cameras) {
+  if (!a.mode.empty()) mode = *parseMode(a.mode);  // checked by the option
+  if (!a.fps.empty()) fps = *parseFps(a.fps);
+  auto apply = [&](CameraConfig& c) {
     if (mode) c.mode = *mode;
     if (fps) c.fps = *fps;
+  };
+  for (const std::string& source : a.sources) {
+    const size_t eq = source.find('=');
+    CameraConfig c;
+    c.name = source.substr(0, eq);
+    c.uri = source.substr(eq + 1);
+    apply(c);
     config.cameras.push_back(c);
   }
-  if (frames) config.frames_endpoint = *frames;
-  if (control) config.control_endpoint = *control;
+  if (!a.frames.empty()) config.frames_endpoint = a.frames;
+  if (!a.control.empty()) config.control_endpoint = a.control;
   if (config.cameras.empty()) {
     CameraConfig c;
     c.name = "cam0";
     c.uri = "synthetic:";
-    if (mode) c.mode = *mode;
-    if (fps) c.fps = *fps;
+    apply(c);
     config.cameras.push_back(c);
   }
   if (auto ok = checkUniqueNames(config.cameras); !ok) return ok.error();

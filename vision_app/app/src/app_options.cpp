@@ -1,97 +1,122 @@
-// picksight-vision option parsing.
+// picksight-vision option parsing, with CLI11.
 #include "picksight/vision_app/app_options.hpp"
 
+#include <CLI/CLI.hpp>
+
+#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
 
+namespace {
+
+// Values checked by the options' validators, converted after the parse.
+struct RawOptions {
+  std::string robot_port;
+  std::string threshold;
+  std::string polarity;
+  std::string window;
+  std::string min_area;
+};
+
+std::string checkRange(const std::string& v, long long low, long long high) {
+  auto n = parseInt(v);
+  if (n && *n >= low && *n <= high) return "";
+  return "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "], got '" + v + "'";
+}
+
+std::string checkThreshold(const std::string& v) {
+  if (v == "adaptive" || v == "otsu") return "";
+  if (v.rfind("fixed:", 0) == 0) {
+    auto level = parseInt(v.substr(6));
+    if (level && *level >= 0 && *level <= 255) return "";
+    return "fixed level must be in [0, 255], got '" + v + "'";
+  }
+  return "must be adaptive, otsu or fixed:LEVEL, got '" + v + "'";
+}
+
+// Declares the options on `app`, bound to `o` and `raw`; parseAppArgs and
+// appUsage share it, so the help lists exactly what is parsed.
+void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--frames", o.frames_endpoint, "video server frame endpoint")
+      ->type_name("ENDPOINT")
+      ->capture_default_str();
+  app.add_option("--control", o.control_endpoint, "video server control endpoint")
+      ->type_name("ENDPOINT")
+      ->capture_default_str();
+  app.add_option("--camera", o.camera, "camera to watch")->type_name("NAME")->capture_default_str();
+  app.add_option("--robot-port", raw.robot_port,
+                 "TCP port for robot controllers (default 5600, 0 = any free)")
+      ->type_name("PORT")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
+  app.add_option("--bind", o.robot.bind_address, "address the robot port listens on")
+      ->type_name("ADDRESS")
+      ->capture_default_str();
+  app.add_option("--data-dir", o.data_dir, "models and calibrations")
+      ->type_name("DIR")
+      ->capture_default_str();
+  app.add_option("--threshold", raw.threshold, "binarization (default adaptive)")
+      ->type_name("adaptive|otsu|fixed:LEVEL")
+      ->check(checkValue(checkThreshold));
+  app.add_option("--polarity", raw.polarity,
+                 "dark parts on light background (default) or light on dark")
+      ->type_name("dark|light")
+      ->check(checkValue([](const std::string& v) {
+        return v == "dark" || v == "light" ? std::string()
+                                           : "must be dark or light, got '" + v + "'";
+      }));
+  app.add_option("--window", raw.window,
+                 "adaptive illumination window, wider than the largest part")
+      ->type_name("PIXELS")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 8, 16384); }));
+  app.add_option("--min-area", raw.min_area, "smallest region that counts as a part (default 50)")
+      ->type_name("PIXELS")
+      ->check(checkValue([](const std::string& v) {
+        auto m = parseDouble(v);
+        return m && *m >= 1 ? std::string() : "must be a number >= 1, got '" + v + "'";
+      }));
+  app.footer("On start it prints 'robot <port>' and 'ready' on stdout.");
+}
+
+CLI::App visionApp() {
+  return CLI::App("Subscribes to one camera of a video server and answers robot controllers.",
+                  "picksight-vision");
+}
+
+}  // namespace
+
 std::string appUsage() {
-  return "usage: picksight-vision [--frames ENDPOINT] [--control ENDPOINT] [--camera NAME]\n"
-         "         [--robot-port PORT] [--bind ADDRESS] [--data-dir DIR]\n"
-         "         [--threshold adaptive|otsu|fixed:LEVEL] [--polarity dark|light]\n"
-         "         [--window PIXELS] [--min-area PIXELS]\n"
-         "\n"
-         "  --frames E       video server frame endpoint (default tcp://127.0.0.1:5555)\n"
-         "  --control E      video server control endpoint (default tcp://127.0.0.1:5556)\n"
-         "  --camera NAME    camera to watch (default cam0)\n"
-         "  --robot-port P   TCP port for robot controllers (default 5600, 0 = any free)\n"
-         "  --bind ADDRESS   address the robot port listens on (default 0.0.0.0)\n"
-         "  --data-dir DIR   models and calibrations (default ./picksight-data)\n"
-         "  --threshold M    binarization (default adaptive)\n"
-         "  --polarity P     dark parts on light background (default) or light on dark\n"
-         "  --window PIXELS  adaptive illumination window, wider than the largest part\n"
-         "  --min-area PX    smallest region that counts as a part (default 50)\n"
-         "\n"
-         "On start it prints 'robot <port>' and 'ready' on stdout.\n";
+  CLI::App app = visionApp();
+  AppOptions options;
+  RawOptions raw;
+  defineAppOptions(app, options, raw);
+  return app.help();
 }
 
 Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help) {
+  CLI::App app = visionApp();
   AppOptions o;
-  if (help) *help = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--help" || a == "-h") {
-      if (help) *help = true;
-      return o;
-    }
-    if (i + 1 >= args.size())
-      return makeError(OptionsErrc::kBadOption, a + ": missing value or unknown option");
-    const std::string& v = args[++i];
-    if (a == "--frames") {
-      o.frames_endpoint = v;
-    } else if (a == "--control") {
-      o.control_endpoint = v;
-    } else if (a == "--camera") {
-      o.camera = v;
-    } else if (a == "--data-dir") {
-      o.data_dir = v;
-    } else if (a == "--bind") {
-      o.robot.bind_address = v;
-    } else if (a == "--robot-port") {
-      auto p = parseInt(v);
-      if (!p || *p < 0 || *p > 65535)
-        return makeError(OptionsErrc::kBadOption,
-                         "--robot-port: must be in [0, 65535], got '" + v + "'");
-      o.robot.port = static_cast<uint16_t>(*p);
-    } else if (a == "--threshold") {
-      if (v == "adaptive") {
-        o.vision.binarize.method = vision::ThresholdMethod::kAdaptive;
-      } else if (v == "otsu") {
-        o.vision.binarize.method = vision::ThresholdMethod::kOtsu;
-      } else if (v.rfind("fixed:", 0) == 0) {
-        auto level = parseInt(v.substr(6));
-        if (!level || *level < 0 || *level > 255) {
-          return makeError(OptionsErrc::kBadOption,
-                           "--threshold: fixed level must be in [0, 255], got '" + v + "'");
-        }
-        o.vision.binarize.method = vision::ThresholdMethod::kFixed;
-        o.vision.binarize.fixed_threshold = static_cast<int>(*level);
-      } else {
-        return makeError(OptionsErrc::kBadOption,
-                         "--threshold: must be adaptive, otsu or fixed:LEVEL, got '" + v + "'");
-      }
-    } else if (a == "--polarity") {
-      if (v != "dark" && v != "light")
-        return makeError(OptionsErrc::kBadOption,
-                         "--polarity: must be dark or light, got '" + v + "'");
-      o.vision.binarize.polarity =
-          v == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
-    } else if (a == "--window") {
-      auto w = parseInt(v);
-      if (!w || *w < 8 || *w > 16384)
-        return makeError(OptionsErrc::kBadOption,
-                         "--window: must be in [8, 16384], got '" + v + "'");
-      o.vision.binarize.adaptive_window = static_cast<int>(*w);
-    } else if (a == "--min-area") {
-      auto m = parseDouble(v);
-      if (!m || *m < 1)
-        return makeError(OptionsErrc::kBadOption,
-                         "--min-area: must be a number >= 1, got '" + v + "'");
-      o.vision.regions.min_area = *m;
-    } else {
-      return makeError(OptionsErrc::kBadOption, "unknown option '" + a + "'");
-    }
+  RawOptions raw;
+  defineAppOptions(app, o, raw);
+  if (auto ok = parseArgs(app, args, help); !ok) return ok.error();
+  // The validators accepted these: the conversions cannot fail.
+  if (!raw.robot_port.empty()) o.robot.port = static_cast<uint16_t>(*parseInt(raw.robot_port));
+  if (raw.threshold == "adaptive") {
+    o.vision.binarize.method = vision::ThresholdMethod::kAdaptive;
+  } else if (raw.threshold == "otsu") {
+    o.vision.binarize.method = vision::ThresholdMethod::kOtsu;
+  } else if (!raw.threshold.empty()) {
+    o.vision.binarize.method = vision::ThresholdMethod::kFixed;
+    o.vision.binarize.fixed_threshold = static_cast<int>(*parseInt(raw.threshold.substr(6)));
   }
+  if (!raw.polarity.empty()) {
+    o.vision.binarize.polarity =
+        raw.polarity == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
+  }
+  if (!raw.window.empty())
+    o.vision.binarize.adaptive_window = static_cast<int>(*parseInt(raw.window));
+  if (!raw.min_area.empty()) o.vision.regions.min_area = *parseDouble(raw.min_area);
   return o;
 }
 

@@ -10,11 +10,6 @@
 
 namespace picksight::app {
 
-// A command-line option picksight-vision cannot use; the message names it.
-enum class OptionsErrc { kBadOption = 1 };
-inline const char* errorName(OptionsErrc) { return "bad option"; }
-PICKSIGHT_ERROR_DOMAIN(OptionsErrc, "options")
-
 struct AppOptions {
   std::string frames_endpoint = "tcp://127.0.0.1:5555";
   std::string control_endpoint = "tcp://127.0.0.1:5556";
@@ -29,5 +24,3 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
 std::string appUsage();
 
 }  // namespace picksight::app
-
-PICKSIGHT_ERROR_ENUM(picksight::app::OptionsErrc)
