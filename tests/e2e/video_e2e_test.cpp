@@ -174,7 +174,7 @@ TEST_CASE("a stalled subscriber loses frames on its own side only", "[e2e][video
   CHECK(stats.out.find("\"subscribers\":2") != std::string::npos);
 }
 
-TEST_CASE("snap saves the next frame; close releases the camera and open resumes it",
+TEST_CASE("snap saves the next frame and close releases the camera until open resumes it",
           "[e2e][video]") {
   VideoServerProcess server(
       {"--source", "cam0=synthetic:width=640,height=480,parts=3,noise=0", "--fps", "20"});

@@ -34,7 +34,7 @@ TEST_CASE("finger footprints land where the fingers are", "[grasp]") {
   CHECK(centre.y == Approx(80));
 }
 
-TEST_CASE("a grasp whose fingers cover another part is not offered; the next clear one is",
+TEST_CASE("a grasp whose fingers cover another part is not offered and the next clear one is",
           "[grasp]") {
   Obstacles obstacles;
   obstacles.mask = cv::Mat(300, 400, CV_8UC1, cv::Scalar(0));

@@ -74,7 +74,7 @@ TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][mo
   CHECK(disc.model.orientation_order == 0);
 }
 
-TEST_CASE("a hole becomes one arc; a rectangle four lines with convex right-angle corners",
+TEST_CASE("a hole becomes one arc and a rectangle four lines with convex right-angle corners",
           "[vision][model]") {
   const Trained slot = train("slot", 1);
   REQUIRE(slot.model.loops.size() == 2);
