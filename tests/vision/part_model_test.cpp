@@ -3,6 +3,8 @@
 // trained pose, boundary primitives.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "recognition_support.hpp"
 
 #include <map>
@@ -153,6 +155,9 @@ TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vi
     const ps::SceneRenderer s(scene(1920, 1080, 20, seed, types));
     const auto matches = recognizeScene(s, models);
     CHECK(matches.size() == 20);
+    // Best first: a robot taking the first part takes the surest one.
+    CHECK(std::is_sorted(matches.begin(), matches.end(),
+                         [](const Match& a, const Match& b) { return a.score > b.score; }));
     for (const auto& t : s.truth()) {
       INFO(t.type << " at " << t.x << ", " << t.y << " turned " << t.angle_deg);
       const Match* m = nearest(matches, t);
