@@ -1,3 +1,14 @@
 // Catch2's main, compiled once for every test executable.
-#define CATCH_CONFIG_MAIN
+#define CATCH_CONFIG_RUNNER
 #include <catch2/catch.hpp>
+
+int main(int argc, char* argv[]) {
+  Catch::Session session;
+  // A test spec that matches nothing is an error, not a pass: CTest runs one
+  // test case per entry by name, and a name CTest mangled must fail loudly.
+  // Set before parsing so that --warn on the command line adds to it.
+  session.configData().warnings = Catch::WarnAbout::NoTests;
+  const int parsed = session.applyCommandLine(argc, argv);
+  if (parsed != 0) return parsed;
+  return session.run();
+}

@@ -142,3 +142,48 @@ TEST_CASE("too few or collinear points are refused with the reason", "[calibrati
   CHECK(r.error().code == CalibrationErrc::kDegeneratePoints);
   CHECK(r.error().message.find("line") != std::string::npos);
 }
+
+// The outlier cut in numbers: 2.5 robust standard deviations of the point
+// residuals, never below 0.1 mm, decided against the refit on the core.
+TEST_CASE("with only noise every point is an inlier", "[calibration]") {
+  // 0.05 mm of noise per coordinate: no genuine point lies 2.5 standard
+  // deviations off a transform fitted on all of them (judging them against
+  // a two-point hypothesis, or with an underestimated scale, rejects some).
+  for (uint64_t seed = 1; seed <= 30; ++seed) {
+    INFO("seed " << seed);
+    RigidTransform truth = kTruth;
+    truth.rz_deg = -170 + 11.0 * static_cast<double>(seed);
+    auto r = calibrate(makePoints(truth, 12, 0.05, seed), Method::kLeastSquares);
+    REQUIRE(r);
+    CHECK(r->inliers == 12);
+  }
+}
+
+TEST_CASE("a point off by 0.8 mm among points with 0.05 mm of noise is an outlier",
+          "[calibration]") {
+  // Residuals here are about 0.07 mm per axis: 0.8 mm is past any 2.5 sigma
+  // cut, but within a 6 sigma one.
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    INFO("seed " << seed);
+    auto pts = makePoints(kTruth, 20, 0.05, seed);
+    pts[5].robot += cv::Point2d(0.8, 0.0);
+    auto r = calibrate(pts, Method::kLeastSquares);
+    REQUIRE(r);
+    CHECK_FALSE(r->residuals[5].inlier);
+    CHECK(r->inliers >= 18);  // a genuine point may fall past 2.5 sigma
+  }
+}
+
+TEST_CASE("a 0.3 mm slip among nearly exact points is an outlier", "[calibration]") {
+  // 0.005 mm of noise: the cut is its floor, 0.1 mm.
+  auto pts = makePoints(kTruth, 10, 0.005, 4);
+  pts[2].robot += cv::Point2d(0.0, -0.3);
+  for (Method m : {Method::kLeastSquares, Method::kGeometric, Method::kBest}) {
+    INFO(methodName(m));
+    auto r = calibrate(pts, m);
+    REQUIRE(r);
+    CHECK_FALSE(r->residuals[2].inlier);
+    CHECK(r->inliers == 9);
+    CHECK(worstPlacementError(r->transform, kTruth) < 0.02);
+  }
+}

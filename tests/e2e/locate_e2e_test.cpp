@@ -4,7 +4,8 @@
 
 #include <cmath>
 #include <limits>
-#include <thread>
+#include <utility>
+#include <vector>
 
 #include "cell_fixture.hpp"
 #include "picksight/common/angles.hpp"
@@ -45,7 +46,7 @@ TEST_CASE("LOCATE matches the synthetic ground truth", "[e2e][locate]") {
   VisionProcess vision(server);
   zmq::context_t context;
   FrameSubscriber watcher(context, server.frames, "cam0", 16);
-  std::this_thread::sleep_for(300ms);  // the subscription must reach the server first
+  waitForSubscription(server, watcher);  // the LOCATE frames must all reach it
   auto robot = vision.connect();
 
   double worst_position = 0;
@@ -93,11 +94,19 @@ TEST_CASE("a malformed robot line gets ERROR and the connection goes on", "[e2e]
       {"--source", "cam0=synthetic:width=640,height=480,parts=3", "--mode", "trigger"});
   VisionProcess vision(server);
   auto robot = vision.connect();
-  for (const std::string& bad : std::vector<std::string>{"LOCATE", "LOCATE x", "FLY 1 2",
-                                                         std::string("\x01\x02\xff", 3), ""}) {
+  // Each fault has its own code: bad arguments 11, unknown command 10 (binary
+  // bytes are an unknown command too), empty line 14.
+  const std::vector<std::pair<std::string, std::string>> bad_lines = {
+      {"LOCATE", "ERROR 11 "},
+      {"LOCATE x", "ERROR 11 "},
+      {"FLY 1 2", "ERROR 10 "},
+      {std::string("\x01\x02\xff", 3), "ERROR 10 "},
+      {"", "ERROR 14 "}};
+  for (const auto& [bad, expected] : bad_lines) {
     auto reply = robot.request(bad, 5s);
     REQUIRE(reply);
-    CHECK(reply->rfind("ERROR ", 0) == 0);
+    INFO("request '" << bad << "' got '" << *reply << "'");
+    CHECK(reply->rfind(expected, 0) == 0);
   }
   auto reply = robot.request("locate,1", 10s);
   REQUIRE(reply);
@@ -150,7 +159,7 @@ TEST_CASE("LEARN a part, then LOCATE finds it turned from the trained pose",
   VisionProcess vision(server);
   zmq::context_t context;
   FrameSubscriber watcher(context, server.frames, "cam0", 16);
-  std::this_thread::sleep_for(300ms);
+  waitForSubscription(server, watcher);
   auto robot = vision.connect();
   const auto truthOf = [&](uint64_t sequence) {
     auto frame = receiveUntil(watcher, [&](const Frame& f) { return f.info.sequence == sequence; });

@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <thread>
+#include <optional>
+#include <sstream>
 
 #include "cell_fixture.hpp"
 #include "picksight/common/clock.hpp"
 #include "picksight/common/text.hpp"
+#include "temp_dir.hpp"
 
 using namespace picksight;
 using namespace picksight::e2e;
@@ -20,6 +22,18 @@ CommandResult cam(const VideoServerProcess& server, std::vector<std::string> arg
   std::vector<std::string> argv = {binPath("picksight-cam"), "--control", server.control};
   argv.insert(argv.end(), args.begin(), args.end());
   return run(argv);
+}
+// The value of `key` in picksight-cam's "key: value" lines (values aligned
+// with spaces), or "" when there is no such line.
+std::string infoValue(const std::string& out, const std::string& key) {
+  std::istringstream lines(out);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind(key + ":", 0) != 0) continue;
+    const size_t value = line.find_first_not_of(' ', key.size() + 1);
+    return value == std::string::npos ? "" : line.substr(value);
+  }
+  return "";
 }
 }  // namespace
 
@@ -98,9 +112,9 @@ TEST_CASE("a software trigger's frame carries the sequence its reply named", "[e
       {"--source", "cam0=synthetic:width=640,height=480,parts=2", "--mode", "trigger"});
   zmq::context_t context;
   FrameSubscriber sub(context, server.frames, "cam0", 4);
-  std::this_thread::sleep_for(300ms);
-  // No trigger, no frame.
-  CHECK_FALSE(sub.receive(500ms));
+  // No trigger, no frame: every frame the subscriber sees has the sequence
+  // number of the trigger that asked for it, with no frame in between.
+  uint64_t last = waitForSubscription(server, sub);
   for (int i = 0; i < 3; ++i) {
     const uint64_t before = realtimeNs();
     const auto reply = cam(server, {"--json", "trigger", "cam0"});
@@ -110,9 +124,11 @@ TEST_CASE("a software trigger's frame carries the sequence its reply named", "[e
     const auto seq =
         parseInt(reply.out.substr(at + 11, reply.out.find_first_of(",}", at) - at - 11));
     REQUIRE(seq);
+    CHECK(static_cast<uint64_t>(*seq) == last + 1);
     auto frame = sub.receive(5s);
     REQUIRE(frame);
     CHECK(static_cast<long long>(frame->info.sequence) == *seq);
+    last = frame->info.sequence;
     CHECK(frame->info.triggered);
     CHECK(frame->info.host_timestamp_ns > before);
   }
@@ -127,7 +143,12 @@ TEST_CASE("picksight-cam reports cameras and refuses unknown ones", "[e2e][video
   CHECK(list.out.find("side") != std::string::npos);
   const auto info = cam(server, {"info", "side"});
   CHECK(info.exit_code == 0);
-  CHECK(info.out.find("320") != std::string::npos);
+  INFO(info.out);
+  // The camera asked for, not the other one: its name, source and sizes.
+  CHECK(infoValue(info.out, "camera") == "side");
+  CHECK(infoValue(info.out, "source") == "synthetic:width=320,height=240,seed=2");
+  CHECK(infoValue(info.out, "sensor") == "320x240");
+  CHECK(infoValue(info.out, "output") == "320x240");
   CHECK(cam(server, {"info", "front"}).exit_code == 1);
   CHECK(cam(server, {"roi", "top", "x", "0", "10", "10"}).exit_code == 2);
   CHECK(cam(server, {"stats"}).exit_code == 0);
@@ -174,32 +195,42 @@ TEST_CASE("a stalled subscriber loses frames on its own side only", "[e2e][video
   CHECK(stats.out.find("\"subscribers\":2") != std::string::npos);
 }
 
-TEST_CASE("snap saves the next frame; close releases the camera and open resumes it",
+TEST_CASE("snap saves the next frame and close releases the camera until open resumes it",
           "[e2e][video]") {
+  // Noise-free and static: every frame holds the very same pixels.
   VideoServerProcess server(
       {"--source", "cam0=synthetic:width=640,height=480,parts=3,noise=0", "--fps", "20"});
-  char dir[] = "/tmp/picksight-snap-XXXXXX";
-  REQUIRE(::mkdtemp(dir));
-  const std::string file = std::string(dir) + "/frame.png";
+  picksight::test::TempDir dir;
+  const std::string file = dir.file("frame.png");
+  zmq::context_t context;
+  FrameSubscriber sub(context, server.frames, "cam0", 4);
+  const auto published = sub.receive(5s);
+  REQUIRE(published);
   REQUIRE(cam(server, {"snap", "cam0", file}).exit_code == 0);
   const cv::Mat saved = cv::imread(file, cv::IMREAD_UNCHANGED);
   REQUIRE_FALSE(saved.empty());
-  CHECK(saved.cols == 640);
-  CHECK(saved.rows == 480);
-  CHECK(saved.channels() == 1);
+  REQUIRE(saved.size() == cv::Size(640, 480));
+  REQUIRE(saved.type() == CV_8UC1);
+  CHECK(cv::countNonZero(saved != published->image) == 0);
 
-  zmq::context_t context;
-  FrameSubscriber sub(context, server.frames, "cam0", 4);
-  REQUIRE(sub.receive(5s));
   REQUIRE(cam(server, {"close", "cam0"}).exit_code == 0);
-  // Frames already on their way may still arrive; then nothing.
-  while (sub.receive(500ms)) {
-  }
+  const uint64_t closed_ns = realtimeNs();
   CHECK(cam(server, {"list"}).out.find("closed") != std::string::npos);
   CHECK(cam(server, {"snap", "cam0", file}).exit_code == 1);
+  const uint64_t opening_ns = realtimeNs();
   REQUIRE(cam(server, {"open", "cam0"}).exit_code == 0);
-  auto resumed = sub.receive(5s);
+  // Frames already on their way may still arrive; none was taken while the
+  // camera was closed, and frames come again after open.
+  std::optional<Frame> resumed;
+  for (int i = 0; i < 20 && !resumed; ++i) {
+    auto f = sub.receive(5s);
+    REQUIRE(f);
+    const uint64_t taken = f->info.host_timestamp_ns;
+    INFO("frame " << f->info.sequence << " taken at " << taken);
+    CHECK_FALSE((taken > closed_ns && taken < opening_ns));
+    if (taken > opening_ns) resumed = std::move(f);
+  }
   REQUIRE(resumed);
+  CHECK(cv::countNonZero(resumed->image != published->image) == 0);
   CHECK(cam(server, {"list"}).out.find("streaming") != std::string::npos);
-  std::filesystem::remove_all(dir);
 }

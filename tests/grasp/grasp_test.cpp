@@ -34,7 +34,7 @@ TEST_CASE("finger footprints land where the fingers are", "[grasp]") {
   CHECK(centre.y == Approx(80));
 }
 
-TEST_CASE("a grasp whose fingers cover another part is not offered; the next clear one is",
+TEST_CASE("a grasp whose fingers cover another part is not offered and the next clear one is",
           "[grasp]") {
   Obstacles obstacles;
   obstacles.mask = cv::Mat(300, 400, CV_8UC1, cv::Scalar(0));
@@ -67,4 +67,31 @@ TEST_CASE("obstacles in a resized frame are checked through the frame's mapping"
   cv::rectangle(obstacles.mask, cv::Rect(95, 35, 10, 4), cv::Scalar(255), cv::FILLED);
   CHECK_FALSE(fingersClear({200, -100, 0}, parallelGripper(), kFrame, obstacles));
   CHECK(fingersClear({200, -100, 90}, parallelGripper(), kFrame, obstacles));
+}
+
+TEST_CASE("one obstacle pixel under any corner of a finger blocks it", "[grasp]") {
+  // Finger 1 of style 0 at part (200, -100): pixels x 195..205, y 77..83.
+  for (const cv::Point corner : {cv::Point(196, 78), cv::Point(204, 78), cv::Point(204, 82),
+                                 cv::Point(196, 82), cv::Point(200, 80)}) {
+    INFO("obstacle pixel " << corner);
+    Obstacles obstacles;
+    obstacles.mask = cv::Mat(300, 400, CV_8UC1, cv::Scalar(0));
+    obstacles.mask.at<uint8_t>(corner) = 255;
+    CHECK_FALSE(fingersClear({200, -100, 0}, parallelGripper(), kFrame, obstacles));
+  }
+  // ... and one just beside it does not.
+  Obstacles beside;
+  beside.mask = cv::Mat(300, 400, CV_8UC1, cv::Scalar(0));
+  beside.mask.at<uint8_t>(cv::Point(207, 80)) = 255;
+  CHECK(fingersClear({200, -100, 0}, parallelGripper(), kFrame, beside));
+}
+
+TEST_CASE("a finger 2 px past the image edge is blocked and one at the edge is not", "[grasp]") {
+  Obstacles obstacles;
+  obstacles.mask = cv::Mat(300, 400, CV_8UC1, cv::Scalar(0));
+  // Fingers 10 mm wide about x: from x - 5 to x + 5 pixels.
+  CHECK_FALSE(fingersClear({3, -150, 0}, parallelGripper(), kFrame, obstacles));
+  CHECK(fingersClear({5, -150, 0}, parallelGripper(), kFrame, obstacles));
+  CHECK_FALSE(fingersClear({397, -150, 0}, parallelGripper(), kFrame, obstacles));
+  CHECK(fingersClear({394, -150, 0}, parallelGripper(), kFrame, obstacles));
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "picksight/common/text.hpp"
+#include "picksight/transport/control_client.hpp"
 
 namespace picksight::e2e {
 using namespace std::chrono_literals;
@@ -77,6 +78,20 @@ std::optional<Frame> receiveUntil(FrameSubscriber& subscriber,
     if (f && accept(*f)) return f;
   }
   return std::nullopt;
+}
+
+uint64_t waitForSubscription(const VideoServerProcess& server, FrameSubscriber& subscriber,
+                             const std::string& camera) {
+  zmq::context_t context;
+  ControlClient control(context, server.control);
+  proto::ControlRequest trigger;
+  trigger.mutable_trigger()->set_camera(camera);
+  for (int i = 0; i < 50; ++i) {
+    REQUIRE(control.call(trigger));
+    if (auto frame = subscriber.receive(200ms)) return frame->info.sequence;
+  }
+  FAIL("no frame of " << camera << " reached the subscriber");
+  return 0;
 }
 
 std::vector<Pose> parseLocateReply(const std::string& reply) {

@@ -52,6 +52,13 @@ CommandResult run(const std::vector<std::string>& argv);
 std::optional<Frame> receiveUntil(FrameSubscriber& subscriber,
                                   const std::function<bool(const Frame&)>& accept, int tries = 100);
 
+// Sends software triggers to `camera` until `subscriber` has a frame (for a
+// server in trigger mode): the subscription has then reached the server and
+// nothing published later is lost to it. REQUIREs it within 10 s. Returns
+// that frame's sequence number.
+uint64_t waitForSubscription(const VideoServerProcess& server, FrameSubscriber& subscriber,
+                             const std::string& camera = "cam0");
+
 // The reply "OK n x y rz ..." as (x, y, rz) triples; REQUIREs the format.
 struct Pose {
   double x, y, rz;

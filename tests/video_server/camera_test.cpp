@@ -17,6 +17,7 @@
 #include <catch2/catch.hpp>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include "temp_dir.hpp"
 
 #include "picksight/video_server/camera.hpp"
@@ -192,7 +193,8 @@ TEST_CASE("Camera free-run trigger ticket follows every published frame", "[vide
 
 TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]") {
   CollectingSink sink;
-  auto camera = makeCamera(config(AcquisitionMode::kTrigger), sink);
+  // Noise-free: every frame holds the same scene, pixel for pixel.
+  auto camera = makeCamera(config(AcquisitionMode::kTrigger, 10, kSource + ",noise=0"), sink);
   camera->start();
   REQUIRE(waitForState(*camera, "streaming"));
   camera->trigger();
@@ -210,6 +212,9 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   const auto cropped = sink.frames()[1];
   CHECK(cropped.image.size() == cv::Size(64, 48));
   CHECK(cv::Point2d(cropped.mapping.roi_x, cropped.mapping.roi_y) == cv::Point2d(10, 20));
+  const cv::Mat sensor = sink.frames()[0].image;
+  const cv::Mat region = sensor(roi.roi);
+  CHECK(cv::countNonZero(cropped.image != region) == 0);
 
   OutputSettings scaled = roi;
   scaled.scale = 0.5;
@@ -221,8 +226,18 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   CHECK(small.image.size() == cv::Size(32, 24));
   CHECK(small.image.type() == CV_8UC3);
   CHECK(small.mapping.scale_x == 0.5);
+  // The pixels are the region halved, in colour.
+  cv::Mat expected;
+  cv::resize(region, expected, cv::Size(32, 24), 0, 0, cv::INTER_AREA);
+  cv::cvtColor(expected, expected, cv::COLOR_GRAY2BGR);
+  CHECK(cv::norm(small.image, expected, cv::NORM_INF) <= 1);
   // Ground truth stays in sensor pixels.
-  CHECK(small.truth.size() == 2);
+  REQUIRE(small.truth.size() == 2);
+  REQUIRE(sink.frames()[0].truth.size() == 2);
+  for (size_t i = 0; i < 2; ++i) {
+    CHECK(small.truth[i].x == sink.frames()[0].truth[i].x);
+    CHECK(small.truth[i].y == sink.frames()[0].truth[i].y);
+  }
 }
 
 TEST_CASE("Camera setOutput rejects a ROI beyond the sensor once open", "[video_server]") {

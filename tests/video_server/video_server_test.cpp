@@ -7,6 +7,8 @@
 #include <thread>
 
 #include <catch2/catch.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <zmq.hpp>
 
 #include "picksight/transport/control_client.hpp"
@@ -32,7 +34,9 @@ ServerConfig testConfig() {
   config.control_endpoint = "tcp://127.0.0.1:*";
   CameraConfig cam1;
   cam1.name = "cam1";
-  cam1.uri = "synthetic:width=320,height=240,parts=3,size=40,seed=7";
+  // Noise-free: every frame of cam1 holds the same pixels, so a transformed
+  // frame can be checked against the full one pixel for pixel.
+  cam1.uri = "synthetic:width=320,height=240,parts=3,size=40,seed=7,noise=0";
   cam1.mode = AcquisitionMode::kTrigger;
   CameraConfig cam10;
   cam10.name = "cam10";
@@ -386,6 +390,11 @@ TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", 
   }
 
   SECTION("ROI, scale and bgr") {
+    auto full_ticket = control.call(trigger("cam1"));
+    REQUIRE(full_ticket);
+    const auto full = receiveSequence(sub, full_ticket->trigger().sequence());
+    REQUIRE(full);
+    REQUIRE(full->info.width == 320);
     REQUIRE(control.call(setRoi("cam1", 10, 20, 200, 100)));
     proto::ControlRequest size;
     size.mutable_set_size()->set_camera("cam1");
@@ -410,8 +419,18 @@ TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", 
     CHECK(m.roi_y == 20);
     CHECK(m.scale_x == 0.5);
     CHECK(m.scale_y == 0.5);
+    // The pixels are the sensor's region, halved and in colour.
+    cv::Mat expected;
+    cv::resize(full->image(cv::Rect(10, 20, 200, 100)), expected, cv::Size(100, 50), 0, 0,
+               cv::INTER_AREA);
+    cv::cvtColor(expected, expected, cv::COLOR_GRAY2BGR);
+    CHECK(cv::norm(frame->image, expected, cv::NORM_INF) <= 1);
     // Truth stays in sensor pixels, whatever the output transform.
-    CHECK(frame->truth.size() == 3);
+    REQUIRE(frame->truth.size() == 3);
+    for (size_t i = 0; i < 3; ++i) {
+      CHECK(frame->truth[i].x == full->truth[i].x);
+      CHECK(frame->truth[i].y == full->truth[i].y);
+    }
     checkConsistent(*frame);
   }
 

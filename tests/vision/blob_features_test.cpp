@@ -120,7 +120,7 @@ TEST_CASE("the perimeter estimate holds at any angle", "[vision][blob]") {
   }
 }
 
-TEST_CASE("an L shape's log Hu invariants survive rotation; the 7th changes sign in a mirror",
+TEST_CASE("an L shape's log Hu invariants survive rotation and the 7th changes sign in a mirror",
           "[vision][blob]") {
   const BlobFeatures base = blobFeatures(only(drawPolygon(lPolygon(0, false), {400, 400})));
   for (double deg : {33.0, 90.0, 161.0, 270.0}) {

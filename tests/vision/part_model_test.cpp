@@ -3,6 +3,8 @@
 // trained pose, boundary primitives.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 #include "recognition_support.hpp"
 
 #include <map>
@@ -74,7 +76,7 @@ TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][mo
   CHECK(disc.value().orientation_order == 0);
 }
 
-TEST_CASE("a hole becomes one arc; a rectangle four lines with convex right-angle corners",
+TEST_CASE("a hole becomes one arc and a rectangle four lines with convex right-angle corners",
           "[vision][model]") {
   const Trained slot = train("slot", 1);
   REQUIRE(slot.model.loops.size() == 2);
@@ -153,6 +155,9 @@ TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vi
     const ps::SceneRenderer s(scene(1920, 1080, 20, seed, types));
     const auto matches = recognizeScene(s, models);
     CHECK(matches.size() == 20);
+    // Best first: a robot taking the first part takes the surest one.
+    CHECK(std::is_sorted(matches.begin(), matches.end(),
+                         [](const Match& a, const Match& b) { return a.score > b.score; }));
     for (const auto& t : s.truth()) {
       INFO(t.type << " at " << t.x << ", " << t.y << " turned " << t.angle_deg);
       const Match* m = nearest(matches, t);

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <utility>
+#include <vector>
 
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/regions.hpp"
@@ -12,26 +14,33 @@ using picksight::vision::findRegions;
 using picksight::vision::Region;
 
 namespace {
-// An L shape (long leg 120, short leg 70, thickness 30) turned by `deg`
-// about (200, 200), optionally mirrored: drawn 8x larger and averaged down,
-// as a camera sees it (edge pixels partly covered). `truth` gets the centroid
-// and angle of what was drawn, from the moments of the 8x drawing.
+// Parts drawn 8x larger and averaged down, as a camera sees them (edge pixels
+// partly covered), with the centroid and axis of what was drawn from the
+// moments of the 8x drawing. drawL: an L shape (long leg 120, short leg 70,
+// thickness 30) turned by `deg` about (200, 200), optionally mirrored.
 struct Drawn {
-  cv::Mat grey;  // a dark part (50) on a light background (220)
+  cv::Mat grey;  // by default a dark part (50) on a light background (220)
   cv::Point2d centroid;
   double axis_deg = 0;  // axis of least inertia, modulo 180
 };
 
-Drawn drawL(double deg, bool mirrored) {
+struct Look {
+  double part = 50;
+  double background = 220;
+};
+
+// The polygon `local` (its own axes, about (45, 25)) turned by `deg` about
+// `centre`, optionally mirrored, in a 400x400 image.
+Drawn drawShape(const std::vector<cv::Point2d>& local, double deg, bool mirrored,
+                cv::Point2d centre = {200, 200}, Look look = {}) {
   constexpr int kSuper = 8;
-  const std::vector<cv::Point2d> local = {{0, 0}, {120, 0}, {120, 30}, {30, 30}, {30, 70}, {0, 70}};
   const double a = deg * M_PI / 180.0;
   std::vector<cv::Point> pts;
   for (auto p : local) {
     p -= cv::Point2d(45, 25);
     if (mirrored) p.y = -p.y;
-    const double x = 200 + p.x * std::cos(a) - p.y * std::sin(a);
-    const double y = 200 + p.x * std::sin(a) + p.y * std::cos(a);
+    const double x = centre.x + p.x * std::cos(a) - p.y * std::sin(a);
+    const double y = centre.y + p.x * std::sin(a) + p.y * std::cos(a);
     // Pixel centres at integers at both scales: u = (x + 0.5) * S - 0.5.
     pts.emplace_back(static_cast<int>(std::lround(((x + 0.5) * kSuper - 0.5) * 256)),
                      static_cast<int>(std::lround(((y + 0.5) * kSuper - 0.5) * 256)));
@@ -41,7 +50,7 @@ Drawn drawL(double deg, bool mirrored) {
   Drawn d;
   cv::Mat coverage;
   cv::resize(big, coverage, cv::Size(400, 400), 0, 0, cv::INTER_AREA);
-  coverage.convertTo(d.grey, CV_8U, -170.0 / 255.0, 220.0);
+  coverage.convertTo(d.grey, CV_8U, (look.part - look.background) / 255.0, look.background);
   const cv::Moments m = cv::moments(big, true);
   d.centroid =
       cv::Point2d((m.m10 / m.m00 + 0.5) / kSuper - 0.5, (m.m01 / m.m00 + 0.5) / kSuper - 0.5);
@@ -49,8 +58,17 @@ Drawn drawL(double deg, bool mirrored) {
   return d;
 }
 
-std::vector<Region> regionsOf(const Drawn& d, bool use_grey) {
-  return findRegions(d.grey < 135, {}, use_grey ? d.grey : cv::Mat());
+Drawn drawL(double deg, bool mirrored, Look look = {}) {
+  return drawShape({{0, 0}, {120, 0}, {120, 30}, {30, 30}, {30, 70}, {0, 70}}, deg, mirrored,
+                   {200, 200}, look);
+}
+
+// The regions of a drawing, the mask cut half way between part and
+// background, whichever is darker.
+std::vector<Region> regionsOf(const Drawn& d, bool use_grey, Look look = {}) {
+  const double middle = (look.part + look.background) / 2;
+  const cv::Mat mask = look.part < look.background ? d.grey < middle : d.grey > middle;
+  return findRegions(mask, {}, use_grey ? d.grey : cv::Mat());
 }
 }  // namespace
 
@@ -160,20 +178,6 @@ TEST_CASE("an L shape's angle follows its rotation over the full turn", "[vision
   }
 }
 
-TEST_CASE("grey-level moments beat binary ones on diagonal edges", "[vision][regions]") {
-  // At 45 degrees every edge pixel of a side has the same coverage, so the
-  // binary cut errs the same way all along the side.
-  const Drawn d = drawL(315, false);
-  const auto grey = regionsOf(d, true);
-  const auto binary = regionsOf(d, false);
-  REQUIRE(grey.size() == 1);
-  REQUIRE(binary.size() == 1);
-  const double grey_error = cv::norm(grey[0].centroid - d.centroid);
-  const double binary_error = cv::norm(binary[0].centroid - d.centroid);
-  CHECK(grey_error < 0.02);
-  CHECK(binary_error > 5 * grey_error);
-}
-
 TEST_CASE("a mirrored L shape turns the other way", "[vision][regions]") {
   const auto base = regionsOf(drawL(0, false), true);
   REQUIRE(base.size() == 1);
@@ -184,4 +188,97 @@ TEST_CASE("a mirrored L shape turns the other way", "[vision][regions]") {
     // Mirroring about the x axis maps an angle t to -t, then the turn adds.
     CHECK(angleDiffDeg(mirrored[0].angle_deg, -base[0].angle_deg + deg) < 0.1);
   }
+}
+
+// The direction along the axis is not a convention of the code under test:
+// it points from the centroid towards the boundary point farthest from it,
+// and angles turn clockwise on screen (image y grows downwards).
+TEST_CASE("the angle points towards the far end of a part and turns clockwise on screen",
+          "[vision][regions]") {
+  // A 100x30 bar with a 30x6 spike at its right end: the far end is right.
+  cv::Mat right(300, 300, CV_8UC1, cv::Scalar(0));
+  right(cv::Rect(90, 135, 100, 30)).setTo(255);
+  right(cv::Rect(190, 147, 30, 6)).setTo(255);
+  const std::vector<std::pair<int, double>> turns = {{-1, 0},
+                                                     {cv::ROTATE_90_CLOCKWISE, 90},
+                                                     {cv::ROTATE_180, 180},
+                                                     {cv::ROTATE_90_COUNTERCLOCKWISE, 270}};
+  for (const auto& [turn, expected] : turns) {
+    cv::Mat img;
+    if (turn >= 0) {
+      cv::rotate(right, img, turn);
+    } else {
+      img = right;
+    }
+    const auto regions = findRegions(img);
+    REQUIRE(regions.size() == 1);
+    INFO("expected " << expected << " got " << regions[0].angle_deg);
+    CHECK(angleDiffDeg(regions[0].angle_deg, expected) < 1e-6);
+  }
+}
+
+TEST_CASE("regions cut by any of the four borders are left out", "[vision][regions]") {
+  cv::Mat img(200, 300, CV_8UC1, cv::Scalar(0));
+  img(cv::Rect(0, 50, 40, 40)).setTo(255);     // left
+  img(cv::Rect(100, 0, 40, 40)).setTo(255);    // top
+  img(cv::Rect(260, 100, 40, 40)).setTo(255);  // right
+  img(cv::Rect(200, 160, 40, 40)).setTo(255);  // bottom
+  img(cv::Rect(120, 80, 30, 30)).setTo(255);   // the only whole part
+  const auto regions = findRegions(img);
+  REQUIRE(regions.size() == 1);
+  CHECK(regions[0].bbox == cv::Rect(120, 80, 30, 30));
+  CHECK_FALSE(regions[0].touches_border);
+}
+
+TEST_CASE("grey-level moments beat binary ones on diagonal edges for dark and light parts",
+          "[vision][regions]") {
+  // At 45 degrees every edge pixel of a side has the same coverage, so the
+  // binary cut errs the same way all along the side. Dark parts on a lit
+  // background (also at low contrast), light parts (the contrast changes
+  // sign), and light parts on a black background, read additively (there is
+  // no light to divide by, down to none at all): the grey centroid keeps its
+  // accuracy in every case.
+  for (const Look look :
+       {Look{50, 220}, Look{180, 220}, Look{240, 100}, Look{200, 5}, Look{220, 0}}) {
+    INFO("part " << look.part << " on " << look.background);
+    const Drawn d = drawL(315, false, look);
+    const auto grey = regionsOf(d, true, look);
+    const auto binary = regionsOf(d, false, look);
+    REQUIRE(grey.size() == 1);
+    REQUIRE(binary.size() == 1);
+    const double grey_error = cv::norm(grey[0].centroid - d.centroid);
+    const double binary_error = cv::norm(binary[0].centroid - d.centroid);
+    CHECK(grey_error < 0.02);
+    CHECK(binary_error > 5 * grey_error);
+    // The L's area: 120 x 30 + 40 x 30 px (read 0.3 % high today).
+    CHECK(grey[0].area == Approx(4800).epsilon(0.005));
+  }
+}
+
+TEST_CASE("an upright rectangle at a subpixel position is measured from its grey levels",
+          "[vision][regions]") {
+  // Its box hugs it: the background ring for the light must come from the
+  // margin around the box, 4 px wide, not from the box's corners.
+  const Drawn d = drawShape({{0, 0}, {90, 0}, {90, 50}, {0, 50}}, 0, false, {200.3, 150.6});
+  const auto grey = regionsOf(d, true);
+  REQUIRE(grey.size() == 1);
+  CHECK(cv::norm(grey[0].centroid - d.centroid) < 0.02);
+  CHECK(grey[0].area == Approx(4500).epsilon(0.005));
+}
+
+TEST_CASE("coverage is a fraction between 0 and 1 even under noise", "[vision][regions]") {
+  Drawn d = drawL(20, false);
+  cv::Mat noise(d.grey.size(), CV_16S);
+  cv::randn(noise, 0, 12);
+  cv::Mat noisy;
+  d.grey.convertTo(noisy, CV_16S);
+  noisy += noise;
+  noisy.convertTo(d.grey, CV_8U);
+  const auto regions = regionsOf(d, true);
+  REQUIRE(regions.size() == 1);
+  double least = 0, most = 0;
+  cv::minMaxLoc(regions[0].coverage, &least, &most);
+  CHECK(least >= 0.0);
+  CHECK(most <= 1.0);
+  CHECK(most == 1.0);  // the interior is covered, whatever its noise
 }

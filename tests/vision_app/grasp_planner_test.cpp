@@ -83,7 +83,7 @@ struct Cell {
 };
 }  // namespace
 
-TEST_CASE("the first grasp whose fingers are clear wins; a blocked part is not offered",
+TEST_CASE("the first grasp whose fingers are clear wins and a blocked part is not offered",
           "[cell][grasp]") {
   Cell cell;
   REQUIRE(cell.ask(Scene().bar({320, 240}), "LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);

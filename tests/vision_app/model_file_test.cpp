@@ -71,7 +71,7 @@ TEST_CASE("a model survives its file unchanged", "[vision_app][models]") {
   CHECK(modelToYaml(*back) == text);
 }
 
-TEST_CASE("grasps travel with the model; version 1 files still load", "[vision_app][models]") {
+TEST_CASE("grasps travel with the model and version 1 files still load", "[vision_app][models]") {
   const auto model = trainedModel("rectangle", 4);
   const GraspSetup grasp{{{1.5, -2, 90}, {0, 3, 180}}, {{{-10, 0, 4, 8}, {10, 0, 4, 8}}}};
   auto back = modelRecordFromYaml(modelToYaml(model, grasp));

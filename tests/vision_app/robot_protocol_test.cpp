@@ -4,15 +4,17 @@
 #include <filesystem>
 
 #include "picksight/vision_app/vision_cell.hpp"
+#include "temp_dir.hpp"
 
 using namespace picksight::app;
 
 namespace {
 // The whole command table with no camera: enough for every command that
-// fails before asking for a frame.
+// fails before asking for a frame. Each test has its own data directory, so
+// concurrent runs never share models or calibrations.
 struct Fixture {
-  std::string dir = std::filesystem::temp_directory_path() / "picksight-protocol-test-nothing";
-  VisionCell protocol{dir, std::make_unique<NoCamera>(), VisionOptions{}};
+  picksight::test::TempDir dir;
+  VisionCell protocol{dir.path().string(), std::make_unique<NoCamera>(), VisionOptions{}};
 };
 }  // namespace
 
@@ -107,5 +109,5 @@ TEST_CASE("cell commands check their arguments before the camera or a file",
   const std::string status = f.protocol.handle("STATUS");
   CHECK(status.rfind("OK frame=vision-px scale=none ", 0) == 0);
   CHECK(status.find(" skipped=0 ") != std::string::npos);
-  CHECK_FALSE(std::filesystem::exists(f.dir));  // nothing was written
+  CHECK(std::filesystem::is_empty(f.dir.path()));  // nothing was written
 }

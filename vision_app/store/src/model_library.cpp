@@ -66,7 +66,12 @@ std::vector<std::string> ModelLibrary::load() {
 Result<void> ModelLibrary::store(const vision::PartModel& model) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
-  fs::create_directories(directory_, ec);
+  if (fs::create_directories(directory_, ec)) {
+    // A new models/ is itself an entry of its parent: durable only once the
+    // parent is synced, or a crash loses the directory with every model.
+    const fs::path parent = fs::absolute(directory_, ec).parent_path();
+    if (!ec) (void)syncDirectory(parent.string());
+  }
   if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   const auto kept = grasps_->find(model.type);
   auto written = writeFileAtomically(
@@ -92,6 +97,8 @@ Result<void> ModelLibrary::remove(int type) {
   std::error_code ec;
   fs::remove(pathOf(type), ec);
   if (ec) return makeError(ModelErrc::kStorage, pathOf(type) + ": " + ec.message());
+  // Without this a crash can bring the forgotten model back at restart.
+  (void)syncDirectory(directory_);
   auto models = std::make_shared<ModelList>(*models_);
   models->erase(std::remove_if(models->begin(), models->end(),
                                [&](const vision::PartModel& m) { return m.type == type; }),

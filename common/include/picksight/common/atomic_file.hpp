@@ -2,7 +2,9 @@
 // sees either the old content or the new one, never a torn file.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <string_view>
 
 #include "picksight/common/result.hpp"
 
@@ -11,6 +13,17 @@ namespace picksight {
 // Writes `content` to a temporary file beside `path`, fsyncs it, renames it
 // over `path` and fsyncs the directory.
 Result<void> writeFileAtomically(const std::string& path, const std::string& content);
+
+// Test seam: the same, calling `before_step` with the name of each step just
+// before it runs ("create", "write", "sync", "close", "rename", "sync-dir"),
+// so that tests can check the order and kill a child process at every step.
+// Called on the caller's thread.
+Result<void> writeFileAtomically(const std::string& path, const std::string& content,
+                                 const std::function<void(std::string_view step)>& before_step);
+
+// Makes the entries of `directory` (a new, renamed or removed file, a new
+// subdirectory) durable: fsync of the directory itself.
+Result<void> syncDirectory(const std::string& directory);
 
 // Reads a whole file.
 Result<std::string> readFile(const std::string& path);

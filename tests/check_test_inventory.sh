@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Checks that CTest runs every Catch test case of a build exactly once, by name.
+#
+# CTest learns the test cases from `<binary> --list-test-names-only` through
+# catch_discover_tests, which keeps them in a CMake list: a ';' in a name
+# splits it into two entries that each match no test case, and a test that
+# matches nothing used to exit 0 and count as a pass. This fails when
+#   - a test binary holds a case that has no CTest entry of the same name,
+#   - a CTest entry of a test binary names no case of that binary,
+#   - the number of cases and of entries differ,
+#   - a name holds a character that CMake or Catch's test-spec parser reads
+#     as syntax (see below).
+# Usage: tests/check_test_inventory.sh <build dir>
+set -euo pipefail
+
+build="${1:?usage: check_test_inventory.sh <build dir>}"
+tests_dir="$build/tests"
+[ -d "$tests_dir" ] || { echo "no $tests_dir" >&2; exit 2; }
+
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+
+# Every Catch case, as "<binary>:<name>" (the TEST_PREFIX the CMake files use).
+: >"$work/cases"
+binaries=0
+while IFS= read -r -d '' binary; do
+  name="$(basename "$binary")"
+  binaries=$((binaries + 1))
+  # Catch exits with the number of cases listed: not an error.
+  listed="$("$binary" --list-test-names-only)" || true
+  [ -n "$listed" ] || { echo "FAIL: $name lists no test case" >&2; exit 1; }
+  printf '%s\n' "$listed" | sed "s|^|$name:|" >>"$work/cases"
+done < <(find "$tests_dir" -maxdepth 1 -type f -executable -print0)
+[ "$binaries" -gt 0 ] || { echo "FAIL: no test binary in $tests_dir" >&2; exit 1; }
+
+# Every CTest entry, by name; only those of a test binary (prefix "<binary>:").
+(cd "$build" && ctest -N) | sed -n 's/^ *Test *#[0-9]*: //p' >"$work/all_entries"
+find "$tests_dir" -maxdepth 1 -type f -executable -printf '%f\n' >"$work/binaries"
+awk -F: 'NR == FNR { binary[$0] = 1; next } ($1 in binary)' "$work/binaries" \
+  "$work/all_entries" >"$work/entries"
+
+export LC_ALL=C
+sort "$work/cases" >"$work/cases.sorted"
+sort "$work/entries" >"$work/entries.sorted"
+status=0
+
+# ';' splits a name in CMake's list; '\\' and a leading '~', '#' or '*' (or
+# a trailing '*') are test-spec syntax that catch_discover_tests does not
+# escape (it escapes ',' '[' ']', so those run; new names avoid them anyway).
+bad="$(cut -d: -f2- "$work/cases" | grep -E '[;\\]|^[~#*]|[*]$' || true)"
+if [ -n "$bad" ]; then
+  echo "FAIL: test names with characters CTest or Catch read as syntax:" >&2
+  printf '%s\n' "$bad" | sed 's/^/  /' >&2
+  status=1
+fi
+
+missing="$(comm -23 "$work/cases.sorted" "$work/entries.sorted")"
+if [ -n "$missing" ]; then
+  echo "FAIL: test cases CTest does not run:" >&2
+  printf '%s\n' "$missing" | sed 's/^/  /' >&2
+  status=1
+fi
+phantom="$(comm -13 "$work/cases.sorted" "$work/entries.sorted")"
+if [ -n "$phantom" ]; then
+  echo "FAIL: CTest entries that name no test case (they run nothing):" >&2
+  printf '%s\n' "$phantom" | sed 's/^/  /' >&2
+  status=1
+fi
+
+cases=$(wc -l <"$work/cases")
+entries=$(wc -l <"$work/entries")
+if [ "$cases" -ne "$entries" ]; then
+  echo "FAIL: $cases test cases in $binaries binaries, $entries CTest entries" >&2
+  status=1
+fi
+[ "$status" -eq 0 ] && echo "test inventory: $cases test cases in $binaries binaries, one CTest entry each"
+exit "$status"
