@@ -494,7 +494,7 @@ int main(int argc, char** argv) {
   int scenes = 10;
   int rounds = 10;
   bool accuracy = true;  // --accuracy 0: the speed figures alone (profiling)
-  std::string data_dir = PICKSIGHT_SHARED_DATA_DIR;
+  std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     const auto v = picksight::parseInt(argv[i + 1]);

@@ -12,7 +12,7 @@ using namespace picksight::calibration;
 
 namespace {
 const std::string kBoardDir =
-    std::string(PICKSIGHT_SHARED_DATA_DIR) + "/calibration/opencv_chessboard/";
+    std::string(PICKSIGHT_TEST_DATA_DIR) + "/calibration/opencv_chessboard/";
 
 // Moments of an ellipse of semi-axes a, b (pixels), drawn 8x larger and
 // averaged down so edges are partial pixels as a camera sees them.

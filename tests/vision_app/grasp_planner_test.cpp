@@ -138,7 +138,7 @@ TEST_CASE("the lens subcommand stores the chessboard lens model the cell then us
   std::vector<std::string> args{"lens", "--data-dir", cell.dir, "--corners",
                                 "9x6",  "--square",   "25"};
   const std::string boards =
-      std::string(PICKSIGHT_SHARED_DATA_DIR) + "/calibration/opencv_chessboard/";
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/calibration/opencv_chessboard/";
   for (const char* name : {"left01.jpg", "left02.jpg", "left03.jpg", "left04.jpg", "left05.jpg",
                            "left06.jpg", "left07.jpg", "left08.jpg", "left09.jpg", "left11.jpg",
                            "left12.jpg", "left13.jpg", "left14.jpg"})
