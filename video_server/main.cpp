@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "picksight/common/log.hpp"
+#include "picksight/common/stop_signals.hpp"
 #include "picksight/video_server/video_server.hpp"
 
 int main(int argc, char** argv) {
@@ -20,13 +21,7 @@ int main(int argc, char** argv) {
               << video::serverUsage();
     return 2;
   }
-  // Block the stop signals in every thread; the main thread waits for them.
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  std::signal(SIGPIPE, SIG_IGN);
+  const StopSignals stop_signals;
   try {
     video::VideoServer server(*config);
     server.start();
@@ -35,9 +30,7 @@ int main(int argc, char** argv) {
               << "control " << server.controlEndpoint() << "\n"
               << "ready" << std::endl;
     for (const auto& c : config->cameras) logInfo("camera ", c.name, " = ", c.uri);
-    int sig = 0;
-    sigwait(&signals, &sig);
-    logInfo("stopping on signal ", sig);
+    logInfo("stopping on signal ", stop_signals.wait());
     server.stop();
   } catch (const std::exception& e) {
     std::cerr << "picksight-video-server: " << e.what() << "\n";

@@ -9,6 +9,7 @@
 
 #include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/log.hpp"
+#include "picksight/common/stop_signals.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
@@ -34,12 +35,7 @@ int main(int argc, char** argv) {
               << std::strerror(errno) << "\n";
     return 2;
   }
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  std::signal(SIGPIPE, SIG_IGN);
+  const StopSignals stop_signals;
   try {
     zmq::context_t context;
     app::VisionCell cell(options->data_dir,
@@ -58,9 +54,7 @@ int main(int argc, char** argv) {
               << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ",
             robots.port());
-    int sig = 0;
-    sigwait(&signals, &sig);
-    logInfo("stopping on signal ", sig);
+    logInfo("stopping on signal ", stop_signals.wait());
     robots.stop();
     cell.stop();
   } catch (const std::exception& e) {
