@@ -16,7 +16,7 @@
 //   socket thread over an inproc PUSH/PULL pair (a ZeroMQ socket belongs to
 //   one thread); the socket thread polls both sockets.
 // * At most `max_pending` slow requests wait (not counting those running); one
-//   more gets an immediate TIMEOUT reply saying the server is busy.
+//   more gets an immediate BUSY reply (VideoErrc::kBusy).
 // * The handler runs on either thread and must be safe to call concurrently;
 //   no exception leaves a thread (a throwing handler becomes an INTERNAL reply).
 // * stop() joins every thread: queued requests are dropped (their REQ clients
