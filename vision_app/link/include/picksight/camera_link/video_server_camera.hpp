@@ -34,7 +34,7 @@ class VideoServerCamera : public CameraLink {
   const std::string& camera() const override { return camera_; }
 
  private:
-  // One request to the video server, its errors as CameraError codes.
+  // One request to the video server, its errors as CameraErrc values.
   Result<proto::ControlReply> call(const proto::ControlRequest& request);
 
   const std::string camera_;

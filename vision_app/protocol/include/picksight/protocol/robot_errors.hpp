@@ -1,5 +1,5 @@
 // The one table from errors, of every domain a robot request can meet, to
-// the robot protocol's ERROR codes (docs/PROTOCOL.md, "Error codes"). The
+// the robot protocol's ERROR codes (docs/PROTOCOL.md, "Errors"). The
 // codes are the protocol's contract with robot programs: they never change
 // when an error enum does.
 #pragma once
