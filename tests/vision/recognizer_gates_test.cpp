@@ -116,10 +116,10 @@ TEST_CASE("parts of one shape 6 percent apart in size are each their own type",
 
 TEST_CASE("when two look-alike types both verify the closer body wins",
           "[vision][recognizer][gates]") {
-  // Bores 1.5 px apart in radius: both boundary models verify on both parts
+  // Bores 0.75 px apart in radius: both boundary models verify on both parts
   // (within the 2 px edge tolerance), the Hu distance decides.
   const ps::Shape small_bore = shapeOf({pt::rectLoop(120, 70), pt::circleLoop(9, {25, 5})});
-  const ps::Shape large_bore = shapeOf({pt::rectLoop(120, 70), pt::circleLoop(10.5, {25, 5})});
+  const ps::Shape large_bore = shapeOf({pt::rectLoop(120, 70), pt::circleLoop(9.75, {25, 5})});
   const PartModel a = trainDrawn(small_bore, 1, "small bore");
   const PartModel b = trainDrawn(large_bore, 2, "large bore");
   const auto parts =
