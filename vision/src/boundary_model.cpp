@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "picksight/common/angles.hpp"
@@ -333,6 +334,37 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
   return samples;
 }
 
+double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& loop : loops) {
+    for (const auto& prim : loop.primitives) {
+      const double to_ends = std::min(std::hypot(p.x - prim.start.x, p.y - prim.start.y),
+                                      std::hypot(p.x - prim.end.x, p.y - prim.end.y));
+      double d = to_ends;
+      if (prim.kind == PrimitiveKind::kLine) {
+        const cv::Point2d v = prim.end - prim.start;
+        const double n2 = v.dot(v);
+        if (n2 > 0) {
+          const double t = (p - prim.start).dot(v) / n2;
+          if (t > 0 && t < 1) d = std::min(d, pointLineDistance(p, prim.start, prim.end));
+        }
+      } else {
+        // On the arc when the point's direction from the centre lies within
+        // the sweep, walked the arc's way from its start.
+        const cv::Point2d r = p - prim.centre;
+        double along = angleOf(r) - angleOf(prim.start - prim.centre);
+        if (prim.sweep_deg < 0) along = -along;
+        along = along - 360.0 * std::floor(along / 360.0);
+        if (along <= std::abs(prim.sweep_deg)) {
+          d = std::min(d, std::abs(std::hypot(r.x, r.y) - prim.radius));
+        }
+      }
+      best = std::min(best, d);
+    }
+  }
+  return best;
+}
+
 EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
                            double max_distance)
     : origin_(roi.tl()) {
@@ -418,17 +450,6 @@ double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centr
     if (d <= tolerance) on += w;
   });
   return total > 0 ? on / total : 0;
-}
-
-double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
-                        double angle_deg, const EdgeDistance& edges, double clip, bool mirrored) {
-  double sum = 0;
-  double total = 0;
-  forPlaced(samples, centre, angle_deg, edges, mirrored, [&](double w, double d) {
-    total += w;
-    sum += w * std::min(d, clip);
-  });
-  return total > 0 ? sum / total : clip;
 }
 
 }  // namespace picksight::vision

@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
+
+#include "picksight/common/angles.hpp"
 
 namespace picksight::vision {
 namespace {
@@ -21,6 +24,11 @@ constexpr int kMaxPreferredOrder = 6;
 // Fraction of the boundary that must coincide with itself turned (or
 // mirrored) for the part to count as symmetric.
 constexpr double kSymmetryScore = 0.97;
+// Boundary length (pixels, weighted as in handednessWeight) by which a part
+// must differ from its mirror image, however it is turned, to count as
+// chiral: a 5 x 5 px notch differs by ~8 px, a symmetric part's fitted
+// primitives from their mirror images by well under one.
+constexpr double kMinChiralLength = 3.0;
 // Turns of the training image that measure how stable each Hu invariant is.
 constexpr double kProbeTurnsDeg[] = {23, 67, 141, 212, 299};
 // An invariant whose log changes by more than this under a turn is noise.
@@ -60,6 +68,64 @@ void complexMoments(const Region& r, std::vector<double>* strength,
     (*strength)[k] = a[k] > 0 ? std::abs(c[k]) / a[k] : 0;
     (*phase_deg)[k] = std::arg(c[k]) * 180.0 / M_PI;
   }
+}
+
+// How much a model sample at `separation` pixels from the other hand's
+// boundary tells the two apart: nothing within the edge tolerance (both
+// would verify there), fully from twice the tolerance.
+double handednessWeight(double separation, double tolerance) {
+  return std::clamp((separation - tolerance) / tolerance, 0.0, 1.0);
+}
+
+// The weighted boundary length of the model that lies apart from its
+// mirror image turned by `turn_deg`: sample p against the set R(t) M P, i.e.
+// M R(-t) p against P (M: y -> -y).
+double chiralLength(const PartModel& m, double turn_deg) {
+  const double c = std::cos(turn_deg * kRadPerDeg);
+  const double s = std::sin(turn_deg * kRadPerDeg);
+  double length = 0;
+  for (const auto& sample : m.samples) {
+    const cv::Point2d p = sample.point;
+    const cv::Point2d u(c * p.x + s * p.y, -(-s * p.x + c * p.y));
+    length += sample.weight * handednessWeight(boundaryDistance(m.loops, u), m.edge_tolerance);
+  }
+  return length;
+}
+
+// What one hand (the model, or its mirror image) placed at `pose` shows on
+// the region's edges where the other hand, placed at `other`, lies apart
+// from it.
+struct HandEvidence {
+  double weight = 0;    // of the samples that tell the hands apart
+  double on = 0;        // of those, within the tolerance of an edge
+  double distance = 0;  // weighted sum of their clipped edge distances
+};
+
+HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const ImagePose& other,
+                          const EdgeDistance& edges) {
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  const double oc = std::cos(other.angle_deg * kRadPerDeg);
+  const double os = std::sin(other.angle_deg * kRadPerDeg);
+  const double clip = 2 * m.edge_tolerance;
+  HandEvidence e;
+  for (const auto& sample : m.samples) {
+    const double py = pose.mirrored ? -sample.point.y : sample.point.y;
+    const cv::Point2d x =
+        pose.centre + cv::Point2d(c * sample.point.x - s * py, s * sample.point.x + c * py);
+    // The same image point in the other hand's model frame.
+    const cv::Point2d d = x - other.centre;
+    cv::Point2d u(oc * d.x + os * d.y, -os * d.x + oc * d.y);
+    if (other.mirrored) u.y = -u.y;
+    const double w =
+        sample.weight * handednessWeight(boundaryDistance(m.loops, u), m.edge_tolerance);
+    if (w <= 0) continue;
+    const double at = edges.at(x);
+    e.weight += w;
+    if (at <= m.edge_tolerance) e.on += w;
+    e.distance += w * std::min<double>(at, clip);
+  }
+  return e;
 }
 
 std::vector<std::vector<cv::Point>> contoursOf(const Region& r) {
@@ -206,14 +272,18 @@ Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& n
   if (m.orientation_order == 0) {
     m.body.mirror_symmetric = true;
   } else {
+    // The mirror image lines up with the part at one of the turns where its
+    // complex moment does (as in recognition); a hair either side absorbs
+    // the phase's pixel noise.
     const int k = m.orientation_order;
-    double best = 0;
+    double least = std::numeric_limits<double>::infinity();
     for (int j = 0; j < k; ++j) {
-      const double turn = 2 * m.orientation_phase_deg / k + j * 360.0 / k;
-      best =
-          std::max(best, verifyScore(m.samples, r.centroid, turn, edges, m.edge_tolerance, true));
+      for (double nudge : {-0.5, -0.25, 0.0, 0.25, 0.5}) {
+        least = std::min(least,
+                         chiralLength(m, 2 * m.orientation_phase_deg / k + j * 360.0 / k + nudge));
+      }
     }
-    m.body.mirror_symmetric = best >= kSymmetryScore;
+    m.body.mirror_symmetric = least < kMinChiralLength;
   }
 
   // Which Hu invariants survive turning, and how far they move.
@@ -288,6 +358,18 @@ std::string modelProblem(const PartModel& m) {
 }
 
 }  // namespace
+
+bool showsMirrorImage(const PartModel& model, const ImagePose& direct, const ImagePose& mirror,
+                      const EdgeDistance& edges) {
+  const HandEvidence d = handEvidence(model, direct, mirror, edges);
+  const HandEvidence m = handEvidence(model, mirror, direct, edges);
+  // Placed this way the two hands coincide: nothing shows it is the model.
+  if (d.weight <= 0 || m.weight <= 0) return true;
+  const double on_direct = d.on / d.weight;
+  const double on_mirror = m.on / m.weight;
+  if (std::abs(on_direct - on_mirror) > 1e-9) return on_mirror > on_direct;
+  return m.distance / m.weight <= d.distance / d.weight;
+}
 
 Result<void> validateModel(const PartModel& model) {
   const std::string problem = modelProblem(model);

@@ -106,16 +106,12 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
                                r.centroid, edges, false);
     if (direct.score * 100 < model->verify_percent) continue;
     if (!body.mirror_symmetric) {
-      // The mirror image of the model, turned its own way: if it fits the
-      // region as well as the model does, the region is the mirror part.
-      // Both may verify on a small or nearly symmetric part: the mean
-      // edge distance then decides.
+      // The mirror image of the model, turned its own way, at its best
+      // pose: where the two hands differ decides which one the region is.
       const Best mirror = bestOf(candidates(phase, -model->orientation_phase_deg, k), *model,
                                  r.centroid, edges, true);
-      if (mirror.score > direct.score) continue;
-      const double clip = 2 * model->edge_tolerance;
-      if (meanEdgeDistance(model->samples, r.centroid, mirror.angle_deg, edges, clip, true) <=
-          meanEdgeDistance(model->samples, r.centroid, direct.angle_deg, edges, clip, false)) {
+      if (showsMirrorImage(*model, {r.centroid, direct.angle_deg, false},
+                           {r.centroid, mirror.angle_deg, true}, edges)) {
         continue;
       }
     }

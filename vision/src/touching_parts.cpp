@@ -32,7 +32,8 @@ constexpr double kCoarseSlack = 0.25;
 constexpr double kScanStepPx = 1.5;
 constexpr int kMaxRefinedPerModel = 16;
 // A mirror-image candidate that verifies within this of the direct one
-// means the part cannot be told from its mirror image: neither is reported.
+// makes the handedness a question: where the two hands differ decides it
+// (showsMirrorImage), and a part shown mirrored is not reported.
 constexpr double kMirrorMargin = 0.03;
 // Parts that touch share at most their contact pixels; a part lies in its blob.
 constexpr double kMaxOverlap = 0.04;
@@ -511,7 +512,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       return q.model == c.model &&
              std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
                  0.5 * m.radius &&
-             q.score >= c.score - kMirrorMargin;
+             q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     });
     if (mirror_as_good) continue;
     shape.setTo(0);

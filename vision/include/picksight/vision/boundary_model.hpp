@@ -80,6 +80,10 @@ struct BoundarySample {
 std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loops,
                                            double step = 1.0);
 
+// Distance (pixels) from `p` to the nearest primitive of the loops: exact,
+// for comparing a model with itself turned or mirrored.
+double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p);
+
 // Distance to the nearest boundary pixel of a set of contours, over a region
 // of interest; the image edges a pose is verified against.
 class EdgeDistance {
@@ -104,12 +108,5 @@ class EdgeDistance {
 // moved to `centre`. `mirrored` reflects the samples (y -> -y) first.
 double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
                    const EdgeDistance& edges, double tolerance, bool mirrored = false);
-
-// The weighted mean distance (pixels, each clipped at `clip`) from the placed
-// samples to the nearest edge: finer than verifyScore where two poses both
-// verify, e.g. a part against its own mirror image.
-double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
-                        double angle_deg, const EdgeDistance& edges, double clip,
-                        bool mirrored = false);
 
 }  // namespace picksight::vision

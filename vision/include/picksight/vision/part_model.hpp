@@ -27,9 +27,12 @@ struct BodyModel {
   // left out of the distance.
   std::array<bool, 7> hu_used{};
   double hu_tolerance = 1.0;  // on sum_i |H_i(a) - H_i(b)| over the used invariants
-  // A part that equals its mirror image (after a turn). A part that does not
-  // is never matched to its mirror image: the 7th invariant changes sign and
-  // the mirrored boundary fits worse than the direct one.
+  // A part that equals its mirror image (after a turn): its boundary and the
+  // mirror image's, lined up, lie apart by less than 3 px of length. A part
+  // that does not is never matched to its mirror image: the 7th invariant
+  // changes sign (where it is stable), and where the two boundaries differ,
+  // however little of the outline that is, the mirror image fits the edges
+  // better (showsMirrorImage).
   bool mirror_symmetric = false;
 };
 
@@ -91,6 +94,24 @@ Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& n
 
 // Fills the derived members; call after training or loading.
 void prepareModel(PartModel& model);
+
+// Where a model lies in the image, in pixels (not grasp::Pose, which is in
+// millimetres in the vision frame): model point m lands at
+// centre + R(angle) (m.x, s m.y), s = -1 for the mirror image of the model.
+struct ImagePose {
+  cv::Point2d centre;
+  double angle_deg = 0;
+  bool mirrored = false;
+};
+
+// Whether the region whose edges are `edges` shows the mirror image of a
+// chiral model rather than the model, given the best pose of each: decided
+// only on the boundary where the two placed hands lie apart (weighted by
+// how far apart, from the edge tolerance to twice it), so that a small
+// off-axis notch decides as surely as the legs of an L. True as well when
+// nothing there tells them apart.
+bool showsMirrorImage(const PartModel& model, const ImagePose& direct, const ImagePose& mirror,
+                      const EdgeDistance& edges);
 
 // Checks a model's values (finite, in range, consistent); kInvalid says
 // what is wrong.

@@ -13,15 +13,6 @@
 
 namespace picksight::vision {
 
-// Where a model lies in the image, in pixels (not grasp::Pose, which is in
-// millimetres in the vision frame): model point m lands at
-// centre + R(angle) (m.x, s m.y), s = -1 for the mirror image of the model.
-struct ImagePose {
-  cv::Point2d centre;
-  double angle_deg = 0;
-  bool mirrored = false;
-};
-
 struct EdgeFit {
   bool ok = false;
   ImagePose pose;

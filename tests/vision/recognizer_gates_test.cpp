@@ -1,0 +1,220 @@
+// The recognizer's gates on look-alike part types that only one gate tells
+// apart: a hole more or less, a size 6 % off, a difference inside the edge
+// tolerance (the closer body wins), a part partly off its model (the
+// verification threshold), and nearly mirror-symmetric parts whose
+// handedness lies in a small off-axis notch or key.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "drawn_parts.hpp"
+#include "picksight/vision/binarize.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/recognizer.hpp"
+#include "picksight/vision/regions.hpp"
+
+using namespace picksight::vision;
+namespace pt = picksight::test;
+namespace ps = picksight::synthetic;
+
+namespace {
+ps::Shape shapeOf(std::vector<pt::Loop> loops) { return pt::centred(ps::Shape{std::move(loops)}); }
+
+PartModel trainDrawn(const ps::Shape& shape, int id, const std::string& name,
+                     const TrainOptions& options = {}) {
+  const cv::Mat grey = pt::drawParts(300, 300, {{shape, 150.3, 149.6, 17, false}}, 99 + id);
+  auto outcome = trainModel(grey, id, name, options);
+  INFO(name << ": " << (outcome ? std::string() : outcome.error().message));
+  REQUIRE(outcome.ok());
+  return outcome.value();
+}
+
+std::vector<Match> recognizeDrawn(const std::vector<pt::DrawnPart>& parts,
+                                  const std::vector<const PartModel*>& models, uint64_t seed) {
+  const cv::Mat grey = pt::drawParts(1000, 640, parts, seed);
+  return recognize(findRegions(binarize(grey, {}), {}, grey), models);
+}
+
+const Match* matchAt(const std::vector<Match>& matches, const pt::DrawnPart& part) {
+  for (const auto& m : matches) {
+    if (std::hypot(m.centroid.x - part.x, m.centroid.y - part.y) < 5) return &m;
+  }
+  return nullptr;
+}
+
+std::vector<pt::DrawnPart> concat(std::vector<pt::DrawnPart> a,
+                                  const std::vector<pt::DrawnPart>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Every part in `parts` is reported whole (not as a touching part) as the
+// model named `expected[i]`, or not at all where that is empty.
+void checkReported(const std::vector<Match>& matches, const std::vector<pt::DrawnPart>& parts,
+                   const std::vector<std::string>& expected) {
+  for (size_t i = 0; i < parts.size(); ++i) {
+    INFO("part " << i << " at " << parts[i].x << ", " << parts[i].y << " turned "
+                 << parts[i].angle_deg << (parts[i].mirrored ? " mirrored" : ""));
+    const Match* m = matchAt(matches, parts[i]);
+    if (expected[i].empty()) {
+      CHECK((m == nullptr || m->touching));
+      continue;
+    }
+    REQUIRE(m);
+    CHECK(m->model->name == expected[i]);
+    CHECK_FALSE(m->touching);
+  }
+}
+
+std::vector<std::string> names(size_t first_count, const std::string& first, size_t second_count,
+                               const std::string& second) {
+  std::vector<std::string> out(first_count, first);
+  out.insert(out.end(), second_count, second);
+  return out;
+}
+
+const ps::Shape& plate() {
+  static const ps::Shape s = shapeOf({pt::rectLoop(120, 70)});
+  return s;
+}
+}  // namespace
+
+TEST_CASE("a part with a hole is not taken for the same outline without one",
+          "[vision][recognizer][gates]") {
+  const ps::Shape holed = shapeOf({pt::rectLoop(120, 70), pt::circleLoop(6, {25, 0})});
+  const PartModel plain_model = trainDrawn(plate(), 1, "plate");
+  const PartModel holed_model = trainDrawn(holed, 2, "holed");
+  const auto parts = concat(pt::partRow(plate(), 4, 100, 10), pt::partRow(holed, 4, 300, 40));
+  // Only the plain plate trained: its outline fits the holed part at every
+  // edge, and the hole count alone keeps the holed part out.
+  checkReported(recognizeDrawn(parts, {&plain_model}, 1), parts, names(4, "plate", 4, ""));
+  // Both trained: each is itself, whichever model comes first.
+  checkReported(recognizeDrawn(parts, {&plain_model, &holed_model}, 2), parts,
+                names(4, "plate", 4, "holed"));
+  checkReported(recognizeDrawn(parts, {&holed_model, &plain_model}, 2), parts,
+                names(4, "plate", 4, "holed"));
+}
+
+TEST_CASE("parts of one shape 6 percent apart in size are each their own type",
+          "[vision][recognizer][gates]") {
+  // A trapezoid (directed: its Hu invariants are all stable) with a 3 px
+  // edge tolerance: each model's boundary lies within it of the other's,
+  // only the area (12 % apart) tells them apart.
+  const ps::Shape tab = shapeOf({{{-35, -20}, {35, -12}, {35, 12}, {-35, 20}}});
+  const ps::Shape big_tab = pt::scaled(tab, 1.06);
+  TrainOptions options;
+  options.conformity = 2;
+  const PartModel small_model = trainDrawn(tab, 1, "tab", options);
+  const PartModel big_model = trainDrawn(big_tab, 2, "big tab", options);
+  const auto parts = concat(pt::partRow(tab, 5, 100, 10), pt::partRow(big_tab, 5, 300, 40));
+  const auto expected = names(5, "tab", 5, "big tab");
+  checkReported(recognizeDrawn(parts, {&small_model, &big_model}, 3), parts, expected);
+  checkReported(recognizeDrawn(parts, {&big_model, &small_model}, 4), parts, expected);
+}
+
+TEST_CASE("when two look-alike types both verify the closer body wins",
+          "[vision][recognizer][gates]") {
+  // Bores 0.75 px apart in radius: both boundary models verify on both parts
+  // (within the 2 px edge tolerance), the Hu distance decides.
+  const ps::Shape small_bore = shapeOf({pt::rectLoop(120, 70), pt::circleLoop(9, {25, 5})});
+  const ps::Shape large_bore = shapeOf({pt::rectLoop(120, 70), pt::circleLoop(9.75, {25, 5})});
+  const PartModel a = trainDrawn(small_bore, 1, "small bore");
+  const PartModel b = trainDrawn(large_bore, 2, "large bore");
+  const auto parts =
+      concat(pt::partRow(small_bore, 4, 100, 10), pt::partRow(large_bore, 4, 300, 30));
+  const auto expected = names(4, "small bore", 4, "large bore");
+  for (const auto& order : {std::vector<const PartModel*>{&a, &b}, {&b, &a}}) {
+    const auto matches = recognizeDrawn(parts, order, 5);
+    checkReported(matches, parts, expected);
+    for (const auto& m : matches) CHECK(m.score == 1.0);  // a tie: only the body decides
+  }
+}
+
+TEST_CASE(
+    "a part partly off its model is reported only down to the verification threshold and after "
+    "better parts",
+    "[vision][recognizer][gates]") {
+  // A slot 5 px deep across most of each end: the plate's boundary misses
+  // about a quarter of the part's, while area and Hu invariants pass.
+  pt::Loop slotted{{-60, -35}, {60, -35}, {60, -28}, {55, -28}, {55, 28},   {60, 28},
+                   {60, 35},   {-60, 35}, {-60, 28}, {-55, 28}, {-55, -28}, {-60, -28}};
+  const ps::Shape slotted_plate = shapeOf({slotted});
+  PartModel model = trainDrawn(plate(), 1, "plate");
+  REQUIRE(model.verify_percent == 80);
+  const auto parts =
+      concat(pt::partRow(slotted_plate, 4, 100, 10), pt::partRow(plate(), 4, 300, 50));
+  checkReported(recognizeDrawn(parts, {&model}, 6), parts, names(4, "", 4, "plate"));
+
+  model.verify_percent = 60;
+  const auto matches = recognizeDrawn(parts, {&model}, 6);
+  checkReported(matches, parts, names(4, "plate", 4, "plate"));
+  for (size_t i = 0; i < 4; ++i) {
+    const Match* m = matchAt(matches, parts[i]);
+    REQUIRE(m);
+    CHECK(m->score >= 0.6);
+    CHECK(m->score < 0.8);
+  }
+  // Best first: the plates that verify whole come before the slotted ones.
+  REQUIRE(matches.size() == 8);
+  CHECK(std::is_sorted(matches.begin(), matches.end(),
+                       [](const Match& x, const Match& y) { return x.score > y.score; }));
+  CHECK(matches.front().score > 0.95);
+}
+
+TEST_CASE("a nearly mirror-symmetric part is told from its mirror image by a small notch",
+          "[vision][recognizer][mirror]") {
+  // A 5 x 5 px notch off the axes of a 160 x 80 plate: under 3 % of the
+  // outline differs from the mirror image.
+  const ps::Shape notched = shapeOf({{{-80, -40},
+                                      {37.5, -40},
+                                      {37.5, -35},
+                                      {42.5, -35},
+                                      {42.5, -40},
+                                      {80, -40},
+                                      {80, 40},
+                                      {-80, 40}}});
+  // A disc with a flat and a small key slot off the flat's axis.
+  pt::Loop keyed;
+  for (const auto& q : pt::circleLoop(50, {0, 0}, 180)) {
+    const double deg = std::atan2(q.y, q.x) * 180 / M_PI;
+    if (q.x > 30) {
+      keyed.emplace_back(30, q.y);
+    } else {
+      keyed.push_back(deg > 60 && deg < 68 ? q * 0.88 : q);
+    }
+  }
+  const ps::Shape keyed_disc = shapeOf({keyed});
+  const PartModel notched_model = trainDrawn(notched, 1, "notched");
+  const PartModel keyed_model = trainDrawn(keyed_disc, 2, "keyed");
+  CHECK_FALSE(notched_model.body.mirror_symmetric);
+  CHECK_FALSE(keyed_model.body.mirror_symmetric);
+  // Every other part lies mirrored: only the others are the trained parts.
+  const auto parts =
+      concat(pt::partRow(notched, 5, 100, 10, true), pt::partRow(keyed_disc, 5, 300, 30, true));
+  std::vector<std::string> expected;
+  for (const auto& p : parts) {
+    expected.push_back(p.mirrored ? "" : (p.y < 200 ? "notched" : "keyed"));
+  }
+  for (uint64_t seed : {7u, 8u}) {
+    const auto matches = recognizeDrawn(parts, {&notched_model, &keyed_model}, seed);
+    checkReported(matches, parts, expected);
+    // Not even as a part touching nothing: a mirror image is no part.
+    for (const auto& p : parts) {
+      if (p.mirrored) CHECK(matchAt(matches, p) == nullptr);
+    }
+  }
+}
+
+TEST_CASE("a mirror-symmetric part is recognized whichever way it lies",
+          "[vision][recognizer][mirror]") {
+  const PartModel plate_model = trainDrawn(plate(), 1, "plate");
+  const PartModel disc_model = trainDrawn(shapeOf({pt::circleLoop(45)}), 2, "disc");
+  CHECK(plate_model.body.mirror_symmetric);
+  CHECK(disc_model.body.mirror_symmetric);
+  const auto parts = concat(pt::partRow(plate(), 5, 100, 10, true),
+                            pt::partRow(shapeOf({pt::circleLoop(45)}), 5, 300, 30, true));
+  checkReported(recognizeDrawn(parts, {&plate_model, &disc_model}, 9), parts,
+                names(5, "plate", 5, "disc"));
+}
