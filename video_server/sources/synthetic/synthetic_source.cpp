@@ -102,12 +102,29 @@ Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/)
     }
   }
   SourceFrame frame;
-  frame.image = renderer_->render(frame_index_++);
+  cv::Mat& buffer = freeBuffer();
+  renderer_->renderInto(frame_index_++, buffer);
+  frame.image = buffer;
+  frame.keepable = true;  // freeBuffer() never hands out a buffer still held
   frame.device_timestamp_ns = monotonicNs();
   for (const auto& p : renderer_->truth()) {
     frame.truth.push_back(TruthPart{p.type, p.x, p.y, p.angle_deg, p.symmetry_deg, p.area_px});
   }
   return frame;
+}
+
+cv::Mat& SyntheticSource::freeBuffer() {
+  // Enough for the frames in flight in trigger mode and at moderate rates; a
+  // burst beyond it gets fresh buffers.
+  constexpr size_t kPoolSize = 4;
+  for (auto& b : pool_) {
+    // Only the pool refers to it: every frame made from it was released. The
+    // count is read atomically, as other threads release their references.
+    if (b.u != nullptr && CV_XADD(&b.u->refcount, 0) == 1) return b;
+  }
+  if (pool_.size() < kPoolSize) return pool_.emplace_back();
+  spare_ = cv::Mat();
+  return spare_;
 }
 
 }  // namespace picksight::video
