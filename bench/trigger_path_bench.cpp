@@ -6,8 +6,9 @@
 //
 // Stamps of one triggered frame: t0 (request, here), the trigger reply
 // (here), the synthetic source's device timestamp (CLOCK_MONOTONIC when its
-// render ended, on the same machine), received_ns (the feed thread decoded
-// it), the request thread woken, the vision pass done.
+// render started, on the same machine), its host timestamp (CLOCK_REALTIME
+// when the grab ended, turned monotonic here), received_ns (the feed thread
+// decoded it), the request thread woken, the vision pass done.
 #include <unistd.h>
 
 #include <cstdio>
@@ -102,8 +103,8 @@ CameraSteps timeCameraSteps(const std::string& uri, int runs) {
 }
 
 struct PathSamples {
-  std::vector<double> trigger_rtt, to_frame, to_render_start, render_end_to_received, hand_over,
-      pass, total;
+  std::vector<double> trigger_rtt, to_frame, to_render_start, server_render, render_end_to_received,
+      hand_over, pass, total;
 };
 }  // namespace
 
@@ -137,7 +138,8 @@ int main(int argc, char** argv) {
     feed.start();
     picksight::proto::ControlRequest trigger;
     trigger.mutable_trigger()->set_camera("cam0");
-    const double render_ms = median(steps.render);
+    // Both clocks read together: the host timestamp is CLOCK_REALTIME.
+    const uint64_t realtime_ahead = picksight::realtimeNs() - monotonicNs();
     for (int i = 0; i < args.requests + 10; ++i) {
       const uint64_t t0 = monotonicNs();
       auto reply = control.call(trigger);
@@ -151,11 +153,13 @@ int main(int argc, char** argv) {
       const auto outcome = picksight::app::locateInFrame(*frame, {}, nullptr, -1);
       const uint64_t t3 = monotonicNs();
       if (i < 10 || outcome.parts.empty()) continue;  // warm-up
-      const uint64_t rendered = frame->info.device_timestamp_ns;
+      const uint64_t render_start = frame->info.device_timestamp_ns;
+      const uint64_t grabbed = frame->info.host_timestamp_ns - realtime_ahead;
       s.trigger_rtt.push_back(msBetween(t0, t1));
       s.to_frame.push_back(msBetween(t0, t2));
-      s.to_render_start.push_back(msBetween(t0, rendered) - render_ms);
-      s.render_end_to_received.push_back(msBetween(rendered, frame->info.received_ns));
+      s.to_render_start.push_back(msBetween(t0, render_start));
+      s.server_render.push_back(msBetween(render_start, grabbed));
+      s.render_end_to_received.push_back(msBetween(grabbed, frame->info.received_ns));
       s.hand_over.push_back(msBetween(frame->info.received_ns, t2));
       s.pass.push_back(msBetween(t2, t3));
       s.total.push_back(msBetween(t0, t3));
@@ -204,7 +208,8 @@ int main(int argc, char** argv) {
   row("bare ZeroMQ PUB/SUB of the pixels, loopback TCP", steps.bare_transfer);
   std::printf(" trigger path against the video server (stamps of each frame):\n");
   row("trigger request round trip (control socket)", s.trigger_rtt);
-  row("trigger sent -> render starts (render end - render median)", s.to_render_start);
+  row("trigger sent -> render starts (device timestamp)", s.to_render_start);
+  row("render in the server (device to host timestamp)", s.server_render);
   row("render ends -> frame decoded on the feed thread", s.render_end_to_received);
   row("frame decoded -> request thread woken", s.hand_over);
   row("trigger sent -> request thread has the frame", s.to_frame);

@@ -102,11 +102,13 @@ Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/)
     }
   }
   SourceFrame frame;
+  // Stamped when the exposure (the render) starts, as cameras stamp theirs:
+  // the host timestamp, taken after the grab, then tells the render's length.
+  frame.device_timestamp_ns = monotonicNs();
   cv::Mat& buffer = freeBuffer();
   renderer_->renderInto(frame_index_++, buffer);
   frame.image = buffer;
   frame.keepable = true;  // freeBuffer() never hands out a buffer still held
-  frame.device_timestamp_ns = monotonicNs();
   for (const auto& p : renderer_->truth()) {
     frame.truth.push_back(TruthPart{p.type, p.x, p.y, p.angle_deg, p.symmetry_deg, p.area_px});
   }
