@@ -6,7 +6,7 @@
 //
 // Stamps of one triggered frame: t0 (request, here), the trigger reply
 // (here), the synthetic source's device timestamp (CLOCK_MONOTONIC when its
-// render started, on the same machine), its host timestamp (CLOCK_REALTIME
+// grab started, on the same machine; it renders each frame ahead), its host timestamp (CLOCK_REALTIME
 // when the grab ended, turned monotonic here), received_ns (the feed thread
 // decoded it), the request thread woken, the vision pass done.
 #include <unistd.h>
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
               args.width, args.height, args.parts, s.total.size(), failures);
   std::printf("  %-58s %8s %8s\n", "ms", "median", "p90");
   std::printf(" camera steps in process (same source, same frames):\n");
-  row("render (synthetic exposure: clean scene + noise)", steps.render);
+  row("synthetic grab (exposure; renders the next frame ahead)", steps.render);
   row("standardize + output settings", steps.standardize);
   row("frame header encode (20 truth parts)", steps.header_encode);
   row("frame header parse + decode", steps.header_decode);
@@ -209,7 +209,7 @@ int main(int argc, char** argv) {
   std::printf(" trigger path against the video server (stamps of each frame):\n");
   row("trigger request round trip (control socket)", s.trigger_rtt);
   row("trigger sent -> render starts (device timestamp)", s.to_render_start);
-  row("render in the server (device to host timestamp)", s.server_render);
+  row("grab in the server (device to host timestamp)", s.server_render);
   row("render ends -> frame decoded on the feed thread", s.render_end_to_received);
   row("frame decoded -> request thread woken", s.hand_over);
   row("trigger sent -> request thread has the frame", s.to_frame);
