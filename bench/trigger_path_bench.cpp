@@ -6,9 +6,9 @@
 //
 // Stamps of one triggered frame: t0 (request, here), the trigger reply
 // (here), the synthetic source's device timestamp (CLOCK_MONOTONIC when its
-// grab started, on the same machine; it renders each frame ahead), its host timestamp (CLOCK_REALTIME
-// when the grab ended, turned monotonic here), received_ns (the feed thread
-// decoded it), the request thread woken, the vision pass done.
+// grab started, on the same machine; it renders each frame ahead), its host timestamp
+// (CLOCK_REALTIME when the grab ended, turned monotonic here), received_ns (the feed thread decoded
+// it), the request thread woken, the vision pass done.
 #include <unistd.h>
 
 #include <cstdio>
@@ -25,6 +25,7 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/clock.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/synthetic/scene.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
 #include "picksight/transport/control_client.hpp"
@@ -48,11 +49,25 @@ void row(const char* what, const std::vector<double>& ms) {
 
 // The camera's own steps, in process, on frames of the same synthetic source.
 struct CameraSteps {
-  std::vector<double> render, standardize, header_encode, header_decode, bare_transfer;
+  std::vector<double> render, grab, standardize, header_encode, header_decode, bare_transfer;
 };
 
-CameraSteps timeCameraSteps(const std::string& uri, int runs) {
+CameraSteps timeCameraSteps(const std::string& uri, const picksight::bench::LocateArgs& args) {
+  const int runs = args.requests;
   CameraSteps t;
+  // The render itself, which the source now does ahead of the trigger.
+  picksight::synthetic::SceneOptions scene;
+  scene.width = args.width;
+  scene.height = args.height;
+  scene.parts = args.parts;
+  scene.seed = 5;
+  const picksight::synthetic::SceneRenderer renderer(scene);
+  cv::Mat rendered;
+  for (int i = 0; i < runs; ++i) {
+    const uint64_t a = monotonicNs();
+    renderer.renderInto(static_cast<uint64_t>(i), rendered);
+    t.render.push_back(msBetween(a, monotonicNs()));
+  }
   auto source = picksight::video::makeSource(uri);
   if (!source || !(*source)->open()) return t;
   // Bare ZeroMQ PUB/SUB of the same bytes over loopback TCP: the transfer's physics.
@@ -68,7 +83,7 @@ CameraSteps timeCameraSteps(const std::string& uri, int runs) {
     auto grabbed = (*source)->grab(1000ms);
     uint64_t b = monotonicNs();
     if (!grabbed) continue;
-    t.render.push_back(msBetween(a, b));
+    t.grab.push_back(msBetween(a, b));
     auto out = picksight::video::applyOutputSettings(*grabbed, {});
     a = monotonicNs();
     t.standardize.push_back(msBetween(b, a));
@@ -114,8 +129,8 @@ int main(int argc, char** argv) {
   const std::string params = "width=" + std::to_string(args.width) +
                              ",height=" + std::to_string(args.height) +
                              ",parts=" + std::to_string(args.parts) + ",seed=5";
-  const CameraSteps steps = timeCameraSteps("synthetic:" + params, args.requests);
-  if (steps.render.empty()) {
+  const CameraSteps steps = timeCameraSteps("synthetic:" + params, args);
+  if (steps.grab.empty()) {
     std::cerr << "bench: the synthetic source did not open\n";
     return 1;
   }
@@ -201,7 +216,7 @@ int main(int argc, char** argv) {
               args.width, args.height, args.parts, s.total.size(), failures);
   std::printf("  %-58s %8s %8s\n", "ms", "median", "p90");
   std::printf(" camera steps in process (same source, same frames):\n");
-  row("synthetic grab (exposure; renders the next frame ahead)", steps.render);
+  row("render of one synthetic frame (clean scene + noise)", steps.render);
   row("standardize + output settings", steps.standardize);
   row("frame header encode (20 truth parts)", steps.header_encode);
   row("frame header parse + decode", steps.header_decode);
