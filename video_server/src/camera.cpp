@@ -346,7 +346,8 @@ Camera::Grab Camera::grabAndConvert(bool triggered, bool streams, const OutputSe
                                  : Result<cv::Mat>(grabbed.error());
   if (standard) grab.delivered = standard->size();
   grab.out = standard ? Result<OutputFrame>(applyOutputSettings(
-                            *standard, output, standard->datastart != grabbed->image.datastart))
+                            *standard, output,
+                            grabbed->keepable || standard->datastart != grabbed->image.datastart))
                       : Result<OutputFrame>(standard.error());
   return grab;
 }

@@ -102,7 +102,8 @@ OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& set
 Result<OutputFrame> applyOutputSettings(const SourceFrame& frame, const OutputSettings& settings) {
   auto standard = toOutputFormat(frame.image, frame.layout, settings.format);
   if (!standard) return standard.error();
-  return applyOutputSettings(*standard, settings, standard->datastart != frame.image.datastart);
+  return applyOutputSettings(*standard, settings,
+                             frame.keepable || standard->datastart != frame.image.datastart);
 }
 
 }  // namespace picksight::video

@@ -2,6 +2,7 @@
 #include "synthetic_source.hpp"
 
 #include <algorithm>
+#include <future>
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/text.hpp"
@@ -92,6 +93,17 @@ SourceInfo SyntheticSource::info() const {
 
 Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/) {
   if (!renderer_) return makeError(SourceErrc::kUnavailable, "synthetic source not open");
+  // The scene is static between frames, so the next frame is rendered ahead,
+  // while this one travels: a trigger then costs no render, as a real
+  // camera's exposure costs no host time.
+  SourceFrame frame = ahead_.valid() ? ahead_.get() : renderNext();
+  // Stamped when the frame is taken, the exposure of a triggered camera.
+  frame.device_timestamp_ns = monotonicNs();
+  ahead_ = std::async(std::launch::async, [this] { return renderNext(); });
+  return frame;
+}
+
+SourceFrame SyntheticSource::renderNext() {
   if (options_.scene_every > 0) {
     const uint64_t layout = frame_index_ / options_.scene_every;
     if (layout != layout_) {
@@ -102,12 +114,28 @@ Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/)
     }
   }
   SourceFrame frame;
-  frame.image = renderer_->render(frame_index_++);
-  frame.device_timestamp_ns = monotonicNs();
+  cv::Mat& buffer = freeBuffer();
+  renderer_->renderInto(frame_index_++, buffer);
+  frame.image = buffer;
+  frame.keepable = true;  // freeBuffer() never hands out a buffer still held
   for (const auto& p : renderer_->truth()) {
     frame.truth.push_back(TruthPart{p.type, p.x, p.y, p.angle_deg, p.symmetry_deg, p.area_px});
   }
   return frame;
+}
+
+cv::Mat& SyntheticSource::freeBuffer() {
+  // Enough for the frames in flight in trigger mode and at moderate rates; a
+  // burst beyond it gets fresh buffers.
+  constexpr size_t kPoolSize = 4;
+  for (auto& b : pool_) {
+    // Only the pool refers to it: every frame made from it was released. The
+    // count is read atomically, as other threads release their references.
+    if (b.u != nullptr && CV_XADD(&b.u->refcount, 0) == 1) return b;
+  }
+  if (pool_.size() < kPoolSize) return pool_.emplace_back();
+  spare_ = cv::Mat();
+  return spare_;
 }
 
 }  // namespace picksight::video

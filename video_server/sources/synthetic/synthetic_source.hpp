@@ -2,11 +2,13 @@
 // product runs, and is tested, on a machine with no camera.
 #pragma once
 
+#include <future>
 #include <memory>
 #include <string>
+#include <vector>
 
-#include "picksight/synthetic/scene.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/synthetic/scene.hpp"
 
 namespace picksight::video {
 
@@ -31,10 +33,25 @@ class SyntheticSource : public Source {
   Result<SourceFrame> grab(std::chrono::milliseconds timeout) override;
 
  private:
+  // A pooled image buffer nobody else holds any more, or a fresh one when
+  // all are still in use.
+  cv::Mat& freeBuffer();
+  // Renders frame frame_index_ (and moves on); only ever run by grab() or by
+  // the one render ahead grab() waits for first.
+  SourceFrame renderNext();
+
   SyntheticSourceOptions options_;
   std::unique_ptr<synthetic::SceneRenderer> renderer_;
   uint64_t frame_index_ = 0;
   uint64_t layout_ = 0;  // which layout renderer_ holds
+  // Rendered frames live in these buffers while published (the camera's last
+  // frame, ZeroMQ until sent): reusing them spares the page faults of a fresh
+  // 2 MB allocation per frame.
+  std::vector<cv::Mat> pool_;
+  cv::Mat spare_;  // when every pooled buffer is in use
+  // The next frame, rendered ahead; declared last so it is waited for before
+  // the renderer and the pool go.
+  std::future<SourceFrame> ahead_;
 };
 
 }  // namespace picksight::video

@@ -33,7 +33,8 @@ Result<void> validateOutputSettings(const OutputSettings& settings, cv::Size sen
 // that do not fit this frame (a sensor that changed size) are clamped. The
 // output never shares memory with `sensor`.
 // `sensor_is_private`: the caller made `sensor` for this frame alone (a
-// format conversion), so it may be published as it is instead of copied.
+// format conversion, or a keepable source frame), so it may be published as
+// it is instead of copied.
 OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings,
                                 bool sensor_is_private = false);
 

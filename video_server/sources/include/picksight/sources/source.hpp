@@ -71,6 +71,11 @@ struct SourceFrame {
   PixelLayout layout = PixelLayout::kMono8;
   uint64_t device_timestamp_ns = 0;  // 0 when the device gives none
   std::vector<TruthPart> truth;
+  // True when the source never writes into these pixels again while anyone
+  // else holds them (a fresh buffer, or a pooled one reused only once
+  // released): consumers may then keep the image, and the camera publishes
+  // it without copying.
+  bool keepable = false;
 };
 
 struct SourceInfo {
