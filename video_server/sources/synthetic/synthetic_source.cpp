@@ -2,7 +2,6 @@
 #include "synthetic_source.hpp"
 
 #include <algorithm>
-#include <future>
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/text.hpp"
@@ -93,17 +92,6 @@ SourceInfo SyntheticSource::info() const {
 
 Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/) {
   if (!renderer_) return makeError(SourceErrc::kUnavailable, "synthetic source not open");
-  // The scene is static between frames, so the next frame is rendered ahead,
-  // while this one travels: a trigger then costs no render, as a real
-  // camera's exposure costs no host time.
-  SourceFrame frame = ahead_.valid() ? ahead_.get() : renderNext();
-  // Stamped when the frame is taken, the exposure of a triggered camera.
-  frame.device_timestamp_ns = monotonicNs();
-  ahead_ = std::async(std::launch::async, [this] { return renderNext(); });
-  return frame;
-}
-
-SourceFrame SyntheticSource::renderNext() {
   if (options_.scene_every > 0) {
     const uint64_t layout = frame_index_ / options_.scene_every;
     if (layout != layout_) {
@@ -114,6 +102,9 @@ SourceFrame SyntheticSource::renderNext() {
     }
   }
   SourceFrame frame;
+  // Stamped when the exposure (the render) starts, as cameras stamp theirs:
+  // the host timestamp, taken after the grab, then tells the render's length.
+  frame.device_timestamp_ns = monotonicNs();
   cv::Mat& buffer = freeBuffer();
   renderer_->renderInto(frame_index_++, buffer);
   frame.image = buffer;

@@ -2,7 +2,6 @@
 // product runs, and is tested, on a machine with no camera.
 #pragma once
 
-#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,9 +35,6 @@ class SyntheticSource : public Source {
   // A pooled image buffer nobody else holds any more, or a fresh one when
   // all are still in use.
   cv::Mat& freeBuffer();
-  // Renders frame frame_index_ (and moves on); only ever run by grab() or by
-  // the one render ahead grab() waits for first.
-  SourceFrame renderNext();
 
   SyntheticSourceOptions options_;
   std::unique_ptr<synthetic::SceneRenderer> renderer_;
@@ -49,9 +45,6 @@ class SyntheticSource : public Source {
   // 2 MB allocation per frame.
   std::vector<cv::Mat> pool_;
   cv::Mat spare_;  // when every pooled buffer is in use
-  // The next frame, rendered ahead; declared last so it is waited for before
-  // the renderer and the pool go.
-  std::future<SourceFrame> ahead_;
 };
 
 }  // namespace picksight::video
