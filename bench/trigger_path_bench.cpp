@@ -6,9 +6,11 @@
 //
 // Stamps of one triggered frame: t0 (request, here), the trigger reply
 // (here), the synthetic source's device timestamp (CLOCK_MONOTONIC when its
-// grab started, on the same machine; it renders each frame ahead), its host timestamp
-// (CLOCK_REALTIME when the grab ended, turned monotonic here), received_ns (the feed thread decoded
-// it), the request thread woken, the vision pass done.
+// grab started, on the same machine: the render is the synthetic camera's
+// exposure, on the trigger path as a real exposure is), its host timestamp
+// (CLOCK_REALTIME when the grab ended, turned monotonic here), received_ns
+// (the feed thread decoded it), the request thread woken, the vision pass
+// done.
 #include <unistd.h>
 
 #include <cstdio>
@@ -55,7 +57,7 @@ struct CameraSteps {
 CameraSteps timeCameraSteps(const std::string& uri, const picksight::bench::LocateArgs& args) {
   const int runs = args.requests;
   CameraSteps t;
-  // The render itself, which the source now does ahead of the trigger.
+  // The render itself: the synthetic camera's exposure.
   picksight::synthetic::SceneOptions scene;
   scene.width = args.width;
   scene.height = args.height;
