@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_cell.hpp"
 #include "locate_args.hpp"
 #include "picksight/cell/grasp_planner.hpp"
 #include "picksight/common/text.hpp"
@@ -102,28 +103,16 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
 int main(int argc, char** argv) {
   const auto args = picksight::bench::parseLocateArgs(argc, argv, {500, 1920, 1080, 20});
   const int requests = args.requests, width = args.width, height = args.height, parts = args.parts;
-  char data_dir[] = "/tmp/picksight-cell-bench-XXXXXX";
-  if (!::mkdtemp(data_dir) || !prepareDataDir(data_dir)) return 1;
+  const std::string data_dir = picksight::bench::makeDataDir();
+  if (data_dir.empty() || !prepareDataDir(data_dir)) return 1;
   std::string types;
   for (const auto& t : kTypes) types += (types.empty() ? "" : "+") + t;
-  const std::string dir = picksight::bench::binDir();
-  const std::string source = "cam0=synthetic:width=" + std::to_string(width) +
-                             ",height=" + std::to_string(height) +
-                             ",parts=" + std::to_string(parts) + ",size=120,seed=5,types=" + types;
-  picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
-                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
-                                "trigger"});
-  const auto frames = server.waitForLine("frames ", 10s);
-  const auto control = server.waitForLine("control ", 10s);
-  if (!frames || !control) return 1;
-  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
-                                *control, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir",
-                                data_dir});
-  const auto port = vision.waitForLine("robot ", 10s);
-  if (!port || !vision.waitForLine("ready", 10s)) return 1;
-  auto robot =
-      picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
-  if (!robot) return 1;
+  auto server = picksight::bench::startVideoServer(
+      picksight::bench::syntheticCamera(args, "size=120,types=" + types));
+  if (!server) return 1;
+  auto vision = picksight::bench::startVision(*server, data_dir);
+  if (!vision) return 1;
+  picksight::LineClient* robot = &vision->robot;
 
   for (int i = 0; i < 10; ++i) (void)robot->request("LOCATE 1", 10s);  // warm-up
   std::vector<double> ms;
@@ -144,8 +133,8 @@ int main(int argc, char** argv) {
   }
   auto status = robot->request("STATUS", 5s);
   robot->close();
-  vision.terminate();
-  server.terminate();
+  vision->process->terminate();
+  server->process->terminate();
   const Breakdown inside = breakdown(data_dir, width, height, parts);
   std::error_code ignored;
   std::filesystem::remove_all(data_dir, ignored);

@@ -16,6 +16,7 @@
 
 #include <zmq.hpp>
 
+#include "bench_cell.hpp"
 #include "locate_args.hpp"
 #include "picksight.pb.h"
 #include "picksight/tool_support/line_client.hpp"
@@ -79,26 +80,12 @@ int main(int argc, char** argv) {
   const auto args = picksight::bench::parseLocateArgs(argc, argv, {240, 1920, 1080, 20});
   constexpr int kRounds = 6;
   const int per_round = std::max(1, args.requests / kRounds);
-  const std::string dir = picksight::bench::binDir();
-  const std::string source = "cam0=synthetic:width=" + std::to_string(args.width) +
-                             ",height=" + std::to_string(args.height) +
-                             ",parts=" + std::to_string(args.parts) + ",seed=5";
-  picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
-                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
-                                "trigger"});
-  const auto frames = server.waitForLine("frames ", 10s);
-  const auto control = server.waitForLine("control ", 10s);
-  if (!frames || !control) return 1;
-  char data_dir[] = "/tmp/picksight-bench-XXXXXX";
-  if (!::mkdtemp(data_dir)) return 1;
-  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
-                                *control, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir",
-                                data_dir});
-  const auto port = vision.waitForLine("robot ", 10s);
-  if (!port || !vision.waitForLine("ready", 10s)) return 1;
-  auto robot =
-      picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
-  if (!robot) return 1;
+  auto server = picksight::bench::startVideoServer(picksight::bench::syntheticCamera(args));
+  const std::string data_dir = picksight::bench::makeDataDir();
+  if (!server || data_dir.empty()) return 1;
+  auto vision = picksight::bench::startVision(*server, data_dir);
+  if (!vision) return 1;
+  picksight::LineClient* robot = &vision->robot;
 
   zmq::context_t context;
   int failures = 0;
@@ -113,7 +100,7 @@ int main(int argc, char** argv) {
   std::vector<double> ignored;
   for (int i = 0; i < 10; ++i) locate(ignored);
   {
-    SnapLoop warm(context, *control, "cam0");
+    SnapLoop warm(context, server->control, "cam0");
     for (int i = 0; i < 5; ++i) locate(ignored);
   }
 
@@ -124,7 +111,7 @@ int main(int argc, char** argv) {
   double snapping_s = 0;
   for (int round = 0; round < kRounds; ++round) {
     for (int i = 0; i < per_round; ++i) locate(alone);
-    SnapLoop loop(context, *control, "cam0");
+    SnapLoop loop(context, server->control, "cam0");
     // Measure only once the loop is snapping.
     const auto deadline = Clock::now() + 10s;
     while (loop.snaps() == 0 && loop.failures() == 0 && Clock::now() < deadline) {
@@ -138,8 +125,8 @@ int main(int argc, char** argv) {
     snap_failures += loop.failures();
   }
   robot->close();
-  vision.terminate();
-  server.terminate();
+  vision->process->terminate();
+  server->process->terminate();
   std::error_code ec;
   std::filesystem::remove_all(data_dir, ec);
 

@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <zmq.hpp>
 
+#include "bench_cell.hpp"
 #include "locate_args.hpp"
 #include "opencv_baseline.hpp"
 #include "picksight/common/text.hpp"
@@ -65,30 +66,16 @@ void row(const char* what, const Stats& s, double baseline) {
 int main(int argc, char** argv) {
   const auto args = picksight::bench::parseLocateArgs(argc, argv, {300, 1920, 1080, 20});
   const int requests = args.requests, width = args.width, height = args.height, parts = args.parts;
-  const std::string dir = picksight::bench::binDir();
-  const std::string source = "cam0=synthetic:width=" + std::to_string(width) +
-                             ",height=" + std::to_string(height) +
-                             ",parts=" + std::to_string(parts) + ",seed=5";
-  picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
-                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
-                                "trigger"});
-  const auto frames = server.waitForLine("frames ", 10s);
-  const auto control = server.waitForLine("control ", 10s);
-  if (!frames || !control) return 1;
-  char data_dir[] = "/tmp/picksight-bench-XXXXXX";
-  if (!::mkdtemp(data_dir)) return 1;
-  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
-                                *control, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir",
-                                data_dir});
-  const auto port = vision.waitForLine("robot ", 10s);
-  if (!port || !vision.waitForLine("ready", 10s)) return 1;
+  auto server = picksight::bench::startVideoServer(picksight::bench::syntheticCamera(args));
+  const std::string data_dir = picksight::bench::makeDataDir();
+  if (!server || data_dir.empty()) return 1;
+  auto vision = picksight::bench::startVision(*server, data_dir);
+  if (!vision) return 1;
+  picksight::LineClient* robot = &vision->robot;
 
   zmq::context_t context;
-  picksight::FrameSubscriber watcher(context, *frames, "cam0", 64);
+  picksight::FrameSubscriber watcher(context, server->frames, "cam0", 64);
   std::this_thread::sleep_for(300ms);
-  auto robot =
-      picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
-  if (!robot) return 1;
 
   // Warm-up: caches, page faults, TCP and ZeroMQ connections.
   for (int i = 0; i < 10; ++i) (void)robot->request("LOCATE 1", 10s);
@@ -117,8 +104,8 @@ int main(int argc, char** argv) {
     if (!f) break;
     images.push_back(f->image.clone());
   }
-  vision.terminate();
-  server.terminate();
+  vision->process->terminate();
+  server->process->terminate();
   std::error_code ignored;
   std::filesystem::remove_all(data_dir, ignored);
   if (images.empty()) {

@@ -21,6 +21,7 @@
 
 #include <zmq.hpp>
 
+#include "bench_cell.hpp"
 #include "locate_args.hpp"
 #include "opencv_baseline.hpp"
 #include "picksight/camera_link/frame_feed.hpp"
@@ -186,18 +187,16 @@ int main(int argc, char** argv) {
 
   // The same LOCATE through the vision app, over TCP (the only subscriber now).
   std::vector<double> locate;
-  char data_dir[] = "/tmp/picksight-bench-XXXXXX";
-  if (!::mkdtemp(data_dir)) return 1;
+  const std::string data_dir = picksight::bench::makeDataDir();
+  if (data_dir.empty()) return 1;
   {
-    picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
-                                  *control_endpoint, "--robot-port", "0", "--bind", "127.0.0.1",
-                                  "--data-dir", data_dir});
-    const auto port = vision.waitForLine("robot ", 10s);
-    if (!port || !vision.waitForLine("ready", 10s)) return 1;
+    picksight::bench::VideoServerRun endpoints;
+    endpoints.frames = *frames;
+    endpoints.control = *control_endpoint;
+    auto vision = picksight::bench::startVision(endpoints, data_dir);
+    if (!vision) return 1;
     std::this_thread::sleep_for(300ms);
-    auto robot =
-        picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
-    if (!robot) return 1;
+    picksight::LineClient* robot = &vision->robot;
     for (int i = 0; i < args.requests + 10; ++i) {
       const uint64_t t0 = monotonicNs();
       auto r = robot->request("LOCATE 1", 10s);
@@ -208,7 +207,7 @@ int main(int argc, char** argv) {
       if (i >= 10) locate.push_back(msBetween(t0, monotonicNs()));
     }
     robot->close();
-    vision.terminate();
+    vision->process->terminate();
   }
   server.terminate();
   std::error_code ignored;
