@@ -3,6 +3,7 @@
 #include <csignal>
 #include <iostream>
 
+#include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
 #include "picksight/common/stop_signals.hpp"
 #include "picksight/video_server/video_server.hpp"
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
               << video::serverUsage();
     return 2;
   }
+  retainLargeBuffers();
   const StopSignals stop_signals;
   try {
     video::VideoServer server(*config);

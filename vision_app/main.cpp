@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "picksight/camera_link/video_server_camera.hpp"
+#include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
 #include "picksight/common/stop_signals.hpp"
 #include "picksight/protocol/robot_server.hpp"
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
               << std::strerror(errno) << "\n";
     return 2;
   }
+  retainLargeBuffers();
   const StopSignals stop_signals;
   try {
     zmq::context_t context;
