@@ -338,17 +338,9 @@ Camera::Grab Camera::grabAndConvert(bool triggered, bool streams, const OutputSe
   grab.grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
                        : Result<SourceFrame>(asked.error());
   grab.host_ns = realtimeNs();
-  // Standardize, then ROI and resize; the standardized size is the size of
-  // the frames the device delivers.
-  const Result<SourceFrame>& grabbed = grab.grabbed;
-  Result<cv::Mat> standard = grabbed
-                                 ? toOutputFormat(grabbed->image, grabbed->layout, output.format)
-                                 : Result<cv::Mat>(grabbed.error());
-  if (standard) grab.delivered = standard->size();
-  grab.out = standard ? Result<OutputFrame>(applyOutputSettings(
-                            *standard, output,
-                            grabbed->keepable || standard->datastart != grabbed->image.datastart))
-                      : Result<OutputFrame>(standard.error());
+  // Standardize, then ROI and resize, in the pipeline's one step.
+  grab.out = grab.grabbed ? applyOutputSettings(*grab.grabbed, output)
+                          : Result<OutputFrame>(grab.grabbed.error());
   return grab;
 }
 
@@ -393,7 +385,8 @@ void Camera::publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool
   frame.truth = std::move(grab.grabbed->truth);
   // Statistics first, then the hand-over: a subscriber must never hold a
   // frame that `stats` does not count yet.
-  frame_size_ = grab.delivered;
+  // The standardized size is the size of the frames the device delivers.
+  frame_size_ = out.sensor_size;
   last_frame_ = frame;
   ++status_.frames_acquired;
   status_.last_sequence = sequence;

@@ -67,6 +67,7 @@ Result<void> validateOutputSettings(const OutputSettings& s, cv::Size sensor) {
 OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& settings,
                                 bool sensor_is_private) {
   OutputFrame out;
+  out.sensor_size = sensor.size();
   cv::Rect roi = effectiveRoi(settings, sensor.size());
   if (roi.empty()) roi = cv::Rect(0, 0, sensor.cols, sensor.rows);
   const cv::Size size = outputSize(settings, roi.size());

@@ -114,7 +114,6 @@ class Camera {
   struct Grab {
     Result<SourceFrame> grabbed = Error{};
     Result<OutputFrame> out = Error{};
-    cv::Size delivered;  // of the standardized frame: what the device sends
     uint64_t host_ns = 0;
   };
 

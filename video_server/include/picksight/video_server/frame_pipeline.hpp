@@ -24,6 +24,7 @@ struct OutputFrame {
   cv::Point roi_offset;
   double scale_x = 1;  // output pixels per sensor pixel
   double scale_y = 1;
+  cv::Size sensor_size;  // of the standardized frame the settings were applied to
 };
 
 // Checks settings against a sensor size; the error names what is wrong.
