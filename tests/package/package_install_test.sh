@@ -33,9 +33,22 @@ done
 exec 9>/run/lock/picksight-package-test.lock
 flock -w 150 9 || fail "another package test held the lock for 150 s"
 
+# Present while this test has the package installed, with the ids of the
+# services it started: a run killed before its purge (a CTest timeout
+# sends SIGKILL) leaves it, and the next run stops and purges what that
+# run left instead of refusing to touch it.
+marker=/run/lock/picksight-package-test.installed
 if dpkg-query -W -f='${Status}' picksight 2>/dev/null | grep -q 'installed'; then
-  skip "a picksight package is already installed on this machine; not touching it"
+  [ -e "$marker" ] || skip "a picksight package is already installed on this machine; not touching it"
+  echo "purging the package an interrupted run left installed"
+  while read -r pid; do
+    case "$(readlink "/proc/$pid/exe" 2>/dev/null)" in
+      /usr/bin/picksight-*) kill -KILL "$pid" ;;
+    esac
+  done <"$marker"
+  dpkg --purge picksight >/dev/null || fail "cannot purge the package an interrupted run left"
 fi
+rm -f "$marker"
 
 work="$(mktemp -d)"
 pids=()
@@ -43,10 +56,11 @@ installed=0
 cleanup() {
   for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null; done
   # Always purge what we installed, even after a failure.
-  [ "$installed" = 1 ] && dpkg --purge picksight >/dev/null 2>&1
+  [ "$installed" = 1 ] && dpkg --purge picksight >/dev/null 2>&1 && rm -f "$marker"
   rm -rf "$work"
 }
 trap cleanup EXIT
+trap 'exit 1' INT TERM
 
 # --- build ------------------------------------------------------------------
 "$cpack" -G DEB --config "$build/CPackConfig.cmake" -B "$work/pkg" >"$work/cpack.log" 2>&1 ||
@@ -83,11 +97,19 @@ echo "contents: $(grep -c '^-' "$work/contents") files; conffiles: $(tr '\n' ' '
 
 # --- install ----------------------------------------------------------------
 installed=1
+touch "$marker"
 dpkg -i "$deb" >"$work/dpkg-i.log" 2>&1 || { cat "$work/dpkg-i.log" >&2; fail "dpkg -i"; }
 getent passwd picksight >/dev/null || fail "no picksight user after install"
 id -nG picksight | tr ' ' '\n' | grep -qx video || fail "picksight is not in group video"
 [ "$(stat -c '%U %a' /var/lib/picksight)" = "picksight 750" ] ||
   fail "/var/lib/picksight is $(stat -c '%U %a' /var/lib/picksight), not picksight 750"
+
+# An upgrade (here the same version again) keeps an edited conffile and
+# runs postinst's upgrade branch.
+echo "# edited on this cell" >>/etc/picksight/vision/cam0.yaml
+dpkg -i "$deb" >"$work/dpkg-i2.log" 2>&1 || { cat "$work/dpkg-i2.log" >&2; fail "dpkg -i over itself"; }
+grep -q '^# edited on this cell$' /etc/picksight/vision/cam0.yaml ||
+  fail "reinstalling lost the edit of a conffile"
 
 # Starts a unit's ExecStart (instance %i = cam0, %S = /var/lib) as its
 # User=, with extra arguments; its stdout goes to $work/<name>.out.
@@ -102,6 +124,7 @@ start_unit() {
   (cd / && exec setpriv --reuid=picksight --regid=picksight --init-groups --no-new-privs \
     -- $exec_start "$@") >"$work/$name.out" 2>"$work/$name.err" &
   pids+=("$!")
+  echo "$!" >>"$marker"
 }
 
 # Waits until $work/<name>.out has a line starting with `prefix `; prints
@@ -147,6 +170,7 @@ pids=()
 dpkg-query -L picksight >"$work/owned"
 dpkg --purge picksight >"$work/dpkg-purge.log" 2>&1 || { cat "$work/dpkg-purge.log" >&2; fail "dpkg --purge"; }
 installed=0
+rm -f "$marker"
 left=()
 while IFS= read -r path; do
   # Shared directories (/usr/bin, /etc...) stay; the package's own go.
