@@ -104,6 +104,12 @@ id -nG picksight | tr ' ' '\n' | grep -qx video || fail "picksight is not in gro
 [ "$(stat -c '%U %a' /var/lib/picksight)" = "picksight 750" ] ||
   fail "/var/lib/picksight is $(stat -c '%U %a' /var/lib/picksight), not picksight 750"
 
+# The installed units, at their real paths, with their real ExecStart.
+out="$(systemd-analyze verify --man=no picksight-video-server.service \
+         picksight-vision@cam0.service 2>&1)" || fail "systemd-analyze verify: $out"
+[ -z "$out" ] || fail "systemd-analyze verify on the installed units: $out"
+echo "systemd-analyze verify: the installed units are clean"
+
 # An upgrade (here the same version again) keeps an edited conffile and
 # runs postinst's upgrade branch.
 echo "# edited on this cell" >>/etc/picksight/vision/cam0.yaml
