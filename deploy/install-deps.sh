@@ -17,6 +17,10 @@ PACKAGES=(
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli libv4l-dev
   # tests
   catch2
+  # services: sd_notify readiness and watchdog
+  libsystemd-dev
+  # Debian package (CPack: dpkg-shlibdeps, file) and its unit tests (systemd-analyze)
+  dpkg-dev file systemd
 )
 
 missing=()

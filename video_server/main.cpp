@@ -5,6 +5,7 @@
 
 #include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
+#include "picksight/common/service_notify.hpp"
 #include "picksight/common/stop_signals.hpp"
 #include "picksight/video_server/video_server.hpp"
 
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   }
   retainLargeBuffers();
   const StopSignals stop_signals;
+  ServiceNotifier notifier;
   try {
     video::VideoServer server(*config);
     server.start();
@@ -32,7 +34,11 @@ int main(int argc, char** argv) {
               << "control " << server.controlEndpoint() << "\n"
               << "ready" << std::endl;
     for (const auto& c : config->cameras) logInfo("camera ", c.name, " = ", c.uri);
+    // Both sockets are bound: clients started after us can connect.
+    notifier.ready(std::to_string(config->cameras.size()) + " cameras, frames " +
+                   server.framesEndpoint() + ", control " + server.controlEndpoint());
     logInfo("stopping on signal ", stop_signals.wait());
+    notifier.stopping();
     server.stop();
   } catch (const std::exception& e) {
     std::cerr << "picksight-video-server: " << e.what() << "\n";

@@ -10,6 +10,7 @@
 #include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
+#include "picksight/common/service_notify.hpp"
 #include "picksight/common/stop_signals.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/app_options.hpp"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   }
   retainLargeBuffers();
   const StopSignals stop_signals;
+  ServiceNotifier notifier;
   try {
     zmq::context_t context;
     app::VisionCell cell(options->data_dir,
@@ -56,7 +58,10 @@ int main(int argc, char** argv) {
               << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ",
             robots.port());
+    // The robot port is listening: a robot program started after us connects.
+    notifier.ready("camera " + options->camera + ", robot port " + std::to_string(robots.port()));
     logInfo("stopping on signal ", stop_signals.wait());
+    notifier.stopping();
     robots.stop();
     cell.stop();
   } catch (const std::exception& e) {

@@ -19,7 +19,10 @@ struct AppOptions {
   VisionOptions vision;
 };
 
-// Parses argv without the program name; errors name the option.
+// Parses argv without the program name; errors name the option. With
+// --config FILE the YAML map in FILE supplies options first (each key is an
+// option without its dashes, a list repeats it, a flag is true or false) and
+// the command line overrides them; errors there name the file and the key.
 Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help);
 std::string appUsage();
 

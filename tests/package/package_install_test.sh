@@ -1,0 +1,199 @@
+#!/usr/bin/env bash
+# The Debian package as a cell gets it: builds picksight_<version>_amd64.deb
+# from this build tree (cpack), checks its contents, installs it with
+# `dpkg -i`, runs the installed binaries as their units would (as the
+# picksight user, with the unit's ExecStart and the installed example
+# configuration; only the ports are made free ones, and systemd's
+# StateDirectory= is made by hand, since no systemd runs here), LOCATEs
+# through the robot port, then `dpkg --purge`s and checks that nothing of
+# the package is left. The picksight user stays (Debian keeps system users).
+# Prints the package's size and dependencies.
+#
+# Root only, and it installs into this machine's /usr: without root, dpkg
+# or setpriv, or when a picksight package is already installed (not ours to
+# remove), it exits 77, which CTest reports as skipped.
+# Usage: tests/package/package_install_test.sh <build dir> <cpack>
+set -uo pipefail
+
+build="${1:?usage: package_install_test.sh <build dir> <cpack>}"
+cpack="${2:?usage: package_install_test.sh <build dir> <cpack>}"
+SKIP=77
+
+skip() { echo "SKIPPED: $*"; exit "$SKIP"; }
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+[ "$(id -u)" = 0 ] || skip "needs root (dpkg -i into this machine)"
+for tool in dpkg dpkg-deb setpriv flock getent; do
+  command -v "$tool" >/dev/null || skip "no $tool"
+done
+[ -w /var/lib/dpkg ] || skip "dpkg's database is not writable"
+
+# One package test at a time on this machine (several build trees may run
+# their suites at once); dpkg itself refuses a second dpkg anyway.
+exec 9>/run/lock/picksight-package-test.lock
+flock -w 150 9 || fail "another package test held the lock for 150 s"
+
+# Present while this test has the package installed, with the ids of the
+# services it started: a run killed before its purge (a CTest timeout
+# sends SIGKILL) leaves it, and the next run stops and purges what that
+# run left instead of refusing to touch it.
+marker=/run/lock/picksight-package-test.installed
+if dpkg-query -W -f='${Status}' picksight 2>/dev/null | grep -q 'installed'; then
+  [ -e "$marker" ] || skip "a picksight package is already installed on this machine; not touching it"
+  echo "purging the package an interrupted run left installed"
+  while read -r pid; do
+    case "$(readlink "/proc/$pid/exe" 2>/dev/null)" in
+      /usr/bin/picksight-*) kill -KILL "$pid" ;;
+    esac
+  done <"$marker"
+  dpkg --purge picksight >/dev/null || fail "cannot purge the package an interrupted run left"
+fi
+rm -f "$marker"
+
+work="$(mktemp -d)"
+pids=()
+installed=0
+cleanup() {
+  for pid in "${pids[@]}"; do kill -KILL "$pid" 2>/dev/null; done
+  # Always purge what we installed, even after a failure.
+  [ "$installed" = 1 ] && dpkg --purge picksight >/dev/null 2>&1 && rm -f "$marker"
+  rm -rf "$work"
+}
+trap cleanup EXIT
+trap 'exit 1' INT TERM
+
+# --- build ------------------------------------------------------------------
+"$cpack" -G DEB --config "$build/CPackConfig.cmake" -B "$work/pkg" >"$work/cpack.log" 2>&1 ||
+  { cat "$work/cpack.log" >&2; fail "cpack"; }
+debs=("$work"/pkg/picksight_*_amd64.deb)
+[ "${#debs[@]}" = 1 ] && [ -f "${debs[0]}" ] || fail "cpack made no picksight_<version>_amd64.deb"
+deb="${debs[0]}"
+echo "package: $(basename "$deb"), $(stat -c %s "$deb") bytes," \
+  "Installed-Size $(dpkg-deb -f "$deb" Installed-Size) KiB"
+echo "Depends: $(dpkg-deb -f "$deb" Depends)"
+
+# --- contents ---------------------------------------------------------------
+dpkg-deb -c "$deb" >"$work/contents"
+for path in ./usr/bin/picksight-video-server ./usr/bin/picksight-vision ./usr/bin/picksight-cam \
+  ./usr/bin/picksight-calib ./usr/lib/systemd/system/picksight-video-server.service \
+  "./usr/lib/systemd/system/picksight-vision@.service" ./usr/lib/sysusers.d/picksight.conf \
+  ./usr/lib/tmpfiles.d/picksight.conf ./etc/picksight/video-server.yaml \
+  ./etc/picksight/vision/cam0.yaml ./usr/share/doc/picksight/README.md \
+  ./usr/share/doc/picksight/copyright; do
+  awk '{print $6}' "$work/contents" | grep -qxF "$path" || fail "package lacks $path"
+done
+# Only the product: no test, benchmark or fuzzer binary.
+if awk '{print $6}' "$work/contents" | grep -E '_test$|bench|fuzz|/tests/'; then
+  fail "test, benchmark or fuzzer files in the package"
+fi
+# Everything root's, nothing group or world writable.
+awk '$2 != "root/root" || $1 ~ /^.....w|^........w/' "$work/contents" >"$work/loose"
+[ -s "$work/loose" ] && { cat "$work/loose" >&2; fail "files not root's or writable by others"; }
+dpkg-deb -e "$deb" "$work/control"
+diff <(sort "$work/control/conffiles") \
+  <(printf '%s\n' /etc/picksight/video-server.yaml /etc/picksight/vision/cam0.yaml | sort) ||
+  fail "conffiles are not the two example files"
+echo "contents: $(grep -c '^-' "$work/contents") files; conffiles: $(tr '\n' ' ' <"$work/control/conffiles")"
+
+# --- install ----------------------------------------------------------------
+installed=1
+touch "$marker"
+dpkg -i "$deb" >"$work/dpkg-i.log" 2>&1 || { cat "$work/dpkg-i.log" >&2; fail "dpkg -i"; }
+getent passwd picksight >/dev/null || fail "no picksight user after install"
+id -nG picksight | tr ' ' '\n' | grep -qx video || fail "picksight is not in group video"
+[ "$(stat -c '%U %a' /var/lib/picksight)" = "picksight 750" ] ||
+  fail "/var/lib/picksight is $(stat -c '%U %a' /var/lib/picksight), not picksight 750"
+
+# The installed units, at their real paths, with their real ExecStart.
+out="$(systemd-analyze verify --man=no picksight-video-server.service \
+         picksight-vision@cam0.service 2>&1)" || fail "systemd-analyze verify: $out"
+[ -z "$out" ] || fail "systemd-analyze verify on the installed units: $out"
+echo "systemd-analyze verify: the installed units are clean"
+
+# An upgrade (here the same version again) keeps an edited conffile and
+# runs postinst's upgrade branch.
+echo "# edited on this cell" >>/etc/picksight/vision/cam0.yaml
+dpkg -i "$deb" >"$work/dpkg-i2.log" 2>&1 || { cat "$work/dpkg-i2.log" >&2; fail "dpkg -i over itself"; }
+grep -q '^# edited on this cell$' /etc/picksight/vision/cam0.yaml ||
+  fail "reinstalling lost the edit of a conffile"
+
+# Starts a unit's ExecStart (instance %i = cam0, %S = /var/lib) as its
+# User=, with extra arguments; its stdout goes to $work/<name>.out.
+start_unit() {
+  local unit="$1" name="$2"
+  shift 2
+  local exec_start
+  exec_start="$(sed -n 's/^ExecStart=//p' "/usr/lib/systemd/system/$unit")"
+  exec_start="${exec_start//%i/cam0}"
+  exec_start="${exec_start//%S//var/lib}"
+  # shellcheck disable=SC2086 # ExecStart is split into words as systemd does
+  (cd / && exec setpriv --reuid=picksight --regid=picksight --init-groups --no-new-privs \
+    -- $exec_start "$@") >"$work/$name.out" 2>"$work/$name.err" &
+  pids+=("$!")
+  echo "$!" >>"$marker"
+}
+
+# Waits until $work/<name>.out has a line starting with `prefix `; prints
+# the rest of it.
+wait_line() {
+  local name="$1" prefix="$2" deadline=$((SECONDS + 30))
+  while [ "$SECONDS" -lt "$deadline" ]; do
+    local line
+    line="$(grep -m1 "^$prefix " "$work/$name.out" 2>/dev/null)" && { echo "${line#"$prefix "}"; return 0; }
+    sleep 0.1
+  done
+  cat "$work/$name.err" >&2
+  return 1
+}
+
+start_unit picksight-video-server.service video-server \
+  --frames 'tcp://127.0.0.1:*' --control 'tcp://127.0.0.1:*'
+frames="$(wait_line video-server frames)" || fail "the installed video server did not start"
+control="$(wait_line video-server control)" || fail "the installed video server did not start"
+
+# The unit's StateDirectory=picksight/%i, as systemd would make it.
+install -d -o picksight -g picksight -m 0750 /var/lib/picksight/cam0
+start_unit picksight-vision@.service vision \
+  --frames "$frames" --control "$control" --robot-port 0 --bind 127.0.0.1
+port="$(wait_line vision robot)" || fail "the installed vision app did not start"
+for pid in "${pids[@]}"; do
+  [ "$(stat -c %U "/proc/$pid")" = picksight ] || fail "process $pid does not run as picksight"
+done
+
+exec 3<>"/dev/tcp/127.0.0.1/$port" || fail "cannot connect to the robot port $port"
+printf 'LOCATE 1\n' >&3
+IFS= read -r -t 30 reply <&3 || fail "no reply to LOCATE"
+exec 3>&-
+reply="${reply%$'\r'}"
+echo "LOCATE 1 -> $reply"
+[[ "$reply" == "OK "* ]] || fail "LOCATE replied '$reply'"
+
+for pid in "${pids[@]}"; do kill -TERM "$pid"; done
+for pid in "${pids[@]}"; do wait "$pid" || fail "a service exited with status $? on SIGTERM"; done
+pids=()
+
+# --- purge ------------------------------------------------------------------
+dpkg-query -L picksight >"$work/owned"
+dpkg --purge picksight >"$work/dpkg-purge.log" 2>&1 || { cat "$work/dpkg-purge.log" >&2; fail "dpkg --purge"; }
+installed=0
+rm -f "$marker"
+left=()
+while IFS= read -r path; do
+  # Shared directories (/usr/bin, /etc...) stay; the package's own go.
+  [ -e "$path" ] && ! [ -d "$path" ] && left+=("$path")
+done <"$work/owned"
+for dir in /etc/picksight /var/lib/picksight /usr/share/doc/picksight; do
+  [ -e "$dir" ] && left+=("$dir")
+done
+if [ "${#left[@]}" -gt 0 ]; then
+  printf '  %s\n' "${left[@]}" >&2
+  fail "dpkg --purge left files behind"
+fi
+# Where a package's files go (not the whole disk: container images of the
+# package may be stored under /var/lib).
+stray="$(find /etc /usr/bin /usr/lib/systemd /usr/lib/sysusers.d /usr/lib/tmpfiles.d \
+           /usr/share/doc /var/lib/dpkg/info -name '*picksight*' -print 2>/dev/null
+         find /var/lib -maxdepth 1 -name '*picksight*' -print)"
+[ -n "$stray" ] && { printf '%s\n' "$stray" >&2; fail "files named picksight left after purge"; }
+echo "purged: nothing left; the picksight user stays ($(getent passwd picksight | cut -d: -f1,3,6))"
+echo "PASS"
