@@ -7,8 +7,10 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "picksight/video_server/camera.hpp"
 #include "picksight/video_server/control_errors.hpp"
 #include "picksight/video_server/control_request.hpp"
+#include "picksight/video_server/frame_pipeline.hpp"
 
 namespace {
 void check(bool ok) {
