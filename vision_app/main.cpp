@@ -50,18 +50,34 @@ int main(int argc, char** argv) {
     // A bad file costs what it holds, never the start.
     for (const auto& problem : cell.load()) logError(problem);
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
-    app::RobotServer robots(options->robot,
-                            [&cell](std::string_view line) { return cell.handle(line); });
+    const bool read_only = options->robot_read_only;
+    app::RobotServer robots(options->robot, [&cell, read_only](std::string_view line) {
+      return cell.handle(line, read_only);
+    });
+    std::unique_ptr<app::RobotServer> setup;
+    if (options->setup) {
+      setup = std::make_unique<app::RobotServer>(
+          *options->setup, [&cell](std::string_view line) { return cell.handle(line); });
+    }
     cell.start();
     robots.start();
-    std::cout << "robot " << robots.port() << "\n"
-              << "ready" << std::endl;
-    logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ",
-            robots.port());
+    if (setup) setup->start();
+    std::cout << "robot " << robots.port() << "
+";
+    if (setup) std::cout << "setup " << setup->port() << "
+";
+    std::cout << "ready" << std::endl;
+    logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on ",
+            options->robot.bind_address, ":", robots.port(), read_only ? " (read-only)" : "",
+            ", allowed: ", options->robot.allow.describe());
+    if (setup) {
+      logInfo("set-up port on ", options->setup->bind_address, ":", setup->port());
+    }
     // The robot port is listening: a robot program started after us connects.
     notifier.ready("camera " + options->camera + ", robot port " + std::to_string(robots.port()));
     logInfo("stopping on signal ", stop_signals.wait());
     notifier.stopping();
+    if (setup) setup->stop();
     robots.stop();
     cell.stop();
   } catch (const std::exception& e) {

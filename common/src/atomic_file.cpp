@@ -5,8 +5,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -23,7 +25,37 @@ struct FdGuard {
     if (fd >= 0) ::close(fd);
   }
 };
+
+constexpr std::string_view kTemporaryMark = ".tmp.";
+
+// "<name>.tmp.<digits>", as writeFileAtomically names its temporary file.
+bool isTemporaryName(const std::string& name) {
+  const size_t mark = name.rfind(kTemporaryMark);
+  if (mark == std::string::npos || mark == 0) return false;
+  const size_t digits = mark + kTemporaryMark.size();
+  if (digits == name.size()) return false;
+  for (size_t i = digits; i < name.size(); ++i) {
+    if (!std::isdigit(static_cast<unsigned char>(name[i]))) return false;
+  }
+  return true;
+}
 }  // namespace
+
+Result<std::vector<std::string>> removeStaleTemporaries(const std::string& directory) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> removed;
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) return removed;
+  for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (!isTemporaryName(name) || !it->is_regular_file(ec)) continue;
+    if (fs::remove(it->path(), ec)) removed.push_back(name);
+    if (ec) break;
+  }
+  if (ec) return systemError(ec.value(), directory + ": " + ec.message());
+  if (!removed.empty()) (void)syncDirectory(directory);
+  return removed;
+}
 
 Result<void> writeFileAtomically(const std::string& path, const std::string& content) {
   return writeFileAtomically(path, content, [](std::string_view) {});
@@ -31,7 +63,7 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& con
 
 Result<void> writeFileAtomically(const std::string& path, const std::string& content,
                                  const std::function<void(std::string_view step)>& before_step) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  const std::string tmp = path + std::string(kTemporaryMark) + std::to_string(::getpid());
   {
     before_step("create");
     FdGuard file{::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644)};

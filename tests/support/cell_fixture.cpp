@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 
@@ -29,7 +30,8 @@ VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
 }
 
 VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string& camera,
-                             const std::string& given_data_dir) {
+                             const std::string& given_data_dir,
+                             const std::vector<std::string>& extra_args) {
   if (given_data_dir.empty()) {
     char dir[] = "/tmp/picksight-e2e-XXXXXX";
     REQUIRE(::mkdtemp(dir) != nullptr);
@@ -38,14 +40,32 @@ VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string
     data_dir = given_data_dir;
     own_data_dir = false;
   }
-  process = std::make_unique<Subprocess>(std::vector<std::string>{
-      binPath("picksight-vision"), "--frames", server.frames, "--control", server.control,
-      "--camera", camera, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
-  auto port = process->waitForLine("robot ", 10s);
-  REQUIRE(port);
-  auto value = parseInt(*port);
-  REQUIRE(value);
-  robot_port = static_cast<uint16_t>(*value);
+  std::vector<std::string> argv{binPath("picksight-vision"),
+                                "--frames",
+                                server.frames,
+                                "--control",
+                                server.control,
+                                "--camera",
+                                camera,
+                                "--robot-port",
+                                "0",
+                                "--bind",
+                                "127.0.0.1",
+                                "--data-dir",
+                                data_dir};
+  argv.insert(argv.end(), extra_args.begin(), extra_args.end());
+  process = std::make_unique<Subprocess>(argv);
+  const auto portLine = [&](const std::string& prefix) {
+    auto port = process->waitForLine(prefix, 10s);
+    REQUIRE(port);
+    auto value = parseInt(*port);
+    REQUIRE(value);
+    return static_cast<uint16_t>(*value);
+  };
+  robot_port = portLine("robot ");
+  if (std::find(extra_args.begin(), extra_args.end(), "--setup-port") != extra_args.end()) {
+    setup_port = portLine("setup ");
+  }
   REQUIRE(process->waitForLine("ready", 10s));
 }
 

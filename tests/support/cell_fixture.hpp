@@ -30,12 +30,14 @@ struct VideoServerProcess {
 
 struct VisionProcess {
   // With an empty `data_dir` a fresh one, removed at the end; a given one
-  // is kept (restart tests).
+  // is kept (restart tests). `extra_args` are added to the command line; with
+  // --setup-port, setup_port is the port it printed.
   VisionProcess(const VideoServerProcess& server, const std::string& camera = "cam0",
-                const std::string& data_dir = "");
+                const std::string& data_dir = "", const std::vector<std::string>& extra_args = {});
   ~VisionProcess();
   std::unique_ptr<Subprocess> process;
   uint16_t robot_port = 0;
+  uint16_t setup_port = 0;
   std::string data_dir;
   bool own_data_dir = true;
   LineClient connect() const;

@@ -4,9 +4,11 @@
 // retries of a source that is not there yet.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
@@ -21,6 +23,7 @@
 #include "temp_dir.hpp"
 
 #include "picksight/video_server/camera.hpp"
+#include "picksight/video_server/video_errors.hpp"
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
@@ -131,8 +134,9 @@ TEST_CASE("Camera trigger tickets are consecutive and each gives exactly one fra
   std::vector<uint64_t> tickets;
   for (int i = 0; i < 5; ++i) {
     const auto t = camera->trigger();
-    CHECK(t.triggered);
-    tickets.push_back(t.sequence);
+    REQUIRE(t);
+    CHECK(t->triggered);
+    tickets.push_back(t->sequence);
   }
   for (size_t i = 1; i < tickets.size(); ++i) CHECK(tickets[i] == tickets[i - 1] + 1);
 
@@ -151,15 +155,16 @@ TEST_CASE("Camera trigger tickets are consecutive and each gives exactly one fra
 
   // A later trigger continues the numbering.
   const auto next = camera->trigger();
-  CHECK(next.sequence == tickets.back() + 1);
+  REQUIRE(next);
+  CHECK(next->sequence == tickets.back() + 1);
   REQUIRE(sink.waitForCount(tickets.size() + 1));
-  CHECK(sink.frames().back().info.sequence == next.sequence);
+  CHECK(sink.frames().back().info.sequence == next->sequence);
   // The status is updated beside the hand-over to the sink, not before it.
   REQUIRE(waitForStatus(*camera, [&](const picksight::video::CameraStatus& s) {
     return s.frames_acquired >= tickets.size() + 1;
   }));
   CHECK(camera->status().frames_acquired == tickets.size() + 1);
-  CHECK(camera->status().last_sequence == next.sequence);
+  CHECK(camera->status().last_sequence == next->sequence);
 }
 
 TEST_CASE("Camera in free-run publishes increasing sequences untriggered", "[video_server]") {
@@ -183,11 +188,12 @@ TEST_CASE("Camera free-run trigger ticket follows every published frame", "[vide
   for (int i = 0; i < 3; ++i) {
     const uint64_t published = maxSequence(sink.frames());
     const auto ticket = camera->trigger();
-    CHECK_FALSE(ticket.triggered);
-    CHECK(ticket.sequence > published);
+    REQUIRE(ticket);
+    CHECK_FALSE(ticket->triggered);
+    CHECK(ticket->sequence > published);
     // ... and a frame with that sequence does come.
     CHECK(sink.waitUntil(
-        [&](const std::vector<Frame>& f) { return maxSequence(f) >= ticket.sequence; }));
+        [&](const std::vector<Frame>& f) { return maxSequence(f) >= ticket->sequence; }));
   }
 }
 
@@ -197,7 +203,7 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   auto camera = makeCamera(config(AcquisitionMode::kTrigger, 10, kSource + ",noise=0"), sink);
   camera->start();
   REQUIRE(waitForState(*camera, "streaming"));
-  camera->trigger();
+  REQUIRE(camera->trigger());
   REQUIRE(sink.waitForCount(1));
   CHECK(sink.frames()[0].image.size() == cv::Size(160, 120));
   CHECK(cv::Point2d(sink.frames()[0].mapping.roi_x, sink.frames()[0].mapping.roi_y) ==
@@ -207,7 +213,7 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   roi.roi = cv::Rect(10, 20, 64, 48);
   REQUIRE(camera->setOutput(roi));
   CHECK(camera->output().roi == roi.roi);
-  camera->trigger();
+  REQUIRE(camera->trigger());
   REQUIRE(sink.waitForCount(2));
   const auto cropped = sink.frames()[1];
   CHECK(cropped.image.size() == cv::Size(64, 48));
@@ -220,7 +226,7 @@ TEST_CASE("Camera setOutput applies a ROI from the next frame", "[video_server]"
   scaled.scale = 0.5;
   scaled.format = picksight::video::OutputFormat::kBgr8;
   REQUIRE(camera->setOutput(scaled));
-  camera->trigger();
+  REQUIRE(camera->trigger());
   REQUIRE(sink.waitForCount(3));
   const auto small = sink.frames()[2];
   CHECK(small.image.size() == cv::Size(32, 24));
@@ -270,9 +276,10 @@ TEST_CASE("Camera setMode switches between free-run and trigger", "[video_server
   CHECK(sink.count() == settled);
 
   const auto ticket = camera->trigger();
-  CHECK(ticket.triggered);
+  REQUIRE(ticket);
+  CHECK(ticket->triggered);
   REQUIRE(sink.waitForCount(settled + 1));
-  CHECK(sink.frames().back().info.sequence == ticket.sequence);
+  CHECK(sink.frames().back().info.sequence == ticket->sequence);
   CHECK(sink.frames().back().info.triggered);
 
   REQUIRE(camera->setMode(AcquisitionMode::kFreeRun, 40));
@@ -282,6 +289,9 @@ TEST_CASE("Camera setMode switches between free-run and trigger", "[video_server
 
   CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, -1));
   CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, 5000));
+  CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, std::nan("")));
+  CHECK_FALSE(camera->setMode(AcquisitionMode::kFreeRun, HUGE_VAL));
+  CHECK(camera->status().fps_setting == 40);
 }
 
 TEST_CASE("Camera retries a source that is missing and streams once it appears", "[video_server]") {
@@ -303,4 +313,70 @@ TEST_CASE("Camera retries a source that is missing and streams once it appears",
   REQUIRE_FALSE(frames.empty());
   CHECK(frames[0].image.size() == cv::Size(40, 30));
   CHECK(frames[0].image.at<uint8_t>(0, 0) == 99);
+}
+
+TEST_CASE("Camera of a file that goes away fails after the grace period until it returns",
+          "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+  REQUIRE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 20, "file:" + path), sink);
+  camera->start();
+  REQUIRE(sink.waitForCount(1));
+
+  // Gone: a moment of the last image, then the camera says it fails.
+  fs::remove(path);
+  REQUIRE(waitForState(*camera, "reconnecting"));
+  const auto failing = camera->status();
+  CHECK_THAT(failing.last_error, Catch::Contains(path));
+  CHECK(failing.acquisition_errors >= 1);
+  // Garbage in its place: still failing, now saying why.
+  std::ofstream(path) << "not an image";
+  CHECK(waitForStatus(*camera, [](const auto& s) {
+    return s.state == "reconnecting" &&
+           s.last_error.find("not a readable image") != std::string::npos;
+  }));
+  // Back: streams the new image.
+  const size_t before = sink.count();
+  const std::string tmp = dir.file("scene.tmp.png");
+  REQUIRE(cv::imwrite(tmp, cv::Mat(30, 40, CV_8UC1, cv::Scalar(7))));
+  fs::rename(tmp, path);
+  REQUIRE(sink.waitForCount(before + 1));
+  CHECK(waitForState(*camera, "streaming"));
+  CHECK(sink.frames().back().image.at<uint8_t>(0, 0) == 7);
+  CHECK(camera->status().last_error.empty());
+}
+
+TEST_CASE("Camera in an outage refuses triggers at once and never bursts afterwards",
+          "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kTrigger, 10, "file:" + path), sink);
+  camera->start();
+  REQUIRE(waitForState(*camera, "reconnecting"));
+  for (int i = 0; i < 20; ++i) {
+    const auto refused = camera->trigger();
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().code == picksight::video::SourceErrc::kUnavailable);
+    CHECK_THAT(refused.error().message, Catch::Contains("cam1") && Catch::Contains(path));
+  }
+  REQUIRE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
+  REQUIRE(waitForState(*camera, "streaming"));
+  // Absence, not speed: the refused triggers would have been served by now.
+  std::this_thread::sleep_for(300ms);
+  CHECK(sink.count() == 0);
+  CHECK(camera->status().frames_acquired == 0);
+  // A trigger now is served, once.
+  const auto ticket = camera->trigger();
+  REQUIRE(ticket);
+  REQUIRE(sink.waitForCount(1));
+  CHECK(sink.frames()[0].info.sequence == ticket->sequence);
+
+  camera->setOpen(false);
+  REQUIRE(waitForState(*camera, "closed"));
+  const auto closed = camera->trigger();
+  REQUIRE_FALSE(closed);
+  CHECK(closed.error().code == picksight::video::VideoErrc::kCameraClosed);
 }

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/protocol/model_commands.hpp"
@@ -197,4 +199,57 @@ TEST_CASE("model commands check their arguments before touching the camera",
   CHECK(protocol.handle("LOCATE 2").rfind("ERROR 32 ", 0) == 0);
   CHECK(protocol.handle("FORGET 1") == "OK");
   CHECK(protocol.handle("MODELS") == "OK 0");
+}
+
+TEST_CASE("the library loads models in type order, not file-name order", "[vision_app][models]") {
+  TempDir dir;
+  const std::string models_dir = dir.path + "/models";
+  {
+    ModelLibrary library(models_dir);
+    for (int type : {100, 2, 10, 1}) REQUIRE(library.store(trainedModel("rectangle", type)));
+  }
+  // A second file for type 2 under another name: type_2.yaml, where LEARN
+  // writes, wins whatever the names' order.
+  auto other = trainedModel("l_shape", 2);
+  writeText(models_dir + "/a_copy.yaml", modelToYaml(other));
+  ModelLibrary library(models_dir);
+  const auto problems = library.load();
+  REQUIRE(problems.size() == 1);
+  CHECK_THAT(problems[0], Catch::Contains("a_copy.yaml") && Catch::Contains("type 2"));
+  std::vector<int> types;
+  for (const auto& m : *library.snapshot()) types.push_back(m.type);
+  CHECK(types == std::vector<int>{1, 2, 10, 100});
+  CHECK(library.snapshot()->at(1).name == "rectangle");
+}
+
+TEST_CASE("the library removes temporary files of interrupted writes at load",
+          "[vision_app][models]") {
+  TempDir dir;
+  const std::string models_dir = dir.path + "/models";
+  {
+    ModelLibrary library(models_dir);
+    REQUIRE(library.store(trainedModel("rectangle", 1)));
+  }
+  // As a crash between create and rename leaves them, by this process or another.
+  writeText(models_dir + "/type_1.yaml.tmp.999999", "format: picksight-part-model\nvers");
+  writeText(models_dir + "/type_2.yaml.tmp.12", "");
+  writeText(models_dir + "/notes.tmp.txt", "not ours: kept");
+  ModelLibrary library(models_dir);
+  CHECK(library.load().empty());
+  CHECK_FALSE(fs::exists(models_dir + "/type_1.yaml.tmp.999999"));
+  CHECK_FALSE(fs::exists(models_dir + "/type_2.yaml.tmp.12"));
+  CHECK(fs::exists(models_dir + "/notes.tmp.txt"));
+  CHECK(library.snapshot()->size() == 1);
+}
+
+TEST_CASE("a models path that is a file is a problem of the load, naming it",
+          "[vision_app][models]") {
+  TempDir dir;
+  const std::string models_dir = dir.path + "/models";
+  writeText(models_dir, "a file where the models directory should be\n");
+  ModelLibrary library(models_dir);
+  const auto problems = library.load();
+  REQUIRE(problems.size() == 1);
+  CHECK_THAT(problems[0], Catch::Contains(models_dir) && Catch::Contains("not a directory"));
+  CHECK(library.snapshot()->empty());
 }

@@ -111,3 +111,31 @@ TEST_CASE("cell commands check their arguments before the camera or a file",
   CHECK(status.find(" skipped=0 ") != std::string::npos);
   CHECK(std::filesystem::is_empty(f.dir.path()));  // nothing was written
 }
+
+TEST_CASE("a read-only port answers reads and refuses every change with ERROR 17",
+          "[vision_app][protocol]") {
+  Fixture f;
+  const auto readOnly = [&](const std::string& line) { return f.protocol.handle(line, true); };
+  // Reads behave as on a full port (here: no camera, no calibration).
+  for (const char* read :
+       {"PING", "VERSION", "HELP", "STATUS", "MODELS", "LIST", "FRAME", "LOCATE 1", "BLOBS",
+        "RESIDUALS", "EXPOSURE", "ROI", "GRASP 1 LIST", "gripper 1 list"}) {
+    INFO(read);
+    CHECK(readOnly(read) == f.protocol.handle(read));
+    CHECK(readOnly(read).rfind("ERROR 17 ", 0) != 0);
+  }
+  // Changes to a model, a calibration or a camera are refused, before any
+  // argument is looked at.
+  for (const char* change : {"LEARN 1", "FORGET 1", "CALCAM 5", "STORE 1 2", "DELETE 1", "COMPUTE",
+                             "EXPOSURE 500", "ROI 0 0 8 8", "ROI FULL", "GRASP 1 ADD 0 0 0",
+                             "GRASP 1 CLEAR", "GRIPPER 1 CLEAR", "GRASP", "learn"}) {
+    INFO(change);
+    const std::string reply = readOnly(change);
+    CHECK(reply.rfind("ERROR 17 ", 0) == 0);
+    CHECK_THAT(reply, Catch::Contains("read-only"));
+  }
+  // Unknown and empty requests keep their own errors.
+  CHECK(readOnly("FLY").rfind("ERROR 10 ", 0) == 0);
+  CHECK(readOnly("").rfind("ERROR 14 ", 0) == 0);
+  CHECK(f.protocol.models().snapshot()->empty());
+}

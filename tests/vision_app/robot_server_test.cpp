@@ -2,10 +2,14 @@
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <thread>
+#include <vector>
 
-#include "picksight/tool_support/line_client.hpp"
+#include "picksight/common/allow_list.hpp"
+
 #include "picksight/protocol/robot_server.hpp"
+#include "picksight/tool_support/line_client.hpp"
 
 using namespace picksight;
 using namespace std::chrono_literals;
@@ -16,12 +20,21 @@ std::string echo(std::string_view line) {
   return "OK " + std::to_string(line.size()) + " " + std::string(line.substr(0, 32));
 }
 
+app::RobotServerOptions loopback() {
+  app::RobotServerOptions o;
+  o.bind_address = "127.0.0.1";
+  o.port = 0;
+  return o;
+}
+
 struct Server {
   explicit Server(size_t max_connections = 64) {
-    app::RobotServerOptions o;
-    o.bind_address = "127.0.0.1";
-    o.port = 0;
+    app::RobotServerOptions o = loopback();
     o.max_connections = max_connections;
+    start(o);
+  }
+  explicit Server(const app::RobotServerOptions& o) { start(o); }
+  void start(const app::RobotServerOptions& o) {
     server = std::make_unique<app::RobotServer>(o, echo);
     server->start();
   }
@@ -32,6 +45,18 @@ struct Server {
   }
   std::unique_ptr<app::RobotServer> server;
 };
+
+// Two connections served and kept in `held`, then the first line a third gets.
+std::string beyondTwo(Server& s, std::vector<LineClient>& held) {
+  for (int i = 0; i < 2; ++i) {
+    held.push_back(s.connect());
+    CHECK(*held.back().request("PING", 2s) == "OK 4 PING");
+  }
+  auto third = s.connect();
+  const auto reply = third.readLine(2s);
+  REQUIRE(reply);
+  return *reply;
+}
 }  // namespace
 
 TEST_CASE("one reply per line, LF or CR LF, pipelined or split across writes",
@@ -97,15 +122,9 @@ TEST_CASE("32 connections at once each get their own replies", "[vision_app][rob
 
 TEST_CASE("connections beyond the limit are told why and closed", "[vision_app][robot_server]") {
   Server s(2);
-  auto a = s.connect();
-  auto b = s.connect();
-  CHECK(*a.request("PING", 2s) == "OK 4 PING");
-  CHECK(*b.request("PING", 2s) == "OK 4 PING");
-  auto c = s.connect();
-  const auto reply = c.readLine(2s);
-  REQUIRE(reply);
-  CHECK(reply->rfind("ERROR 13 ", 0) == 0);
-  a.close();
+  std::vector<LineClient> held;
+  CHECK(beyondTwo(s, held).rfind("ERROR 13 ", 0) == 0);
+  held[0].close();
   // The slot frees once the server notices the close.
   bool served = false;
   for (int i = 0; i < 50 && !served; ++i) {
@@ -114,6 +133,87 @@ TEST_CASE("connections beyond the limit are told why and closed", "[vision_app][
     if (!d) continue;
     auto r = d->request("PING", 2s);
     served = r && *r == "OK 4 PING";
+  }
+  CHECK(served);
+}
+
+TEST_CASE("a peer outside the allow-list gets ERROR 15 and is closed",
+          "[vision_app][robot_server]") {
+  app::RobotServerOptions o = loopback();
+  auto list = AllowList::parse("10.0.0.0/8");
+  REQUIRE(list);
+  o.allow = *list;
+  Server refusing(o);
+  for (int i = 0; i < 3; ++i) {  // every time, logged once
+    auto c = refusing.connect();
+    const auto reply = c.readLine(2s);
+    REQUIRE(reply);
+    CHECK(reply->rfind("ERROR 15 address 127.0.0.1 is not allowed", 0) == 0);
+    CHECK_FALSE(c.readLine(2s));  // closed
+  }
+  o.allow = *AllowList::parse("10.0.0.0/8 127.0.0.0/8");
+  Server allowing(o);
+  auto c = allowing.connect();
+  CHECK(*c.request("PING", 2s) == "OK 4 PING");
+}
+
+TEST_CASE("connections beyond the per-address limit are told why and closed",
+          "[vision_app][robot_server]") {
+  app::RobotServerOptions o = loopback();
+  o.max_per_address = 2;
+  Server s(o);
+  std::vector<LineClient> held;
+  CHECK(beyondTwo(s, held).rfind(
+            "ERROR 13 too many connections from 127.0.0.1 (limit 2 per address)", 0) == 0);
+  CHECK(*held[0].request("PING", 2s) == "OK 4 PING");
+}
+
+TEST_CASE("an idle or trickling connection gets ERROR 16 and is closed",
+          "[vision_app][robot_server]") {
+  app::RobotServerOptions o = loopback();
+  o.idle_timeout = 300ms;
+  Server s(o);
+  auto idle = s.connect();
+  auto trickling = s.connect();
+  CHECK(*trickling.request("PING", 2s) == "OK 4 PING");
+  // Bytes that never end a line are no request: the connection is idle.
+  for (int i = 0; i < 20 && trickling.sendRaw("x"); ++i) std::this_thread::sleep_for(50ms);
+  for (auto* c : {&idle, &trickling}) {
+    const auto reply = c->readLine(10s);
+    REQUIRE(reply);
+    CHECK(reply->rfind("ERROR 16 no request for 0.3 s", 0) == 0);
+    CHECK_FALSE(c->readLine(2s));
+  }
+}
+
+TEST_CASE("64 idle connections lock robots out only until the idle timeout",
+          "[vision_app][robot_server]") {
+  app::RobotServerOptions o = loopback();
+  o.idle_timeout = 1s;
+  o.max_per_address = 0;  // all from loopback: the total is what is tested
+  Server s(o);
+  std::vector<LineClient> idle;
+  for (int i = 0; i < 64; ++i) {
+    idle.push_back(s.connect());
+    REQUIRE(*idle.back().request("PING", 2s) == "OK 4 PING");
+  }
+  CHECK(s.server->connections() == 64);
+  {
+    auto refused = s.connect();
+    const auto reply = refused.readLine(2s);
+    REQUIRE(reply);
+    CHECK(reply->rfind("ERROR 13 ", 0) == 0);
+  }
+  // The idle ones are closed: a robot gets in again, without anyone leaving.
+  bool served = false;
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!served && std::chrono::steady_clock::now() < deadline) {
+    auto robot = LineClient::connect("127.0.0.1", s.server->port(), 2s);
+    if (robot) {
+      auto r = robot->request("PING", 2s);
+      served = r && *r == "OK 4 PING";
+    }
+    if (!served) std::this_thread::sleep_for(50ms);
   }
   CHECK(served);
 }

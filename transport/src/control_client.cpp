@@ -51,13 +51,21 @@ void ControlClient::reconnect() {
 
 Result<proto::ControlReply> ControlClient::call(const proto::ControlRequest& request) {
   const std::string bytes = request.SerializeAsString();
+  if (bytes.size() > kMaxControlRequestBytes) {
+    return makeError(ControlErrc::kBadRequest,
+                     "control request of " + std::to_string(bytes.size()) +
+                         " bytes exceeds the video server's limit of " +
+                         std::to_string(kMaxControlRequestBytes) + " bytes");
+  }
   socket_->send(zmq::buffer(bytes), zmq::send_flags::none);
   zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
   if (zmq::poll(&item, 1, timeout_) == 0) {
     reconnect();
     return makeError(ControlErrc::kNoReply, "video server at " + endpoint_ +
                                                 " did not answer within " +
-                                                std::to_string(timeout_.count()) + " ms");
+                                                std::to_string(timeout_.count()) +
+                                                " ms (is it running and reachable? a request "
+                                                "over 64 KiB is dropped without a reply)");
   }
   zmq::message_t reply_bytes;
   if (!socket_->recv(reply_bytes)) {

@@ -90,7 +90,9 @@ OutputSettings Camera::output() const {
 }
 
 Result<void> Camera::setMode(AcquisitionMode mode, double fps) {
-  if (fps < 0 || fps > 1000) return makeError(VideoErrc::kOutOfRange, "fps must be in (0, 1000]");
+  // Written so that NaN fails too.
+  if (!(fps >= 0 && fps <= kMaxFps))
+    return makeError(VideoErrc::kOutOfRange, "fps must be in (0, 1000]");
   {
     std::lock_guard<std::mutex> lock(mutex_);
     mode_ = mode;
@@ -111,10 +113,20 @@ void Camera::setOpen(bool open) {
   wake_.notify_all();
 }
 
-TriggerTicket Camera::trigger() {
+Result<TriggerTicket> Camera::trigger() {
   TriggerTicket ticket;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!open_requested_) {
+      return makeError(VideoErrc::kCameraClosed, "camera '" + config_.name + "' is closed");
+    }
+    // During an outage the answer is an error at once: a queued trigger
+    // would be served, with every other one, in a burst when the camera
+    // returns, long after anybody waited for it.
+    if (status_.state == "reconnecting") {
+      return makeError(SourceErrc::kUnavailable,
+                       "camera '" + config_.name + "' is not streaming: " + status_.last_error);
+    }
     if (mode_ == AcquisitionMode::kTrigger) {
       ticket.sequence = next_sequence_ + pending_triggers_;
       ticket.triggered = true;
@@ -225,6 +237,7 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
   lock.lock();
   if (!opened) {
     status_.state = "reconnecting";
+    pending_triggers_ = 0;  // their clients get no frame; new ones are refused
     if (status_.last_error != opened.error().message) {
       logWarning("camera ", config_.name, ": ", opened.error().message, " (retrying)");
     }
@@ -355,15 +368,20 @@ void Camera::handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequ
     return;
   }
   ++status_.acquisition_errors;
+  const bool repeated = status_.last_error == error.message;
   status_.last_error = error.message;
   if (error.code == SourceErrc::kUnavailable) {
     logWarning("camera ", config_.name, ": ", error.message);
     closeSource(lock);
     status_.state = "reconnecting";
+    // Owed frames are not delivered after the outage; their clients time
+    // out, and new triggers are refused until the camera is back.
+    pending_triggers_ = 0;
     waitBackoff(lock);
   } else {
-    // A bad frame (a corrupt buffer): drop it and go on.
-    logWarning("camera ", config_.name, ": frame dropped: ", error.message);
+    // A bad frame (a corrupt buffer, settings too big for it): drop it and
+    // go on; logged once while the reason stays the same.
+    if (!repeated) logWarning("camera ", config_.name, ": frame dropped: ", error.message);
   }
 }
 

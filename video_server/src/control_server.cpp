@@ -34,6 +34,9 @@ ControlServer::ControlServer(zmq::context_t& context, const std::string& endpoin
       socket_(context, zmq::socket_type::router),
       replies_(context, zmq::socket_type::pull) {
   socket_.set(zmq::sockopt::linger, 0);
+  // ZeroMQ drops a bigger message and closes the connection that sent it,
+  // before it is buffered whole: the client gets no reply and times out.
+  socket_.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(kMaxControlRequestBytes));
   socket_.bind(endpoint);
   bound_endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
   // Unique within the context: several servers may share one.
@@ -124,15 +127,14 @@ void ControlServer::receiveRequest() {
   if (body >= parts.size()) return;    // identity alone: nothing to answer
   Job job;
   // Parts after the body (a multi-part request) are ignored, as before.
-  const zmq::message_t& bytes = parts[body];
-  const bool parsed = job.request.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()));
+  auto decoded = decodeRequest(parts[body].data(), parts[body].size());
   parts.resize(body);
   job.envelope = std::move(parts);
 
   proto::ControlReply reply;
-  if (!parsed || job.request.request_case() == proto::ControlRequest::REQUEST_NOT_SET) {
-    reply = errorReply(makeError(VideoErrc::kBadRequest, "malformed or empty control request"));
-  } else if (answeredAtOnce(job.request)) {
+  if (!decoded) {
+    reply = errorReply(decoded.error());
+  } else if (job.request = std::move(*decoded); answeredAtOnce(job.request)) {
     reply = answer(job.request);
   } else {
     if (enqueue(*requestCamera(job.request), job)) return;

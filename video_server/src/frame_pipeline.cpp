@@ -13,8 +13,6 @@
 
 namespace picksight::video {
 namespace {
-// Output sizes beyond this are a typing error, not a camera.
-constexpr int kMaxOutputSide = 16384;
 
 cv::Rect effectiveRoi(const OutputSettings& s, cv::Size sensor) {
   if (s.roi.empty()) return cv::Rect(0, 0, sensor.width, sensor.height);
@@ -28,6 +26,29 @@ cv::Size outputSize(const OutputSettings& s, cv::Size roi) {
                     std::max(1, static_cast<int>(std::lround(roi.height * s.scale))));
   }
   return roi;
+}
+
+std::string shown(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+// The bound on what is allocated per frame, whichever way the size was set.
+Result<void> checkOutputSize(cv::Size size, const char* how) {
+  const long long pixels = static_cast<long long>(size.width) * size.height;
+  if (size.width <= kMaxOutputSide && size.height <= kMaxOutputSide && pixels <= kMaxOutputPixels) {
+    return {};
+  }
+  return makeError(VideoErrc::kOutOfRange,
+                   std::string(how) + " " + shown(size) + " exceeds the output limit (" +
+                       std::to_string(kMaxOutputSide) + " pixels a side, " +
+                       std::to_string(kMaxOutputPixels) + " pixels in all)");
+}
+
+// The ROI and output size `s` gives on a sensor of `sensor` pixels.
+cv::Size derivedSize(const OutputSettings& s, cv::Size sensor) {
+  cv::Rect roi = effectiveRoi(s, sensor);
+  if (roi.empty()) roi = cv::Rect(0, 0, sensor.width, sensor.height);
+  return outputSize(s, roi.size());
 }
 }  // namespace
 
@@ -59,8 +80,15 @@ Result<void> validateOutputSettings(const OutputSettings& s, cv::Size sensor) {
     return makeError(VideoErrc::kOutOfRange,
                      "size must be between 1 and " + std::to_string(kMaxOutputSide));
   }
-  if (s.scale < 0 || s.scale > 16)
+  if (s.size.area() > 0) {
+    if (auto ok = checkOutputSize(s.size, "size"); !ok) return ok;
+  }
+  // Written so that NaN fails too.
+  if (!(s.scale >= 0 && s.scale <= kMaxOutputScale))
     return makeError(VideoErrc::kOutOfRange, "scale must be in (0, 16]");
+  if (sensor.area() > 0 && s.size.area() == 0) {
+    return checkOutputSize(derivedSize(s, sensor), "scaled size");
+  }
   return {};
 }
 
@@ -103,6 +131,11 @@ OutputFrame applyOutputSettings(const cv::Mat& sensor, const OutputSettings& set
 Result<OutputFrame> applyOutputSettings(const SourceFrame& frame, const OutputSettings& settings) {
   auto standard = toOutputFormat(frame.image, frame.layout, settings.format);
   if (!standard) return standard.error();
+  // Settings checked before the first frame (or before the device changed
+  // size) may give a frame too big on this one: dropped, with the reason.
+  if (auto ok = checkOutputSize(derivedSize(settings, standard->size()), "output size"); !ok) {
+    return ok.error();
+  }
   return applyOutputSettings(*standard, settings,
                              frame.keepable || standard->datastart != frame.image.datastart);
 }

@@ -27,7 +27,7 @@ Result<OutputFormat> parseFormat(const std::string& text) {
 
 Result<double> parseFps(const std::string& text) {
   auto v = parseDouble(text);
-  if (!v || *v <= 0 || *v > 1000) {
+  if (!v || *v <= 0 || *v > kMaxFps) {
     return makeError(VideoErrc::kBadConfig, "must be a number in (0, 1000], got '" + text + "'");
   }
   return *v;
@@ -102,7 +102,7 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
   }
   if (node["scale"]) {
     auto s = parseDouble(node["scale"].Scalar());
-    if (!s || *s <= 0 || *s > 16)
+    if (!s || *s <= 0 || *s > kMaxOutputScale)
       return makeError(VideoErrc::kBadConfig, where + ".scale: must be a number in (0, 16]");
     c.output.scale = *s;
   }

@@ -130,10 +130,11 @@ proto::ControlReply setMode(Camera& camera, const proto::SetModeRequest& request
 }
 
 proto::ControlReply trigger(Camera& camera) {
-  const TriggerTicket t = camera.trigger();
+  const auto t = camera.trigger();
+  if (!t) return errorReply(t.error());
   proto::ControlReply reply = okReply();
-  reply.mutable_trigger()->set_sequence(t.sequence);
-  reply.mutable_trigger()->set_triggered(t.triggered);
+  reply.mutable_trigger()->set_sequence(t->sequence);
+  reply.mutable_trigger()->set_triggered(t->triggered);
   return reply;
 }
 
@@ -164,8 +165,9 @@ proto::ControlReply snap(Camera& camera) {
   if (!camera.status().open_requested) {
     return errorReply(makeError(VideoErrc::kCameraClosed, "camera '" + name + "' is closed"));
   }
-  const TriggerTicket t = camera.trigger();
-  auto frame = camera.waitForFrame(t.sequence, kSnapTimeout);
+  const auto t = camera.trigger();
+  if (!t) return errorReply(t.error());
+  auto frame = camera.waitForFrame(t->sequence, kSnapTimeout);
   if (!frame) {
     return errorReply(makeError(VideoErrc::kNoFrame, "no frame from camera '" + name + "' within " +
                                                          std::to_string(kSnapTimeout.count()) +
@@ -254,6 +256,8 @@ proto::ControlReply VideoServer::statistics(const proto::StatisticsRequest& requ
     cs->set_reconnects(s.reconnects);
     cs->set_fps(s.fps_measured);
     cs->set_last_sequence(s.last_sequence);
+    cs->set_state(s.state);
+    cs->set_last_error(s.last_error);
   }
   return reply;
 }

@@ -4,12 +4,14 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include <catch2/catch.hpp>
 
@@ -186,4 +188,37 @@ TEST_CASE("FileSource keeps the last image while the file is missing or unreadab
   REQUIRE(cv::imwrite(tmp, sceneImage(3)));
   REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
   CHECK(sameImage(grabImage(*source), sceneImage(3)));
+}
+
+TEST_CASE("FileSource fails once the file stays gone or unreadable past the grace period",
+          "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.file("scene.png");
+  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  auto source = fileSource(path);
+  REQUIRE(source->open());
+  CHECK(sameImage(grabImage(*source), sceneImage(1)));
+
+  std::ofstream(path) << "";  // truncated to nothing
+  // The last image stands in for a moment, then never again.
+  picksight::Result<picksight::video::SourceFrame> grabbed = source->grab(100ms);
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (grabbed && std::chrono::steady_clock::now() < deadline) {
+    CHECK(sameImage(grabbed->image, sceneImage(1)));
+    std::this_thread::sleep_for(20ms);
+    grabbed = source->grab(100ms);
+  }
+  REQUIRE_FALSE(grabbed);
+  CHECK(grabbed.error().code == picksight::video::SourceErrc::kUnavailable);
+  CHECK_THAT(grabbed.error().message, Catch::Contains(path) &&
+                                          Catch::Contains("not a readable image") &&
+                                          Catch::Contains("for more than 1000 ms"));
+  CHECK_FALSE(source->grab(100ms));
+
+  // As the camera does: close, then open again until the file is back.
+  source->close();
+  CHECK_FALSE(source->open());
+  REQUIRE(cv::imwrite(path, sceneImage(2)));
+  REQUIRE(source->open());
+  CHECK(sameImage(grabImage(*source), sceneImage(2)));
 }

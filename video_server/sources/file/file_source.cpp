@@ -11,12 +11,14 @@
 
 namespace picksight::video {
 
-FileSource::FileSource(std::string path) : path_(std::move(path)) {}
+FileSource::FileSource(std::string path, std::chrono::milliseconds grace)
+    : path_(std::move(path)), grace_(grace) {}
 
 Result<void> FileSource::open() { return refresh(); }
 
 void FileSource::close() {
   image_.release();
+  failing_since_.reset();
   inode_ = 0;
   size_ = -1;
 }
@@ -34,26 +36,33 @@ SourceInfo FileSource::info() const {
 
 Result<void> FileSource::refresh() {
   struct stat st {};
-  if (::stat(path_.c_str(), &st) != 0) {
-    if (!image_.empty()) return {};  // keep serving the last image while the file is being replaced
-    return makeError(SourceErrc::kUnavailable, "file:" + path_ + ": " + std::strerror(errno));
-  }
+  if (::stat(path_.c_str(), &st) != 0) return failing(std::strerror(errno));
   if (!image_.empty() && st.st_ino == inode_ && st.st_size == size_ &&
       st.st_mtim.tv_sec == mtime_.tv_sec && st.st_mtim.tv_nsec == mtime_.tv_nsec) {
+    failing_since_.reset();  // back as it was (moved away and back)
     return {};
   }
   cv::Mat loaded = cv::imread(path_, cv::IMREAD_UNCHANGED);
-  if (loaded.empty()) {
-    // A half-written file reads as garbage: keep the previous image and try
-    // again on the next frame.
-    if (!image_.empty()) return {};
-    return makeError(SourceErrc::kUnavailable, "file:" + path_ + ": not a readable image");
-  }
+  if (loaded.empty()) return failing("not a readable image");
+  failing_since_.reset();
   image_ = toEightBit(loaded);
   inode_ = st.st_ino;
   size_ = st.st_size;
   mtime_ = st.st_mtim;
   return {};
+}
+
+Result<void> FileSource::failing(const std::string& why) {
+  const auto now = std::chrono::steady_clock::now();
+  if (!failing_since_) failing_since_ = now;
+  // A file being replaced (rewritten in place, or deleted then created) is
+  // briefly gone or half-written: the last image stands in for it a moment.
+  if (!image_.empty() && now - *failing_since_ <= grace_) return {};
+  std::string message = "file:" + path_ + ": " + why;
+  if (!image_.empty()) {
+    message += " for more than " + std::to_string(grace_.count()) + " ms";
+  }
+  return makeError(SourceErrc::kUnavailable, message);
 }
 
 Result<SourceFrame> FileSource::grab(std::chrono::milliseconds /*timeout*/) {

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <set>
 
+#include "picksight/common/allow_list.hpp"
 #include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 
@@ -16,6 +17,11 @@ namespace {
 // Values checked by the options' validators, converted after the parse.
 struct RawOptions {
   std::string robot_port;
+  std::string robot_allow;
+  std::string robot_idle_timeout;
+  std::string robot_per_address;
+  std::string setup_port;
+  std::string setup_bind = "127.0.0.1";
   std::string threshold;
   std::string polarity;
   std::string window;
@@ -58,7 +64,33 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
                  "TCP port for robot controllers (default 5600, 0 = any free)")
       ->type_name("PORT")
       ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
-  app.add_option("--bind", o.robot.bind_address, "address the robot port listens on")
+  app.add_option("--bind", o.robot.bind_address,
+                 "address the robot port listens on (robots are other hosts: all interfaces)")
+      ->type_name("ADDRESS")
+      ->capture_default_str();
+  app.add_option("--robot-allow", raw.robot_allow,
+                 "addresses or networks allowed to connect, e.g. '10.0.0.0/8 192.168.1.7' "
+                 "(default: any)")
+      ->type_name("LIST")
+      ->check(checkValue([](const std::string& v) {
+        auto list = AllowList::parse(v);
+        return list ? std::string() : list.error().message;
+      }));
+  app.add_flag("--robot-read-only", o.robot_read_only,
+               "the robot port refuses requests that change models, calibration or camera");
+  app.add_option("--robot-idle-timeout", raw.robot_idle_timeout,
+                 "seconds without a request before a connection is closed (default 60, 0 = never)")
+      ->type_name("SECONDS")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 86400); }));
+  app.add_option("--robot-per-address", raw.robot_per_address,
+                 "connections allowed from one address (default 32 of 64, 0 = no own limit)")
+      ->type_name("N")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 64); }));
+  app.add_option("--setup-port", raw.setup_port,
+                 "a second, full-access port for set-up (0 = any free; default: none)")
+      ->type_name("PORT")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
+  app.add_option("--setup-bind", raw.setup_bind, "address the set-up port listens on")
       ->type_name("ADDRESS")
       ->capture_default_str();
   app.add_option("--data-dir", o.data_dir, "models and calibrations")
@@ -126,6 +158,16 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   }
   // The validators accepted these: the conversions cannot fail.
   if (!raw.robot_port.empty()) o.robot.port = static_cast<uint16_t>(*parseInt(raw.robot_port));
+  if (!raw.robot_allow.empty()) o.robot.allow = *AllowList::parse(raw.robot_allow);
+  if (!raw.robot_idle_timeout.empty())
+    o.robot.idle_timeout = std::chrono::seconds(*parseInt(raw.robot_idle_timeout));
+  if (!raw.robot_per_address.empty())
+    o.robot.max_per_address = static_cast<size_t>(*parseInt(raw.robot_per_address));
+  if (!raw.setup_port.empty()) {
+    o.setup = o.robot;
+    o.setup->port = static_cast<uint16_t>(*parseInt(raw.setup_port));
+    o.setup->bind_address = raw.setup_bind;
+  }
   if (raw.threshold == "adaptive") {
     o.vision.binarize.method = vision::ThresholdMethod::kAdaptive;
   } else if (raw.threshold == "otsu") {

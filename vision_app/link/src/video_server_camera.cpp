@@ -41,9 +41,9 @@ Result<std::shared_ptr<const Frame>> VideoServerCamera::freshFrame() {
       return makeError(CameraErrc::kNoFrame, "no frame from camera " + camera_ + " within " +
                                                  std::to_string(frame_timeout_.count()) + " ms");
     }
-    auto reply = control_.call(request);
-    if (!reply)
-      return makeError(CameraErrc::kNoVideoServer, "video server: " + reply.error().message);
+    // A camera in an outage refuses at once (camera refused, with its reason).
+    auto reply = call(request);
+    if (!reply) return reply.error();
     const auto wait = std::min<std::chrono::milliseconds>(
         kRetrigger, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now));
     auto frame = feed_.waitFor(reply->trigger().sequence(), requested_ns, wait);

@@ -87,7 +87,8 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
     auto ok = calibration.deletePoint(static_cast<int>(*id));
     return ok ? std::string("OK") : reply(ok.error());
   });
-  table.add("LIST", "LIST", [&](const Request& r) { return list(r, calibration); });
+  table.add(
+      "LIST", "LIST", [&](const Request& r) { return list(r, calibration); }, neverChanges);
   table.add("COMPUTE", "COMPUTE [BEST|LSQ|GEOMETRIC]", [&](const Request& r) {
     const auto method = parseMethod(r.args);
     if (!method)
@@ -98,22 +99,25 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
     return "OK " + formatFixed(t.dx) + " " + formatFixed(t.dy) + " " + formatFixed(t.rz_deg) + " " +
            formatFixed(result->rms);
   });
-  table.add("RESIDUALS", "RESIDUALS", [&](const Request& r) {
-    if (!r.args.empty())
-      return errorReply(ProtocolErrc::kBadArguments, "RESIDUALS takes no arguments");
-    const auto geometry = calibration.geometry();
-    if (!geometry.transform)
-      return errorReply(CellCalibrationErrc::kNotComputed,
-                        "no robot-camera transform yet (see COMPUTE)");
-    const auto points = calibration.points();
-    std::string out = "OK " + std::to_string(points.size());
-    for (const auto& [id, p] : points) {
-      const cv::Point2d d = geometry.transform->apply(p.vision) - p.robot;
-      out += " " + std::to_string(id) + " " + formatFixed(d.x) + " " + formatFixed(d.y) + " " +
-             formatFixed(std::hypot(d.x, d.y));
-    }
-    return out;
-  });
+  table.add(
+      "RESIDUALS", "RESIDUALS",
+      [&](const Request& r) {
+        if (!r.args.empty())
+          return errorReply(ProtocolErrc::kBadArguments, "RESIDUALS takes no arguments");
+        const auto geometry = calibration.geometry();
+        if (!geometry.transform)
+          return errorReply(CellCalibrationErrc::kNotComputed,
+                            "no robot-camera transform yet (see COMPUTE)");
+        const auto points = calibration.points();
+        std::string out = "OK " + std::to_string(points.size());
+        for (const auto& [id, p] : points) {
+          const cv::Point2d d = geometry.transform->apply(p.vision) - p.robot;
+          out += " " + std::to_string(id) + " " + formatFixed(d.x) + " " + formatFixed(d.y) + " " +
+                 formatFixed(std::hypot(d.x, d.y));
+        }
+        return out;
+      },
+      neverChanges);
 }
 
 }  // namespace picksight::app

@@ -208,16 +208,23 @@ const std::vector<std::string>& exposureFeatureNames() {
 }
 
 void addCellCommands(CommandTable& table, CellContext& cell) {
-  table.add("LOCATE", "LOCATE <type>", [&cell](const Request& r) { return locate(r, cell); });
-  table.add("GRASP", "GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST",
-            [&cell](const Request& r) { return editGrasp(r, cell, false); });
-  table.add("GRIPPER", "GRIPPER <type> FINGER <x> <y> <w> <h> | CLEAR | LIST",
-            [&cell](const Request& r) { return editGrasp(r, cell, true); });
-  table.add("STATUS", "STATUS", [&cell](const Request& r) { return status(r, cell); });
-  table.add("EXPOSURE", "EXPOSURE [<value>]",
-            [&cell](const Request& r) { return exposure(r, cell); });
-  table.add("ROI", "ROI [<x> <y> <w> <h> | FULL]",
-            [&cell](const Request& r) { return roi(r, cell); });
+  table.add(
+      "LOCATE", "LOCATE <type>", [&cell](const Request& r) { return locate(r, cell); },
+      neverChanges);
+  table.add(
+      "GRASP", "GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST",
+      [&cell](const Request& r) { return editGrasp(r, cell, false); }, changesUnlessList);
+  table.add(
+      "GRIPPER", "GRIPPER <type> FINGER <x> <y> <w> <h> | CLEAR | LIST",
+      [&cell](const Request& r) { return editGrasp(r, cell, true); }, changesUnlessList);
+  table.add(
+      "STATUS", "STATUS", [&cell](const Request& r) { return status(r, cell); }, neverChanges);
+  table.add(
+      "EXPOSURE", "EXPOSURE [<value>]", [&cell](const Request& r) { return exposure(r, cell); },
+      changesWithArguments);
+  table.add(
+      "ROI", "ROI [<x> <y> <w> <h> | FULL]", [&cell](const Request& r) { return roi(r, cell); },
+      changesWithArguments);
 }
 
 }  // namespace picksight::app

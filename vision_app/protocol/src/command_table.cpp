@@ -20,6 +20,12 @@ const char* errorName(ProtocolErrc e) {
       return "empty request";
     case ProtocolErrc::kInternalError:
       return "internal error";
+    case ProtocolErrc::kNotAllowed:
+      return "not allowed";
+    case ProtocolErrc::kIdle:
+      return "idle";
+    case ProtocolErrc::kReadOnly:
+      return "read-only port";
   }
   return "unknown";
 }
@@ -64,17 +70,28 @@ std::optional<Request> parseRequest(std::string_view line) {
   return r;
 }
 
-void CommandTable::add(const std::string& word, const std::string& usage, Handler handler) {
-  commands_[toUpper(word)] = Entry{usage, std::move(handler)};
+bool changesUnlessList(const Request& r) {
+  return r.args.size() < 2 || toUpper(r.args[1]) != "LIST";
 }
 
-std::string CommandTable::dispatch(std::string_view line) const {
+void CommandTable::add(const std::string& word, const std::string& usage, Handler handler,
+                       ChangesCell changes) {
+  commands_[toUpper(word)] = Entry{usage, std::move(handler), std::move(changes)};
+}
+
+std::string CommandTable::dispatch(std::string_view line, bool read_only) const {
   const auto request = parseRequest(line);
   if (!request) return errorReply(ProtocolErrc::kEmptyRequest, "empty request");
   const auto it = commands_.find(request->command);
   if (it == commands_.end()) {
     return errorReply(ProtocolErrc::kUnknownCommand,
                       "unknown command '" + printable(request->command) + "' (try HELP)");
+  }
+  if (read_only && it->second.changes(*request)) {
+    return errorReply(ProtocolErrc::kReadOnly,
+                      request->command + " " +
+                          (request->args.empty() ? "" : "with these arguments ") +
+                          "changes the cell: refused on this read-only port (use the set-up port)");
   }
   return it->second.handler(*request);
 }

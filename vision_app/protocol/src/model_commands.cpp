@@ -52,15 +52,18 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
     if (!model) return errorReply(model.error());
     return "OK " + modelSummary(*model) + " " + (model->body.mirror_symmetric ? "1" : "0");
   });
-  table.add("MODELS", "MODELS", [&vision](const Request& r) {
-    if (!r.args.empty())
-      return errorReply(ProtocolErrc::kBadArguments, "MODELS takes no arguments");
-    const auto models =
-        vision.models() ? vision.models()->snapshot() : std::make_shared<const ModelList>();
-    std::string reply = "OK " + std::to_string(models->size());
-    for (const auto& m : *models) reply += " " + modelSummary(m);
-    return reply;
-  });
+  table.add(
+      "MODELS", "MODELS",
+      [&vision](const Request& r) {
+        if (!r.args.empty())
+          return errorReply(ProtocolErrc::kBadArguments, "MODELS takes no arguments");
+        const auto models =
+            vision.models() ? vision.models()->snapshot() : std::make_shared<const ModelList>();
+        std::string reply = "OK " + std::to_string(models->size());
+        for (const auto& m : *models) reply += " " + modelSummary(m);
+        return reply;
+      },
+      neverChanges);
   table.add("FORGET", "FORGET <type>", [&vision](const Request& r) {
     if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: FORGET <type>");
     const auto type = parseType(r.args[0]);
@@ -80,14 +83,18 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
     }
     return std::string("OK");
   });
-  table.add("BLOBS", "BLOBS", [&vision](const Request& r) {
-    if (!r.args.empty()) return errorReply(ProtocolErrc::kBadArguments, "BLOBS takes no arguments");
-    auto blobs = vision.blobs();
-    if (!blobs) return errorReply(blobs.error());
-    std::string reply = "OK " + std::to_string(blobs->size());
-    for (const auto& b : *blobs) reply += " " + blobSummary(b);
-    return reply;
-  });
+  table.add(
+      "BLOBS", "BLOBS",
+      [&vision](const Request& r) {
+        if (!r.args.empty())
+          return errorReply(ProtocolErrc::kBadArguments, "BLOBS takes no arguments");
+        auto blobs = vision.blobs();
+        if (!blobs) return errorReply(blobs.error());
+        std::string reply = "OK " + std::to_string(blobs->size());
+        for (const auto& b : *blobs) reply += " " + blobSummary(b);
+        return reply;
+      },
+      neverChanges);
 }
 
 }  // namespace picksight::app

@@ -19,7 +19,7 @@ using calibration::CalibrationErrc;
 
 constexpr int kInternal = 99;
 
-const std::array<std::pair<std::error_code, int>, 28> kTable = {{
+const std::array<std::pair<std::error_code, int>, 31> kTable = {{
     {VisionErrc::kNoTarget, 1},
     {VisionErrc::kSeveralTargets, 2},
     {VisionErrc::kNotADisc, 3},
@@ -28,6 +28,9 @@ const std::array<std::pair<std::error_code, int>, 28> kTable = {{
     {ProtocolErrc::kRequestTooLong, 12},
     {ProtocolErrc::kTooManyConnections, 13},
     {ProtocolErrc::kEmptyRequest, 14},
+    {ProtocolErrc::kNotAllowed, 15},
+    {ProtocolErrc::kIdle, 16},
+    {ProtocolErrc::kReadOnly, 17},
     {CameraErrc::kNoFrame, 20},
     {CameraErrc::kNoVideoServer, 21},
     {ControlErrc::kNoReply, 21},

@@ -9,13 +9,20 @@ constexpr const char* kVersion = "0.1.0";
 }  // namespace
 
 RobotProtocol::RobotProtocol(VisionService& vision) : vision_(vision) {
-  table_.add("PING", "PING", [](const Request& r) {
-    return r.args.empty() ? std::string("OK")
-                          : errorReply(ProtocolErrc::kBadArguments, "PING takes no arguments");
-  });
-  table_.add("VERSION", "VERSION", [](const Request&) { return std::string("OK ") + kVersion; });
-  table_.add("HELP", "HELP", [this](const Request&) { return table_.help(); });
-  table_.add("FRAME", "FRAME", [this](const Request& r) { return frame(r); });
+  table_.add(
+      "PING", "PING",
+      [](const Request& r) {
+        return r.args.empty() ? std::string("OK")
+                              : errorReply(ProtocolErrc::kBadArguments, "PING takes no arguments");
+      },
+      neverChanges);
+  table_.add(
+      "VERSION", "VERSION", [](const Request&) { return std::string("OK ") + kVersion; },
+      neverChanges);
+  table_.add(
+      "HELP", "HELP", [this](const Request&) { return table_.help(); }, neverChanges);
+  table_.add(
+      "FRAME", "FRAME", [this](const Request& r) { return frame(r); }, neverChanges);
 }
 
 std::string RobotProtocol::frame(const Request& request) {

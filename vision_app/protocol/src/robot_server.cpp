@@ -14,8 +14,10 @@
 #include <stdexcept>
 
 #include "picksight/common/log.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/protocol/line_framer.hpp"
+#include "picksight/protocol/robot_errors.hpp"
 
 namespace picksight::app {
 namespace {
@@ -29,6 +31,14 @@ bool sendAll(int fd, const std::string& data) {
     sent += static_cast<size_t>(n);
   }
   return true;
+}
+
+// Refused addresses remembered for logging once each; beyond this many a
+// scan of the network is not worth more memory.
+constexpr size_t kMaxRefusedLogged = 1024;
+
+std::string errorLine(ProtocolErrc code, const std::string& text) {
+  return errorReply(code, text) + "\n";
 }
 }  // namespace
 
@@ -80,6 +90,7 @@ void RobotServer::stop() {
     ::close(c.fd);
   }
   connections_.clear();
+  per_address_.clear();
 }
 
 void RobotServer::reapFinished() {
@@ -101,31 +112,64 @@ void RobotServer::acceptLoop() {
     const int r = ::poll(&p, 1, 200);
     reapFinished();
     if (r <= 0) continue;
-    const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
+    sockaddr_storage peer{};
+    socklen_t peer_len = sizeof(peer);
+    const int fd =
+        ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&peer), &peer_len, SOCK_CLOEXEC);
     if (fd < 0) continue;
     int one = 1;
     ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
-    if (active_ >= options_.max_connections) {
-      sendAll(fd, "ERROR 13 too many connections (limit " +
-                      std::to_string(options_.max_connections) + ")\n");
-      ::close(fd);
-      continue;
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    connections_.emplace_back();
-    Connection& c = connections_.back();
-    c.fd = fd;
-    ++active_;
-    c.thread = std::thread([this, &c] { serve(c); });
+    const auto* address = reinterpret_cast<const sockaddr*>(&peer);
+    admit(fd, peerAddress(address), options_.allow.allows(address));
   }
+}
+
+void RobotServer::admit(int fd, const std::string& peer, bool allowed) {
+  if (!allowed) {
+    sendAll(fd, errorLine(ProtocolErrc::kNotAllowed,
+                          "address " + peer + " is not allowed on this port"));
+    ::close(fd);
+    if (refused_logged_.size() < kMaxRefusedLogged && refused_logged_.insert(peer).second) {
+      logWarning("robot port: refused ", peer, " (not in the allow-list ",
+                 options_.allow.describe(), "; logged once per address)");
+    }
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  size_t& from_peer = per_address_[peer];
+  std::string refusal;
+  if (active_ >= options_.max_connections) {
+    refusal = "too many connections (limit " + std::to_string(options_.max_connections) + ")";
+  } else if (options_.max_per_address > 0 && from_peer >= options_.max_per_address) {
+    refusal = "too many connections from " + peer + " (limit " +
+              std::to_string(options_.max_per_address) + " per address)";
+  }
+  if (!refusal.empty()) {
+    if (from_peer == 0) per_address_.erase(peer);
+    sendAll(fd, errorLine(ProtocolErrc::kTooManyConnections, refusal));
+    ::close(fd);
+    return;
+  }
+  ++from_peer;
+  connections_.emplace_back();
+  Connection& c = connections_.back();
+  c.fd = fd;
+  c.peer = peer;
+  ++active_;
+  c.thread = std::thread([this, &c] { serve(c); });
 }
 
 void RobotServer::serve(Connection& connection) {
   const int fd = connection.fd;
   LineFramer framer(options_.max_line);
   const std::string too_long =
-      "ERROR 12 request too long (limit " + std::to_string(options_.max_line) + " bytes)\n";
+      errorLine(ProtocolErrc::kRequestTooLong,
+                "request too long (limit " + std::to_string(options_.max_line) + " bytes)");
+  using Clock = std::chrono::steady_clock;
+  // Only a complete request (or an over-long one) counts as activity.
+  Clock::time_point last_request = Clock::now();
   const auto on_line = [&](std::string_view line) {
+    last_request = Clock::now();
     std::string reply;
     try {
       reply = handler_(line);
@@ -136,11 +180,21 @@ void RobotServer::serve(Connection& connection) {
     }
     return sendAll(fd, reply + "\n");
   };
-  const auto on_too_long = [&] { return sendAll(fd, too_long); };
+  const auto on_too_long = [&] {
+    last_request = Clock::now();
+    return sendAll(fd, too_long);
+  };
+  const auto idle = options_.idle_timeout;
   char chunk[4096];
   while (!stop_) {
     pollfd p{fd, POLLIN, 0};
     const int r = ::poll(&p, 1, 200);
+    if (idle.count() > 0 && Clock::now() - last_request >= idle) {
+      sendAll(fd, errorLine(ProtocolErrc::kIdle, "no request for " +
+                                                     formatFixed(idle.count() / 1000.0, 1) +
+                                                     " s: connection closed"));
+      break;
+    }
     if (r == 0) continue;
     if (r < 0 && errno == EINTR) continue;
     if (r < 0) break;
@@ -148,6 +202,11 @@ void RobotServer::serve(Connection& connection) {
     if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
     if (n <= 0) break;  // closed by the client, maybe mid-request: nothing to answer
     if (!framer.feed(std::string_view(chunk, static_cast<size_t>(n)), on_line, on_too_long)) break;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = per_address_.find(connection.peer);
+    if (it != per_address_.end() && --it->second == 0) per_address_.erase(it);
   }
   --active_;
   connection.done = true;

@@ -3,8 +3,11 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
+#include <utility>
 
 #include "picksight/common/atomic_file.hpp"
+#include "picksight/common/log.hpp"
 #include "picksight/store/model_file.hpp"
 
 namespace picksight::app {
@@ -21,8 +24,14 @@ std::string ModelLibrary::pathOf(int type) const {
 
 std::vector<std::string> ModelLibrary::load() {
   std::vector<std::string> problems;
-  auto models = std::make_shared<ModelList>();
-  auto grasps = std::make_shared<GraspMap>();
+  // Left by a write that a crash interrupted; this process owns the directory.
+  if (auto removed = removeStaleTemporaries(directory_); !removed) {
+    problems.push_back(removed.error().message);
+  } else {
+    for (const auto& name : *removed) {
+      logInfo(directory_, ": removed ", name, " (left by an interrupted write)");
+    }
+  }
   std::error_code ec;
   std::vector<fs::path> files;
   if (!fs::exists(directory_, ec)) {
@@ -31,9 +40,13 @@ std::vector<std::string> ModelLibrary::load() {
     for (fs::directory_iterator it(directory_, ec), end; !ec && it != end; it.increment(ec)) {
       if (it->path().extension() == ".yaml") files.push_back(it->path());
     }
+  } else if (!ec) {
+    problems.push_back(directory_ + ": not a directory: no model can be loaded or stored");
   }
   if (ec) problems.push_back(directory_ + ": " + ec.message());
+  // By name, so that which of two files for one type is reported is stable.
   std::sort(files.begin(), files.end());
+  std::map<int, std::pair<fs::path, ModelRecord>> by_type;  // ordered by type number
   for (const auto& path : files) {
     auto text = readFile(path.string());
     if (!text) {
@@ -45,17 +58,25 @@ std::vector<std::string> ModelLibrary::load() {
       problems.push_back(path.string() + ": " + record.error().message);
       continue;
     }
-    auto* model = &record->model;
-    const bool duplicate =
-        std::any_of(models->begin(), models->end(),
-                    [&](const vision::PartModel& m) { return m.type == model->type; });
-    if (duplicate) {
-      problems.push_back(path.string() + ": type " + std::to_string(model->type) +
-                         " is already defined by another file");
-      continue;
+    const int type = record->model.type;
+    // try_emplace leaves `record` alone when the type is already there.
+    auto [it, fresh] = by_type.try_emplace(type, path, std::move(*record));
+    if (fresh) continue;
+    // Two files for one type: the one store() writes (type_<n>.yaml) wins,
+    // so that a restart keeps what LEARN wrote last.
+    const std::string why = " is already defined by another file";
+    if (path.filename() == fs::path(pathOf(type)).filename()) {
+      problems.push_back(it->second.first.string() + ": type " + std::to_string(type) + why);
+      it->second = {path, std::move(*record)};
+    } else {
+      problems.push_back(path.string() + ": type " + std::to_string(type) + why);
     }
-    (*grasps)[model->type] = record->grasp;
-    models->push_back(std::move(*model));
+  }
+  auto models = std::make_shared<ModelList>();
+  auto grasps = std::make_shared<GraspMap>();
+  for (auto& [type, loaded] : by_type) {
+    (*grasps)[type] = loaded.second.grasp;
+    models->push_back(std::move(loaded.second.model));
   }
   std::lock_guard<std::mutex> lock(mutex_);
   models_ = std::move(models);

@@ -5,6 +5,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "picksight/common/result.hpp"
 
@@ -24,6 +25,14 @@ Result<void> writeFileAtomically(const std::string& path, const std::string& con
 // Makes the entries of `directory` (a new, renamed or removed file, a new
 // subdirectory) durable: fsync of the directory itself.
 Result<void> syncDirectory(const std::string& directory);
+
+// Removes from `directory` the temporary files ("<name>.tmp.<pid>") that
+// writeFileAtomically leaves when its process dies mid-write, and returns
+// their names. For a directory the calling process alone writes to, called
+// at start (before any write of its own): it does not ask whether <pid> is
+// still alive, because after a reboot the number may belong to anybody.
+// A missing directory has nothing to remove.
+Result<std::vector<std::string>> removeStaleTemporaries(const std::string& directory);
 
 // Reads a whole file.
 Result<std::string> readFile(const std::string& path);

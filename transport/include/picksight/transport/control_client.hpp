@@ -3,6 +3,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -30,6 +31,11 @@ enum class ControlErrc {
 };
 const char* errorName(ControlErrc e);
 PICKSIGHT_ERROR_DOMAIN(ControlErrc, "control")
+
+// The largest control request a video server accepts (ZMQ_MAXMSGSIZE on its
+// socket: ZeroMQ drops a bigger message and the connection, and no reply
+// ever comes). call() refuses bigger requests itself, as kBadRequest.
+constexpr size_t kMaxControlRequestBytes = 64 * 1024;
 
 class ControlClient {
  public:

@@ -25,6 +25,9 @@
 
 namespace picksight::video {
 
+// The highest frame rate a camera may be set to.
+constexpr double kMaxFps = 1000;
+
 struct CameraConfig {
   std::string name;
   std::string uri;
@@ -90,7 +93,10 @@ class Camera {
 
   // In trigger mode queues one frame and returns its sequence number. In
   // free-run returns the first sequence number acquired after this call.
-  TriggerTicket trigger();
+  // A closed camera (kCameraClosed) or one in an outage (SourceErrc::
+  // kUnavailable, state "reconnecting") refuses at once; triggers still owed
+  // when an outage starts are dropped, never served in a burst afterwards.
+  Result<TriggerTicket> trigger();
 
   // Opens or closes the stream. A closed camera releases its device (another
   // program may use it) and keeps its settings.

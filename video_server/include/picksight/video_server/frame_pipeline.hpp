@@ -10,6 +10,13 @@ namespace picksight::video {
 
 struct SourceFrame;
 
+// Output frames beyond these are a typing error, not a camera: a side of
+// 16384 pixels, and 64 Mi pixels in all (192 MiB in bgr8), however the size
+// is derived (explicit, or the ROI times the scale).
+constexpr int kMaxOutputSide = 16384;
+constexpr long long kMaxOutputPixels = 64LL * 1024 * 1024;
+constexpr double kMaxOutputScale = 16;
+
 enum class OutputFormat { kMono8, kBgr8 };
 
 struct OutputSettings {
@@ -27,7 +34,8 @@ struct OutputFrame {
   cv::Size sensor_size;  // of the standardized frame the settings were applied to
 };
 
-// Checks settings against a sensor size; the error names what is wrong.
+// Checks settings against a sensor size; the error names what is wrong. With
+// a sensor size, the derived output size is checked against the bounds too.
 Result<void> validateOutputSettings(const OutputSettings& settings, cv::Size sensor);
 
 // Applies the settings to a sensor frame (CV_8UC1 or CV_8UC3 BGR). Settings

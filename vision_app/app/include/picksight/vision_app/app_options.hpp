@@ -1,6 +1,7 @@
 // Command-line options of picksight-vision.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,11 @@ struct AppOptions {
   std::string camera = "cam0";
   std::string data_dir = "picksight-data";
   RobotServerOptions robot;
+  // The robot port refuses requests that change the cell (docs/SECURITY.md).
+  bool robot_read_only = false;
+  // A second, full-access port for set-up (--setup-port); same limits and
+  // allow-list as the robot port, on loopback unless --setup-bind says.
+  std::optional<RobotServerOptions> setup;
   VisionOptions vision;
 };
 

@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "picksight/camera_link/camera_link.hpp"
-#include "picksight/store/cell_calibration.hpp"
-#include "picksight/protocol/cell_commands.hpp"
-#include "picksight/store/model_library.hpp"
-#include "picksight/protocol/robot_protocol.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/cell_commands.hpp"
+#include "picksight/protocol/robot_protocol.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/store/model_library.hpp"
 
 namespace picksight::app {
 
@@ -37,7 +37,10 @@ class VisionCell {
   void stop() { vision_.stop(); }
 
   // One request line in, one reply line out.
-  std::string handle(std::string_view line) const { return protocol_.handle(line); }
+  // On a read-only port requests that change the cell are refused.
+  std::string handle(std::string_view line, bool read_only = false) const {
+    return protocol_.handle(line, read_only);
+  }
 
   VisionService& vision() { return vision_; }
   ModelLibrary& models() { return models_; }

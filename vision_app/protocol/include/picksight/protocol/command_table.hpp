@@ -22,6 +22,9 @@ enum class ProtocolErrc {
   kTooManyConnections,  // sent by RobotServer
   kEmptyRequest,
   kInternalError,
+  kNotAllowed,  // sent by RobotServer: the peer is not in the allow-list
+  kIdle,        // sent by RobotServer: no request for the idle timeout
+  kReadOnly,    // a request that changes the cell, on a read-only port
 };
 const char* errorName(ProtocolErrc e);
 PICKSIGHT_ERROR_DOMAIN(ProtocolErrc, "robot protocol")
@@ -51,15 +54,31 @@ std::optional<std::vector<double>> parseNumbers(const std::vector<std::string>& 
 // Up to `limit` characters of client text, safe to echo in a reply line.
 std::string printable(std::string_view text, size_t limit = 40);
 
+// Whether a request changes the cell (a model, a calibration, a camera
+// setting), and is therefore refused on a read-only port. A command that
+// reads with some arguments and writes with others decides per request.
+using ChangesCell = std::function<bool(const Request&)>;
+inline bool alwaysChanges(const Request&) { return true; }
+inline bool neverChanges(const Request&) { return false; }
+// True unless the request has no argument (EXPOSURE, ROI: read the setting).
+inline bool changesWithArguments(const Request& r) { return !r.args.empty(); }
+// True unless the sub-command (second argument) is LIST (GRASP, GRIPPER).
+bool changesUnlessList(const Request& r);
+
 class CommandTable {
  public:
   // Returns the whole reply line (without line end).
   using Handler = std::function<std::string(const Request&)>;
 
-  // Registers (or replaces) a command word, upper case.
-  void add(const std::string& word, const std::string& usage, Handler handler);
-  // Parses and runs one request line. Thread-safe once set up.
-  std::string dispatch(std::string_view line) const;
+  // Registers (or replaces) a command word, upper case. A command changes
+  // the cell unless it says otherwise, so that a new command is refused on
+  // a read-only port until someone decides it only reads.
+  void add(const std::string& word, const std::string& usage, Handler handler,
+           ChangesCell changes = alwaysChanges);
+  // Parses and runs one request line. On a read-only port a request that
+  // changes the cell gets ProtocolErrc::kReadOnly and does nothing.
+  // Thread-safe once set up.
+  std::string dispatch(std::string_view line, bool read_only = false) const;
   // "OK" and every usage, separated by " | ".
   std::string help() const;
 
@@ -67,6 +86,7 @@ class CommandTable {
   struct Entry {
     std::string usage;
     Handler handler;
+    ChangesCell changes;
   };
   std::map<std::string, Entry> commands_;
 };

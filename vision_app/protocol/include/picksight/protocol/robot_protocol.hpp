@@ -6,8 +6,8 @@
 #include <string>
 #include <string_view>
 
-#include "picksight/protocol/command_table.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/command_table.hpp"
 
 namespace picksight::app {
 
@@ -15,8 +15,11 @@ class RobotProtocol {
  public:
   explicit RobotProtocol(VisionService& vision);
 
-  // One request line in, one reply line out. Thread-safe.
-  std::string handle(std::string_view line) const { return table_.dispatch(line); }
+  // One request line in, one reply line out; on a read-only port requests
+  // that change the cell are refused. Thread-safe.
+  std::string handle(std::string_view line, bool read_only = false) const {
+    return table_.dispatch(line, read_only);
+  }
   // For features that add commands; only before serving starts.
   CommandTable& table() { return table_; }
 

@@ -25,8 +25,12 @@ class ModelLibrary {
   // `directory` is created on the first store if missing.
   explicit ModelLibrary(std::string directory);
 
-  // Loads every *.yaml file of the directory, replacing what was held. Bad
-  // files are skipped; each gets one message naming the file and its problem.
+  // Loads every *.yaml file of the directory, replacing what was held, in
+  // type order. Bad files are skipped; each gets one message naming the file
+  // and its problem, as does a `directory` that is not a directory. Of two
+  // files for one type, type_<n>.yaml (the one store() writes) wins.
+  // Temporary files of interrupted writes are removed first (the library
+  // owns its directory; call before any store()).
   std::vector<std::string> load();
 
   // Adds or replaces the model of model.type: the file first, then memory.
