@@ -62,10 +62,8 @@ int main(int argc, char** argv) {
     cell.start();
     robots.start();
     if (setup) setup->start();
-    std::cout << "robot " << robots.port() << "
-";
-    if (setup) std::cout << "setup " << setup->port() << "
-";
+    std::cout << "robot " << robots.port() << "\n";
+    if (setup) std::cout << "setup " << setup->port() << "\n";
     std::cout << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on ",
             options->robot.bind_address, ":", robots.port(), read_only ? " (read-only)" : "",
