@@ -17,6 +17,8 @@ PACKAGES=(
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli libv4l-dev
   # tests
   catch2
+  # network namespaces for the fake-camera tests (tests/support/run_in_netns.sh)
+  iproute2
 )
 
 missing=()
