@@ -21,6 +21,8 @@ PACKAGES=(
   libsystemd-dev
   # Debian package (CPack: dpkg-shlibdeps, file) and its unit tests (systemd-analyze)
   dpkg-dev file systemd
+  # network namespaces for the fake-camera tests (tests/support/run_in_netns.sh)
+  iproute2
 )
 
 missing=()

@@ -7,8 +7,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "picksight/video_server/frame_pipeline.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/video_server/frame_pipeline.hpp"
 
 using Catch::Detail::Approx;
 using picksight::video::applyOutputSettings;
@@ -79,6 +79,20 @@ TEST_CASE("applyOutputSettings crops the ROI with the pixels at their sensor pos
     }
   }
   CHECK(wrong == 0);
+}
+
+TEST_CASE("a crop of a buffer the pipeline owns is still published as one continuous block",
+          "[video_server]") {
+  // A converted frame is the pipeline's own and may be published without a
+  // copy, but a crop of it is a view with the full row stride: the
+  // publisher sends rows x width bytes from its start, so it must be copied.
+  const cv::Mat sensor = monoGradient(64, 48);
+  OutputSettings s;
+  s.roi = cv::Rect(10, 5, 20, 15);
+  const auto out = applyOutputSettings(sensor, s, /*sensor_is_private=*/true);
+  REQUIRE(out.image.size() == cv::Size(20, 15));
+  CHECK(out.image.isContinuous());
+  CHECK(cv::norm(out.image, sensor(s.roi), cv::NORM_INF) == 0);
 }
 
 TEST_CASE("applyOutputSettings with default settings is the whole sensor, mono", "[video_server]") {

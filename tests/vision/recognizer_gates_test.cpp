@@ -79,6 +79,20 @@ const ps::Shape& plate() {
   static const ps::Shape s = shapeOf({pt::rectLoop(120, 70)});
   return s;
 }
+
+// A 160 x 80 plate with a 5 x 5 px notch off its axes, in its top edge to
+// the right: nearly mirror-symmetric.
+const ps::Shape& notchedPlate() {
+  static const ps::Shape s = shapeOf({{{-80, -40},
+                                       {37.5, -40},
+                                       {37.5, -35},
+                                       {42.5, -35},
+                                       {42.5, -40},
+                                       {80, -40},
+                                       {80, 40},
+                                       {-80, 40}}});
+  return s;
+}
 }  // namespace
 
 TEST_CASE("a part with a hole is not taken for the same outline without one",
@@ -167,14 +181,7 @@ TEST_CASE("a nearly mirror-symmetric part is told from its mirror image by a sma
           "[vision][recognizer][mirror]") {
   // A 5 x 5 px notch off the axes of a 160 x 80 plate: under 3 % of the
   // outline differs from the mirror image.
-  const ps::Shape notched = shapeOf({{{-80, -40},
-                                      {37.5, -40},
-                                      {37.5, -35},
-                                      {42.5, -35},
-                                      {42.5, -40},
-                                      {80, -40},
-                                      {80, 40},
-                                      {-80, 40}}});
+  const ps::Shape& notched = notchedPlate();
   // A disc with a flat and a small key slot off the flat's axis.
   pt::Loop keyed;
   for (const auto& q : pt::circleLoop(50, {0, 0}, 180)) {
@@ -217,4 +224,48 @@ TEST_CASE("a mirror-symmetric part is recognized whichever way it lies",
                             pt::partRow(shapeOf({pt::circleLoop(45)}), 5, 300, 30, true));
   checkReported(recognizeDrawn(parts, {&plate_model, &disc_model}, 9), parts,
                 names(5, "plate", 5, "disc"));
+}
+
+TEST_CASE("a nearly mirror-symmetric part touching another is found and its mirror image is not",
+          "[vision][recognizer][mirror][locator]") {
+  // The notched plate with a corner of a plain plate against its left end:
+  // one blob, so the touching-part locator places them. The notched plate's
+  // mirror candidate verifies within a few percent of the direct one (the
+  // hands differ only at the notch): the notch, not the scores, must decide,
+  // as for separated parts.
+  const PartModel notched_model = trainDrawn(notchedPlate(), 1, "notched");
+  const PartModel plate_model = trainDrawn(plate(), 2, "plate");
+  REQUIRE_FALSE(notched_model.body.mirror_symmetric);
+  const std::vector<const PartModel*> models{&notched_model, &plate_model};
+  // The plain plate's corner (60, 35) points along its angle + 30.26 deg.
+  const double corner_deg = std::atan2(35.0, 60.0) * 180 / M_PI;
+  const double corner_reach = std::hypot(60.0, 35.0);
+  for (const bool mirrored : {false, true}) {
+    for (const double deg : {20.0, 145.0, 250.0}) {
+      INFO((mirrored ? "mirrored, " : "") << "turned " << deg);
+      const double a = deg * M_PI / 180;
+      // The plain plate to the left, its corner 1 px into the notched
+      // plate's left end.
+      const double back = 80 + corner_reach - 1;
+      const pt::DrawnPart notched_part{notchedPlate(), 400, 320, deg, mirrored};
+      const pt::DrawnPart plate_part{plate(), 400 - back * std::cos(a), 320 - back * std::sin(a),
+                                     deg - corner_deg};
+      const cv::Mat grey = pt::drawParts(800, 640, {notched_part, plate_part}, 11);
+      const auto regions = findRegions(binarize(grey, {}), {}, grey);
+      REQUIRE(regions.size() == 1);  // otherwise the locator is not asked
+      const auto matches = recognize(regions, models);
+      const Match* other = matchAt(matches, plate_part);
+      REQUIRE(other);
+      CHECK(other->model->name == "plate");
+      CHECK(other->touching);
+      const Match* m = matchAt(matches, notched_part);
+      if (mirrored) {
+        CHECK(m == nullptr);
+      } else {
+        REQUIRE(m);
+        CHECK(m->model->name == "notched");
+        CHECK(m->touching);
+      }
+    }
+  }
 }
