@@ -19,6 +19,8 @@ PACKAGES=(
   python3-zmq python3-protobuf python3-numpy python3-pytest
   # picksight-robot's line editing and history (BSD licence)
   libedit-dev
+  # the two-host test (deploy/two-hosts): network namespaces and veth pairs
+  iproute2
   # tests
   catch2
 )
