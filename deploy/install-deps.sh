@@ -21,6 +21,8 @@ PACKAGES=(
   libedit-dev
   # the two-host test (deploy/two-hosts): network namespaces and veth pairs
   iproute2
+  # container images without a registry (deploy/containers, opt-in test)
+  mmdebstrap podman
   # tests
   catch2
 )
