@@ -79,7 +79,9 @@ def _status_value(key, text):
 
 class RobotClient:
     """A connection to a vision app's robot port. One request at a time (the
-    protocol is synchronous per connection); use one client per thread."""
+    protocol is synchronous per connection); use one client per thread.
+    After a connection error or a timeout the client is closed: make a new
+    one."""
 
     def __init__(self, host="127.0.0.1", port=5600, timeout=10.0):
         self.host = host
@@ -106,8 +108,14 @@ class RobotClient:
         if "\n" in line or "\r" in line:
             raise ValueError("a request is one line")
         data = line.encode() + b"\n"
-        self._socket.sendall(data)
-        reply = self._reader.readline(MAX_REPLY_BYTES)
+        try:
+            self._socket.sendall(data)
+            reply = self._reader.readline(MAX_REPLY_BYTES)
+        except OSError:
+            # A late reply would be read as the next request's: this
+            # connection is done (TimeoutError included).
+            self.close()
+            raise
         if not reply:
             raise ConnectionError(f"{self.host}:{self.port} closed the connection")
         if not reply.endswith(b"\n"):

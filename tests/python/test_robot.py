@@ -149,3 +149,15 @@ def test_a_closed_port_is_a_connection_error():
     with pytest.raises(ConnectionRefusedError):
         RobotClient("127.0.0.1", port, timeout=2)
     s.close()
+
+
+def test_no_reply_in_time_is_a_timeout_and_closes_the_client():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    s.listen(1)  # accepts (the kernel does) and never answers
+    robot = RobotClient("127.0.0.1", s.getsockname()[1], timeout=0.2)
+    with pytest.raises(TimeoutError):
+        robot.ping()
+    with pytest.raises(OSError):
+        robot.ping()  # closed: a late reply can never be taken for another's
+    s.close()
