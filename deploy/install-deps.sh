@@ -15,6 +15,14 @@ PACKAGES=(
   # camera drivers: GigE/USB3 Vision (and the fake camera used by tests), V4L2
   # (libusb-1.0-0-dev: aravis-0.8.pc requires it, but libaravis-dev does not pull it in)
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli libv4l-dev
+  # Python client (python/) and its tests: Debian's /usr/bin/python3 modules
+  python3-zmq python3-protobuf python3-numpy python3-pytest
+  # picksight-robot's line editing and history (BSD licence)
+  libedit-dev
+  # the two-host test (deploy/two-hosts): network namespaces and veth pairs
+  iproute2
+  # container images without a registry (deploy/containers, opt-in test)
+  mmdebstrap podman
   # tests
   catch2
   # services: sd_notify readiness and watchdog

@@ -1,0 +1,21 @@
+"""PickSight clients: camera frames as numpy arrays, the robot protocol and
+the video server's camera control, over Debian's python3-zmq,
+python3-protobuf and python3-numpy.
+
+    from picksight import FrameSubscriber, RobotClient, CameraControl
+"""
+
+from picksight.frames import Frame, FrameSubscriber, decode_frame
+from picksight.robot import RobotClient, RobotError
+from picksight.control import CameraControl, ControlError, ControlTimeout
+
+__all__ = [
+    "Frame",
+    "FrameSubscriber",
+    "decode_frame",
+    "RobotClient",
+    "RobotError",
+    "CameraControl",
+    "ControlError",
+    "ControlTimeout",
+]

@@ -1,0 +1,261 @@
+"""The robot protocol (docs/PROTOCOL.md) as Python calls with parsed replies.
+
+Every command of the protocol is a method; an `ERROR <code> <text>` reply is
+raised as RobotError carrying the code, and a lost connection or a reply
+that does not come in time as the socket's own OSError (ConnectionError,
+TimeoutError).
+"""
+
+import socket
+from collections import namedtuple
+
+Pose = namedtuple("Pose", "x y rz")
+Finger = namedtuple("Finger", "x y width height")
+Model = namedtuple("Model", "type name area holes symmetry mirror_symmetric")
+FrameInfo = namedtuple("FrameInfo", "camera sequence host_timestamp_ns width height triggered")
+CalibrationPoint = namedtuple("CalibrationPoint", "id xv yv xr yr")
+Transform = namedtuple("Transform", "dx dy rz rms")
+Residual = namedtuple("Residual", "id dx dy distance")
+Exposure = namedtuple("Exposure", "feature value")
+Roi = namedtuple("Roi", "x y width height")
+Blob = namedtuple(
+    "Blob",
+    "x y angle area perimeter roundness holes eccentricity bx by bw bh "
+    "h1 h2 h3 h4 h5 h6 h7",
+)
+
+# A reply longer than this is not the vision app's: the connection is dropped.
+MAX_REPLY_BYTES = 16 * 1024 * 1024
+# Requests longer than this are refused by the server (ERROR 12).
+MAX_REQUEST_BYTES = 4096
+
+
+class RobotError(Exception):
+    """An `ERROR <code> <text>` reply: `code` is the protocol's error code
+    (docs/PROTOCOL.md, e.g. 32 no model for that type), `text` its message."""
+
+    def __init__(self, code, text, request=""):
+        super().__init__(f"ERROR {code} {text}" + (f" (request: {request})" if request else ""))
+        self.code = code
+        self.text = text
+        self.request = request
+
+
+def _number(value):
+    """A number as the protocol wants it: '.' decimal point, no exponent."""
+    if isinstance(value, int):
+        return str(value)
+    text = f"{float(value):.6f}".rstrip("0").rstrip(".")
+    return text if text not in ("", "-0") else "0"
+
+
+def _groups(words, size, kind, convert):
+    """`OK <n>` followed by n groups of `size` words, as `kind` tuples."""
+    n = int(words[0])
+    rest = words[1:]
+    if len(rest) != n * size:
+        raise ValueError(f"expected {n} groups of {size} fields, got {len(rest)} fields")
+    return [kind(*convert(rest[i : i + size])) for i in range(0, len(rest), size)]
+
+
+def _floats(fields):
+    return [float(f) for f in fields]
+
+
+def _status_value(key, text):
+    if text == "none":
+        return None
+    if key == "scale":
+        return tuple(float(v) for v in text.split("x"))
+    if key == "transform":
+        return tuple(float(v) for v in text.split(","))
+    for convert in (int, float):
+        try:
+            return convert(text)
+        except ValueError:
+            pass
+    return text
+
+
+class RobotClient:
+    """A connection to a vision app's robot port. One request at a time (the
+    protocol is synchronous per connection); use one client per thread.
+    After a connection error or a timeout the client is closed: make a new
+    one."""
+
+    def __init__(self, host="127.0.0.1", port=5600, timeout=10.0):
+        self.host = host
+        self.port = port
+        self._socket = socket.create_connection((host, port), timeout=timeout)
+        self._socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._reader = self._socket.makefile("rb")
+
+    def close(self):
+        self._reader.close()
+        self._socket.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    # ------------------------------------------------------------ raw lines
+
+    def request(self, line):
+        """Sends one request line; returns the reply's words after `OK`.
+        Raises RobotError for `ERROR` replies."""
+        if "\n" in line or "\r" in line:
+            raise ValueError("a request is one line")
+        data = line.encode() + b"\n"
+        try:
+            self._socket.sendall(data)
+            reply = self._reader.readline(MAX_REPLY_BYTES)
+        except OSError:
+            # A late reply would be read as the next request's: this
+            # connection is done (TimeoutError included).
+            self.close()
+            raise
+        if not reply:
+            raise ConnectionError(f"{self.host}:{self.port} closed the connection")
+        if not reply.endswith(b"\n"):
+            self.close()
+            raise ConnectionError(f"reply longer than {MAX_REPLY_BYTES} bytes")
+        words = reply.decode(errors="replace").rstrip("\r\n").split(" ")
+        if words[0] == "OK":
+            return [w for w in words[1:] if w]
+        if words[0] == "ERROR" and len(words) >= 2 and words[1].isdigit():
+            raise RobotError(int(words[1]), " ".join(words[2:]), line)
+        raise ValueError(f"not a protocol reply: {reply!r}")
+
+    # ----------------------------------------------------------------- core
+
+    def ping(self):
+        self.request("PING")
+
+    def version(self):
+        return " ".join(self.request("VERSION"))
+
+    def help(self):
+        """Every command's usage, separated by " | " (as sent: the usages of
+        GRASP, GRIPPER and ROI hold " | " themselves, so no split is exact)."""
+        return " ".join(self.request("HELP"))
+
+    def status(self):
+        """STATUS as a dict by key: numbers as int or float, `scale` as
+        (mm_x, mm_y), `transform` as (dx, dy, rz), None for `none`."""
+        out = {}
+        for word in self.request("STATUS"):
+            key, _, value = word.partition("=")
+            out[key] = _status_value(key, value)
+        return out
+
+    def frame(self):
+        """The frame the last vision request worked on."""
+        w = self.request("FRAME")
+        return FrameInfo(w[0], int(w[1]), int(w[2]), int(w[3]), int(w[4]), w[5] == "1")
+
+    # ------------------------------------------------------ locating, picking
+
+    def locate(self, part_type):
+        """The grasp poses of the parts of `part_type`, best first."""
+        return _groups(self.request(f"LOCATE {int(part_type)}"), 3, Pose, _floats)
+
+    def grasp_add(self, part_type, x, y, rz):
+        """Adds a grasp style; returns the type's number of styles."""
+        return int(self.request(f"GRASP {int(part_type)} ADD {_number(x)} {_number(y)} {_number(rz)}")[0])
+
+    def grasp_clear(self, part_type):
+        self.request(f"GRASP {int(part_type)} CLEAR")
+
+    def grasp_list(self, part_type):
+        return _groups(self.request(f"GRASP {int(part_type)} LIST"), 3, Pose, _floats)
+
+    def gripper_finger(self, part_type, x, y, width, height):
+        """Adds a finger rectangle; returns the type's number of fingers."""
+        args = " ".join(_number(v) for v in (x, y, width, height))
+        return int(self.request(f"GRIPPER {int(part_type)} FINGER {args}")[0])
+
+    def gripper_clear(self, part_type):
+        self.request(f"GRIPPER {int(part_type)} CLEAR")
+
+    def gripper_list(self, part_type):
+        return _groups(self.request(f"GRIPPER {int(part_type)} LIST"), 4, Finger, _floats)
+
+    # ------------------------------------------------------ teaching, blobs
+
+    def learn(self, part_type, name=None):
+        """Trains `part_type` from the single part in a fresh frame."""
+        line = f"LEARN {int(part_type)}" + (f" {name}" if name else "")
+        w = self.request(line)
+        return Model(int(w[0]), w[1], float(w[2]), int(w[3]), float(w[4]), w[5] == "1")
+
+    def models(self):
+        def convert(f):
+            return int(f[0]), f[1], float(f[2]), int(f[3]), float(f[4]), None
+
+        return _groups(self.request("MODELS"), 5, Model, convert)
+
+    def forget(self, part_type):
+        self.request(f"FORGET {int(part_type)}")
+
+    def blobs(self):
+        """Blob features of every region of a fresh frame, largest first."""
+
+        def convert(f):
+            v = _floats(f)
+            v[6] = int(v[6])
+            return v
+
+        return _groups(self.request("BLOBS"), 19, Blob, convert)
+
+    # ---------------------------------------------------------- calibration
+
+    def calcam(self, radius_mm):
+        """Camera scale from a disc target: (mm per pixel x, y)."""
+        w = self.request(f"CALCAM {_number(radius_mm)}")
+        return float(w[0]), float(w[1])
+
+    def store(self, x, y):
+        """Stores a calibration point (robot x, y mm); returns its id."""
+        return int(self.request(f"STORE {_number(x)} {_number(y)}")[0])
+
+    def delete(self, point_id):
+        self.request(f"DELETE {int(point_id)}")
+
+    def list_points(self):
+        def convert(f):
+            return [int(f[0])] + _floats(f[1:])
+
+        return _groups(self.request("LIST"), 5, CalibrationPoint, convert)
+
+    def compute(self, method=None):
+        """Fits the robot-camera transform (method BEST, LSQ or GEOMETRIC)."""
+        w = self.request("COMPUTE" + (f" {method}" if method else ""))
+        return Transform(*_floats(w))
+
+    def residuals(self):
+        def convert(f):
+            return [int(f[0])] + _floats(f[1:])
+
+        return _groups(self.request("RESIDUALS"), 4, Residual, convert)
+
+    # ------------------------------------------------------ camera settings
+
+    def exposure(self, value=None):
+        """Reads, or sets and reads back, the camera's exposure."""
+        w = self.request("EXPOSURE" + ("" if value is None else f" {_number(value)}"))
+        return Exposure(w[0], float(w[1]))
+
+    def roi(self, x=None, y=None, width=None, height=None):
+        """Reads the camera's region, or crops it (all four given)."""
+        given = [v is not None for v in (x, y, width, height)]
+        if any(given):
+            if not all(given):
+                raise ValueError("roi needs x, y, width and height, or none of them")
+            self.request(f"ROI {int(x)} {int(y)} {int(width)} {int(height)}")
+            return None
+        return Roi(*(int(v) for v in self.request("ROI")))
+
+    def roi_full(self):
+        self.request("ROI FULL")

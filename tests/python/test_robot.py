@@ -1,0 +1,163 @@
+"""RobotClient against a real cell: every command of docs/PROTOCOL.md with
+its parsed reply, and ERROR replies raised with their code."""
+
+import math
+import socket
+
+import pytest
+
+from conftest import Scene
+from picksight import RobotClient, RobotError
+
+
+def test_core_commands(synthetic_cell):
+    _, vision = synthetic_cell
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        robot.ping()
+        assert robot.version()
+        usages = robot.help()
+        assert "| LOCATE <type> |" in usages and "| PING |" in usages
+        status = robot.status()
+        assert status["frame"] == "vision-px"
+        assert status["scale"] is None and status["transform"] is None
+        assert status["camera"] == "cam0"
+        assert status["models"] == 0
+        poses = robot.locate(1)  # no model: every region at its own pose
+        assert len(poses) == 4
+        assert all(0 <= p.rz < 360 and p.y <= 0 for p in poses)  # y up the image
+        info = robot.frame()
+        assert info.camera == "cam0" and info.width == 640 and info.height == 480
+        assert info.triggered
+        assert robot.status()["locates"] == 1
+        blobs = robot.blobs()
+        assert len(blobs) == 4
+        assert blobs[0].area >= blobs[-1].area and isinstance(blobs[0].holes, int)
+
+
+def test_error_replies_are_raised_with_their_code(synthetic_cell):
+    _, vision = synthetic_cell
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        with pytest.raises(RobotError) as e:
+            robot.request("FLY")
+        assert e.value.code == 10
+        with pytest.raises(RobotError) as e:
+            robot.request("LOCATE")
+        assert e.value.code == 11 and "usage" in e.value.text
+        with pytest.raises(RobotError) as e:
+            robot.residuals()
+        assert e.value.code == 44
+        with pytest.raises(RobotError) as e:
+            robot.delete(7)
+        assert e.value.code == 40
+        with pytest.raises(RobotError) as e:
+            robot.compute()
+        assert e.value.code == 41
+        with pytest.raises(RobotError) as e:
+            robot.learn(1)  # four parts in the frame
+        assert e.value.code == 31
+        with pytest.raises(RobotError) as e:
+            robot.request("X" * 5000)
+        assert e.value.code == 12
+        robot.ping()  # the connection goes on
+        with pytest.raises(ValueError):
+            robot.request("PING\nPING")
+
+
+def test_camera_settings(synthetic_cell):
+    _, vision = synthetic_cell
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        assert tuple(robot.roi()) == (0, 0, 640, 480)
+        robot.roi(100, 50, 320, 240)
+        assert tuple(robot.roi()) == (100, 50, 320, 240)
+        robot.roi_full()
+        assert tuple(robot.roi()) == (0, 0, 640, 480)
+        # The synthetic camera has no exposure feature.
+        with pytest.raises(RobotError) as e:
+            robot.exposure()
+        assert e.value.code == 22
+        with pytest.raises(ValueError):
+            robot.roi(1, 2)
+
+
+def test_a_whole_set_up_calibrate_teach_grip_pick(cell_factory, tmp_path):
+    scene = Scene(tmp_path)
+    _, vision = cell_factory("--source", f"cam0=file:{scene.path}", "--mode", "trigger")
+    with RobotClient("127.0.0.1", vision.port, timeout=20) as robot:
+        with pytest.raises(RobotError) as e:
+            robot.calcam(10)
+        assert e.value.code == 1  # empty scene
+        scene.show([(320.3, 240.7, 40)])
+        mm_x, mm_y = robot.calcam(10)  # 10 mm radius, 40 px: 0.25 mm per pixel
+        assert mm_x == pytest.approx(0.25, rel=0.005)
+        assert mm_y == pytest.approx(0.25, rel=0.005)
+        assert robot.status()["frame"] == "vision-mm"
+
+        # Robot frame: vision mm turned by 30 degrees and moved.
+        a = math.radians(30)
+
+        def to_robot(px, py):
+            vx, vy = px * mm_x, -py * mm_y
+            return (math.cos(a) * vx - math.sin(a) * vy + 400.0,
+                    math.sin(a) * vx + math.cos(a) * vy - 100.0)
+
+        pixels = [(100.2, 90.6), (520.8, 110.1), (480.4, 400.3), (130.7, 380.9)]
+        for i, (px, py) in enumerate(pixels):
+            scene.show([(px, py, 20)])
+            assert robot.store(*to_robot(px, py)) == i + 1
+        points = robot.list_points()
+        assert [p.id for p in points] == [1, 2, 3, 4]
+        assert points[0].xr == pytest.approx(to_robot(*pixels[0])[0], abs=0.01)
+        t = robot.compute("LSQ")
+        assert (t.dx, t.dy, t.rz) == pytest.approx((400.0, -100.0, 30.0), abs=0.1)
+        assert t.rms < 0.1
+        assert len(robot.residuals()) == 4
+        status = robot.status()
+        assert status["frame"] == "robot"
+        assert status["transform"] == pytest.approx((t.dx, t.dy, t.rz), abs=0.001)
+
+        scene.show([(250.4, 200.6, 30)])
+        model = robot.learn(3, "disc")
+        assert (model.type, model.name, model.holes) == (3, "disc", 0)
+        assert model.area > 0
+        models = robot.models()
+        assert [(m.type, m.name) for m in models] == [(3, "disc")]
+        assert robot.grasp_add(3, 0, 0, 0) == 1
+        assert robot.grasp_add(3, 5, 0, 90) == 2
+        assert robot.grasp_list(3)[1] == pytest.approx((5, 0, 90))
+        assert robot.gripper_finger(3, 0, 12, 6, 4) == 1
+        assert robot.gripper_list(3)[0].width == pytest.approx(6)
+        poses = robot.locate(3)
+        assert len(poses) == 1
+        assert (poses[0].x, poses[0].y) == pytest.approx(to_robot(250.4, 200.6), abs=0.2)
+        with pytest.raises(RobotError) as e:
+            robot.locate(4)
+        assert e.value.code == 32
+        robot.gripper_clear(3)
+        assert robot.gripper_list(3) == []
+        robot.grasp_clear(3)
+        assert robot.grasp_list(3) == []
+        robot.delete(4)
+        assert len(robot.list_points()) == 3
+        robot.forget(3)
+        assert robot.models() == []
+
+
+def test_a_closed_port_is_a_connection_error():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))  # bound, not listening: connections are refused
+    port = s.getsockname()[1]
+    with pytest.raises(ConnectionRefusedError):
+        RobotClient("127.0.0.1", port, timeout=2)
+    s.close()
+
+
+def test_no_reply_in_time_is_a_timeout_and_closes_the_client():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    s.listen(1)  # accepts (the kernel does) and never answers
+    robot = RobotClient("127.0.0.1", s.getsockname()[1], timeout=0.2)
+    with pytest.raises(TimeoutError):
+        robot.ping()
+    with pytest.raises(OSError):
+        robot.ping()  # closed: a late reply can never be taken for another's
+    s.close()
