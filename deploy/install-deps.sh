@@ -17,6 +17,10 @@ PACKAGES=(
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli libv4l-dev
   # tests
   catch2
+  # PLC port: Modbus TCP server (libmodbus), and the independent client of its tests
+  libmodbus-dev python3-pymodbus
+  # pymodbus imports its serial client with every client (a Recommends of python3-pymodbus)
+  python3-serial-asyncio
 )
 
 missing=()

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <memory>
 
 #include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/large_buffers.hpp"
@@ -14,6 +15,7 @@
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
+#include "picksight/vision_app/plc_port.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 int main(int argc, char** argv) {
@@ -50,13 +52,25 @@ int main(int argc, char** argv) {
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
     app::RobotServer robots(options->robot,
                             [&cell](std::string_view line) { return cell.handle(line); });
+    // The PLC port has threads of its own: a PLC never delays a robot.
+    std::unique_ptr<app::PlcPort> plc;
+    if (options->plc.enabled) plc = std::make_unique<app::PlcPort>(options->plc, cell);
     cell.start();
     robots.start();
-    std::cout << "robot " << robots.port() << "\n"
-              << "ready" << std::endl;
+    if (plc) plc->start();
+    std::cout << "robot " << robots.port() << "\n";
+    if (plc) std::cout << "modbus " << plc->port() << "\n";
+    std::cout << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ",
             robots.port());
+    if (plc) {
+      logInfo("PLCs on Modbus port ", plc->port(), " (unit ",
+              static_cast<int>(options->plc.device.unit_id), ", word order ",
+              plc::wordOrderName(options->plc.device.word_order), ", allowed ",
+              options->plc.server.allow.describe(), ")");
+    }
     logInfo("stopping on signal ", stop_signals.wait());
+    if (plc) plc->stop();
     robots.stop();
     cell.stop();
   } catch (const std::exception& e) {

@@ -7,6 +7,7 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
+#include "picksight/vision_app/plc_port.hpp"
 
 namespace picksight::app {
 
@@ -17,6 +18,7 @@ struct AppOptions {
   std::string data_dir = "picksight-data";
   RobotServerOptions robot;
   VisionOptions vision;
+  PlcPortOptions plc;  // off unless --modbus-port is given
 };
 
 // Parses argv without the program name; errors name the option.
