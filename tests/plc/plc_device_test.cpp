@@ -306,3 +306,19 @@ TEST_CASE("peers outside the allow-list and beyond the connection cap are closed
   modbus_free(ctx);
   CHECK(a.status() == kStatusReady);
 }
+
+TEST_CASE("a silent connection is closed after the idle timeout", "[plc][server]") {
+  ModbusServerOptions options;
+  options.idle_timeout = std::chrono::milliseconds(200);
+  Port port({}, options);
+  ModbusClient plc(port.server->port());
+  CHECK(plc.status() == kStatusReady);
+  CHECK(port.server->connections() == 1);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (port.server->connections() != 0) {
+    REQUIRE(std::chrono::steady_clock::now() < deadline);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  uint16_t v = 0;
+  CHECK(modbus_read_registers(plc.ctx(), 0, 1, &v) == -1);
+}
