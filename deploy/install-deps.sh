@@ -19,7 +19,8 @@ PACKAGES=(
   python3-zmq python3-protobuf python3-numpy python3-pytest
   # picksight-robot's line editing and history (BSD licence)
   libedit-dev
-  # the two-host test (deploy/two-hosts): network namespaces and veth pairs
+  # network namespaces and veth pairs: the two-host test (deploy/two-hosts) and
+  # the fake GigE camera tests (tests/support/run_in_netns.sh)
   iproute2
   # container images without a registry (deploy/containers, opt-in test)
   mmdebstrap podman
@@ -29,8 +30,10 @@ PACKAGES=(
   libsystemd-dev
   # Debian package (CPack: dpkg-shlibdeps, file) and its unit tests (systemd-analyze)
   dpkg-dev file systemd
-  # network namespaces for the fake-camera tests (tests/support/run_in_netns.sh)
-  iproute2
+  # PLC port: Modbus TCP server (libmodbus), and the independent client of its tests
+  libmodbus-dev python3-pymodbus
+  # pymodbus imports its serial client with every client (a Recommends of python3-pymodbus)
+  python3-serial-asyncio
 )
 
 missing=()

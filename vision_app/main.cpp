@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <memory>
 
 #include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/large_buffers.hpp"
@@ -15,6 +16,7 @@
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
+#include "picksight/vision_app/plc_port.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 int main(int argc, char** argv) {
@@ -59,11 +61,16 @@ int main(int argc, char** argv) {
       setup = std::make_unique<app::RobotServer>(
           *options->setup, [&cell](std::string_view line) { return cell.handle(line); });
     }
+    // The PLC port has threads of its own: a PLC never delays a robot.
+    std::unique_ptr<app::PlcPort> plc;
+    if (options->plc.enabled) plc = std::make_unique<app::PlcPort>(options->plc, cell);
     cell.start();
     robots.start();
     if (setup) setup->start();
+    if (plc) plc->start();
     std::cout << "robot " << robots.port() << "\n";
     if (setup) std::cout << "setup " << setup->port() << "\n";
+    if (plc) std::cout << "modbus " << plc->port() << "\n";
     std::cout << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on ",
             options->robot.bind_address, ":", robots.port(), read_only ? " (read-only)" : "",
@@ -71,10 +78,17 @@ int main(int argc, char** argv) {
     if (setup) {
       logInfo("set-up port on ", options->setup->bind_address, ":", setup->port());
     }
+    if (plc) {
+      logInfo("PLCs on Modbus port ", plc->port(), " (unit ",
+              static_cast<int>(options->plc.device.unit_id), ", word order ",
+              plc::wordOrderName(options->plc.device.word_order), ", allowed ",
+              options->plc.server.allow.describe(), ")");
+    }
     // The robot port is listening: a robot program started after us connects.
     notifier.ready("camera " + options->camera + ", robot port " + std::to_string(robots.port()));
     logInfo("stopping on signal ", stop_signals.wait());
     notifier.stopping();
+    if (plc) plc->stop();
     if (setup) setup->stop();
     robots.stop();
     cell.stop();

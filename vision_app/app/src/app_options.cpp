@@ -27,6 +27,10 @@ struct RawOptions {
   std::string window;
   std::string min_area;
   std::string config_file;
+  std::string modbus_port;
+  std::string modbus_unit;
+  std::string modbus_allow;
+  std::string modbus_word_order;
 };
 
 std::string checkRange(const std::string& v, long long low, long long high) {
@@ -116,7 +120,32 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
         auto m = parseDouble(v);
         return m && *m >= 1 ? std::string() : "must be a number >= 1, got '" + v + "'";
       }));
-  app.footer("On start it prints 'robot <port>' and 'ready' on stdout.");
+  app.add_option("--modbus-port", raw.modbus_port,
+                 "TCP port of the PLC (Modbus TCP) server; absent = no PLC port, 0 = any free")
+      ->type_name("PORT")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
+  app.add_option("--modbus-bind", o.plc.server.bind_address, "address the Modbus port listens on")
+      ->type_name("ADDRESS")
+      ->capture_default_str();
+  app.add_option("--modbus-unit", raw.modbus_unit, "Modbus unit id answered (default 1)")
+      ->type_name("1-247")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 1, 247); }));
+  app.add_option("--modbus-allow", raw.modbus_allow,
+                 "PLCs that may connect: addresses or networks (default any)")
+      ->type_name("LIST")
+      ->check(checkValue([](const std::string& v) {
+        auto list = AllowList::parse(v);
+        return list ? std::string() : list.error().message;
+      }));
+  app.add_option("--modbus-word-order", raw.modbus_word_order,
+                 "32-bit values: high word first (ABCD, default) or low word first (CDAB)")
+      ->type_name("ABCD|CDAB")
+      ->check(checkValue([](const std::string& v) {
+        return plc::parseWordOrder(v) ? std::string() : "must be ABCD or CDAB, got '" + v + "'";
+      }));
+  app.footer(
+      "On start it prints 'robot <port>', 'modbus <port>' (with --modbus-port) and 'ready' on "
+      "stdout.");
 }
 
 CLI::App visionApp() {
@@ -183,6 +212,13 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   if (!raw.window.empty())
     o.vision.binarize.adaptive_window = static_cast<int>(*parseInt(raw.window));
   if (!raw.min_area.empty()) o.vision.regions.min_area = *parseDouble(raw.min_area);
+  o.plc.enabled = !raw.modbus_port.empty();
+  if (o.plc.enabled) o.plc.server.port = static_cast<uint16_t>(*parseInt(raw.modbus_port));
+  if (!raw.modbus_unit.empty())
+    o.plc.device.unit_id = static_cast<uint8_t>(*parseInt(raw.modbus_unit));
+  if (!raw.modbus_allow.empty()) o.plc.server.allow = *AllowList::parse(raw.modbus_allow);
+  if (!raw.modbus_word_order.empty())
+    o.plc.device.word_order = *plc::parseWordOrder(raw.modbus_word_order);
   return o;
 }
 

@@ -110,7 +110,8 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
   static const std::vector<grasp::GraspStyle> kOwnPose{grasp::GraspStyle{}};
   CellPick pick;
   pick.frame = geometry.frame();
-  for (const auto& part : outcome.parts) {
+  for (size_t index = 0; index < outcome.parts.size(); ++index) {
+    const LocatedPart& part = outcome.parts[index];
     const grasp::Pose pose = partPoseInVisionFrame(part, geometry.vision);
     const auto setup = part.type >= 0 ? grasps.find(part.type) : grasps.end();
     const bool has_setup = setup != grasps.end();
@@ -118,6 +119,7 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
         has_setup && !setup->second.styles.empty() ? setup->second.styles : kOwnPose;
     if (!has_setup || setup->second.gripper.fingers.empty()) {
       pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles.front())));
+      pick.parts.push_back(index);
       continue;
     }
     const grasp::Gripper& gripper = setup->second.gripper;
@@ -134,6 +136,7 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
       continue;
     }
     pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles[*chosen])));
+    pick.parts.push_back(index);
   }
   return pick;
 }

@@ -131,7 +131,7 @@ Result<std::shared_ptr<const Frame>> VisionService::freshFrame() {
 
 Result<LocateOutcome> VisionService::locate(int type) {
   const auto models = models_ ? models_->snapshot() : std::make_shared<const ModelList>();
-  if (!models->empty()) {
+  if (type >= 0 && !models->empty()) {
     bool known = false;
     for (const auto& m : *models) known = known || m.type == type;
     if (!known)

@@ -27,16 +27,9 @@ std::string locate(const Request& r, CellContext& cell) {
   if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: LOCATE <type>");
   const auto type = parseType(r.args[0]);
   if (!type) return typeError("LOCATE", r.args[0]);
-  auto outcome = cell.vision.locate(*type);
-  if (!outcome) return reply(outcome.error());
-  const auto grasps =
-      cell.vision.models() ? cell.vision.models()->grasps() : std::make_shared<const GraspMap>();
-  const CellPick pick = pickPoses(*outcome, *grasps, cell.calibration.geometry());
-  ++cell.locates;
-  cell.last_offered = pick.poses.size();
-  cell.last_skipped = pick.skipped;
-  cell.skipped_total += pick.skipped;
-  return locateReply(pick);
+  auto located = locateAndPick(cell, *type);
+  if (!located) return reply(located.error());
+  return locateReply(located->pick);
 }
 
 // GRASP <type> ADD x y rz | CLEAR | LIST, and GRIPPER <type> FINGER x y w h |
@@ -200,6 +193,21 @@ std::string roi(const Request& r, CellContext& cell) {
   return std::string("OK");
 }
 }  // namespace
+
+Result<CellLocate> locateAndPick(CellContext& cell, int type) {
+  auto outcome = cell.vision.locate(type);
+  if (!outcome) return outcome.error();
+  const auto grasps =
+      cell.vision.models() ? cell.vision.models()->grasps() : std::make_shared<const GraspMap>();
+  CellLocate located;
+  located.pick = pickPoses(*outcome, *grasps, cell.calibration.geometry());
+  located.outcome = std::move(*outcome);
+  ++cell.locates;
+  cell.last_offered = located.pick.poses.size();
+  cell.last_skipped = located.pick.skipped;
+  cell.skipped_total += located.pick.skipped;
+  return located;
+}
 
 const std::vector<std::string>& exposureFeatureNames() {
   static const std::vector<std::string> names{"ExposureTime", "ExposureTimeAbs",

@@ -8,6 +8,7 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
+#include "picksight/vision_app/plc_port.hpp"
 
 namespace picksight::app {
 
@@ -23,6 +24,7 @@ struct AppOptions {
   // allow-list as the robot port, on loopback unless --setup-bind says.
   std::optional<RobotServerOptions> setup;
   VisionOptions vision;
+  PlcPortOptions plc;  // off unless --modbus-port is given
 };
 
 // Parses argv without the program name; errors name the option. With

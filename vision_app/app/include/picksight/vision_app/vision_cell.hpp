@@ -46,6 +46,7 @@ class VisionCell {
   ModelLibrary& models() { return models_; }
   CellCalibration& calibration() { return calibration_; }
   const CellContext& context() const { return context_; }
+  CellContext& context() { return context_; }
 
  private:
   ModelLibrary models_;

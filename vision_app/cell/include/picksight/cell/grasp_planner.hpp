@@ -15,6 +15,7 @@ namespace picksight::app {
 
 struct CellPick {
   std::vector<grasp::Pose> poses;  // reply frame, in the order of the parts
+  std::vector<size_t> parts;       // for each pose, its part in the outcome's parts
   size_t skipped = 0;              // parts with no free grasp, not offered
   CoordinateFrame frame = CoordinateFrame::kVisionPixels;
 };

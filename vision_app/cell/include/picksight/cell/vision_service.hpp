@@ -115,8 +115,9 @@ class VisionService {
   void start();
   void stop();
 
-  // The parts of `type` in a frame taken after this call (every region when
-  // no model exists; VisionErrc::kUnknownType when models exist but none of `type`).
+  // The parts of `type` (-1: of every trained type) in a frame taken after
+  // this call (every region when no model exists; VisionErrc::kUnknownType
+  // when models exist but none of `type`).
   Result<LocateOutcome> locate(int type);
   // Trains type `type` from the single part in a fresh frame and stores it.
   Result<vision::PartModel> learn(int type, const std::string& name);

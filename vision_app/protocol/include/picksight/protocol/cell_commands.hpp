@@ -8,9 +8,10 @@
 #include <cstdint>
 #include <mutex>
 
-#include "picksight/store/cell_calibration.hpp"
-#include "picksight/protocol/command_table.hpp"
+#include "picksight/cell/grasp_planner.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/store/cell_calibration.hpp"
 
 namespace picksight::app {
 
@@ -26,6 +27,17 @@ struct CellContext {
   std::atomic<uint64_t> skipped_total{0};
   std::mutex grasp_edits;  // serializes GRASP/GRIPPER read-modify-writes
 };
+
+// A LOCATE's parts and the grasp poses offered for them.
+struct CellLocate {
+  LocateOutcome outcome;
+  CellPick pick;
+};
+
+// LOCATE of `type` (-1: every trained type) with grasps in the reply frame,
+// counted for STATUS: the one path behind the robot port's LOCATE and the
+// PLC port's trigger, so both give the same poses for the same frame.
+Result<CellLocate> locateAndPick(CellContext& cell, int type);
 
 // The camera feature names EXPOSURE tries, in order: GenICam SFNC, older
 // GenICam cameras, V4L2.

@@ -1,0 +1,225 @@
+#!/usr/bin/python3
+"""The PLC port of a real cell driven by pymodbus (Debian's python3-pymodbus),
+a Modbus implementation independent of the server's libmodbus: the
+handshake, the float decoding in CDAB word order on unit 5, the poses
+against the robot port's LOCATE, and the error paths (no model for the
+type, camera down).
+
+usage: /usr/bin/python3 plc_pymodbus_test.py --bin-dir BUILD/bin
+"""
+import argparse
+import os
+import queue
+import shutil
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+from pymodbus.client import ModbusTcpClient
+
+# docs/PLC.md, register map.
+CONTROL, PART_TYPE, STATUS, HEARTBEAT, ERROR_CODE = 0, 1, 10, 11, 12
+CALIBRATION, RESULT_FRAME, TRIGGER_COUNT = 13, 14, 15
+FRAME_SEQUENCE, PART_COUNT, FIRST_PART, PART_STRIDE = 18, 20, 30, 10
+TRIGGER, CLEAR_ERROR, RESULTS_ACK = 1, 2, 4
+READY, BUSY, TRIGGER_ACK, RESULTS_VALID, ERROR = 1, 2, 4, 8, 16
+ALL_TYPES = 0xFFFF
+UNIT = 5
+
+
+class Process:
+    """A build-tree binary whose stdout lines are read by a thread."""
+
+    def __init__(self, argv):
+        self.proc = subprocess.Popen(argv, stdout=subprocess.PIPE, text=True)
+        self.lines = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in self.proc.stdout:
+            self.lines.put(line.rstrip("\n"))
+
+    def wait_for(self, prefix, timeout=10.0):
+        deadline = time.monotonic() + timeout
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise AssertionError(f"no line starting with {prefix!r}")
+            try:
+                line = self.lines.get(timeout=left)
+            except queue.Empty:
+                continue
+            if line.startswith(prefix):
+                return line[len(prefix):]
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+class Robot:
+    def __init__(self, port):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=20)
+        self.file = self.sock.makefile("rw", newline="\n")
+
+    def request(self, line):
+        self.file.write(line + "\n")
+        self.file.flush()
+        return self.file.readline().rstrip("\n")
+
+
+class Plc:
+    def __init__(self, port):
+        self.client = ModbusTcpClient("127.0.0.1", port=port, timeout=10)
+        assert self.client.connect(), "cannot connect to the Modbus port"
+
+    def read(self, address, count=1):
+        rr = self.client.read_holding_registers(address, count, slave=UNIT)
+        assert not rr.isError(), f"read {address}+{count}: {rr}"
+        return rr.registers
+
+    def write(self, address, value):
+        rr = self.client.write_register(address, value, slave=UNIT)
+        assert not rr.isError(), f"write {address}={value}: {rr}"
+
+    def status(self):
+        return self.read(STATUS)[0]
+
+    def wait_for(self, any_bits, timeout=20.0):
+        deadline = time.monotonic() + timeout
+        while True:
+            s = self.status()
+            if s & any_bits:
+                return s
+            assert time.monotonic() < deadline, f"status {s:#x}: none of {any_bits:#x}"
+            time.sleep(0.001)
+
+    def trigger(self, part_type):
+        """The handshake: wait ready, select, trigger, wait, drop the trigger."""
+        self.wait_for(READY)
+        self.write(PART_TYPE, part_type)
+        self.write(CONTROL, TRIGGER)
+        assert self.status() & (BUSY | TRIGGER_ACK | RESULTS_VALID | ERROR)
+        self.wait_for(RESULTS_VALID | ERROR)
+        self.write(CONTROL, 0)
+        return self.status()
+
+    def acknowledge(self):
+        self.write(CONTROL, RESULTS_ACK)
+        self.write(CONTROL, 0)
+
+
+def float_cdab(words):
+    """Low word first (--modbus-word-order CDAB)."""
+    return struct.unpack(">f", struct.pack(">HH", words[1], words[0]))[0]
+
+
+def u32_cdab(words):
+    return words[1] << 16 | words[0]
+
+
+def parse_locate(reply):
+    words = reply.split()
+    assert words[0] == "OK", reply
+    n = int(words[1])
+    return [tuple(map(float, words[2 + 3 * i:5 + 3 * i])) for i in range(n)]
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--bin-dir", required=True)
+    args = parser.parse_args()
+    data_dir = tempfile.mkdtemp(prefix="picksight-pymodbus-")
+    server = vision = None
+    checks = 0
+    try:
+        server = Process([os.path.join(args.bin_dir, "picksight-video-server"), "--source",
+                          "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,noise=0",
+                          "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*",
+                          "--mode", "trigger"])
+        frames = server.wait_for("frames ")
+        control = server.wait_for("control ")
+        vision = Process([os.path.join(args.bin_dir, "picksight-vision"), "--frames", frames,
+                          "--control", control, "--robot-port", "0", "--bind", "127.0.0.1",
+                          "--data-dir", data_dir, "--modbus-port", "0", "--modbus-bind",
+                          "127.0.0.1", "--modbus-unit", str(UNIT), "--modbus-word-order", "CDAB"])
+        robot = Robot(int(vision.wait_for("robot ")))
+        plc = Plc(int(vision.wait_for("modbus ")))
+        vision.wait_for("ready")
+
+        assert plc.status() & READY
+        assert plc.read(CALIBRATION) == [0]
+        reply = robot.request("LEARN 1 bracket")
+        assert reply.startswith("OK 1 bracket "), reply
+        checks += 2
+
+        # No model for type 2 while type 1 has one: ERROR 32, as on the robot port.
+        s = plc.trigger(2)
+        assert s & ERROR and not s & RESULTS_VALID, hex(s)
+        assert plc.read(ERROR_CODE) == [32]
+        plc.write(CONTROL, CLEAR_ERROR)
+        plc.write(CONTROL, 0)
+        assert not plc.status() & ERROR
+        checks += 1
+
+        for part_type in (1, ALL_TYPES):
+            s = plc.trigger(part_type)
+            assert s & RESULTS_VALID and not s & ERROR, hex(s)
+            sequence = u32_cdab(plc.read(FRAME_SEQUENCE, 2))
+            frame_reply = robot.request("FRAME").split()
+            assert int(frame_reply[2]) == sequence, (frame_reply, sequence)
+            assert plc.read(RESULT_FRAME) == [0]
+            count = plc.read(PART_COUNT)[0]
+            assert count == 1, count
+            block = plc.read(FIRST_PART, PART_STRIDE)
+            part = (block[0], float_cdab(block[2:4]), float_cdab(block[4:6]),
+                    float_cdab(block[6:8]), float_cdab(block[8:10]))
+            plc.acknowledge()
+            assert plc.status() & READY
+            poses = parse_locate(robot.request("LOCATE 1"))
+            assert len(poses) == 1, poses
+            assert part[0] == 1, part
+            assert part[4] > 0.5, part
+            for got, want in zip(part[1:4], poses[0]):
+                assert abs(got - want) < 0.002, (part, poses)
+            checks += 1
+
+        # Reads of registers past the map: exception 2 (illegal data address).
+        rr = plc.client.read_holding_registers(190, 1, slave=UNIT)
+        assert rr.isError() and rr.exception_code == 2, rr
+        rr = plc.client.write_register(STATUS, 1, slave=UNIT)
+        assert rr.isError() and rr.exception_code == 2, rr
+        checks += 1
+
+        # The camera goes away: the trigger fails with the camera's code.
+        server.stop()
+        s = plc.trigger(1)
+        assert s & ERROR, hex(s)
+        assert plc.read(ERROR_CODE)[0] in (20, 21), plc.read(ERROR_CODE)
+        assert robot.request("PING") == "OK"
+        checks += 1
+        plc.client.close()
+    except AssertionError as e:
+        print(f"FAILED after {checks} checks: {e}")
+        print(f"{checks} passed, 1 failed")
+        return 1
+    finally:
+        for p in (vision, server):
+            if p:
+                p.stop()
+        shutil.rmtree(data_dir, ignore_errors=True)
+    print(f"{checks} passed, 0 failed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

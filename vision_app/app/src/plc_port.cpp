@@ -1,0 +1,24 @@
+// PLC port wiring.
+#include "picksight/vision_app/plc_port.hpp"
+
+#include "picksight/plc/cell_locator.hpp"
+
+namespace picksight::app {
+
+PlcPort::PlcPort(const PlcPortOptions& options, VisionCell& cell)
+    : device_(options.device, plc::cellLocator(cell.context()),
+              plc::cellFrameState(cell.calibration()), plc::robotErrorCodeOf),
+      server_(options.server, device_) {}
+
+void PlcPort::start() {
+  device_.start();
+  server_.start();
+}
+
+void PlcPort::stop() {
+  // No request after the device stops: the server goes first.
+  server_.stop();
+  device_.stop();
+}
+
+}  // namespace picksight::app
