@@ -9,16 +9,63 @@
 
 #include <sys/stat.h>
 #include <cerrno>
+#include <cmath>
 
 #include "picksight/common/atomic_file.hpp"
 
 namespace picksight::calibration {
 namespace {
-constexpr int kFormatVersion = 1;
+// Version 2 adds the transform's model (similarity, homography); version 1
+// files (rigid transforms) are still read.
+constexpr int kFormatVersion = 2;
 
-double number(const YAML::Node& node, const char* key) {
-  if (!node[key]) throw std::runtime_error(std::string("missing ") + key);
-  return node[key].as<double>();
+// A finite number under `key`; errors name the key with its section, since
+// a NaN or an infinity read back would turn every LOCATE reply into one.
+double number(const YAML::Node& node, const char* key, const std::string& where) {
+  if (!node[key]) throw std::runtime_error("missing " + where + key);
+  double v = 0;
+  try {
+    v = node[key].as<double>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(where + key + " is not a number");
+  }
+  if (!std::isfinite(v)) throw std::runtime_error(where + key + " is not a finite number");
+  return v;
+}
+
+PlaneTransform transformFromYaml(const YAML::Node& t) {
+  const std::string model = t["model"] ? t["model"].as<std::string>() : "rigid";
+  const RigidTransform rigid{number(t, "dx", "transform."), number(t, "dy", "transform."),
+                             number(t, "rz_deg", "transform."),
+                             t["mirrored"] && t["mirrored"].as<bool>()};
+  if (model == "rigid") return PlaneTransform::rigid(rigid);
+  if (model == "similarity") {
+    const double scale = number(t, "scale", "transform.");
+    if (!(scale > 0)) throw std::runtime_error("transform.scale must be positive");
+    return PlaneTransform::similarity(rigid, scale);
+  }
+  if (model == "homography") {
+    const auto m = t["matrix"] ? t["matrix"].as<std::vector<double>>() : std::vector<double>{};
+    if (m.size() != 9) throw std::runtime_error("transform.matrix must have 9 values");
+    cv::Matx33d h;
+    for (int i = 0; i < 9; ++i) {
+      if (!std::isfinite(m[static_cast<size_t>(i)]))
+        throw std::runtime_error("transform.matrix is not all finite numbers");
+      h.val[i] = m[static_cast<size_t>(i)];
+    }
+    auto p = PlaneTransform::homography(h);
+    if (!p) throw std::runtime_error("transform.matrix: " + p.error().message);
+    return *p;
+  }
+  throw std::runtime_error("transform.model must be rigid, similarity or homography");
+}
+
+Method methodFromName(const std::string& name) {
+  for (Method m :
+       {Method::kGeometric, Method::kLeastSquares, Method::kSimilarity, Method::kHomography}) {
+    if (name == methodName(m)) return m;
+  }
+  throw std::runtime_error("transform.method '" + name + "' is unknown");
 }
 }  // namespace
 
@@ -44,6 +91,13 @@ std::string CalibrationStore::serialize() const {
     out << YAML::Key << "dx" << YAML::Value << t.dx << YAML::Key << "dy" << YAML::Value << t.dy;
     out << YAML::Key << "rz_deg" << YAML::Value << t.rz_deg << YAML::Key << "mirrored"
         << YAML::Value << t.mirrored;
+    out << YAML::Key << "model" << YAML::Value << modelName(t.model);
+    out << YAML::Key << "scale" << YAML::Value << t.scale;
+    if (t.model == TransformModel::kHomography) {
+      out << YAML::Key << "matrix" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (int i = 0; i < 9; ++i) out << t.matrix.val[i];
+      out << YAML::EndSeq;
+    }
     out << YAML::Key << "method" << YAML::Value << methodName(transform_->method);
     out << YAML::Key << "rms" << YAML::Value << transform_->rms;
     out << YAML::Key << "inliers" << YAML::Value << transform_->inliers;
@@ -81,31 +135,31 @@ Result<void> CalibrationStore::load() {
   try {
     const YAML::Node root = YAML::LoadFile(path_);
     if (!root.IsMap()) throw std::runtime_error("not a YAML map");
-    if (!root["format_version"] || root["format_version"].as<int>() != kFormatVersion) {
-      throw std::runtime_error("format_version must be " + std::to_string(kFormatVersion));
+    const int version = root["format_version"] ? root["format_version"].as<int>() : 0;
+    if (version < 1 || version > kFormatVersion) {
+      throw std::runtime_error("format_version must be 1 to " + std::to_string(kFormatVersion));
     }
     loaded.next_id_ = root["next_id"] ? root["next_id"].as<int>() : 1;
     for (const auto& p : root["points"]) {
       const int id = p["id"].as<int>();
       if (id <= 0 || loaded.points_.count(id))
         throw std::runtime_error("bad or repeated point id " + std::to_string(id));
-      loaded.points_[id] = PointPair{{number(p, "vision_x"), number(p, "vision_y")},
-                                     {number(p, "robot_x"), number(p, "robot_y")}};
+      const std::string where = "point " + std::to_string(id) + " ";
+      loaded.points_[id] = PointPair{{number(p, "vision_x", where), number(p, "vision_y", where)},
+                                     {number(p, "robot_x", where), number(p, "robot_y", where)}};
       loaded.next_id_ = std::max(loaded.next_id_, id + 1);
     }
     if (const auto t = root["transform"]) {
       CalibrationResult r;
-      r.transform = RigidTransform{number(t, "dx"), number(t, "dy"), number(t, "rz_deg"),
-                                   t["mirrored"] && t["mirrored"].as<bool>()};
-      const std::string method = t["method"] ? t["method"].as<std::string>() : "lsq";
-      r.method = method == "geometric" ? Method::kGeometric : Method::kLeastSquares;
-      r.rms = number(t, "rms");
+      r.transform = transformFromYaml(t);
+      r.method = methodFromName(t["method"] ? t["method"].as<std::string>() : "lsq");
+      r.rms = number(t, "rms", "transform.");
       r.inliers = t["inliers"] ? t["inliers"].as<int>() : 0;
       loaded.transform_ = r;
     }
     if (const auto s = root["scale"]) {
-      PixelScale scale{number(s, "mm_per_px_x"), number(s, "mm_per_px_y"),
-                       s["skew_deg"] ? number(s, "skew_deg") : 0};
+      PixelScale scale{number(s, "mm_per_px_x", "scale."), number(s, "mm_per_px_y", "scale."),
+                       s["skew_deg"] ? number(s, "skew_deg", "scale.") : 0};
       if (!(scale.mm_per_px_x > 0) || !(scale.mm_per_px_y > 0))
         throw std::runtime_error("scale must be positive");
       loaded.scale_ = scale;
@@ -119,7 +173,13 @@ Result<void> CalibrationStore::load() {
       lens.distortion = l["distortion"].as<std::vector<double>>();
       if (lens.distortion.size() < 4)
         throw std::runtime_error("lens distortion needs at least 4 values");
-      lens.rms_reprojection_px = number(l, "rms_reprojection_px");
+      for (double v : k) {
+        if (!std::isfinite(v)) throw std::runtime_error("lens.camera_matrix is not all finite");
+      }
+      for (double v : lens.distortion) {
+        if (!std::isfinite(v)) throw std::runtime_error("lens.distortion is not all finite");
+      }
+      lens.rms_reprojection_px = number(l, "rms_reprojection_px", "lens.");
       lens.views = l["views"] ? l["views"].as<int>() : 0;
       loaded.lens_ = lens;
     }

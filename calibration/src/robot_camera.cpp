@@ -1,13 +1,15 @@
-// Robot-camera calibration: least-squares (Kabsch in 2D) and geometric
-// (circle intersections) estimators behind least median of
-// squares outlier rejection.
+// Robot-camera calibration: the transforms, and the choice of estimator and
+// model behind outlier rejection (the estimators are in robot_camera_fits).
 #include "picksight/calibration/robot_camera.hpp"
-
-#include "picksight/common/angles.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
+
+#include "picksight/common/angles.hpp"
+#include "robot_camera_fits.hpp"
 
 namespace picksight::calibration {
 
@@ -29,178 +31,90 @@ const char* errorName(CalibrationErrc e) {
 namespace {
 using picksight::kDegPerRad;
 using picksight::signedDeg;
-// Points closer together than this (mm) along their spread's minor axis are
-// taken as lying on one line: rotation and handedness are then unobservable.
-constexpr double kMinSpreadMm = 1.0;
 
-cv::Point2d mirror(cv::Point2d p, bool mirrored) { return mirrored ? cv::Point2d(p.x, -p.y) : p; }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
+int parameters(TransformModel model) {
+  switch (model) {
+    case TransformModel::kRigid:
+      return 3;
+    case TransformModel::kSimilarity:
+      return 4;
+    case TransformModel::kHomography:
+      return 8;
+  }
+  return 8;
 }
 
-std::vector<double> squaredResiduals(const RigidTransform& t, const std::vector<PointPair>& pts) {
-  std::vector<double> r;
-  r.reserve(pts.size());
-  for (const auto& p : pts) {
-    const cv::Point2d d = t.apply(p.vision) - p.robot;
-    r.push_back(d.dot(d));
+// Fewest inliers the homography is fitted to; the fewest points for which
+// it finds the outliers (its 4-point samples need that many to outvote a
+// wrong point) and BEST may choose it (from 6 or 7 points its 8 parameters
+// leave too little to tell a tilt from noise: leaving one point out still
+// predicts it well by chance, and the work area's corners pay).
+constexpr int kHomographyMinInliers = 6;
+constexpr size_t kHomographyOutlierPoints = 8;
+constexpr int kHomographyBestInliers = 8;
+// Cross-validation: every inlier left out in turn up to this many inliers,
+// beyond that this many folds (time linear in the number of points).
+constexpr size_t kLeaveOneOutMax = 30;
+constexpr size_t kFolds = 10;
+
+using Estimator = std::function<std::optional<PlaneTransform>(const std::vector<PointPair>&)>;
+
+Estimator estimator(Method method, bool mirrored, double cluster_radius) {
+  switch (method) {
+    case Method::kGeometric:
+      return [=](const std::vector<PointPair>& p) -> std::optional<PlaneTransform> {
+        return PlaneTransform::rigid(fits::geometric(p, mirrored, cluster_radius));
+      };
+    case Method::kSimilarity:
+      return [=](const std::vector<PointPair>& p) -> std::optional<PlaneTransform> {
+        return fits::similarity(p, mirrored);
+      };
+    case Method::kHomography:
+      return [](const std::vector<PointPair>& p) { return fits::homography(p); };
+    case Method::kLeastSquares:
+    case Method::kBest:
+      break;
   }
-  return r;
+  return [=](const std::vector<PointPair>& p) -> std::optional<PlaneTransform> {
+    return PlaneTransform::rigid(fits::rigid(p, mirrored));
+  };
 }
 
-// Least squares over the points flagged in `use` (2D Kabsch).
-RigidTransform leastSquares(const std::vector<PointPair>& pts, const std::vector<bool>& use,
-                            bool mirrored) {
-  cv::Point2d cv_sum(0, 0), cr_sum(0, 0);
-  int n = 0;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    if (!use[i]) continue;
-    cv_sum += mirror(pts[i].vision, mirrored);
-    cr_sum += pts[i].robot;
-    ++n;
-  }
-  const cv::Point2d cv_mean = cv_sum / n;
-  const cv::Point2d cr_mean = cr_sum / n;
-  double sxx = 0, sxy = 0, syx = 0, syy = 0;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    if (!use[i]) continue;
-    const cv::Point2d a = mirror(pts[i].vision, mirrored) - cv_mean;
-    const cv::Point2d b = pts[i].robot - cr_mean;
-    sxx += a.x * b.x;
-    sxy += a.x * b.y;
-    syx += a.y * b.x;
-    syy += a.y * b.y;
-  }
-  const double theta = std::atan2(sxy - syx, sxx + syy);
-  RigidTransform t;
-  t.mirrored = mirrored;
-  t.rz_deg = signedDeg(theta * kDegPerRad);
-  const double c = std::cos(theta), s = std::sin(theta);
-  t.dx = cr_mean.x - (c * cv_mean.x - s * cv_mean.y);
-  t.dy = cr_mean.y - (s * cv_mean.x + c * cv_mean.y);
-  return t;
-}
-
-// The paper's geometric method. A rigid motion keeps distances, so the
-// vision origin, seen in the robot frame, lies at distance |v_i| from every
-// robot point r_i: on a circle around each. Pairs of circles intersect in
-// two candidates; the right ones cluster at the origin. The rotation then
-// follows from each point's bearing from that origin in both frames (the
-// law of cosines in the paper; bearings here).
-RigidTransform geometric(const std::vector<PointPair>& pts, const std::vector<bool>& use,
-                         bool mirrored, double cluster_radius) {
-  std::vector<cv::Point2d> candidates;
-  std::vector<std::pair<cv::Point2d, cv::Point2d>> pairs;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    for (size_t j = i + 1; j < pts.size(); ++j) {
-      if (!use[i] || !use[j]) continue;
-      const cv::Point2d ci = pts[i].robot, cj = pts[j].robot;
-      const double ri = cv::norm(pts[i].vision), rj = cv::norm(pts[j].vision);
-      const cv::Point2d d = cj - ci;
-      const double dist = cv::norm(d);
-      if (dist < 1e-9) continue;
-      // Distance from ci along d to the chord; with noise the circles may
-      // miss each other: then the closest point on the line of centres.
-      const double a = (ri * ri - rj * rj + dist * dist) / (2 * dist);
-      const double h2 = ri * ri - a * a;
-      const double h = h2 > 0 ? std::sqrt(h2) : 0;
-      const cv::Point2d base = ci + d * (a / dist);
-      const cv::Point2d perp(-d.y / dist, d.x / dist);
-      pairs.emplace_back(base + perp * h, base - perp * h);
-      candidates.push_back(base + perp * h);
-      candidates.push_back(base - perp * h);
+// RMS error of each inlier predicted by the fit of the others: what a part
+// located where no point was stored can expect, the model's extra freedom
+// (which only lowers the residuals of the points it was fitted to) included.
+double crossValidatedRms(const std::vector<PointPair>& inliers, const Estimator& fit) {
+  const size_t n = inliers.size();
+  const size_t folds = n <= kLeaveOneOutMax ? n : kFolds;
+  double sum = 0;
+  for (size_t f = 0; f < folds; ++f) {
+    std::vector<PointPair> train, test;
+    for (size_t i = 0; i < n; ++i) (i % folds == f ? test : train).push_back(inliers[i]);
+    const auto t = train.size() >= 2 ? fit(train) : std::nullopt;
+    if (!t) return std::numeric_limits<double>::infinity();
+    for (const auto& p : test) {
+      const cv::Point2d d = t->apply(p.vision) - p.robot;
+      const double e2 = d.dot(d);
+      if (!std::isfinite(e2)) return std::numeric_limits<double>::infinity();
+      sum += e2;
     }
   }
-  // The candidate with the most neighbours seeds the cluster.
-  cv::Point2d seed(0, 0);
-  int best = -1;
-  for (const auto& c : candidates) {
-    int count = 0;
-    for (const auto& o : candidates) count += cv::norm(o - c) < cluster_radius;
-    if (count > best) {
-      best = count;
-      seed = c;
-    }
-  }
-  // From each pair, the candidate nearer the seed; their median is the origin.
-  std::vector<double> xs, ys;
-  for (const auto& [p, q] : pairs) {
-    const cv::Point2d pick = cv::norm(p - seed) <= cv::norm(q - seed) ? p : q;
-    xs.push_back(pick.x);
-    ys.push_back(pick.y);
-  }
-  const cv::Point2d origin(median(xs), median(ys));
-
-  // Mean bearing difference, weighted by distance from the origin (far
-  // points give the best-defined bearings).
-  double sx = 0, sy = 0;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    if (!use[i]) continue;
-    const cv::Point2d v = mirror(pts[i].vision, mirrored);
-    const cv::Point2d r = pts[i].robot - origin;
-    const double w = cv::norm(v);
-    if (w < 1e-9 || cv::norm(r) < 1e-9) continue;
-    const double diff = std::atan2(r.y, r.x) - std::atan2(v.y, v.x);
-    sx += w * std::cos(diff);
-    sy += w * std::sin(diff);
-  }
-  RigidTransform t;
-  t.mirrored = mirrored;
-  t.rz_deg = signedDeg(std::atan2(sy, sx) * kDegPerRad);
-  t.dx = origin.x;
-  t.dy = origin.y;
-  return t;
+  return std::sqrt(sum / static_cast<double>(n));
 }
 
-// Least median of squares over every two-point hypothesis, for both
-// handedness cases: robust to just under half the points being wrong.
-std::vector<bool> findInliers(const std::vector<PointPair>& pts, bool* mirrored_out) {
-  double best_median = std::numeric_limits<double>::max();
-  RigidTransform best;
-  for (bool mirrored : {false, true}) {
-    for (size_t i = 0; i < pts.size(); ++i) {
-      for (size_t j = i + 1; j < pts.size(); ++j) {
-        std::vector<bool> use(pts.size(), false);
-        use[i] = use[j] = true;
-        const RigidTransform t = leastSquares(pts, use, mirrored);
-        const double m = median(squaredResiduals(t, pts));
-        if (m < best_median) {
-          best_median = m;
-          best = t;
-        }
-      }
-    }
-  }
-  *mirrored_out = best.mirrored;
-  // Rousseeuw's scale estimate with its small-sample correction.
-  const size_t n = pts.size();
-  const double scale = 1.4826 * (1.0 + 5.0 / static_cast<double>(std::max<size_t>(n, 3) - 2)) *
-                       std::sqrt(best_median);
-  // Below a tenth of a millimetre the scale is noise in the noise: never cut
-  // tighter than that.
-  const double cut = std::max(2.5 * scale, 0.1);
-  // Refit on the core and decide inliers against the refit, not the
-  // two-point hypothesis.
-  std::vector<bool> use(n);
-  const auto r0 = squaredResiduals(best, pts);
-  for (size_t i = 0; i < n; ++i) use[i] = std::sqrt(r0[i]) <= cut;
-  const RigidTransform refit = leastSquares(pts, use, best.mirrored);
-  const auto r1 = squaredResiduals(refit, pts);
-  for (size_t i = 0; i < n; ++i) use[i] = std::sqrt(r1[i]) <= cut;
-  return use;
-}
-
-CalibrationResult evaluate(const RigidTransform& t, Method method,
-                           const std::vector<PointPair>& pts, const std::vector<bool>& use) {
+// The estimator fitted to the inliers, with every point's residual.
+std::optional<CalibrationResult> evaluate(const Estimator& fit, Method method,
+                                          const std::vector<PointPair>& pts,
+                                          const std::vector<bool>& use) {
+  const auto inliers = fits::select(pts, use);
+  const auto t = fit(inliers);
+  if (!t) return std::nullopt;
   CalibrationResult r;
-  r.transform = t;
+  r.transform = *t;
   r.method = method;
   double sum = 0;
   for (size_t i = 0; i < pts.size(); ++i) {
-    const cv::Point2d d = t.apply(pts[i].vision) - pts[i].robot;
+    const cv::Point2d d = t->apply(pts[i].vision) - pts[i].robot;
     Residual res{d.x, d.y, cv::norm(d), static_cast<bool>(use[i])};
     if (use[i]) {
       sum += d.dot(d);
@@ -209,12 +123,18 @@ CalibrationResult evaluate(const RigidTransform& t, Method method,
     r.residuals.push_back(res);
   }
   r.rms = r.inliers > 0 ? std::sqrt(sum / r.inliers) : 0;
+  r.predicted_error = crossValidatedRms(inliers, fit);
   return r;
+}
+
+Error tooFewAgree() {
+  return makeError(CalibrationErrc::kTooFewPoints,
+                   "fewer than 3 points agree with each other: check the stored points");
 }
 }  // namespace
 
 cv::Point2d RigidTransform::apply(cv::Point2d vision) const {
-  const cv::Point2d v = mirror(vision, mirrored);
+  const cv::Point2d v = mirrored ? cv::Point2d(vision.x, -vision.y) : vision;
   const double a = rz_deg / kDegPerRad;
   return {dx + std::cos(a) * v.x - std::sin(a) * v.y, dy + std::sin(a) * v.x + std::cos(a) * v.y};
 }
@@ -223,22 +143,113 @@ double RigidTransform::applyToAngleDeg(double vision_deg) const {
   return picksight::normalizeDeg((mirrored ? -vision_deg : vision_deg) + rz_deg);
 }
 
+PlaneTransform PlaneTransform::rigid(const RigidTransform& t) {
+  PlaneTransform p = similarity(t, 1.0);
+  p.model = TransformModel::kRigid;
+  return p;
+}
+
+PlaneTransform PlaneTransform::similarity(const RigidTransform& t, double scale) {
+  PlaneTransform p;
+  p.model = TransformModel::kSimilarity;
+  const double a = t.rz_deg / kDegPerRad;
+  const double c = scale * std::cos(a), s = scale * std::sin(a);
+  const double m = t.mirrored ? -1.0 : 1.0;
+  p.matrix = cv::Matx33d(c, -s * m, t.dx, s, c * m, t.dy, 0, 0, 1);
+  p.dx = t.dx;
+  p.dy = t.dy;
+  p.rz_deg = signedDeg(t.rz_deg);
+  p.scale = scale;
+  p.mirrored = t.mirrored;
+  return p;
+}
+
+Result<PlaneTransform> PlaneTransform::homography(const cv::Matx33d& h) {
+  for (int i = 0; i < 9; ++i) {
+    if (!std::isfinite(h.val[i]))
+      return makeError(CalibrationErrc::kBadInput, "the homography has a non-finite element");
+  }
+  const double norm = cv::norm(h);
+  if (!(norm > 0) || std::abs(h(2, 2)) < 1e-12 * norm ||
+      std::abs(cv::determinant(h)) < 1e-15 * std::pow(norm, 3))
+    return makeError(CalibrationErrc::kBadInput, "the homography is singular");
+  PlaneTransform p;
+  p.model = TransformModel::kHomography;
+  p.matrix = h * (1.0 / h(2, 2));
+  p.dx = p.matrix(0, 2);
+  p.dy = p.matrix(1, 2);
+  // The local linear map at the vision origin (where w = 1).
+  const cv::Matx22d j(
+      p.matrix(0, 0) - p.dx * p.matrix(2, 0), p.matrix(0, 1) - p.dx * p.matrix(2, 1),
+      p.matrix(1, 0) - p.dy * p.matrix(2, 0), p.matrix(1, 1) - p.dy * p.matrix(2, 1));
+  const double det = cv::determinant(j);
+  p.mirrored = det < 0;
+  p.scale = std::sqrt(std::abs(det));
+  p.rz_deg = signedDeg(std::atan2(j(1, 0), j(0, 0)) * kDegPerRad);
+  return p;
+}
+
+cv::Point2d PlaneTransform::apply(cv::Point2d vision) const {
+  const cv::Vec3d q = matrix * cv::Vec3d(vision.x, vision.y, 1);
+  return {q[0] / q[2], q[1] / q[2]};
+}
+
+double PlaneTransform::applyToAngleDeg(double vision_deg, cv::Point2d at) const {
+  const double a = vision_deg / kDegPerRad;
+  // The image of a short step along the direction: exact for rigid and
+  // similarity, the local direction for a homography.
+  const double w = matrix(2, 0) * at.x + matrix(2, 1) * at.y + matrix(2, 2);
+  const cv::Point2d p = apply(at);
+  const cv::Point2d d(std::cos(a), std::sin(a));
+  const cv::Point2d jd(
+      ((matrix(0, 0) - p.x * matrix(2, 0)) * d.x + (matrix(0, 1) - p.x * matrix(2, 1)) * d.y) / w,
+      ((matrix(1, 0) - p.y * matrix(2, 0)) * d.x + (matrix(1, 1) - p.y * matrix(2, 1)) * d.y) / w);
+  return picksight::normalizeDeg(std::atan2(jd.y, jd.x) * kDegPerRad);
+}
+
 const char* methodName(Method method) {
   switch (method) {
     case Method::kGeometric:
       return "geometric";
     case Method::kLeastSquares:
       return "lsq";
+    case Method::kSimilarity:
+      return "similarity";
+    case Method::kHomography:
+      return "homography";
     case Method::kBest:
       return "best";
   }
   return "?";
 }
 
+const char* modelName(TransformModel model) {
+  switch (model) {
+    case TransformModel::kRigid:
+      return "rigid";
+    case TransformModel::kSimilarity:
+      return "similarity";
+    case TransformModel::kHomography:
+      return "homography";
+  }
+  return "?";
+}
+
+int minimumPoints(Method method) { return method == Method::kHomography ? 6 : 3; }
+
 Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method method) {
-  if (points.size() < 3) {
+  const size_t need = static_cast<size_t>(minimumPoints(method));
+  if (points.size() < need) {
     return makeError(CalibrationErrc::kTooFewPoints,
-                     "need at least 3 points, have " + std::to_string(points.size()));
+                     std::string(methodName(method)) + " needs at least " + std::to_string(need) +
+                         " points, have " + std::to_string(points.size()));
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    const auto& p = points[i];
+    if (!std::isfinite(p.vision.x) || !std::isfinite(p.vision.y) || !std::isfinite(p.robot.x) ||
+        !std::isfinite(p.robot.y))
+      return makeError(CalibrationErrc::kBadInput,
+                       "point " + std::to_string(i + 1) + " has a non-finite coordinate");
   }
   // Spread of the vision points along their minor axis.
   cv::Mat data(static_cast<int>(points.size()), 2, CV_64F);
@@ -248,27 +259,61 @@ Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method
   }
   cv::PCA pca(data, cv::Mat(), cv::PCA::DATA_AS_ROW);
   const double minor = std::sqrt(std::max(0.0, pca.eigenvalues.at<double>(1)));
-  if (minor < kMinSpreadMm) {
+  if (minor < fits::kMinSpreadMm) {
     return makeError(CalibrationErrc::kDegeneratePoints,
                      "the points lie (nearly) on one line: spread them over the work area");
   }
-  bool mirrored = false;
-  const std::vector<bool> use = findInliers(points, &mirrored);
-  const int inliers = static_cast<int>(std::count(use.begin(), use.end(), true));
-  if (inliers < 3) {
-    return makeError(CalibrationErrc::kTooFewPoints,
-                     "fewer than 3 points agree with each other: check the stored points");
+  const TransformModel outlier_model =
+      method == Method::kSimilarity   ? TransformModel::kSimilarity
+      : method == Method::kHomography ? TransformModel::kHomography
+      : method == Method::kBest
+          ? (points.size() >= kHomographyOutlierPoints ? TransformModel::kHomography
+                                                       : TransformModel::kSimilarity)
+          : TransformModel::kRigid;
+  const auto robust = fits::robustFit(points, outlier_model);
+  if (!robust) {
+    return makeError(CalibrationErrc::kDegeneratePoints,
+                     "no well-spread subset of the points: spread them over the work area");
   }
-  // Cluster radius for the geometric method: a few times the noise level,
-  // never below a tenth of a millimetre.
-  const RigidTransform lsq = leastSquares(points, use, mirrored);
-  CalibrationResult by_lsq = evaluate(lsq, Method::kLeastSquares, points, use);
-  if (method == Method::kLeastSquares) return by_lsq;
-  const double radius = std::max(0.1, 5 * by_lsq.rms);
-  CalibrationResult by_geometry =
-      evaluate(geometric(points, use, mirrored, radius), Method::kGeometric, points, use);
-  if (method == Method::kGeometric) return by_geometry;
-  return by_geometry.rms < by_lsq.rms ? by_geometry : by_lsq;
+  const std::vector<bool>& use = robust->inliers;
+  const int inliers = static_cast<int>(std::count(use.begin(), use.end(), true));
+  if (inliers < 3) return tooFewAgree();
+  const bool mirrored = robust->transform.mirrored;
+  // Cluster radius for the geometric method: a few times the noise level
+  // (the robust fit's RMS), never below a tenth of a millimetre.
+  double ss = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!use[i]) continue;
+    const cv::Point2d d = robust->transform.apply(points[i].vision) - points[i].robot;
+    ss += d.dot(d);
+  }
+  const double radius = std::max(0.1, 5 * std::sqrt(ss / inliers));
+  if (method == Method::kHomography && inliers < kHomographyMinInliers) return tooFewAgree();
+  if (method != Method::kBest) {
+    auto r = evaluate(estimator(method, mirrored, radius), method, points, use);
+    if (!r)
+      return makeError(CalibrationErrc::kDegeneratePoints,
+                       "the inliers do not determine a homography: spread them over the work area");
+    return *r;
+  }
+  // Every model on the same inliers; the lowest cross-validated error wins,
+  // but a more general model must predict 20 % better than the simpler one
+  // kept so far: points left out one at a time all lie among the others,
+  // where a homography fitted to noise still predicts well, while parts are
+  // also located beyond them, where it does not. A real scale error or tilt
+  // makes a simpler model several times worse, not 20 %.
+  std::vector<Method> methods{Method::kLeastSquares, Method::kGeometric, Method::kSimilarity};
+  if (inliers >= kHomographyBestInliers) methods.push_back(Method::kHomography);
+  std::optional<CalibrationResult> best;
+  for (Method m : methods) {
+    auto r = evaluate(estimator(m, mirrored, radius), m, points, use);
+    if (!r) continue;
+    const bool simpler_or_same =
+        best && parameters(r->transform.model) <= parameters(best->transform.model);
+    if (!best || r->predicted_error < (simpler_or_same ? 1.0 : 0.8) * best->predicted_error)
+      best = std::move(r);
+  }
+  return *best;
 }
 
 }  // namespace picksight::calibration

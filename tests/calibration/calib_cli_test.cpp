@@ -76,3 +76,28 @@ TEST_CASE("picksight-calib names the bad line and refuses too few points", "[cal
   std::remove(bad.c_str());
   std::remove(few.c_str());
 }
+
+TEST_CASE("picksight-calib prints every model's fit beside the chosen one", "[calibration][cli]") {
+  // A camera scale 0.3 % off: the similarity and homography read it.
+  std::string csv = "robot_x,robot_y,vision_x,vision_y\n";
+  const calibration::RigidTransform turn{328.4, -614.4, -179.0, false};
+  for (int i = 0; i < 9; ++i) {
+    const cv::Point2d v(-150.0 + 150.0 * (i % 3), -70.0 + 70.0 * (i / 3) + (i % 2) * 3.0);
+    const cv::Point2d r = turn.apply(v / 1.003);
+    char row[128];
+    std::snprintf(row, sizeof(row), "%.5f,%.5f,%.5f,%.5f\n", r.x, r.y, v.x, v.y);
+    csv += row;
+  }
+  const std::string path = tempCsv(csv);
+  const Run r = calib({"--csv", path});
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("method similarity") != std::string::npos);
+  CHECK(r.out.find("scale 0.997009") != std::string::npos);
+  CHECK(r.out.find("dx 328.4000") != std::string::npos);
+  CHECK(r.out.find("rz 181.0000") == std::string::npos);  // (-180, 180]: -179
+  CHECK(r.out.find("rz -179.0000") != std::string::npos);
+  for (const char* fit : {"\nlsq ", "\ngeometric ", "\nsimilarity ", "\nhomography "})
+    CHECK(r.out.find(fit) != std::string::npos);
+  std::remove(path.c_str());
+}

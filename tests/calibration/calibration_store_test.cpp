@@ -31,7 +31,7 @@ TEST_CASE("calibration points, transform, scale and lens survive a reload",
     CHECK(*store.addPoint({{30, 5}, {330, 45}}) == 3);
     REQUIRE(store.deletePoint(2));
     CalibrationResult r;
-    r.transform = RigidTransform{300.1234567891, 41.5, -12.25, false};
+    r.transform = PlaneTransform::rigid({300.1234567891, 41.5, -12.25, false});
     r.rms = 0.0123;
     r.inliers = 2;
     REQUIRE(store.setTransform(r));
@@ -103,4 +103,88 @@ TEST_CASE("the vision frame flips y so that a camera looking down is right-hande
   // -30, that is 330, counter-clockwise.
   CHECK(VisionFrame::angleToVision(30) == Approx(330));
   CHECK(VisionFrame::angleToImage(VisionFrame::angleToVision(123)) == Approx(123));
+}
+
+TEST_CASE("similarity and homography transforms survive a reload", "[calibration][store]") {
+  TempDir dir;
+  const std::string file = dir.file("calibration.yaml");
+  const cv::Matx33d h(0.998, -0.061, 328.4, 0.0605, 0.9975, -614.4, 1.2e-6, -3.4e-6, 1);
+  {
+    CalibrationStore store(file);
+    CalibrationResult r;
+    r.transform = PlaneTransform::similarity({10, 20, 179.5, true}, 0.997);
+    r.method = Method::kSimilarity;
+    REQUIRE(store.setTransform(r));
+  }
+  CalibrationStore again(file);
+  REQUIRE(again.load());
+  REQUIRE(again.transform());
+  CHECK(again.transform()->method == Method::kSimilarity);
+  CHECK(again.transform()->transform.model == TransformModel::kSimilarity);
+  CHECK(again.transform()->transform.scale == 0.997);
+  CHECK(again.transform()->transform.mirrored);
+  CHECK(again.transform()->transform.apply({100, 50}).x ==
+        Approx(PlaneTransform::similarity({10, 20, 179.5, true}, 0.997).apply({100, 50}).x));
+  CalibrationResult r;
+  r.transform = *PlaneTransform::homography(h);
+  r.method = Method::kHomography;
+  REQUIRE(again.setTransform(r));
+  CalibrationStore third(file);
+  REQUIRE(third.load());
+  REQUIRE(third.transform());
+  CHECK(third.transform()->transform.model == TransformModel::kHomography);
+  CHECK(third.transform()->transform.matrix == r.transform.matrix);
+}
+
+TEST_CASE("a version 1 calibration file is still read", "[calibration][store]") {
+  TempDir dir;
+  const std::string file = dir.file("calibration.yaml");
+  std::ofstream(file) << "format_version: 1\nnext_id: 3\npoints:\n"
+                         "  - {id: 2, vision_x: 1.5, vision_y: 2, robot_x: 300, robot_y: 40}\n"
+                         "transform:\n  dx: 328.4\n  dy: -614.4\n  rz_deg: 181\n"
+                         "  mirrored: false\n  method: geometric\n  rms: 0.1\n  inliers: 17\n";
+  CalibrationStore store(file);
+  REQUIRE(store.load());
+  REQUIRE(store.transform());
+  CHECK(store.transform()->method == Method::kGeometric);
+  CHECK(store.transform()->transform.model == TransformModel::kRigid);
+  CHECK(store.transform()->transform.apply({0, 0}).x == Approx(328.4));
+  CHECK(store.points().at(2).robot.x == 300);
+}
+
+TEST_CASE("non-finite numbers in a calibration file are refused with the key named",
+          "[calibration][store]") {
+  TempDir dir;
+  const std::string file = dir.file("calibration.yaml");
+  const std::string good_point = "  - {id: 1, vision_x: 1, vision_y: 2, robot_x: 3, robot_y: 4}\n";
+  struct Case {
+    std::string text;
+    std::string key;
+  };
+  for (const Case& c : {
+           Case{"format_version: 2\ntransform: {dx: .nan, dy: 0, rz_deg: 0, rms: 0}\n",
+                "transform.dx"},
+           Case{"format_version: 2\ntransform: {dx: 0, dy: 0, rz_deg: .inf, rms: 0}\n",
+                "transform.rz_deg"},
+           Case{"format_version: 2\ntransform: {dx: 0, dy: 0, rz_deg: 0, rms: 0, model: "
+                "similarity, scale: -.inf}\n",
+                "transform.scale"},
+           Case{"format_version: 2\ntransform: {dx: 0, dy: 0, rz_deg: 0, rms: 0, model: "
+                "homography, matrix: [1, 0, 0, 0, 1, .nan, 0, 0, 1]}\n",
+                "transform.matrix"},
+           Case{"format_version: 2\npoints:\n" + good_point +
+                    "  - {id: 2, vision_x: .nan, vision_y: 2, robot_x: 3, robot_y: 4}\n",
+                "point 2 vision_x"},
+           Case{"format_version: 2\nscale: {mm_per_px_x: .nan, mm_per_px_y: 0.25}\n",
+                "scale.mm_per_px_x"},
+       }) {
+    INFO(c.text);
+    std::ofstream(file) << c.text;
+    CalibrationStore store(file);
+    auto r = store.load();
+    REQUIRE_FALSE(r);
+    CHECK(r.error().code == CalibrationErrc::kBadFile);
+    CHECK(r.error().message.find(c.key) != std::string::npos);
+    CHECK_FALSE(store.transform());
+  }
 }

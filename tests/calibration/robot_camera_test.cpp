@@ -28,7 +28,8 @@ std::vector<PointPair> makePoints(const RigidTransform& truth, int n, double sig
 }
 
 // Largest distance between where the two transforms put a point of the work area.
-double worstPlacementError(const RigidTransform& a, const RigidTransform& b) {
+template <typename A, typename B>
+double worstPlacementError(const A& a, const B& b) {
   double worst = 0;
   for (double x = -200; x <= 200; x += 50) {
     for (double y = -150; y <= 150; y += 50)
@@ -38,7 +39,8 @@ double worstPlacementError(const RigidTransform& a, const RigidTransform& b) {
 }
 
 // RMS of that distance over the work area.
-double rmsPlacementError(const RigidTransform& a, const RigidTransform& b) {
+template <typename A, typename B>
+double rmsPlacementError(const A& a, const B& b) {
   double sum = 0;
   int n = 0;
   for (double x = -200; x <= 200; x += 50) {

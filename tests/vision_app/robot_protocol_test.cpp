@@ -70,11 +70,14 @@ TEST_CASE("cell commands check their arguments before the camera or a file",
                           "STORE 1",
                           "STORE 1 2 3",
                           "STORE a b",
+                          "STORE nan 2",
+                          "STORE 1 inf",
                           "DELETE",
                           "DELETE x",
                           "DELETE -1",
                           "LIST 1",
                           "COMPUTE X",
+                          "COMPUTE SIMILARITY LSQ",
                           "RESIDUALS 1",
                           "GRASP",
                           "GRASP 1",
@@ -101,6 +104,8 @@ TEST_CASE("cell commands check their arguments before the camera or a file",
   CHECK(f.protocol.handle("DELETE 7").find("7") != std::string::npos);
   CHECK(f.protocol.handle("LIST") == "OK 0");
   CHECK(f.protocol.handle("COMPUTE").rfind("ERROR 41 ", 0) == 0);
+  CHECK(f.protocol.handle("COMPUTE similarity").rfind("ERROR 41 ", 0) == 0);
+  CHECK(f.protocol.handle("COMPUTE HOMOGRAPHY").rfind("ERROR 41 ", 0) == 0);
   CHECK(f.protocol.handle("RESIDUALS").rfind("ERROR 44 ", 0) == 0);
   CHECK(f.protocol.handle("GRASP 1 ADD 1 2 3").rfind("ERROR 32 ", 0) == 0);
   CHECK(f.protocol.handle("GRIPPER 1 LIST").rfind("ERROR 32 ", 0) == 0);

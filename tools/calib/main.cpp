@@ -1,10 +1,12 @@
 // picksight-calib: robot-camera calibration offline, from a CSV of point
 // pairs (robot_x,robot_y,vision_x,vision_y, vision in mm). Prints the
-// transform, the RMS and every point's residual.
+// transform, the RMS and every point's residual, and every model's fit
+// beside it.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "picksight/calibration/robot_camera.hpp"
 #include "picksight/common/command_line.hpp"
@@ -21,14 +23,21 @@ int main(int argc, char** argv) {
                  "a header line, then robot_x,robot_y,vision_x,vision_y per point (mm)")
       ->type_name("FILE")
       ->required();
+  const std::vector<calibration::Method> all{
+      calibration::Method::kBest, calibration::Method::kGeometric,
+      calibration::Method::kLeastSquares, calibration::Method::kSimilarity,
+      calibration::Method::kHomography};
+  std::vector<std::string> names;
+  for (auto m : all) names.push_back(calibration::methodName(m));
   app.add_option("--method", method_name, "how to fit the transform")
-      ->type_name("best|geometric|lsq")
-      ->check(CLI::IsMember({"best", "geometric", "lsq"}))
+      ->type_name("best|geometric|lsq|similarity|homography")
+      ->check(CLI::IsMember(names))
       ->capture_default_str();
   if (auto exit_code = parseMainArgs(app, argc, argv)) return *exit_code;
-  const calibration::Method method = method_name == "geometric" ? calibration::Method::kGeometric
-                                     : method_name == "lsq"     ? calibration::Method::kLeastSquares
-                                                                : calibration::Method::kBest;
+  calibration::Method method = calibration::Method::kBest;
+  for (auto m : all) {
+    if (method_name == calibration::methodName(m)) method = m;
+  }
   std::ifstream in(path);
   if (!in) {
     std::cerr << "picksight-calib: cannot read " << path << "\n";
@@ -66,9 +75,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   const auto& t = result->transform;
-  std::printf("method %s\n", calibration::methodName(result->method));
+  std::printf("method %s\nmodel %s\n", calibration::methodName(result->method),
+              calibration::modelName(t.model));
   std::printf("dx %s\ndy %s\nrz %s\n", formatFixed(t.dx, 4).c_str(), formatFixed(t.dy, 4).c_str(),
               formatFixed(t.rz_deg, 4).c_str());
+  std::printf("scale %s\n", formatFixed(t.scale, 6).c_str());
   std::printf("mirrored %s\n", t.mirrored ? "yes" : "no");
   std::printf("rms %s\ninliers %d of %zu\n", formatFixed(result->rms, 4).c_str(), result->inliers,
               points.size());
@@ -79,6 +90,21 @@ int main(int argc, char** argv) {
     std::printf("%5zu %10.3f %10.3f %10.3f %10.3f %9.4f %9.4f %9.4f %s\n", i + 1, points[i].robot.x,
                 points[i].robot.y, points[i].vision.x, points[i].vision.y, r.dx, r.dy, r.distance,
                 r.inlier ? "" : "outlier");
+  }
+  // Every model side by side: the origin, rotation and scale each reads,
+  // its RMS and its cross-validated error (what BEST compares).
+  std::printf("\n%-10s %10s %10s %9s %9s %8s %8s %7s\n", "fit", "dx", "dy", "rz", "scale", "rms",
+              "cv_rms", "inliers");
+  for (auto m : all) {
+    if (m == calibration::Method::kBest) continue;
+    auto r = calibration::calibrate(points, m);
+    if (!r) {
+      std::printf("%-10s %s\n", calibration::methodName(m), r.error().message.c_str());
+      continue;
+    }
+    const auto& f = r->transform;
+    std::printf("%-10s %10.4f %10.4f %9.4f %9.6f %8.4f %8.4f %7d\n", calibration::methodName(m),
+                f.dx, f.dy, f.rz_deg, f.scale, r->rms, r->predicted_error, r->inliers);
   }
   return 0;
 }

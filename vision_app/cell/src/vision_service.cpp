@@ -4,6 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+
 #include "picksight/vision/recognizer.hpp"
 
 namespace picksight::app {
@@ -113,6 +115,15 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& ma
   TargetOutcome t;
   t.centroid = mapping.toSensor(r.centroid);
   t.moments = mapping.momentsToSensor(r.moments);
+  const int margin = std::max(r.bbox.width, r.bbox.height) / 2 + 24;
+  const cv::Rect around =
+      (r.bbox + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
+      cv::Rect(0, 0, grey.cols, grey.rows);
+  t.image = grey(around).clone();  // the frame's pixels go with the frame
+  t.image_origin = around.tl();
+  t.mapping = mapping;
+  t.image_centroid = r.centroid - cv::Point2d(around.tl());
+  t.frame_area = r.area;
   return t;
 }
 

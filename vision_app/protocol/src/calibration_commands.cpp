@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "picksight/calibration/target_measurement.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
@@ -23,6 +24,17 @@ bool looksLikeDisc(const cv::Moments& m) {
   return std::abs(ellipse_area / m.m00 - 1.0) <= kDiscTolerance;
 }
 
+// The disc target measured on its edges, in sensor pixels.
+Result<calibration::DiscMeasurement> measuredDisc(const TargetOutcome& t) {
+  auto disc = calibration::measureDisc(t.image, t.image_centroid, std::sqrt(t.frame_area / M_PI));
+  if (!disc) return disc;
+  const cv::Point2d frame_centre = disc->centre + cv::Point2d(t.image_origin);
+  disc->centre = t.mapping.toSensor(frame_centre);
+  disc->radius_x /= t.mapping.scale_x;
+  disc->radius_y /= t.mapping.scale_y;
+  return disc;
+}
+
 std::string calcam(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const auto radius = parseNumbers(r.args);
   if (!radius || radius->size() != 1 || !((*radius)[0] > 0) || (*radius)[0] > kMaxRadiusMm)
@@ -33,7 +45,9 @@ std::string calcam(const Request& r, VisionService& vision, CellCalibration& cal
   if (!looksLikeDisc(target->moments))
     return errorReply(VisionErrc::kNotADisc,
                       "the target is not a disc (check the target and the lighting)");
-  auto scale = calibration::scaleFromCircle(target->moments, (*radius)[0]);
+  auto disc = measuredDisc(*target);
+  if (!disc) return errorReply(VisionErrc::kNotADisc, disc.error().message);
+  auto scale = calibration::scaleFromDisc(*disc, (*radius)[0]);
   if (!scale) return errorReply(VisionErrc::kNotADisc, scale.error().message);
   if (auto ok = calibration.setScale(*scale); !ok) return reply(ok.error());
   return "OK " + formatFixed(scale->mm_per_px_x, 6) + " " + formatFixed(scale->mm_per_px_y, 6);
@@ -41,11 +55,17 @@ std::string calcam(const Request& r, VisionService& vision, CellCalibration& cal
 
 std::string store(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const auto robot = parseNumbers(r.args);
-  if (!robot || robot->size() != 2)
+  if (!robot || robot->size() != 2 || !std::isfinite((*robot)[0]) || !std::isfinite((*robot)[1]))
     return errorReply(ProtocolErrc::kBadArguments, "usage: STORE <x> <y> (robot mm)");
   auto target = vision.target();
   if (!target) return reply(target.error());
-  const calibration::PointPair pair{calibration.geometry().vision.toMm(target->centroid),
+  // A disc's centre from its edges (unbiased by uneven light); any other
+  // target's grey-weighted centroid.
+  cv::Point2d centre = target->centroid;
+  if (looksLikeDisc(target->moments)) {
+    if (auto disc = measuredDisc(*target)) centre = disc->centre;
+  }
+  const calibration::PointPair pair{calibration.geometry().vision.toMm(centre),
                                     {(*robot)[0], (*robot)[1]}};
   auto id = calibration.addPoint(pair);
   if (!id) return reply(id.error());
@@ -70,6 +90,8 @@ std::optional<calibration::Method> parseMethod(const std::vector<std::string>& a
   if (m == "BEST") return calibration::Method::kBest;
   if (m == "LSQ") return calibration::Method::kLeastSquares;
   if (m == "GEOMETRIC") return calibration::Method::kGeometric;
+  if (m == "SIMILARITY") return calibration::Method::kSimilarity;
+  if (m == "HOMOGRAPHY") return calibration::Method::kHomography;
   return std::nullopt;
 }
 }  // namespace
@@ -89,12 +111,15 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
   });
   table.add(
       "LIST", "LIST", [&](const Request& r) { return list(r, calibration); }, neverChanges);
-  table.add("COMPUTE", "COMPUTE [BEST|LSQ|GEOMETRIC]", [&](const Request& r) {
+  constexpr const char* kComputeUsage = "COMPUTE [BEST|LSQ|GEOMETRIC|SIMILARITY|HOMOGRAPHY]";
+  table.add("COMPUTE", kComputeUsage, [&](const Request& r) {
     const auto method = parseMethod(r.args);
     if (!method)
-      return errorReply(ProtocolErrc::kBadArguments, "usage: COMPUTE [BEST|LSQ|GEOMETRIC]");
+      return errorReply(ProtocolErrc::kBadArguments, std::string("usage: ") + kComputeUsage);
     auto result = calibration.compute(*method);
     if (!result) return reply(result.error());
+    // Four fields whatever the model, as robot programs parse them; the
+    // model and its scale are in the calibration file (and picksight-calib).
     const auto& t = result->transform;
     return "OK " + formatFixed(t.dx) + " " + formatFixed(t.dy) + " " + formatFixed(t.rz_deg) + " " +
            formatFixed(result->rms);

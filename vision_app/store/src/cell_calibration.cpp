@@ -43,7 +43,7 @@ CoordinateFrame CellGeometry::frame() const {
 grasp::Pose CellGeometry::toReply(const grasp::Pose& p) const {
   if (!transform) return p;
   const cv::Point2d r = transform->apply({p.x, p.y});
-  return {r.x, r.y, transform->applyToAngleDeg(p.rz_deg)};
+  return {r.x, r.y, transform->applyToAngleDeg(p.rz_deg, {p.x, p.y})};
 }
 
 CellCalibration::CellCalibration(std::string path) : store_(std::move(path)) {}

@@ -73,6 +73,14 @@ struct TargetOutcome {
   // Area and central second moments (m00, mu20, mu11, mu02), grey-level
   // weighted, in sensor pixels.
   cv::Moments moments;
+  // A copy of the grey frame around it (its top-left at `image_origin` in
+  // frame pixels), the region's centroid in that copy and its area, for
+  // sub-pixel measurement of its edges.
+  cv::Mat image;
+  cv::Point image_origin;
+  SensorMapping mapping;
+  cv::Point2d image_centroid;
+  double frame_area = 0;
 };
 
 struct VisionOptions {

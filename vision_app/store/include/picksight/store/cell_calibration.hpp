@@ -37,7 +37,7 @@ const char* frameName(CoordinateFrame frame);  // "vision-px", "vision-mm", "rob
 // Everything needed to turn sensor pixels into reply poses.
 struct CellGeometry {
   calibration::VisionFrame vision;  // 1 unit per pixel until CALCAM
-  std::optional<calibration::RigidTransform> transform;
+  std::optional<calibration::PlaneTransform> transform;
 
   CoordinateFrame frame() const;
   // A pose in the vision frame to the reply frame (robot when computed).
