@@ -27,11 +27,17 @@ std::string locate(const Request& r, CellContext& cell) {
   if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: LOCATE <type>");
   const auto type = parseType(r.args[0]);
   if (!type) return typeError("LOCATE", r.args[0]);
+  // A damaged calibration file is an error, never a silent change of frame;
+  // checked before the frame is taken.
+  if (auto geometry = cell.calibration.geometry(); !geometry) return reply(geometry.error());
   auto outcome = cell.vision.locate(*type);
   if (!outcome) return reply(outcome.error());
+  // Taken again: a CLEARCAL or a COMPUTE may have come meanwhile.
+  const auto geometry = cell.calibration.geometry();
+  if (!geometry) return reply(geometry.error());
   const auto grasps =
       cell.vision.models() ? cell.vision.models()->grasps() : std::make_shared<const GraspMap>();
-  const CellPick pick = pickPoses(*outcome, *grasps, cell.calibration.geometry());
+  const CellPick pick = pickPoses(*outcome, *grasps, *geometry);
   ++cell.locates;
   cell.last_offered = pick.poses.size();
   cell.last_skipped = pick.skipped;
@@ -112,7 +118,8 @@ std::string status(const Request& r, CellContext& cell) {
   const auto models =
       cell.vision.models() ? cell.vision.models()->snapshot() : std::make_shared<const ModelList>();
   const auto last = cell.vision.lastFrame();
-  std::string out = "OK frame=" + std::string(frameName(geometry.frame()));
+  // A damaged calibration file has no frame: frame=none, calibration=damaged.
+  std::string out = "OK frame=" + std::string(geometry ? frameName(geometry->frame()) : "none");
   out += " scale=";
   out += calib.scale ? formatFixed(calib.scale->mm_per_px_x, 6) + "x" +
                            formatFixed(calib.scale->mm_per_px_y, 6)
@@ -135,6 +142,7 @@ std::string status(const Request& r, CellContext& cell) {
   out += " offered=" + std::to_string(cell.last_offered.load());
   out += " skipped=" + std::to_string(cell.last_skipped.load());
   out += " skipped_total=" + std::to_string(cell.skipped_total.load());
+  out += std::string(" calibration=") + (geometry ? "ok" : "damaged");
   return out;
 }
 

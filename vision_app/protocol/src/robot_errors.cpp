@@ -19,7 +19,7 @@ using calibration::CalibrationErrc;
 
 constexpr int kInternal = 99;
 
-const std::array<std::pair<std::error_code, int>, 28> kTable = {{
+const std::array<std::pair<std::error_code, int>, 31> kTable = {{
     {VisionErrc::kNoTarget, 1},
     {VisionErrc::kSeveralTargets, 2},
     {VisionErrc::kNotADisc, 3},
@@ -47,6 +47,9 @@ const std::array<std::pair<std::error_code, int>, 28> kTable = {{
     {CellCalibrationErrc::kCalibrationStorage, 43},
     {CalibrationErrc::kBadFile, 43},
     {CellCalibrationErrc::kNotComputed, 44},
+    {CellCalibrationErrc::kDamaged, 45},
+    {CellCalibrationErrc::kTooManyPoints, 46},
+    {CellCalibrationErrc::kPointsChanged, 47},
     {ProtocolErrc::kInternalError, kInternal},
 }};
 
