@@ -120,7 +120,7 @@ TEST_CASE("a synthetic cell is calibrated through the protocol with its simulate
   CHECK(ask(robot, "STORE 1 2").rfind("ERROR 1 ", 0) == 0);
 }
 
-TEST_CASE("picksight-cam target refuses bad positions and cameras without a robot",
+TEST_CASE("picksight-cam target refuses bad positions and cameras without a robot and sets parts",
           "[e2e][calibration]") {
   test::TempDir dir;
   REQUIRE(cv::imwrite(dir.file("still.png"), cv::Mat(64, 64, CV_8UC1, cv::Scalar(200))));
@@ -138,6 +138,10 @@ TEST_CASE("picksight-cam target refuses bad positions and cameras without a robo
   CHECK(negative.exit_code == 0);
   CHECK(negative.out.find("\"target_x_mm\":-12.5") != std::string::npos);
   CHECK(negative.out.find("\"target_visible\":true") != std::string::npos);
+  // The table is loaded or cleared through the camera's Parts feature.
+  CHECK(run({cam, "--control", server.control, "set", "cam0", "Parts", "2"}).out == "Parts = 2\n");
+  CHECK(run({cam, "--control", server.control, "set", "cam0", "Parts", "900"}).exit_code == 1);
+  CHECK(run({cam, "--control", server.control, "get", "cam0", "Parts"}).out == "2\n");
 }
 
 TEST_CASE("a damaged calibration file stops LOCATE until CLEARCAL", "[e2e][calibration]") {
