@@ -81,10 +81,10 @@ struct Breakdown {
 Breakdown breakdown(const std::string& data_dir, int width, int height, int parts) {
   picksight::app::ModelLibrary library(data_dir + "/models");
   picksight::app::CellCalibration calibration(data_dir + "/calibration.yaml");
-  if (!library.load().empty() || !calibration.load()) return {};
+  if (!library.load().empty() || !calibration.load() || !calibration.geometry()) return {};
   const picksight::synthetic::SceneRenderer renderer(scene(width, height, parts, 5, kTypes));
   const picksight::Frame frame = picksight::frameFromImage(renderer.render(1), "cam0", 1);
-  const auto geometry = calibration.geometry();
+  const auto geometry = *calibration.geometry();
   std::vector<double> recognition, grasps;
   for (int i = 0; i < 100; ++i) {
     const int type = 1 + i % static_cast<int>(kTypes.size());

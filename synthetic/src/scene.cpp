@@ -87,16 +87,16 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
   }
   options_.part_size = size;
 
-  const cv::Mat light = o.uneven_light ? illumination(o.width, o.height, o.seed) : cv::Mat();
-  cv::Mat image(o.height, o.width, CV_32F, cv::Scalar(o.background_level));
-  if (!light.empty()) {
-    image = light * o.background_level;
+  light_ = o.uneven_light ? illumination(o.width, o.height, o.seed) : cv::Mat();
+  base_ = cv::Mat(o.height, o.width, CV_32F, cv::Scalar(o.background_level));
+  if (!light_.empty()) {
+    base_ = light_ * o.background_level;
   }
   truth_.reserve(part_types.size());
   for (std::size_t i = 0; i < part_types.size(); ++i) {
     const SizedPartType& info = infos.at(part_types[i]);
     const Placement& p = placed[i];
-    drawPart(image, light, placedShape(info.shape, p.x, p.y, p.angle_deg),
+    drawPart(base_, light_, placedShape(info.shape, p.x, p.y, p.angle_deg),
              o.part_level - o.background_level);
     PartTruth t;
     t.type = part_types[i];
@@ -108,11 +108,7 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
     t.touching = touching[i];
     truth_.push_back(std::move(t));
   }
-  if (o.blur_sigma > 0) {
-    // A symmetric kernel moves no centroid and keeps every area.
-    cv::GaussianBlur(image, image, cv::Size(), o.blur_sigma, o.blur_sigma, cv::BORDER_REPLICATE);
-  }
-  image.convertTo(clean_, CV_8U);
+  renderClean(nullptr, nullptr, std::nullopt);
 
   if (o.noise_sigma > 0) {
     cv::RNG noise_rng(splitMix64(o.seed ^ kNoiseStream) | 1);
@@ -122,6 +118,30 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
       noise_bank_.push_back(std::move(field));
     }
   }
+}
+
+void SceneRenderer::setTarget(const RobotCamera& camera, const CalibrationTarget& target,
+                              std::optional<cv::Point2d> at_mm) {
+  renderClean(&camera, &target, at_mm);
+}
+
+void SceneRenderer::renderClean(const RobotCamera* camera, const CalibrationTarget* target,
+                                std::optional<cv::Point2d> at_mm) {
+  const SceneOptions& o = options_;
+  target_truth_.clear();
+  cv::Mat image = base_;
+  if (camera && target && at_mm) {
+    image = base_.clone();
+    target_truth_ = drawTarget(image, light_, RobotCameraModel(*camera, o.width, o.height), *target,
+                               *at_mm, o.part_level);
+  }
+  if (o.blur_sigma > 0) {
+    // A symmetric kernel moves no centroid and keeps every area.
+    cv::Mat blurred;
+    cv::GaussianBlur(image, blurred, cv::Size(), o.blur_sigma, o.blur_sigma, cv::BORDER_REPLICATE);
+    image = blurred;
+  }
+  image.convertTo(clean_, CV_8U);
 }
 
 }  // namespace picksight::synthetic

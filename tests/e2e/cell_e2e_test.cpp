@@ -79,19 +79,6 @@ struct Scene {
   }
 };
 
-std::vector<double> numbers(const std::string& reply, size_t expected) {
-  const auto w = splitFields(reply, " ");
-  REQUIRE(w.size() == expected + 1);
-  REQUIRE(w[0] == "OK");
-  std::vector<double> out;
-  for (size_t i = 1; i < w.size(); ++i) {
-    auto v = parseDouble(w[i]);
-    REQUIRE(v);
-    out.push_back(*v);
-  }
-  return out;
-}
-
 std::string ask(LineClient& robot, const std::string& request) {
   auto reply = robot.request(request, 10s);
   REQUIRE(reply);
@@ -132,7 +119,7 @@ TEST_CASE("a cell calibrated through the protocol locates in robot coordinates",
     Canvas one;
     one.disc({320.3, 240.7}, 40);
     scene.show(one.image());
-    const auto scale = numbers(ask(robot, "CALCAM 10"), 2);
+    const auto scale = replyNumbers(ask(robot, "CALCAM 10"), 2);
     mm_x = scale[0];
     mm_y = scale[1];
     CHECK(mm_x == Approx(0.25).epsilon(0.002));
@@ -158,7 +145,7 @@ TEST_CASE("a cell calibrated through the protocol locates in robot coordinates",
     const std::string missing = ask(robot, "DELETE 6");
     CHECK(missing.rfind("ERROR 40 ", 0) == 0);
     CHECK(missing.find('6') != std::string::npos);
-    const auto t = numbers(ask(robot, "COMPUTE"), 4);
+    const auto t = replyNumbers(ask(robot, "COMPUTE"), 4);
     CHECK(t[0] == Approx(kShiftMm.x).margin(0.1));
     CHECK(t[1] == Approx(kShiftMm.y).margin(0.1));
     CHECK(t[2] == Approx(kRz).margin(0.05));

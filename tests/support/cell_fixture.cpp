@@ -114,6 +114,19 @@ uint64_t waitForSubscription(const VideoServerProcess& server, FrameSubscriber& 
   return 0;
 }
 
+std::vector<double> replyNumbers(const std::string& reply, size_t expected) {
+  const auto w = splitFields(reply, " ");
+  REQUIRE(w.size() == expected + 1);
+  REQUIRE(w[0] == "OK");
+  std::vector<double> out;
+  for (size_t i = 1; i < w.size(); ++i) {
+    auto v = parseDouble(w[i]);
+    REQUIRE(v);
+    out.push_back(*v);
+  }
+  return out;
+}
+
 std::vector<Pose> parseLocateReply(const std::string& reply) {
   const auto words = splitFields(reply, " ");
   REQUIRE(words.size() >= 2);

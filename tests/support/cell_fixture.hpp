@@ -61,6 +61,9 @@ std::optional<Frame> receiveUntil(FrameSubscriber& subscriber,
 uint64_t waitForSubscription(const VideoServerProcess& server, FrameSubscriber& subscriber,
                              const std::string& camera = "cam0");
 
+// The numbers of a reply "OK a b ..."; REQUIREs "OK" and `expected` numbers.
+std::vector<double> replyNumbers(const std::string& reply, size_t expected);
+
 // The reply "OK n x y rz ..." as (x, y, rz) triples; REQUIREs the format.
 struct Pose {
   double x, y, rz;

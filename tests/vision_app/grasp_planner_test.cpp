@@ -157,5 +157,5 @@ TEST_CASE("the lens subcommand stores the chessboard lens model the cell then us
   VisionCell reloaded(cell.dir, std::make_unique<NoCamera>(), VisionOptions{});
   CHECK(reloaded.load().empty());
   CHECK(reloaded.handle("STATUS").find(" lens=1 ") != std::string::npos);
-  CHECK(reloaded.calibration().geometry().vision.calibrated() == false);  // no scale yet
+  CHECK(reloaded.calibration().geometry()->vision.calibrated() == false);  // no scale yet
 }

@@ -40,6 +40,9 @@ TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]")
   CHECK(robotErrorCode(calibration::CalibrationErrc::kDegeneratePoints) == 42);
   CHECK(robotErrorCode(CellCalibrationErrc::kCalibrationStorage) == 43);
   CHECK(robotErrorCode(CellCalibrationErrc::kNotComputed) == 44);
+  CHECK(robotErrorCode(CellCalibrationErrc::kDamaged) == 45);
+  CHECK(robotErrorCode(CellCalibrationErrc::kTooManyPoints) == 46);
+  CHECK(robotErrorCode(CellCalibrationErrc::kPointsChanged) == 47);
   CHECK(robotErrorCode(ProtocolErrc::kInternalError) == 99);
 }
 

@@ -69,6 +69,13 @@ const std::vector<CommandSpec>& commandSpecs() {
        {},
        {{"snap CAM FILE",
          "save the next frame; the extension of FILE\nnames the format (.png, .jpg, .tiff, ...)"}}},
+      // X and Y are optional to CLI11 because --hide replaces them.
+      {"target",
+       {"CAM"},
+       {"X", "Y"},
+       {{"target CAM X Y",
+         "synthetic camera: the simulated robot holds the\ncalibration target at robot X Y mm"},
+        {"target CAM --hide", "synthetic camera: the robot takes the target away"}}},
   };
   return kSpecs;
 }
@@ -188,6 +195,7 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
   std::map<std::string, std::map<std::string, std::string>> words;
   std::map<std::string, CLI::Option*> positionals;
   std::string scale;
+  bool hide = false;
   for (const CommandSpec& spec : commandSpecs()) {
     CLI::App* sub = app.add_subcommand(spec.name, spec.usage.front().help);
     sub->set_help_flag();  // --help after a command is the tool's help
@@ -201,6 +209,7 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
           sub->add_option(name, words[spec.name][name]);
     }
     if (std::string(spec.name) == "size") sub->add_option("--scale", scale)->type_name("S");
+    if (std::string(spec.name) == "target") sub->add_flag("--hide", hide);
   }
 
   try {
@@ -248,6 +257,18 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
       }
       options.command.args["S"] = scale;
     } else if (!options.command.has("H")) {
+      return missingArguments(name);
+    }
+  }
+  if (name == "target") {
+    // Either "X Y" or "--hide".
+    if (hide) {
+      if (options.command.has("X")) {
+        return usageError("target: too many arguments (unexpected '" + options.command.arg("X") +
+                          "')");
+      }
+      options.command.args["HIDE"] = "1";
+    } else if (!options.command.has("Y")) {
       return missingArguments(name);
     }
   }

@@ -223,44 +223,123 @@ void printList(const proto::ListCamerasReply& reply, bool as_json, std::ostream&
   printTable(out, {{"NAME", false}, {"SOURCE", false}, {"STATE", false}, {"MODE", false}}, rows);
 }
 
+// Where the robot's target centre lies on the sensor, through the hidden
+// homography; nullopt when the reply lacks it.
+std::optional<std::pair<double, double>> targetOnSensor(const proto::SimulatedRobot& r) {
+  if (r.robot_to_sensor_size() != 9) return std::nullopt;
+  const auto& h = r.robot_to_sensor();
+  const double x = r.target_x_mm();
+  const double y = r.target_y_mm();
+  const double w = h[6] * x + h[7] * y + h[8];
+  return std::make_pair((h[0] * x + h[1] * y + h[2]) / w, (h[3] * x + h[4] * y + h[5]) / w);
+}
+
+Json robotJson(const proto::SimulatedRobot& r) {
+  Json json = {{"target_visible", r.target_visible()},
+               {"target_kind", r.target_kind()},
+               {"target_radius_mm", r.target_radius_mm()},
+               {"mm_per_px", r.mm_per_px()},
+               {"rz_deg", r.rz_deg()},
+               {"dx_mm", r.dx_mm()},
+               {"dy_mm", r.dy_mm()},
+               {"tilt_x_deg", r.tilt_x_deg()},
+               {"tilt_y_deg", r.tilt_y_deg()},
+               {"robot_to_sensor",
+                std::vector<double>(r.robot_to_sensor().begin(), r.robot_to_sensor().end())}};
+  if (r.target_kind() == "grid") {
+    json["grid_rows"] = r.grid_rows();
+    json["grid_cols"] = r.grid_cols();
+    json["grid_pitch_mm"] = r.grid_pitch_mm();
+  }
+  if (r.target_visible()) {
+    json["target_x_mm"] = r.target_x_mm();
+    json["target_y_mm"] = r.target_y_mm();
+    if (auto p = targetOnSensor(r)) {
+      json["target_sensor_x"] = p->first;
+      json["target_sensor_y"] = p->second;
+    }
+  }
+  return json;
+}
+
+std::string targetText(const proto::SimulatedRobot& r) {
+  std::string text = r.target_kind() + " radius " + formatReadable(r.target_radius_mm()) + " mm";
+  if (r.target_kind() == "grid") {
+    text += ", " + std::to_string(r.grid_cols()) + "x" + std::to_string(r.grid_rows()) + " dots " +
+            formatReadable(r.grid_pitch_mm()) + " mm apart";
+  }
+  if (!r.target_visible()) return text + ", hidden";
+  text += ", at robot " + formatFixed(r.target_x_mm(), 3) + " " + formatFixed(r.target_y_mm(), 3) +
+          " mm";
+  if (auto p = targetOnSensor(r)) {
+    text += " = sensor " + formatFixed(p->first, 3) + " " + formatFixed(p->second, 3) + " px";
+  }
+  return text;
+}
+
+// The hidden transform, as the robot protocol states its own.
+std::string transformText(const proto::SimulatedRobot& r) {
+  return "robot = R(" + formatReadable(r.rz_deg()) + " deg) * vision + (" +
+         formatReadable(r.dx_mm()) + ", " + formatReadable(r.dy_mm()) + ") mm, " +
+         formatReadable(r.mm_per_px()) + " mm/px, tilt " + formatReadable(r.tilt_x_deg()) + " " +
+         formatReadable(r.tilt_y_deg()) + " deg";
+}
+
+void printTarget(const std::string& camera, const proto::SimulatedRobot& r, bool as_json,
+                 std::ostream& out) {
+  if (as_json) {
+    Json json = robotJson(r);
+    json["camera"] = camera;
+    out << toJson(json) << '\n';
+    return;
+  }
+  out << camera << ": target " << targetText(r) << '\n';
+}
+
 void printInfo(const proto::DescribeCameraReply& d, bool as_json, std::ostream& out) {
   const proto::CameraSummary& s = d.summary();
   if (as_json) {
-    const Json json = {{"name", s.name()},
-                       {"source", s.source()},
-                       {"state", s.state()},
-                       {"mode", modeName(s.mode())},
-                       {"vendor", d.vendor()},
-                       {"model", d.model()},
-                       {"serial", d.serial()},
-                       {"sensor_width", d.sensor_width()},
-                       {"sensor_height", d.sensor_height()},
-                       {"roi", roiJson(d.roi())},
-                       {"output_width", d.output_width()},
-                       {"output_height", d.output_height()},
-                       {"pixel_format", formatName(d.pixel_format())},
-                       {"fps", d.fps()},
-                       {"source_formats", std::vector<std::string>(d.source_formats().begin(),
-                                                                   d.source_formats().end())}};
+    Json json = {{"name", s.name()},
+                 {"source", s.source()},
+                 {"state", s.state()},
+                 {"mode", modeName(s.mode())},
+                 {"vendor", d.vendor()},
+                 {"model", d.model()},
+                 {"serial", d.serial()},
+                 {"sensor_width", d.sensor_width()},
+                 {"sensor_height", d.sensor_height()},
+                 {"roi", roiJson(d.roi())},
+                 {"output_width", d.output_width()},
+                 {"output_height", d.output_height()},
+                 {"pixel_format", formatName(d.pixel_format())},
+                 {"fps", d.fps()},
+                 {"source_formats",
+                  std::vector<std::string>(d.source_formats().begin(), d.source_formats().end())}};
+    if (d.has_simulated_robot()) json["simulated_robot"] = robotJson(d.simulated_robot());
     out << toJson(json) << '\n';
     return;
   }
   std::string formats;
   for (const auto& format : d.source_formats()) formats += (formats.empty() ? "" : ", ") + format;
-  printKeyValues(
-      out, {{"camera", s.name()},
-            {"source", s.source()},
-            {"state", s.state()},
-            {"mode", modeName(s.mode())},
-            {"vendor", d.vendor()},
-            {"model", d.model()},
-            {"serial", d.serial()},
-            {"sensor", std::to_string(d.sensor_width()) + "x" + std::to_string(d.sensor_height())},
-            {"roi", roiText(d.roi())},
-            {"output", std::to_string(d.output_width()) + "x" + std::to_string(d.output_height())},
-            {"pixel format", formatName(d.pixel_format())},
-            {"fps", formatFixed(d.fps(), 1)},
-            {"source formats", formats}});
+  std::vector<std::pair<std::string, std::string>> lines = {
+      {"camera", s.name()},
+      {"source", s.source()},
+      {"state", s.state()},
+      {"mode", modeName(s.mode())},
+      {"vendor", d.vendor()},
+      {"model", d.model()},
+      {"serial", d.serial()},
+      {"sensor", std::to_string(d.sensor_width()) + "x" + std::to_string(d.sensor_height())},
+      {"roi", roiText(d.roi())},
+      {"output", std::to_string(d.output_width()) + "x" + std::to_string(d.output_height())},
+      {"pixel format", formatName(d.pixel_format())},
+      {"fps", formatFixed(d.fps(), 1)},
+      {"source formats", formats}};
+  if (d.has_simulated_robot()) {
+    lines.emplace_back("simulated robot", transformText(d.simulated_robot()));
+    lines.emplace_back("target", targetText(d.simulated_robot()));
+  }
+  printKeyValues(out, lines);
 }
 
 void printTrigger(const std::string& camera, const proto::TriggerReply& t, bool as_json,
@@ -433,6 +512,10 @@ Result<void> printReply(const proto::ControlRequest& request, const proto::Contr
       if (!reply.has_snap()) return missing("frame");
       return saveSnap(request.snap().camera(), reply.snap(), options.command.arg("FILE"), as_json,
                       out);
+    case proto::ControlRequest::kSetTarget:
+      if (!reply.has_simulated_robot()) return missing("simulated robot");
+      printTarget(request.set_target().camera(), reply.simulated_robot(), as_json, out);
+      return {};
     default:
       printSetConfirmation(request, as_json, out);
       return {};

@@ -44,6 +44,13 @@ class ArgReader {
     return *value;
   }
 
+  Result<double> number(const std::string& name) const {
+    const std::string& text = command_.arg(name);
+    const std::optional<double> value = parseDouble(text);
+    if (!value) return error(name, "must be a number, got '" + text + "'");
+    return *value;
+  }
+
   Result<std::string> word(const std::string& name) const {
     const std::string& text = command_.arg(name);
     if (text.empty()) return error(name, "must not be empty");
@@ -162,6 +169,24 @@ Result<proto::ControlRequest> buildSnap(const ArgReader& a, const std::string& c
   return request;
 }
 
+Result<proto::ControlRequest> buildTarget(const CamCommand& c, const ArgReader& a,
+                                          const std::string& camera) {
+  proto::ControlRequest request;
+  auto* target = request.mutable_set_target();
+  target->set_camera(camera);
+  if (c.has("HIDE")) {
+    target->set_hide(true);
+    return request;
+  }
+  auto x = a.number("X");
+  if (!x) return x.error();
+  auto y = a.number("Y");
+  if (!y) return y.error();
+  target->set_x_mm(*x);
+  target->set_y_mm(*y);
+  return request;
+}
+
 }  // namespace
 
 Result<proto::ControlRequest> buildRequest(const CamCommand& c) {
@@ -205,6 +230,8 @@ Result<proto::ControlRequest> buildRequest(const CamCommand& c) {
     return buildFeature(c, a, *camera);
   } else if (c.name == "snap") {
     return buildSnap(a, *camera);
+  } else if (c.name == "target") {
+    return buildTarget(c, a, *camera);
   } else {
     return usageError("unknown command '" + c.name + "'");
   }

@@ -1,16 +1,19 @@
-// picksight-demo: the whole slice on the embedded synthetic camera. Starts a
-// video server and a vision app on free ports, asks for parts the way a
-// robot controller does (LOCATE over TCP), prints each reply beside the
-// synthetic ground truth, and stops both processes.
+// picksight-demo: a whole cell on the embedded synthetic camera and its
+// simulated robot. Starts a video server and a vision app on free ports,
+// then does what an integrator and a robot program do over the robot
+// protocol: CALCAM, STORE at several robot points, COMPUTE, LEARN, GRASP,
+// LOCATE, and prints each answer beside the hidden truth (the camera's
+// robot-camera transform and the parts' true places), then stops both.
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <limits>
+#include <optional>
 #include <thread>
 
+#include <opencv2/core.hpp>
 #include <zmq.hpp>
 
 #include "picksight/common/angles.hpp"
@@ -18,11 +21,20 @@
 #include "picksight/common/text.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
+#include "picksight/transport/control_client.hpp"
 #include "picksight/transport/frame_message.hpp"
 
 namespace {
 using namespace std::chrono_literals;
 using picksight::formatFixed;
+
+// The demo cell's hidden robot-camera transform: the robot's frame turned by
+// 178.7 degrees, a 10 mm disc as the calibration target.
+constexpr double kMmPerPx = 0.25;
+constexpr double kRz = 178.7;
+constexpr double kDx = 330.5;
+constexpr double kDy = -612.25;
+constexpr double kTargetRadius = 5;
 
 std::string binDir() {
   char path[4096];
@@ -32,32 +44,221 @@ std::string binDir() {
   return p.substr(0, p.find_last_of('/'));
 }
 
+// The numbers after "OK" of a reply; empty for an error.
+std::vector<double> replyNumbers(const std::string& reply) {
+  const auto words = picksight::splitFields(reply, " ");
+  std::vector<double> out;
+  if (words.empty() || words[0] != "OK") return out;
+  for (size_t i = 1; i < words.size(); ++i)
+    out.push_back(picksight::parseDouble(words[i]).value_or(NAN));
+  return out;
+}
+
+// The cell as the demo drives it: the robot's TCP line, the camera's
+// control socket (the simulated robot moves the target; the scene's part
+// count stands for an operator clearing or loading the table), and a
+// subscriber watching the frames for their truth.
+class Cell {
+ public:
+  Cell(zmq::context_t& context, const std::string& control, const std::string& frames,
+       picksight::LineClient robot)
+      : control_(context, control, 10s),
+        watcher_(context, frames, "cam0", 64),
+        robot_(std::move(robot)) {}
+
+  // Sends a robot request, prints it and its reply.
+  std::string say(const std::string& request) {
+    auto reply = robot_.request(request, 30s);
+    const std::string text = reply ? *reply : "(no reply: " + reply.error().message + ")";
+    std::cout << "> " << request << "\n< " << text << "\n";
+    if (text.rfind("OK", 0) != 0) ++failures_;
+    return text;
+  }
+
+  // The simulated robot: its hidden transform (from the camera's own
+  // description), and moving its target.
+  std::optional<picksight::proto::SimulatedRobot> describe() {
+    picksight::proto::ControlRequest request;
+    request.mutable_describe_camera()->set_camera("cam0");
+    auto reply = control_.call(request);
+    if (!reply || !reply->describe_camera().has_simulated_robot()) return std::nullopt;
+    return reply->describe_camera().simulated_robot();
+  }
+  bool holdTarget(std::optional<cv::Point2d> at_mm) {
+    picksight::proto::ControlRequest request;
+    auto* target = request.mutable_set_target();
+    target->set_camera("cam0");
+    target->set_hide(!at_mm);
+    if (at_mm) {
+      target->set_x_mm(at_mm->x);
+      target->set_y_mm(at_mm->y);
+    }
+    return check(control_.call(request), "target");
+  }
+  bool setParts(int parts) {
+    picksight::proto::ControlRequest request;
+    auto* feature = request.mutable_set_feature();
+    feature->set_camera("cam0");
+    feature->set_name("Parts");
+    feature->set_value(std::to_string(parts));
+    return check(control_.call(request), "Parts");
+  }
+
+  // The truth of the frame the last vision request worked on (FRAME).
+  std::optional<picksight::Frame> lastFrame() {
+    auto used = robot_.request("FRAME", 5s);
+    const auto fields = used ? picksight::splitFields(*used, " ") : std::vector<std::string_view>{};
+    const auto seq = fields.size() >= 3 ? picksight::parseInt(fields[2]) : std::nullopt;
+    for (int tries = 0; tries < 100 && seq; ++tries) {
+      auto f = watcher_.receive(200ms);
+      if (f && static_cast<long long>(f->info.sequence) == *seq) return f;
+    }
+    return std::nullopt;
+  }
+
+  void fail() { ++failures_; }
+  int failures() const { return failures_; }
+  void close() { robot_.close(); }
+
+ private:
+  bool check(const picksight::Result<picksight::proto::ControlReply>& reply, const char* what) {
+    if (reply) return true;
+    std::cerr << "demo: " << what << ": " << reply.error().message << "\n";
+    ++failures_;
+    return false;
+  }
+
+  picksight::ControlClient control_;
+  picksight::FrameSubscriber watcher_;
+  picksight::LineClient robot_;
+  int failures_ = 0;
+};
+
+// Sensor pixels to robot mm through the hidden homography.
+cv::Point2d toRobot(const cv::Matx33d& sensor_to_robot, cv::Point2d px) {
+  const cv::Vec3d r = sensor_to_robot * cv::Vec3d(px.x, px.y, 1);
+  return {r[0] / r[2], r[1] / r[2]};
+}
+
+void calibrate(Cell& cell, const cv::Matx33d& robot_to_sensor, int width, int height, int points) {
+  const cv::Matx33d sensor_to_robot = robot_to_sensor.inv();
+  std::cout << "\n1. Camera scale: the robot holds the disc (radius " << kTargetRadius
+            << " mm) in the middle of the view.\n";
+  cell.holdTarget(toRobot(sensor_to_robot, {0.5 * (width - 1), 0.5 * (height - 1)}));
+  const auto scale = replyNumbers(cell.say("CALCAM " + formatFixed(kTargetRadius, 1)));
+  if (scale.size() == 2) {
+    std::cout << "   truth " << formatFixed(kMmPerPx, 6) << " mm/px: error "
+              << formatFixed(100 * (scale[0] / kMmPerPx - 1), 3) << " % x, "
+              << formatFixed(100 * (scale[1] / kMmPerPx - 1), 3) << " % y\n";
+  }
+
+  std::cout << "\n2. Robot-camera calibration: the robot holds the disc at " << points
+            << " points over the view.\n";
+  const int cols = (points + 1) / 2;
+  for (int i = 0; i < points; ++i) {
+    // Two rows, staggered, inside the central 80 % of the image.
+    const int row = i / cols;
+    const double fx = cols > 1 ? 0.1 + 0.8 * (i % cols) / (cols - 1) : 0.5;
+    const double fy = row == 0 ? 0.15 + 0.05 * (i % 2) : 0.8 + 0.05 * (i % 2);
+    const cv::Point2d robot =
+        toRobot(sensor_to_robot, {fx * (width - 1) + 0.37 * i, fy * (height - 1) + 0.21 * i});
+    cell.holdTarget(robot);
+    cell.say("STORE " + formatFixed(robot.x, 3) + " " + formatFixed(robot.y, 3));
+  }
+  const auto t = replyNumbers(cell.say("COMPUTE"));
+  if (t.size() == 4) {
+    std::cout << "   truth dx " << formatFixed(kDx) << " dy " << formatFixed(kDy) << " rz "
+              << formatFixed(kRz) << ": error " << formatFixed(t[0] - kDx) << " "
+              << formatFixed(t[1] - kDy) << " mm, " << formatFixed(t[2] - kRz) << " deg\n";
+  }
+}
+
+void pick(Cell& cell, const cv::Matx33d& robot_to_sensor, int parts, int requests) {
+  const cv::Matx33d sensor_to_robot = robot_to_sensor.inv();
+  std::cout << "\n3. Teaching: the robot puts the disc away; one part on the table.\n";
+  cell.holdTarget(std::nullopt);
+  cell.setParts(1);
+  cell.say("LEARN 1 bracket");
+  const auto learned = cell.lastFrame();
+  cell.say("GRASP 1 ADD 0 0 0");
+  if (!learned || learned->truth.size() != 1) {
+    std::cerr << "demo: no truth for the taught part\n";
+    cell.fail();
+    return;
+  }
+  const double learned_deg = learned->truth[0].angle_deg;
+
+  std::cout << "\n4. Picking: " << parts << " parts on the table; LOCATE replies in robot mm.\n";
+  cell.setParts(parts);
+  for (int r = 0; r < requests; ++r) {
+    const auto poses = replyNumbers(cell.say("LOCATE 1"));
+    const auto frame = cell.lastFrame();
+    if (poses.empty() || !frame) {
+      cell.fail();
+      continue;
+    }
+    std::printf("   %9s %9s %8s | %9s %9s %8s | %7s %7s\n", "truth x", "y", "rz", "found x", "y",
+                "rz", "d mm", "d deg");
+    for (const auto& t : frame->truth) {
+      // The part's true place and turn in the robot frame: image angles turn
+      // clockwise, the robot's counter-clockwise, from the taught pose.
+      const cv::Point2d truth = toRobot(sensor_to_robot, {t.x, t.y});
+      const double truth_rz = picksight::normalizeDeg(kRz - (t.angle_deg - learned_deg));
+      double best = HUGE_VAL;
+      size_t found = 0;
+      for (size_t i = 1; i + 2 < poses.size(); i += 3) {
+        const double d = std::hypot(poses[i] - truth.x, poses[i + 1] - truth.y);
+        if (d < best) {
+          best = d;
+          found = i;
+        }
+      }
+      if (found == 0) {
+        std::printf("   %9.3f %9.3f %8.3f | %9s\n", truth.x, truth.y, truth_rz, "not found");
+        continue;
+      }
+      const double d_deg = t.symmetry_deg > 0
+                               ? picksight::angleDiffDeg(poses[found + 2], truth_rz, t.symmetry_deg)
+                               : 0.0;
+      std::printf("   %9.3f %9.3f %8.3f | %9.3f %9.3f %8.3f | %7.3f %7.3f\n", truth.x, truth.y,
+                  truth_rz, poses[found], poses[found + 1], poses[found + 2], best, d_deg);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int requests = 3;
-  int parts = 8;
+  int requests = 2;
+  int parts = 6;
+  int points = 8;
   int width = 1280;
   int height = 960;
   long long seed = 1;
-  CLI::App app("Quick-start demo: a synthetic camera, the vision app and a robot's requests.",
-               "picksight-demo");
+  CLI::App app(
+      "Quick-start demo: a whole cell on the synthetic camera and its simulated robot:\n"
+      "CALCAM, STORE, COMPUTE, LEARN, GRASP and LOCATE in robot millimetres, beside the truth.",
+      "picksight-demo");
   app.set_help_flag("-h,--help", "print this help");
   app.add_option("--requests", requests, "LOCATE requests to send")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, 100))
       ->capture_default_str();
-  app.add_option("--parts", parts, "parts in the synthetic scene")
+  app.add_option("--parts", parts, "parts on the table when picking")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(1, 40))
+      ->capture_default_str();
+  app.add_option("--points", points, "calibration points to STORE")
+      ->type_name("N")
+      ->check(CLI::Range(3, 64))
       ->capture_default_str();
   app.add_option("--width", width, "image width")
       ->type_name("W")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(320, 4096))
       ->capture_default_str();
   app.add_option("--height", height, "image height")
       ->type_name("H")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(240, 4096))
       ->capture_default_str();
   app.add_option("--seed", seed, "scene seed")
       ->type_name("S")
@@ -71,12 +272,16 @@ int main(int argc, char** argv) {
     std::perror("mkdtemp");
     return 1;
   }
-  // Trigger mode with a new layout on every frame: each LOCATE sees a new scene.
+  // An empty table to start with (the calibration needs the disc alone);
+  // the parts are all of one type, the one taught.
   const std::string source =
       "cam0=synthetic:width=" + std::to_string(width) + ",height=" + std::to_string(height) +
-      ",parts=" + std::to_string(parts) + ",seed=" + std::to_string(seed) + ",scene_every=1";
-  std::cout << "PickSight demo: synthetic camera " << width << "x" << height << ", " << parts
-            << " parts per scene\n";
+      ",parts=0,types=l_shape,size=160,seed=" + std::to_string(seed) +
+      ",mm_per_px=" + formatFixed(kMmPerPx, 3) + ",rz=" + formatFixed(kRz, 3) +
+      ",dx=" + formatFixed(kDx, 3) + ",dy=" + formatFixed(kDy, 3) +
+      ",target_radius=" + formatFixed(kTargetRadius, 3);
+  std::cout << "PickSight demo: a whole cell on the synthetic camera (" << width << "x" << height
+            << ") and its simulated robot\n";
   picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
                                 "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
                                 "trigger"});
@@ -96,82 +301,39 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::cout << "video server: frames " << *frames << ", control " << *control
-            << "\nvision app: robot port " << *port << "\n"
-            << "Uncalibrated, LOCATE replies in the vision frame in pixels (x right, y up,\n"
-            << "angles counter-clockwise); the tables show both in image axes (y down).\n";
-
-  // The demo also watches the frames, as a viewer would, to read the truth.
-  zmq::context_t context;
-  picksight::FrameSubscriber watcher(context, *frames, "cam0", 16);
-  std::this_thread::sleep_for(300ms);  // let the subscription reach the server
-
+            << "\nvision app: robot port " << *port << ", data " << data_dir << "\n";
   auto robot = picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(*port), 5s);
   if (!robot) {
     std::cerr << "demo: " << robot.error().message << "\n";
     return 1;
   }
-  int failures = 0;
-  for (int r = 0; r < requests; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    auto reply = robot->request("LOCATE 1", 10s);
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (!reply) {
-      std::cerr << "demo: LOCATE failed: " << reply.error().message << "\n";
-      ++failures;
-      continue;
-    }
-    auto used = robot->request("FRAME", 5s);
-    std::cout << "\n> LOCATE 1\n< " << *reply << "\n  (" << formatFixed(ms, 1) << " ms, "
-              << (used ? *used : std::string("?")) << ")\n";
-    // Find the frame LOCATE used among the watched ones, by sequence number.
-    const auto fields = used ? picksight::splitFields(*used, " ") : std::vector<std::string_view>{};
-    const auto seq = fields.size() >= 3 ? picksight::parseInt(fields[2]) : std::nullopt;
-    std::optional<picksight::Frame> frame;
-    for (int tries = 0; tries < 50 && seq; ++tries) {
-      auto f = watcher.receive(200ms);
-      if (f && static_cast<long long>(f->info.sequence) == *seq) {
-        frame = std::move(f);
-        break;
-      }
-    }
-    const auto words = picksight::splitFields(*reply, " ");
-    if (words.size() < 2 || words[0] != "OK" || !frame) {
-      ++failures;
-      continue;
-    }
-    std::printf("  %-16s %9s %9s %8s | %9s %9s %8s | %7s %7s\n", "truth type", "x", "y", "rz",
-                "found x", "y", "rz", "d px", "d deg");
-    for (const auto& t : frame->truth) {
-      double best = std::numeric_limits<double>::max();
-      double fx = 0, fy = 0, fr = 0;
-      for (size_t i = 2; i + 2 < words.size(); i += 3) {
-        // An uncalibrated cell replies in the vision frame (y up, angles
-        // counter-clockwise); the truth is in image axes.
-        const double x = picksight::parseDouble(words[i]).value_or(0);
-        const double y = -picksight::parseDouble(words[i + 1]).value_or(0);
-        const double d = std::hypot(x - t.x, y - t.y);
-        if (d < best) {
-          best = d;
-          fx = x;
-          fy = y;
-          fr = 360.0 - picksight::parseDouble(words[i + 2]).value_or(0);
-        }
-      }
-      const std::string angle_err =
-          t.symmetry_deg > 0
-              ? formatFixed(picksight::angleDiffDeg(fr, t.angle_deg, t.symmetry_deg), 3)
-              : std::string("any");
-      std::printf("  %-16s %9.3f %9.3f %8.3f | %9.3f %9.3f %8.3f | %7.3f %7s\n", t.type.c_str(),
-                  t.x, t.y, t.angle_deg, fx, fy, fr, best, angle_err.c_str());
-    }
+  zmq::context_t context;
+  Cell cell(context, *control, *frames, std::move(*robot));
+  std::this_thread::sleep_for(300ms);  // let the watcher's subscription reach the server
+
+  const auto hidden = cell.describe();
+  if (!hidden || hidden->robot_to_sensor_size() != 9) {
+    std::cerr << "demo: the camera has no simulated robot\n";
+    return 1;
   }
-  robot->close();
+  std::cout << "hidden robot-camera transform (the camera's description): robot = R("
+            << formatFixed(hidden->rz_deg()) << " deg) * vision + (" << formatFixed(hidden->dx_mm())
+            << ", " << formatFixed(hidden->dy_mm()) << ") mm at "
+            << formatFixed(hidden->mm_per_px()) << " mm/px\n\n";
+  cv::Matx33d h;
+  for (int i = 0; i < 9; ++i) h.val[i] = hidden->robot_to_sensor(i);
+
+  cell.say("STATUS");
+  calibrate(cell, h, width, height, points);
+  pick(cell, h, parts, requests);
+  cell.say("STATUS");
+
+  cell.close();
   const int vision_status = vision.terminate();
   const int server_status = server.terminate();
   std::cout << "\nstopped: vision app exit " << WEXITSTATUS(vision_status) << ", video server exit "
             << WEXITSTATUS(server_status) << "\n";
   std::error_code ignored;
   std::filesystem::remove_all(data_dir, ignored);
-  return failures == 0 && vision_status == 0 && server_status == 0 ? 0 : 1;
+  return cell.failures() == 0 && vision_status == 0 && server_status == 0 ? 0 : 1;
 }

@@ -36,6 +36,9 @@ Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& s
   status_.name = config_.name;
   status_.uri = config_.uri;
   status_.state = "stopped";
+  // No thread runs yet: the source may be asked here. Afterwards only
+  // moveTarget() changes the robot, and it refreshes robot_.
+  if (auto robot = source_->simulatedRobot()) robot_ = *robot;
 }
 
 Camera::~Camera() { stop(); }
@@ -194,6 +197,27 @@ Result<Feature> Camera::setFeature(const std::string& name, const std::string& v
     if (auto ok = s.setFeature(name, value); !ok) return ok.error();
     return s.feature(name);
   });
+}
+
+Result<SimulatedRobot> Camera::moveTarget(std::optional<cv::Point2d> at_mm) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!robot_) return makeError(SourceErrc::kNotSupported, "this camera has no simulated robot");
+  }
+  // A closed synthetic source keeps the position for when it opens again.
+  auto robot = onAcquisitionThread<SimulatedRobot>(
+      [at_mm](Source& s, bool /*open*/) { return s.moveTarget(at_mm); });
+  if (robot) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    robot_ = *robot;
+  }
+  return robot;
+}
+
+Result<SimulatedRobot> Camera::simulatedRobot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!robot_) return makeError(SourceErrc::kNotSupported, "this camera has no simulated robot");
+  return *robot_;
 }
 
 void Camera::runCommands(std::unique_lock<std::mutex>& lock) {

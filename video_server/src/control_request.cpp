@@ -129,6 +129,8 @@ std::optional<std::string> requestCamera(const proto::ControlRequest& request) {
       return request.close_stream().camera();
     case R::kSnap:
       return request.snap().camera();
+    case R::kSetTarget:
+      return request.set_target().camera();
     default:
       return std::nullopt;
   }

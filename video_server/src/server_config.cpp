@@ -222,7 +222,9 @@ void defineServerOptions(CLI::App& app, ServerArgs& a) {
       "  file:<path>               one image, re-read when it changes\n"
       "  dir:<path>                images in name order, looping\n"
       "  synthetic:[key=value,...] generated scene with ground truth\n"
-      "    (width, height, parts, seed, noise, size, light, types, scene_every)\n"
+      "    (width, height, parts, seed, noise, size, light, types, touching, blur,\n"
+      "    scene_every; the simulated robot: mm_per_px, rz, dx, dy, tilt_x, tilt_y,\n"
+      "    target=disc|grid, target_radius, grid=COLSxROWS, grid_pitch)\n"
       "\n"
       "On start it prints 'frames <endpoint>' and 'control <endpoint>' on stdout.");
 }

@@ -37,6 +37,8 @@ void fillSummary(const CameraStatus& s, proto::CameraSummary* out) {
   out->set_state(s.state);
   out->set_mode(toProto(s.mode));
 }
+void fillSimulatedRobot(const SimulatedRobot& r, proto::SimulatedRobot* out);
+
 proto::ControlReply okReply() {
   proto::ControlReply reply;
   reply.mutable_error()->set_code(proto::Error::OK);
@@ -77,6 +79,9 @@ proto::ControlReply describeCamera(Camera& camera) {
   d->set_pixel_format(s.output.format == OutputFormat::kBgr8 ? proto::BGR8 : proto::MONO8);
   d->set_fps(s.fps_setting);
   for (const auto& f : s.info.formats) d->add_source_formats(f);
+  // Only synthetic sources have one; the others answer kNotSupported.
+  if (auto robot = camera.simulatedRobot())
+    fillSimulatedRobot(*robot, d->mutable_simulated_robot());
   return reply;
 }
 
@@ -178,6 +183,42 @@ proto::ControlReply snap(Camera& camera) {
   *out->mutable_header() = frameHeaderOf(*frame);
   const cv::Mat& img = frame->image;
   out->set_pixels(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize());
+  return reply;
+}
+
+void fillSimulatedRobot(const SimulatedRobot& r, proto::SimulatedRobot* out) {
+  out->set_target_visible(r.target_visible);
+  out->set_target_x_mm(r.target_x_mm);
+  out->set_target_y_mm(r.target_y_mm);
+  out->set_target_kind(r.target_kind);
+  out->set_target_radius_mm(r.target_radius_mm);
+  out->set_grid_rows(static_cast<uint32_t>(r.grid_rows));
+  out->set_grid_cols(static_cast<uint32_t>(r.grid_cols));
+  out->set_grid_pitch_mm(r.grid_pitch_mm);
+  out->set_mm_per_px(r.mm_per_px);
+  out->set_rz_deg(r.rz_deg);
+  out->set_dx_mm(r.dx_mm);
+  out->set_dy_mm(r.dy_mm);
+  out->set_tilt_x_deg(r.tilt_x_deg);
+  out->set_tilt_y_deg(r.tilt_y_deg);
+  for (int i = 0; i < 9; ++i) out->add_robot_to_sensor(r.robot_to_sensor.val[i]);
+}
+
+proto::ControlReply setTarget(Camera& camera, const proto::SetTargetRequest& request) {
+  std::optional<cv::Point2d> at_mm;
+  if (!request.hide()) {
+    const double x = request.x_mm();
+    const double y = request.y_mm();
+    if (!std::isfinite(x) || !std::isfinite(y) || std::abs(x) > 1e6 || std::abs(y) > 1e6) {
+      return errorReply(
+          makeError(VideoErrc::kOutOfRange, "target x_mm and y_mm must be finite, within 1e6 mm"));
+    }
+    at_mm = cv::Point2d(x, y);
+  }
+  auto robot = camera.moveTarget(at_mm);
+  if (!robot) return errorReply(robot.error());
+  proto::ControlReply reply = okReply();
+  fillSimulatedRobot(*robot, reply.mutable_simulated_robot());
   return reply;
 }
 
@@ -300,6 +341,8 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
       return setOpen(*camera, false);
     case R::kSnap:
       return snap(*camera);
+    case R::kSetTarget:
+      return setTarget(*camera, request.set_target());
     default:
       return notSupported();
   }

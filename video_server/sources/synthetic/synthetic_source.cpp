@@ -2,11 +2,16 @@
 #include "synthetic_source.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::video {
+namespace {
+constexpr int kMaxParts = 500;
+}  // namespace
 
 Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
   SyntheticSourceOptions o;
@@ -28,7 +33,7 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
       if (!integer || *integer < 64 || *integer > 16384) return bad("an integer in [64, 16384]");
       (key == "width" ? o.scene.width : o.scene.height) = static_cast<int>(*integer);
     } else if (key == "parts") {
-      if (!integer || *integer < 0 || *integer > 500) return bad("an integer in [0, 500]");
+      if (!integer || *integer < 0 || *integer > kMaxParts) return bad("an integer in [0, 500]");
       o.scene.parts = static_cast<int>(*integer);
     } else if (key == "seed") {
       if (!integer || *integer < 0) return bad("a non-negative integer");
@@ -59,6 +64,36 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
     } else if (key == "blur") {
       if (!number || *number < 0 || *number > 20) return bad("a number in [0, 20]");
       o.scene.blur_sigma = *number;
+    } else if (key == "mm_per_px") {
+      if (!number || *number < 1e-4 || *number > 1000) return bad("a number in [0.0001, 1000]");
+      o.robot.mm_per_px = *number;
+    } else if (key == "rz") {
+      if (!number || *number < -360 || *number > 360) return bad("a number in [-360, 360]");
+      o.robot.rz_deg = *number;
+    } else if (key == "dx" || key == "dy") {
+      if (!number || std::abs(*number) > 1e6) return bad("a number in [-1e6, 1e6]");
+      (key == "dx" ? o.robot.dx_mm : o.robot.dy_mm) = *number;
+    } else if (key == "tilt_x" || key == "tilt_y") {
+      if (!number || std::abs(*number) > 10) return bad("a number in [-10, 10]");
+      (key == "tilt_x" ? o.robot.tilt_x_deg : o.robot.tilt_y_deg) = *number;
+    } else if (key == "target") {
+      if (value != "disc" && value != "grid") return bad("disc or grid");
+      o.target.kind = value == "grid" ? synthetic::TargetKind::kGrid : synthetic::TargetKind::kDisc;
+    } else if (key == "target_radius") {
+      if (!number || *number <= 0 || *number > 10000) return bad("a number in (0, 10000]");
+      o.target.radius_mm = *number;
+    } else if (key == "grid") {
+      const size_t x = value.find('x');
+      const auto cols = parseInt(value.substr(0, x));
+      const auto rows = x == std::string_view::npos ? std::nullopt : parseInt(value.substr(x + 1));
+      if (!cols || !rows || *cols < 1 || *rows < 1 || *cols > 50 || *rows > 50) {
+        return bad("COLSxROWS with 1 to 50 each");
+      }
+      o.target.cols = static_cast<int>(*cols);
+      o.target.rows = static_cast<int>(*rows);
+    } else if (key == "grid_pitch") {
+      if (!number || *number <= 0 || *number > 10000) return bad("a number in (0, 10000]");
+      o.target.pitch_mm = *number;
     } else if (key == "scene_every") {
       if (!integer || *integer < 0) return bad("a non-negative integer");
       o.scene_every = static_cast<uint64_t>(*integer);
@@ -66,8 +101,14 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
       return makeError(SourceErrc::kBadConfig,
                        "synthetic: unknown key '" + key +
                            "' (known: width, height, parts, seed, noise, size, light, types, "
-                           "touching, blur, scene_every)");
+                           "touching, blur, scene_every, mm_per_px, rz, dx, dy, tilt_x, tilt_y, "
+                           "target, target_radius, grid, grid_pitch)");
     }
+  }
+  if (o.target.kind == synthetic::TargetKind::kGrid &&
+      !(o.target.pitch_mm > 2 * o.target.radius_mm)) {
+    return makeError(SourceErrc::kBadConfig,
+                     "synthetic: grid_pitch must exceed twice target_radius (dots must not touch)");
   }
   return o;
 }
@@ -75,7 +116,7 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
 SyntheticSource::SyntheticSource(SyntheticSourceOptions options) : options_(std::move(options)) {}
 
 Result<void> SyntheticSource::open() {
-  if (!renderer_) renderer_ = std::make_unique<synthetic::SceneRenderer>(options_.scene);
+  if (!renderer_) makeRenderer(layout_);
   return {};
 }
 
@@ -95,9 +136,7 @@ Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/)
   if (options_.scene_every > 0) {
     const uint64_t layout = frame_index_ / options_.scene_every;
     if (layout != layout_) {
-      synthetic::SceneOptions scene = options_.scene;
-      scene.seed += layout;
-      renderer_ = std::make_unique<synthetic::SceneRenderer>(scene);
+      makeRenderer(layout);
       layout_ = layout;
     }
   }
@@ -112,7 +151,92 @@ Result<SourceFrame> SyntheticSource::grab(std::chrono::milliseconds /*timeout*/)
   for (const auto& p : renderer_->truth()) {
     frame.truth.push_back(TruthPart{p.type, p.x, p.y, p.angle_deg, p.symmetry_deg, p.area_px});
   }
+  // Each dot of the target, as an isotropic part of type "target".
+  for (const auto& d : renderer_->targetTruth()) {
+    frame.truth.push_back(TruthPart{"target", d.image_px.x, d.image_px.y, 0, 0, d.area_px});
+  }
   return frame;
+}
+
+Result<SimulatedRobot> SyntheticSource::moveTarget(std::optional<cv::Point2d> at_mm) {
+  if (at_mm && !(std::isfinite(at_mm->x) && std::isfinite(at_mm->y) && std::abs(at_mm->x) <= 1e6 &&
+                 std::abs(at_mm->y) <= 1e6)) {
+    return makeError(SourceErrc::kBadValue, "target position must be finite, within 1e6 mm");
+  }
+  target_at_mm_ = at_mm;
+  if (renderer_) renderer_->setTarget(options_.robot, options_.target, target_at_mm_);
+  return simulatedRobot();
+}
+
+Result<SimulatedRobot> SyntheticSource::simulatedRobot() const {
+  const synthetic::RobotCamera& c = options_.robot;
+  const synthetic::CalibrationTarget& t = options_.target;
+  SimulatedRobot r;
+  r.target_visible = target_at_mm_.has_value();
+  if (target_at_mm_) {
+    r.target_x_mm = target_at_mm_->x;
+    r.target_y_mm = target_at_mm_->y;
+  }
+  r.target_kind = synthetic::targetKindName(t.kind);
+  r.target_radius_mm = t.radius_mm;
+  if (t.kind == synthetic::TargetKind::kGrid) {
+    r.grid_rows = t.rows;
+    r.grid_cols = t.cols;
+    r.grid_pitch_mm = t.pitch_mm;
+  }
+  r.mm_per_px = c.mm_per_px;
+  r.rz_deg = c.rz_deg;
+  r.dx_mm = c.dx_mm;
+  r.dy_mm = c.dy_mm;
+  r.tilt_x_deg = c.tilt_x_deg;
+  r.tilt_y_deg = c.tilt_y_deg;
+  r.robot_to_sensor =
+      synthetic::RobotCameraModel(c, options_.scene.width, options_.scene.height).robotToImage();
+  return r;
+}
+
+void SyntheticSource::makeRenderer(uint64_t seed_offset) {
+  synthetic::SceneOptions scene = options_.scene;
+  scene.seed += seed_offset;
+  renderer_ = std::make_unique<synthetic::SceneRenderer>(scene);
+  if (target_at_mm_) renderer_->setTarget(options_.robot, options_.target, target_at_mm_);
+}
+
+std::vector<Feature> SyntheticSource::features() { return {*feature("Parts")}; }
+
+Result<Feature> SyntheticSource::feature(const std::string& name) {
+  if (name != "Parts")
+    return makeError(SourceErrc::kUnknownFeature, "unknown feature '" + name + "'");
+  Feature f;
+  f.name = "Parts";
+  f.type = FeatureType::kInteger;
+  f.value = std::to_string(options_.scene.parts);
+  f.has_range = true;
+  f.min = 0;
+  f.max = kMaxParts;
+  f.increment = 1;
+  f.description = "parts in the scene (0: an empty table, e.g. to calibrate)";
+  return f;
+}
+
+Result<void> SyntheticSource::setFeature(const std::string& name, const std::string& value) {
+  if (name != "Parts")
+    return makeError(SourceErrc::kUnknownFeature, "unknown feature '" + name + "'");
+  const auto parts = parseInt(value);
+  if (!parts || *parts < 0 || *parts > kMaxParts) {
+    return makeError(
+        SourceErrc::kBadValue,
+        "Parts must be an integer in [0, " + std::to_string(kMaxParts) + "], got '" + value + "'");
+  }
+  const int before = options_.scene.parts;
+  options_.scene.parts = static_cast<int>(*parts);
+  try {
+    makeRenderer(layout_);
+  } catch (const std::invalid_argument& e) {
+    options_.scene.parts = before;  // the old scene stays
+    return makeError(SourceErrc::kBadValue, e.what());
+  }
+  return {};
 }
 
 cv::Mat& SyntheticSource::freeBuffer() {

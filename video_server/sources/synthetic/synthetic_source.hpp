@@ -15,11 +15,18 @@ struct SyntheticSourceOptions {
   synthetic::SceneOptions scene;
   // A new layout (seed + n) every this many frames; 0 = the same parts always.
   uint64_t scene_every = 0;
+  // The simulated robot: its hidden transform and the target it holds
+  // (hidden until moveTarget()).
+  synthetic::RobotCamera robot;
+  synthetic::CalibrationTarget target;
 };
 
 // Parses the part after "synthetic:", comma-separated key=value pairs:
 // width, height, parts, seed, noise, size (part size px), light (uneven|flat),
-// types (names joined by '+'), scene_every. The error names the key.
+// types (names joined by '+'), touching, blur, scene_every; the simulated
+// robot: mm_per_px, rz, dx, dy (mm), tilt_x, tilt_y (degrees); its target:
+// target (disc|grid), target_radius (mm), grid (COLSxROWS), grid_pitch (mm).
+// The error names the key.
 Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text);
 
 class SyntheticSource : public Source {
@@ -30,8 +37,18 @@ class SyntheticSource : public Source {
   void close() override {}
   SourceInfo info() const override;
   Result<SourceFrame> grab(std::chrono::milliseconds timeout) override;
+  // One feature, "Parts": how many parts lie in the scene (0 = an empty
+  // table, as for a calibration), the layout drawn again from the seed.
+  std::vector<Feature> features() override;
+  Result<Feature> feature(const std::string& name) override;
+  Result<void> setFeature(const std::string& name, const std::string& value) override;
+  Result<SimulatedRobot> moveTarget(std::optional<cv::Point2d> at_mm) override;
+  Result<SimulatedRobot> simulatedRobot() const override;
 
  private:
+  // Lays out the scene (with `seed_offset` added to the seed) and shows the
+  // target where the robot holds it.
+  void makeRenderer(uint64_t seed_offset);
   // A pooled image buffer nobody else holds any more, or a fresh one when
   // all are still in use.
   cv::Mat& freeBuffer();
@@ -39,7 +56,8 @@ class SyntheticSource : public Source {
   SyntheticSourceOptions options_;
   std::unique_ptr<synthetic::SceneRenderer> renderer_;
   uint64_t frame_index_ = 0;
-  uint64_t layout_ = 0;  // which layout renderer_ holds
+  uint64_t layout_ = 0;                      // which layout renderer_ holds
+  std::optional<cv::Point2d> target_at_mm_;  // where the robot holds the target
   // Rendered frames live in these buffers while published (the camera's last
   // frame, ZeroMQ until sent): reusing them spares the page faults of a fresh
   // 2 MB allocation per frame.

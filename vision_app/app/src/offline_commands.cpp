@@ -194,7 +194,12 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
       const LocateOutcome outcome =
           locateInFrame(frameFromImage(grey, path, 1), options->vision, library.snapshot(), type);
-      out << locateReply(pickPoses(outcome, *library.grasps(), calibration.geometry())) << "\n";
+      const auto geometry = calibration.geometry();
+      if (!geometry) {
+        out << errorReply(geometry.error()) << "\n";
+        return 1;
+      }
+      out << locateReply(pickPoses(outcome, *library.grasps(), *geometry)) << "\n";
     } else {
       const auto blobs = blobsInImage(grey, options->vision);
       std::string line = "OK " + std::to_string(blobs.size());

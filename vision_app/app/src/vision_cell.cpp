@@ -22,8 +22,9 @@ std::vector<std::string> VisionCell::load() {
   std::vector<std::string> problems;
   for (auto& p : models_.load()) problems.push_back("model rejected: " + p);
   if (auto ok = calibration_.load(); !ok)
-    problems.push_back("calibration rejected (changes refused until repaired): " +
-                       ok.error().message);
+    problems.push_back(
+        "calibration rejected (LOCATE and changes refused until repaired, or CLEARCAL): " +
+        ok.error().message);
   return problems;
 }
 

@@ -39,7 +39,10 @@ PlcDevice::Locator cellLocator(app::CellContext& cell) {
 }
 
 PlcDevice::FrameState cellFrameState(const app::CellCalibration& calibration) {
-  return [&calibration] { return frameCode(calibration.geometry().frame()); };
+  return [&calibration] {
+    const auto geometry = calibration.geometry();
+    return geometry ? frameCode(geometry->frame()) : kFrameDamaged;
+  };
 }
 
 int robotErrorCodeOf(const Error& error) { return app::robotErrorCode(error.code); }

@@ -13,6 +13,8 @@ namespace {
 // smaller, so 3% tells a disc from the usual wrong targets.
 constexpr double kDiscTolerance = 0.03;
 constexpr double kMaxRadiusMm = 10000;
+// Robot coordinates beyond a kilometre are a robot program's bug.
+constexpr double kMaxRobotMm = 1e6;
 
 std::string reply(const Error& e) { return errorReply(e); }
 
@@ -55,8 +57,20 @@ std::string calcam(const Request& r, VisionService& vision, CellCalibration& cal
 
 std::string store(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const auto robot = parseNumbers(r.args);
-  if (!robot || robot->size() != 2 || !std::isfinite((*robot)[0]) || !std::isfinite((*robot)[1]))
-    return errorReply(ProtocolErrc::kBadArguments, "usage: STORE <x> <y> (robot mm)");
+  if (!robot || robot->size() != 2 || !std::isfinite((*robot)[0]) ||
+      !std::isfinite((*robot)[1]) || std::abs((*robot)[0]) > kMaxRobotMm ||
+      std::abs((*robot)[1]) > kMaxRobotMm)
+    return errorReply(ProtocolErrc::kBadArguments,
+                      "usage: STORE <x> <y> (robot mm, each within +-1000000)");
+  // Checked before a frame is taken: a damaged calibration or a full list
+  // costs no camera time.
+  auto geometry = calibration.geometry();
+  if (!geometry) return reply(geometry.error());
+  if (calibration.summary().points >= CellCalibration::kMaxPoints) {
+    return errorReply(
+        CellCalibrationErrc::kTooManyPoints,
+        std::to_string(CellCalibration::kMaxPoints) + " points are stored already (DELETE some)");
+  }
   auto target = vision.target();
   if (!target) return reply(target.error());
   // A disc's centre from its edges (unbiased by uneven light); any other
@@ -65,7 +79,7 @@ std::string store(const Request& r, VisionService& vision, CellCalibration& cali
   if (looksLikeDisc(target->moments)) {
     if (auto disc = measuredDisc(*target)) centre = disc->centre;
   }
-  const calibration::PointPair pair{calibration.geometry().vision.toMm(centre),
+  const calibration::PointPair pair{geometry->vision.toMm(centre),
                                     {(*robot)[0], (*robot)[1]}};
   auto id = calibration.addPoint(pair);
   if (!id) return reply(id.error());
@@ -124,19 +138,26 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
     return "OK " + formatFixed(t.dx) + " " + formatFixed(t.dy) + " " + formatFixed(t.rz_deg) + " " +
            formatFixed(result->rms);
   });
+  table.add("CLEARCAL", "CLEARCAL", [&](const Request& r) {
+    if (!r.args.empty())
+      return errorReply(ProtocolErrc::kBadArguments, "CLEARCAL takes no arguments");
+    auto ok = calibration.clear();
+    return ok ? std::string("OK") : reply(ok.error());
+  });
   table.add(
       "RESIDUALS", "RESIDUALS",
       [&](const Request& r) {
         if (!r.args.empty())
           return errorReply(ProtocolErrc::kBadArguments, "RESIDUALS takes no arguments");
         const auto geometry = calibration.geometry();
-        if (!geometry.transform)
+        if (!geometry) return reply(geometry.error());
+        if (!geometry->transform)
           return errorReply(CellCalibrationErrc::kNotComputed,
                             "no robot-camera transform yet (see COMPUTE)");
         const auto points = calibration.points();
         std::string out = "OK " + std::to_string(points.size());
         for (const auto& [id, p] : points) {
-          const cv::Point2d d = geometry.transform->apply(p.vision) - p.robot;
+          const cv::Point2d d = geometry->transform->apply(p.vision) - p.robot;
           out += " " + std::to_string(id) + " " + formatFixed(d.x) + " " + formatFixed(d.y) + " " +
                  formatFixed(std::hypot(d.x, d.y));
         }

@@ -105,7 +105,8 @@ std::string status(const Request& r, CellContext& cell) {
   const auto models =
       cell.vision.models() ? cell.vision.models()->snapshot() : std::make_shared<const ModelList>();
   const auto last = cell.vision.lastFrame();
-  std::string out = "OK frame=" + std::string(frameName(geometry.frame()));
+  // A damaged calibration file has no frame: frame=none, calibration=damaged.
+  std::string out = "OK frame=" + std::string(geometry ? frameName(geometry->frame()) : "none");
   out += " scale=";
   out += calib.scale ? formatFixed(calib.scale->mm_per_px_x, 6) + "x" +
                            formatFixed(calib.scale->mm_per_px_y, 6)
@@ -128,6 +129,7 @@ std::string status(const Request& r, CellContext& cell) {
   out += " offered=" + std::to_string(cell.last_offered.load());
   out += " skipped=" + std::to_string(cell.last_skipped.load());
   out += " skipped_total=" + std::to_string(cell.skipped_total.load());
+  out += std::string(" calibration=") + (geometry ? "ok" : "damaged");
   return out;
 }
 
@@ -195,12 +197,18 @@ std::string roi(const Request& r, CellContext& cell) {
 }  // namespace
 
 Result<CellLocate> locateAndPick(CellContext& cell, int type) {
+  // A damaged calibration file is an error, never a silent change of frame;
+  // checked before the frame is taken.
+  if (auto geometry = cell.calibration.geometry(); !geometry) return geometry.error();
   auto outcome = cell.vision.locate(type);
   if (!outcome) return outcome.error();
+  // Taken again: a CLEARCAL or a COMPUTE may have come meanwhile.
+  const auto geometry = cell.calibration.geometry();
+  if (!geometry) return geometry.error();
   const auto grasps =
       cell.vision.models() ? cell.vision.models()->grasps() : std::make_shared<const GraspMap>();
   CellLocate located;
-  located.pick = pickPoses(*outcome, *grasps, cell.calibration.geometry());
+  located.pick = pickPoses(*outcome, *grasps, *geometry);
   located.outcome = std::move(*outcome);
   ++cell.locates;
   cell.last_offered = located.pick.poses.size();

@@ -50,6 +50,9 @@ const std::array<std::pair<std::error_code, int>, 31> kTable = {{
     {CellCalibrationErrc::kCalibrationStorage, 43},
     {CalibrationErrc::kBadFile, 43},
     {CellCalibrationErrc::kNotComputed, 44},
+    {CellCalibrationErrc::kDamaged, 45},
+    {CellCalibrationErrc::kTooManyPoints, 46},
+    {CellCalibrationErrc::kPointsChanged, 47},
     {ProtocolErrc::kInternalError, kInternal},
 }};
 

@@ -1,7 +1,13 @@
 // Cell calibration: the calibration store behind a lock, and the reply frame.
 #include "picksight/store/cell_calibration.hpp"
 
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <vector>
+
+#include "picksight/common/atomic_file.hpp"
 
 namespace picksight::app {
 
@@ -13,6 +19,12 @@ const char* errorName(CellCalibrationErrc e) {
       return "calibration storage";
     case CellCalibrationErrc::kNotComputed:
       return "not computed";
+    case CellCalibrationErrc::kDamaged:
+      return "damaged";
+    case CellCalibrationErrc::kTooManyPoints:
+      return "too many points";
+    case CellCalibrationErrc::kPointsChanged:
+      return "points changed";
   }
   return "unknown";
 }
@@ -20,6 +32,42 @@ namespace {
 Error storageError(const Error& e) {
   return makeError(CellCalibrationErrc::kCalibrationStorage,
                    "cannot write the calibration: " + e.message);
+}
+
+bool finite(cv::Point2d p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+
+// The geometry of a loaded store.
+CellGeometry geometryOf(const calibration::CalibrationStore& store) {
+  CellGeometry g;
+  if (store.scale()) g.vision = calibration::VisionFrame(*store.scale(), store.lens());
+  if (store.transform()) g.transform = store.transform()->transform;
+  return g;
+}
+
+// Why a loaded store cannot be used, or empty. Checked through what LOCATE
+// computes (the frame conversions at a few points across a large sensor)
+// rather than field by field, so a non-finite value anywhere in the scale,
+// the lens or the transform is caught whatever their form.
+std::string unusable(const calibration::CalibrationStore& store) {
+  for (const auto& [id, pair] : store.points()) {
+    if (!finite(pair.vision) || !finite(pair.robot)) {
+      return "point " + std::to_string(id) + " has a non-finite coordinate";
+    }
+  }
+  if (store.transform() && !std::isfinite(store.transform()->rms)) {
+    return "its transform has a non-finite RMS";
+  }
+  const CellGeometry g = geometryOf(store);
+  for (const cv::Point2d pixel :
+       {cv::Point2d(0, 0), cv::Point2d(4000, 0), cv::Point2d(0, 3000), cv::Point2d(4000, 3000)}) {
+    const cv::Point2d mm = g.vision.toMm(pixel);
+    const grasp::Pose reply = g.toReply({mm.x, mm.y, 30});
+    if (!finite(mm) || !std::isfinite(reply.x) || !std::isfinite(reply.y) ||
+        !std::isfinite(reply.rz_deg)) {
+      return "its scale, lens model or transform gives non-finite coordinates";
+    }
+  }
+  return {};
 }
 }  // namespace
 
@@ -46,27 +94,59 @@ grasp::Pose CellGeometry::toReply(const grasp::Pose& p) const {
   return {r.x, r.y, transform->applyToAngleDeg(p.rz_deg, {p.x, p.y})};
 }
 
-CellCalibration::CellCalibration(std::string path) : store_(std::move(path)) {}
+CellCalibration::CellCalibration(std::string path, Fit fit)
+    : fit_(std::move(fit)), store_(std::move(path)) {}
 
 Result<void> CellCalibration::load() {
   std::lock_guard<std::mutex> lock(mutex_);
+  ++revision_;
   auto ok = store_.load();
   damaged_ = ok ? std::string() : ok.error().message;
+  if (ok) {
+    if (const std::string why = unusable(store_); !why.empty()) {
+      damaged_ = store_.path() + ": " + why;
+      store_ = calibration::CalibrationStore(store_.path());  // nothing of it is used
+      return makeError(CellCalibrationErrc::kDamaged, damaged_);
+    }
+  }
   return ok;
 }
 
-Error CellCalibration::blocked() const {
-  return makeError(
-      CellCalibrationErrc::kCalibrationStorage,
-      "the calibration file is damaged, nothing is changed: " + damaged_.substr(0, 200));
+std::optional<std::string> CellCalibration::damage() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (damaged_.empty()) return std::nullopt;
+  return damaged_;
 }
 
-CellGeometry CellCalibration::geometry() const {
+Result<void> CellCalibration::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
-  CellGeometry g;
-  if (store_.scale()) g.vision = calibration::VisionFrame(*store_.scale(), store_.lens());
-  if (store_.transform()) g.transform = store_.transform()->transform;
-  return g;
+  const std::string& path = store_.path();
+  // A damaged file is kept for whoever wants to repair it; a sound one goes.
+  const bool keep = !damaged_.empty();
+  const int failed =
+      keep ? std::rename(path.c_str(), (path + ".damaged").c_str()) : std::remove(path.c_str());
+  if (failed != 0 && errno != ENOENT) {
+    return storageError(
+        systemError(errno, keep ? "cannot rename " + path : "cannot remove " + path));
+  }
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  if (auto ok = syncDirectory(dir.empty() ? "." : dir); !ok) return storageError(ok.error());
+  store_ = calibration::CalibrationStore(path);
+  damaged_.clear();
+  ++revision_;
+  return {};
+}
+
+Error CellCalibration::blocked() const {
+  return makeError(CellCalibrationErrc::kDamaged, "the calibration file is damaged (" +
+                                                      damaged_.substr(0, 200) +
+                                                      "): repair it and restart, or CLEARCAL");
+}
+
+Result<CellGeometry> CellCalibration::geometry() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!damaged_.empty()) return blocked();
+  return geometryOf(store_);
 }
 
 CalibrationSummary CellCalibration::summary() const {
@@ -84,6 +164,7 @@ Result<void> CellCalibration::setScale(const calibration::PixelScale& scale) {
   if (!damaged_.empty()) return blocked();
   auto ok = store_.setScale(scale);
   if (!ok) return storageError(ok.error());
+  ++revision_;
   return {};
 }
 
@@ -92,14 +173,23 @@ Result<void> CellCalibration::setLens(const calibration::LensModel& lens) {
   if (!damaged_.empty()) return blocked();
   auto ok = store_.setLens(lens);
   if (!ok) return storageError(ok.error());
+  ++revision_;
   return {};
 }
 
 Result<int> CellCalibration::addPoint(const calibration::PointPair& pair) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!damaged_.empty()) return blocked();
+  if (!finite(pair.vision) || !finite(pair.robot)) {
+    return makeError(calibration::CalibrationErrc::kBadInput, "a point must be finite");
+  }
+  if (store_.points().size() >= kMaxPoints) {
+    return makeError(CellCalibrationErrc::kTooManyPoints,
+                     std::to_string(kMaxPoints) + " points are stored already (DELETE some)");
+  }
   auto id = store_.addPoint(pair);
   if (!id) return storageError(id.error());
+  ++revision_;
   return id;
 }
 
@@ -111,16 +201,28 @@ Result<void> CellCalibration::deletePoint(int id) {
                      "no point with id " + std::to_string(id) + " (see LIST)");
   auto ok = store_.deletePoint(id);
   if (!ok) return storageError(ok.error());
+  ++revision_;
   return {};
 }
 
 Result<calibration::CalibrationResult> CellCalibration::compute(calibration::Method method) {
+  std::vector<calibration::PointPair> pairs;
+  uint64_t revision = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!damaged_.empty()) return blocked();
+    for (const auto& [id, pair] : store_.points()) pairs.push_back(pair);
+    revision = revision_;
+  }
+  // The fit may take long with many points: LOCATE and STATUS go on meanwhile.
+  auto result = fit_ ? fit_(pairs, method) : calibration::calibrate(pairs, method);
+  if (!result) return result.error();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!damaged_.empty()) return blocked();
-  std::vector<calibration::PointPair> pairs;
-  for (const auto& [id, pair] : store_.points()) pairs.push_back(pair);
-  auto result = calibration::calibrate(pairs, method);
-  if (!result) return result.error();
+  if (revision_ != revision) {
+    return makeError(CellCalibrationErrc::kPointsChanged,
+                     "the points or the scale changed while COMPUTE ran; COMPUTE again");
+  }
   auto ok = store_.setTransform(*result);
   if (!ok) return storageError(ok.error());
   return result;

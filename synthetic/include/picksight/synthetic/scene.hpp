@@ -9,11 +9,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "picksight/synthetic/simulated_robot.hpp"
 
 namespace picksight::synthetic {
 
@@ -124,9 +127,25 @@ class SceneRenderer {
   // differ), so a caller with pooled buffers renders without allocating.
   void renderInto(uint64_t frame_index, cv::Mat& out) const;
 
+  // Shows a simulated robot's calibration target held at `at_mm` (robot mm)
+  // as `camera` sees it, over the parts, or no target (nullopt), and renders
+  // the clean image again (the layout and the noise stay). The target is as
+  // dark as a part and blurred like the rest.
+  void setTarget(const RobotCamera& camera, const CalibrationTarget& target,
+                 std::optional<cv::Point2d> at_mm);
+  // Where the target's dots are drawn; empty with no target.
+  const std::vector<TargetDotTruth>& targetTruth() const { return target_truth_; }
+
  private:
+  // clean_ from base_ plus the target, blurred and rounded to 8 bits.
+  void renderClean(const RobotCamera* camera, const CalibrationTarget* target,
+                   std::optional<cv::Point2d> at_mm);
+
   SceneOptions options_;
   std::vector<PartTruth> truth_;
+  std::vector<TargetDotTruth> target_truth_;
+  cv::Mat base_;   // CV_32F: the lit background and the parts, before blur
+  cv::Mat light_;  // CV_32F gain per pixel; empty with even light
   cv::Mat clean_;
   std::vector<cv::Mat> noise_bank_;  // CV_16SC1 noise fields reused across frames
 };

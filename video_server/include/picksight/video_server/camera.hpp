@@ -112,6 +112,13 @@ class Camera {
   Result<Feature> feature(const std::string& name);
   Result<Feature> setFeature(const std::string& name, const std::string& value);
 
+  // The simulated robot of a synthetic source. moveTarget runs on the
+  // acquisition thread: frames acquired after it returns show the target
+  // there. simulatedRobot() answers from the last known state, without
+  // waiting for the acquisition thread. Other sources: kNotSupported.
+  Result<SimulatedRobot> moveTarget(std::optional<cv::Point2d> at_mm);
+  Result<SimulatedRobot> simulatedRobot() const;
+
  private:
   using Command = std::function<void()>;
   using Clock = std::chrono::steady_clock;
@@ -171,6 +178,7 @@ class Camera {
   uint64_t next_sequence_ = 1;
   uint64_t pending_triggers_ = 0;
   CameraStatus status_;
+  std::optional<SimulatedRobot> robot_;  // the source's simulated robot, if it has one
 };
 
 }  // namespace picksight::video

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,28 @@ struct SourceInfo {
   std::vector<std::string> formats;  // formats the device delivers
 };
 
+// A simulated robot holding a calibration target in front of a synthetic
+// camera: where the target is and the hidden robot-camera transform, for
+// checking a calibration against (docs/PROTOCOL.md states the frames).
+struct SimulatedRobot {
+  bool target_visible = false;
+  double target_x_mm = 0;  // robot mm, when visible
+  double target_y_mm = 0;
+  std::string target_kind;  // "disc" or "grid"
+  double target_radius_mm = 0;
+  int grid_rows = 0;  // grid targets only
+  int grid_cols = 0;
+  double grid_pitch_mm = 0;
+  // robot = R(rz_deg) * vision + (dx_mm, dy_mm); vision = (u, -v) * mm_per_px
+  double mm_per_px = 0;
+  double rz_deg = 0;
+  double dx_mm = 0;
+  double dy_mm = 0;
+  double tilt_x_deg = 0;
+  double tilt_y_deg = 0;
+  cv::Matx33d robot_to_sensor = cv::Matx33d::eye();  // sensor px ~ H * (X, Y, 1)
+};
+
 // Why a source call failed: the camera thread decides from it whether to
 // retry, reopen or give up.
 enum class SourceErrc {
@@ -132,6 +155,16 @@ class Source {
   }
   virtual Result<void> setFeature(const std::string& name, const std::string& /*value*/) {
     return makeError(SourceErrc::kUnknownFeature, "unknown feature '" + name + "'");
+  }
+
+  // --- Simulated robot (synthetic sources): moves the calibration target to
+  // robot (x, y) mm, or hides it (nullopt), from the next frame on; returns
+  // the robot's state. Other sources: kNotSupported.
+  virtual Result<SimulatedRobot> moveTarget(std::optional<cv::Point2d> /*at_mm*/) {
+    return makeError(SourceErrc::kNotSupported, "this camera has no simulated robot");
+  }
+  virtual Result<SimulatedRobot> simulatedRobot() const {
+    return makeError(SourceErrc::kNotSupported, "this camera has no simulated robot");
   }
 };
 

@@ -57,6 +57,8 @@ constexpr uint16_t kMaxType = 9999;
 constexpr uint16_t kFrameVisionPixels = 0;
 constexpr uint16_t kFrameVisionMm = 1;
 constexpr uint16_t kFrameRobot = 2;
+// The calibration file is damaged: every trigger fails with error 45.
+constexpr uint16_t kFrameDamaged = 0xffff;
 
 // How a 32-bit value lies in two registers: ABCD sends the high word first
 // (Modicon, Siemens, Rockwell's usual setting), CDAB the low word first.

@@ -4,13 +4,18 @@
 // and the coordinate frame LOCATE replies in, which follows from them.
 //
 // Threading: every member is thread-safe; geometry() returns a copy, so a
-// LOCATE in progress keeps the calibration it started with.
+// LOCATE in progress keeps the calibration it started with. compute() fits
+// on a copy of the points without holding the lock geometry() and
+// summary() take: a long COMPUTE never delays a LOCATE or a STATUS.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "picksight/calibration/calibration_store.hpp"
 #include "picksight/calibration/vision_frame.hpp"
@@ -25,6 +30,9 @@ enum class CellCalibrationErrc {
   kNoSuchPoint = 1,     // DELETE: no point with that id
   kCalibrationStorage,  // calibration.yaml could not be written, or is damaged
   kNotComputed,         // no robot-camera transform yet
+  kDamaged,             // calibration.yaml exists but cannot be used: see CLEARCAL
+  kTooManyPoints,       // STORE: kMaxPoints are stored already
+  kPointsChanged,       // COMPUTE: a STORE or DELETE came while it computed
 };
 const char* errorName(CellCalibrationErrc e);
 PICKSIGHT_ERROR_DOMAIN(CellCalibrationErrc, "cell calibration")
@@ -53,23 +61,45 @@ struct CalibrationSummary {
 
 class CellCalibration {
  public:
-  explicit CellCalibration(std::string path);
+  // At most this many stored points: COMPUTE's time and the file's size stay
+  // bounded, and a robot program stuck in a STORE loop is told so.
+  static constexpr size_t kMaxPoints = 256;
 
-  // Reads the file if it exists. A damaged file is an error, and is left
-  // alone: every change is then refused (CellCalibrationErrc::kCalibrationStorage) rather than
-  // overwrite what an integrator may still repair.
+  // How COMPUTE fits; calibration::calibrate unless a test puts a fit it
+  // controls in its place (to hold a COMPUTE in progress).
+  using Fit = std::function<Result<calibration::CalibrationResult>(
+      const std::vector<calibration::PointPair>&, calibration::Method)>;
+
+  explicit CellCalibration(std::string path, Fit fit = {});
+
+  // Reads the file if it exists. A file that exists but cannot be used
+  // (unreadable, unparsable, or giving non-finite coordinates) is an error
+  // and is left alone: until it is repaired and loaded again, or clear()
+  // is called, geometry() and every change are refused
+  // (CellCalibrationErrc::kDamaged), so that LOCATE never silently replies
+  // in another frame and nothing an integrator may still repair is
+  // overwritten.
   Result<void> load();
+  // Why the file could not be used; nullopt when it is sound (or absent).
+  std::optional<std::string> damage() const;
+  // Forgets the whole calibration (scale, lens, points, transform). A
+  // damaged file is kept beside, renamed to <path>.damaged; a sound one is
+  // removed. LOCATE then replies in vision pixels.
+  Result<void> clear();
 
-  CellGeometry geometry() const;
+  // The geometry LOCATE replies with; kDamaged while the file is damaged.
+  Result<CellGeometry> geometry() const;
   CalibrationSummary summary() const;
   std::map<int, calibration::PointPair> points() const;
 
   // Each change is written before it takes effect (CellCalibrationErrc::kCalibrationStorage).
   Result<void> setScale(const calibration::PixelScale& scale);
   Result<void> setLens(const calibration::LensModel& lens);
+  // Refuses non-finite coordinates, and a point past kMaxPoints.
   Result<int> addPoint(const calibration::PointPair& pair);
   Result<void> deletePoint(int id);  // CellCalibrationErrc::kNoSuchPoint names the id
-  // Fits the transform to the stored points and stores it.
+  // Fits the transform to a copy of the stored points, outside the lock,
+  // and stores it, unless a STORE or DELETE came meanwhile (kPointsChanged).
   Result<calibration::CalibrationResult> compute(
       calibration::Method method = calibration::Method::kBest);
 
@@ -78,9 +108,11 @@ class CellCalibration {
  private:
   Error blocked() const;
 
-  mutable std::mutex mutex_;  // guards store_ and damaged_
+  const Fit fit_;
+  mutable std::mutex mutex_;  // guards store_, damaged_ and revision_
   calibration::CalibrationStore store_;
-  std::string damaged_;  // why load() failed; empty when writable
+  std::string damaged_;    // why load() failed; empty when writable
+  uint64_t revision_ = 0;  // counts changes to the points and the scale
 };
 
 }  // namespace picksight::app
