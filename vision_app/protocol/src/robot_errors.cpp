@@ -19,7 +19,7 @@ using calibration::CalibrationErrc;
 
 constexpr int kInternal = 99;
 
-const std::array<std::pair<std::error_code, int>, 31> kTable = {{
+const std::pair<std::error_code, int> kTable[] = {
     {VisionErrc::kNoTarget, 1},
     {VisionErrc::kSeveralTargets, 2},
     {VisionErrc::kNotADisc, 3},
@@ -54,7 +54,7 @@ const std::array<std::pair<std::error_code, int>, 31> kTable = {{
     {CellCalibrationErrc::kTooManyPoints, 46},
     {CellCalibrationErrc::kPointsChanged, 47},
     {ProtocolErrc::kInternalError, kInternal},
-}};
+};
 
 }  // namespace
 
