@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     app::VisionCell cell(options->data_dir,
                          std::make_unique<app::VideoServerCamera>(
                              context, options->frames_endpoint, options->control_endpoint,
-                             options->camera, options->vision.frame_timeout),
+                             options->camera, options->vision.frame_timeout, options->curve),
                          options->vision);
     // A bad file costs what it holds, never the start.
     for (const auto& problem : cell.load()) logError(problem);
@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
               << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on port ",
             robots.port());
+    if (options->curve) logInfo("CURVE to the video server as ", options->curve->own.public_key);
     logInfo("stopping on signal ", stop_signals.wait());
     robots.stop();
     cell.stop();

@@ -15,10 +15,14 @@ using namespace std::chrono_literals;
 
 std::string binPath(const std::string& name) { return std::string(PICKSIGHT_BIN_DIR) + "/" + name; }
 
-VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
+VideoServerProcess::VideoServerProcess(std::vector<std::string> args, const std::string& log_file) {
   std::vector<std::string> argv = {binPath("picksight-video-server"), "--frames",
                                    "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"};
   argv.insert(argv.end(), args.begin(), args.end());
+  if (!log_file.empty()) {
+    // The shell only redirects and execs: the child is still the server.
+    argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$@\" 2>\"$0\"", log_file});
+  }
   process = std::make_unique<Subprocess>(argv);
   auto f = process->waitForLine("frames ", 10s);
   REQUIRE(f);
@@ -29,7 +33,8 @@ VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
 }
 
 VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string& camera,
-                             const std::string& given_data_dir) {
+                             const std::string& given_data_dir,
+                             const std::vector<std::string>& extra_args) {
   if (given_data_dir.empty()) {
     char dir[] = "/tmp/picksight-e2e-XXXXXX";
     REQUIRE(::mkdtemp(dir) != nullptr);
@@ -38,9 +43,21 @@ VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string
     data_dir = given_data_dir;
     own_data_dir = false;
   }
-  process = std::make_unique<Subprocess>(std::vector<std::string>{
-      binPath("picksight-vision"), "--frames", server.frames, "--control", server.control,
-      "--camera", camera, "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
+  std::vector<std::string> argv = {binPath("picksight-vision"),
+                                   "--frames",
+                                   server.frames,
+                                   "--control",
+                                   server.control,
+                                   "--camera",
+                                   camera,
+                                   "--robot-port",
+                                   "0",
+                                   "--bind",
+                                   "127.0.0.1",
+                                   "--data-dir",
+                                   data_dir};
+  argv.insert(argv.end(), extra_args.begin(), extra_args.end());
+  process = std::make_unique<Subprocess>(argv);
   auto port = process->waitForLine("robot ", 10s);
   REQUIRE(port);
   auto value = parseInt(*port);

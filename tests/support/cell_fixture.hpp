@@ -21,8 +21,8 @@ std::string binPath(const std::string& name);
 
 struct VideoServerProcess {
   // Starts the server with `args` plus free-port endpoints; REQUIREs that it
-  // printed its endpoints.
-  explicit VideoServerProcess(std::vector<std::string> args);
+  // printed its endpoints. With a `log_file` its stderr (the log) goes there.
+  explicit VideoServerProcess(std::vector<std::string> args, const std::string& log_file = "");
   std::unique_ptr<Subprocess> process;
   std::string frames;
   std::string control;
@@ -30,9 +30,9 @@ struct VideoServerProcess {
 
 struct VisionProcess {
   // With an empty `data_dir` a fresh one, removed at the end; a given one
-  // is kept (restart tests).
+  // is kept (restart tests). `extra_args` go at the end of the command line.
   VisionProcess(const VideoServerProcess& server, const std::string& camera = "cam0",
-                const std::string& data_dir = "");
+                const std::string& data_dir = "", const std::vector<std::string>& extra_args = {});
   ~VisionProcess();
   std::unique_ptr<Subprocess> process;
   uint16_t robot_port = 0;

@@ -38,14 +38,19 @@ const char* errorName(ControlErrc e) {
 }
 
 ControlClient::ControlClient(zmq::context_t& context, std::string endpoint,
-                             std::chrono::milliseconds timeout)
-    : context_(context), endpoint_(std::move(endpoint)), timeout_(timeout) {
+                             std::chrono::milliseconds timeout,
+                             std::optional<CurveClientKeys> curve)
+    : context_(context),
+      endpoint_(std::move(endpoint)),
+      timeout_(timeout),
+      curve_(std::move(curve)) {
   reconnect();
 }
 
 void ControlClient::reconnect() {
   socket_ = std::make_unique<zmq::socket_t>(context_, zmq::socket_type::req);
   socket_->set(zmq::sockopt::linger, 0);
+  secureClientSocket(*socket_, curve_);
   socket_->connect(endpoint_);
 }
 

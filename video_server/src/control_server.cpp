@@ -34,6 +34,7 @@ ControlServer::ControlServer(zmq::context_t& context, const std::string& endpoin
       socket_(context, zmq::socket_type::router),
       replies_(context, zmq::socket_type::pull) {
   socket_.set(zmq::sockopt::linger, 0);
+  secureServerSocket(socket_, options_.curve);
   socket_.bind(endpoint);
   bound_endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
   // Unique within the context: several servers may share one.

@@ -17,6 +17,8 @@ struct RawOptions {
   std::string polarity;
   std::string window;
   std::string min_area;
+  std::string curve_server_key;
+  std::string curve_key;
 };
 
 std::string checkRange(const std::string& v, long long low, long long high) {
@@ -76,6 +78,15 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
         auto m = parseDouble(v);
         return m && *m >= 1 ? std::string() : "must be a number >= 1, got '" + v + "'";
       }));
+  CLI::Option* server_key =
+      app.add_option("--curve-server-key", raw.curve_server_key,
+                     "talk CURVE to the video server: its public NAME.key (docs/SECURITY.md)")
+          ->type_name("FILE");
+  app.add_option("--curve-key", raw.curve_key,
+                 "this client's NAME.key_secret, for a server with an allow-list "
+                 "(default: a fresh key pair)")
+      ->type_name("FILE")
+      ->needs(server_key);
   app.footer("On start it prints 'robot <port>' and 'ready' on stdout.");
 }
 
@@ -117,6 +128,11 @@ Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help
   if (!raw.window.empty())
     o.vision.binarize.adaptive_window = static_cast<int>(*parseInt(raw.window));
   if (!raw.min_area.empty()) o.vision.regions.min_area = *parseDouble(raw.min_area);
+  if (!raw.curve_server_key.empty()) {
+    auto keys = loadClientKeys(raw.curve_key, raw.curve_server_key);
+    if (!keys) return keys.error();
+    o.curve = std::move(*keys);
+  }
   return o;
 }
 

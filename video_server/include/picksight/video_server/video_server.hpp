@@ -23,8 +23,9 @@ class VideoServer {
   using SourceFactory = std::function<Result<std::unique_ptr<Source>>(const std::string& uri)>;
 
   // Builds every source (with `make_source`, the driver factory unless a
-  // test brings its own) and binds both sockets; throws std::runtime_error
-  // with a message naming the camera or endpoint when that fails.
+  // test brings its own) and binds both sockets (CURVE servers when the
+  // config has a secret key); throws std::runtime_error with a message
+  // naming the camera, endpoint or key file when that fails.
   explicit VideoServer(const ServerConfig& config, const SourceFactory& make_source = makeSource);
   ~VideoServer();
 
@@ -46,6 +47,8 @@ class VideoServer {
   proto::ControlReply statistics(const proto::StatisticsRequest& request);
 
   zmq::context_t context_;
+  // Before the sockets: its ZAP handler's socket closes after theirs.
+  std::unique_ptr<CurveServer> curve_;
   std::unique_ptr<FramePublisher> publisher_;
   std::vector<std::unique_ptr<Camera>> cameras_;
   std::unique_ptr<ControlServer> control_;

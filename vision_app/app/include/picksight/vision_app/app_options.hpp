@@ -1,12 +1,14 @@
 // Command-line options of picksight-vision.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
+#include "picksight/transport/curve_keys.hpp"
 
 namespace picksight::app {
 
@@ -17,6 +19,8 @@ struct AppOptions {
   std::string data_dir = "picksight-data";
   RobotServerOptions robot;
   VisionOptions vision;
+  // CURVE keys for the camera link (loaded by parseAppArgs); nullopt: plain.
+  std::optional<CurveClientKeys> curve;
 };
 
 // Parses argv without the program name; errors name the option.
