@@ -63,15 +63,17 @@ proto::ControlRequest listCameras() {
 
 }  // namespace
 
-TEST_CASE("CURVE: a listed client gets frames and replies, unlisted and plain ones nothing",
-          "[e2e][curve]") {
+TEST_CASE(
+    "CURVE: a listed client gets frames and replies while unlisted and plain ones get nothing",
+    "[e2e][curve]") {
   Keys keys;
   const std::string log = keys.dir.file("server.log");
   std::vector<std::string> args = {"--source", "cam0=synthetic:width=320,height=240", "--fps",
                                    "30"};
   for (const auto& a : keys.serverArgs()) args.push_back(a);
-  VideoServerProcess server(args, log);
+  // The context ends after the server: no handshake is left half done.
   zmq::context_t context;
+  VideoServerProcess server(args, log);
   // Those that must get nothing connect first: they have at least as long
   // as the listed client, whose frames are the test's positive control.
   FrameSubscriber unlisted(context, server.frames, "cam0", 4, keys.client(keys.strangerSecret()));
@@ -111,7 +113,8 @@ TEST_CASE("CURVE: a listed client gets frames and replies, unlisted and plain on
   CHECK(listed_control.call(listCameras()));
 }
 
-TEST_CASE("CURVE: picksight-cam and the vision app use their keys, LOCATE works", "[e2e][curve]") {
+TEST_CASE("CURVE: picksight-cam and the vision app use their keys and LOCATE works",
+          "[e2e][curve]") {
   Keys keys;
   std::vector<std::string> args = {"--source", "cam0=synthetic:width=640,height=480,parts=4,seed=3",
                                    "--mode", "trigger"};
@@ -144,7 +147,7 @@ TEST_CASE("CURVE: picksight-cam and the vision app use their keys, LOCATE works"
   CHECK_FALSE(parseLocateReply(*reply).empty());
 }
 
-TEST_CASE("CURVE: a secret key others may read stops the server, naming the file", "[e2e][curve]") {
+TEST_CASE("CURVE: a secret key others may read stops the server naming the file", "[e2e][curve]") {
   Keys keys;
   REQUIRE(::chmod(keys.serverSecret().c_str(), 0644) == 0);
   const std::string log = keys.dir.file("server.log");

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "picksight/transport/control_client.hpp"
 #include "picksight/transport/curve_keys.hpp"
 #include "picksight/transport/curve_server.hpp"
 #include "temp_dir.hpp"
@@ -208,4 +209,49 @@ TEST_CASE("Without an allow-list CURVE encrypts but admits any key", "[transport
   zmq::message_t message;
   REQUIRE(rep.recv(message));
   CHECK(message.to_string() == "ping");
+}
+
+TEST_CASE("A control client refused by CURVE gets no reply and never blocks",
+          "[transport][curve]") {
+  test::TempDir dir;
+  const CurveKeyPair server_keys = writePair(dir, "server");
+  const CurveKeyPair listed = writePair(dir, "listed");
+  zmq::context_t context;
+  auto curve = CurveServer::start(context, dir.file("server.key_secret"), dir.file("listed.key"));
+  REQUIRE(curve);
+  zmq::socket_t router(context, zmq::socket_type::router);
+  router.set(zmq::sockopt::linger, 0);
+  (*curve)->secure(router);
+  router.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = router.get(zmq::sockopt::last_endpoint);
+  proto::ControlRequest request;
+  request.mutable_list_cameras();
+  ControlClient stranger(context, endpoint, 300ms,
+                         CurveClientKeys{*generateKeyPair(), server_keys.public_key});
+  ControlClient plain(context, endpoint, 300ms);
+  // A call after the refusal is the one that could block on a socket left
+  // without a connection: wait for the refusal first.
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while ((*curve)->refused() == 0 && std::chrono::steady_clock::now() < deadline) {
+    zmq::pollitem_t none{router.handle(), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&none, 1, 10ms);
+  }
+  REQUIRE((*curve)->refused() >= 1);
+  for (int i = 0; i < 4; ++i) {
+    auto refused = stranger.call(request);
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().code == ControlErrc::kNoReply);
+    auto ignored = plain.call(request);
+    REQUIRE_FALSE(ignored);
+    CHECK(ignored.error().code == ControlErrc::kNoReply);
+  }
+  CHECK((*curve)->refused() >= 1);
+  // The listed client reaches the same socket (positive control).
+  zmq::socket_t dealer(context, zmq::socket_type::req);
+  dealer.set(zmq::sockopt::linger, 0);
+  secureClientSocket(dealer, CurveClientKeys{listed, server_keys.public_key});
+  dealer.connect(endpoint);
+  dealer.send(zmq::str_buffer("hello"), zmq::send_flags::none);
+  zmq::pollitem_t item{router.handle(), 0, ZMQ_POLLIN, 0};
+  CHECK(zmq::poll(&item, 1, 10s) == 1);
 }

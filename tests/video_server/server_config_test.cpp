@@ -215,7 +215,7 @@ TEST_CASE("loadServerConfig rejects unreadable or malformed files naming the fil
              Catch::Contains("cameras[0]"));
 }
 
-TEST_CASE("CURVE key files come from the curve map or the flags, which override it",
+TEST_CASE("CURVE key files come from the curve map or the flags which override it",
           "[video_server]") {
   TempDir dir;
   const std::string path = dir.write("server.yaml",

@@ -56,7 +56,18 @@ void ControlClient::reconnect() {
 
 Result<proto::ControlReply> ControlClient::call(const proto::ControlRequest& request) {
   const std::string bytes = request.SerializeAsString();
-  socket_->send(zmq::buffer(bytes), zmq::send_flags::none);
+  // A REQ socket whose only connection failed its handshake (a CURVE server
+  // that refused our key, or a plain client of a CURVE server) may have no
+  // pipe left to send on: a blocking send would then wait forever. The
+  // send waits within the timeout like the reply.
+  zmq::pollitem_t out{socket_->handle(), 0, ZMQ_POLLOUT, 0};
+  if (zmq::poll(&out, 1, timeout_) == 0 ||
+      !socket_->send(zmq::buffer(bytes), zmq::send_flags::dontwait)) {
+    reconnect();
+    return makeError(ControlErrc::kNoReply, "could not send to the video server at " + endpoint_ +
+                                                " within " + std::to_string(timeout_.count()) +
+                                                " ms (not connected, or refused by CURVE)");
+  }
   zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
   if (zmq::poll(&item, 1, timeout_) == 0) {
     reconnect();
