@@ -2,6 +2,7 @@
 // while and prints what it got, lost and how late (one-way latency from the
 // frame's host timestamp to its arrival, same host clock).
 //   picksight-bench-subscriber --frames E --camera C --seconds S [--bare]
+//                              [--curve-server-key FILE [--curve-key FILE]]
 // --bare reads the benchmark's plain ZeroMQ messages (topic, 16-byte
 // sequence + timestamp, payload) instead of PickSight frames.
 #include <algorithm>
@@ -22,6 +23,8 @@ int main(int argc, char** argv) {
   std::string camera = "cam0";
   double seconds = 5;
   bool bare = false;
+  std::string curve_server_key;
+  std::string curve_key;
   CLI::App app("Receives frames for a while; prints what it got, lost and how late.",
                "picksight-bench-subscriber");
   app.set_help_flag("-h,--help", "print this help");
@@ -34,7 +37,19 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_flag("--bare", bare, "read the benchmark's plain ZeroMQ messages");
+  app.add_option("--curve-server-key", curve_server_key, "the server's public key: talk CURVE")
+      ->type_name("FILE");
+  app.add_option("--curve-key", curve_key, "this client's secret key file")->type_name("FILE");
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  std::optional<picksight::CurveClientKeys> curve;
+  if (!curve_server_key.empty()) {
+    auto keys = picksight::loadClientKeys(curve_key, curve_server_key);
+    if (!keys) {
+      std::fprintf(stderr, "picksight-bench-subscriber: %s\n", keys.error().message.c_str());
+      return 2;
+    }
+    curve = std::move(*keys);
+  }
   zmq::context_t context;
   std::vector<double> latency_ms;
   uint64_t received = 0;
@@ -68,7 +83,7 @@ int main(int argc, char** argv) {
       latency_ms.push_back(static_cast<double>(now - sent_ns) / 1e6);
     }
   } else {
-    picksight::FrameSubscriber sub(context, endpoint, camera, 4);
+    picksight::FrameSubscriber sub(context, endpoint, camera, 4, curve);
     while (picksight::monotonicNs() < end) {
       auto f = sub.receive(std::chrono::milliseconds(100));
       if (!f) continue;

@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     app::VisionCell cell(options->data_dir,
                          std::make_unique<app::VideoServerCamera>(
                              context, options->frames_endpoint, options->control_endpoint,
-                             options->camera, options->vision.frame_timeout),
+                             options->camera, options->vision.frame_timeout, options->curve),
                          options->vision);
     // A bad file costs what it holds, never the start.
     for (const auto& problem : cell.load()) logError(problem);
@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
     }
     // The robot port is listening: a robot program started after us connects.
     notifier.ready("camera " + options->camera + ", robot port " + std::to_string(robots.port()));
+    if (options->curve) logInfo("CURVE to the video server as ", options->curve->own.public_key);
     logInfo("stopping on signal ", stop_signals.wait());
     notifier.stopping();
     if (plc) plc->stop();

@@ -16,10 +16,14 @@ using namespace std::chrono_literals;
 
 std::string binPath(const std::string& name) { return std::string(PICKSIGHT_BIN_DIR) + "/" + name; }
 
-VideoServerProcess::VideoServerProcess(std::vector<std::string> args) {
+VideoServerProcess::VideoServerProcess(std::vector<std::string> args, const std::string& log_file) {
   std::vector<std::string> argv = {binPath("picksight-video-server"), "--frames",
                                    "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"};
   argv.insert(argv.end(), args.begin(), args.end());
+  if (!log_file.empty()) {
+    // The shell only redirects and execs: the child is still the server.
+    argv.insert(argv.begin(), {"/bin/sh", "-c", "exec \"$@\" 2>\"$0\"", log_file});
+  }
   process = std::make_unique<Subprocess>(argv);
   auto f = process->waitForLine("frames ", 10s);
   REQUIRE(f);

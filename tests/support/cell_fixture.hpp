@@ -21,8 +21,8 @@ std::string binPath(const std::string& name);
 
 struct VideoServerProcess {
   // Starts the server with `args` plus free-port endpoints; REQUIREs that it
-  // printed its endpoints.
-  explicit VideoServerProcess(std::vector<std::string> args);
+  // printed its endpoints. With a `log_file` its stderr (the log) goes there.
+  explicit VideoServerProcess(std::vector<std::string> args, const std::string& log_file = "");
   std::unique_ptr<Subprocess> process;
   std::string frames;
   std::string control;

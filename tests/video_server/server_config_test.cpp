@@ -214,3 +214,26 @@ TEST_CASE("loadServerConfig rejects unreadable or malformed files naming the fil
   CHECK_THAT(yamlError("cameras:\n  - {? [x]: 1, name: a, source: 'synthetic:'}\n"),
              Catch::Contains("cameras[0]"));
 }
+
+TEST_CASE("CURVE key files come from the curve map or the flags which override it",
+          "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.write("server.yaml",
+                                     "curve:\n  secret_key: /etc/keys/server.key_secret\n"
+                                     "  clients: /etc/keys/clients\n");
+  auto config = loadServerConfig(path);
+  REQUIRE(config);
+  CHECK(config->curve_secret_key == "/etc/keys/server.key_secret");
+  CHECK(config->curve_allow_list == "/etc/keys/clients");
+  auto flags = parseServerArgs({"--config", path, "--curve-clients", "/tmp/clients"}, nullptr);
+  REQUIRE(flags);
+  CHECK(flags->curve_secret_key == "/etc/keys/server.key_secret");
+  CHECK(flags->curve_allow_list == "/tmp/clients");
+  auto plain = parseServerArgs({}, nullptr);
+  REQUIRE(plain);
+  CHECK(plain->curve_secret_key.empty());
+  CHECK_THAT(yamlError("curve:\n  secret: x\n"), Catch::Contains("curve.secret: unknown key"));
+  CHECK_THAT(yamlError("curve:\n  clients: [a, b]\n"),
+             Catch::Contains("curve.clients: must be a file name"));
+  CHECK_THAT(yamlError("curve: on\n"), Catch::Contains("curve: must be a map"));
+}

@@ -49,9 +49,18 @@ int runCamCli(const std::vector<std::string>& args, std::ostream& out, std::ostr
   const std::chrono::milliseconds timeout =
       request->has_snap() ? std::max(options->timeout, kSnapMinTimeout) : options->timeout;
 
+  std::optional<CurveClientKeys> curve;
+  if (!options->curve_server_key.empty()) {
+    auto keys = loadClientKeys(options->curve_key, options->curve_server_key);
+    if (!keys) {
+      err << kProgram << ": " << keys.error().message << '\n';
+      return kExitUsage;
+    }
+    curve = std::move(*keys);
+  }
   std::optional<ControlClient> client;
   try {
-    client.emplace(ctx, options->endpoint, timeout);
+    client.emplace(ctx, options->endpoint, timeout, curve);
   } catch (const zmq::error_t& e) {
     // connect() rejects malformed endpoints: the user's typo, not the server.
     err << kProgram << ": invalid endpoint '" << options->endpoint << "': " << e.what() << '\n';

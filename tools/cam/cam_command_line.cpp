@@ -189,6 +189,14 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
         return "MS must be a positive integer, got '" + v + "'";
       }));
   app.add_flag("--json", options.json, "print one JSON object on stdout, for scripts");
+  CLI::Option* server_key = app.add_option("--curve-server-key", options.curve_server_key,
+                                           "talk CURVE to the server: its public NAME.key")
+                                ->type_name("FILE");
+  app.add_option("--curve-key", options.curve_key,
+                 "this client's NAME.key_secret, for a server\nwith an allow-list "
+                 "(default: a fresh key pair)")
+      ->type_name("FILE")
+      ->needs(server_key);
 
   // Storage for the positionals, one map per command; std::map nodes stay
   // put, so CLI11 can hold pointers into them.

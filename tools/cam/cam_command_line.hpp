@@ -33,6 +33,10 @@ struct CamOptions {
   std::string endpoint = kDefaultEndpoint;
   std::chrono::milliseconds timeout = kDefaultTimeout;
   bool json = false;
+  // CURVE (docs/SECURITY.md): the server's public key file, and this
+  // client's secret key file (empty: a fresh pair). Both empty: plain.
+  std::string curve_server_key;
+  std::string curve_key;
   // Set when --help was given: print it and do nothing else.
   std::string help_text;
   CamCommand command;

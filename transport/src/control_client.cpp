@@ -38,14 +38,19 @@ const char* errorName(ControlErrc e) {
 }
 
 ControlClient::ControlClient(zmq::context_t& context, std::string endpoint,
-                             std::chrono::milliseconds timeout)
-    : context_(context), endpoint_(std::move(endpoint)), timeout_(timeout) {
+                             std::chrono::milliseconds timeout,
+                             std::optional<CurveClientKeys> curve)
+    : context_(context),
+      endpoint_(std::move(endpoint)),
+      timeout_(timeout),
+      curve_(std::move(curve)) {
   reconnect();
 }
 
 void ControlClient::reconnect() {
   socket_ = std::make_unique<zmq::socket_t>(context_, zmq::socket_type::req);
   socket_->set(zmq::sockopt::linger, 0);
+  secureClientSocket(*socket_, curve_);
   socket_->connect(endpoint_);
 }
 
@@ -57,7 +62,18 @@ Result<proto::ControlReply> ControlClient::call(const proto::ControlRequest& req
                          " bytes exceeds the video server's limit of " +
                          std::to_string(kMaxControlRequestBytes) + " bytes");
   }
-  socket_->send(zmq::buffer(bytes), zmq::send_flags::none);
+  // A REQ socket whose only connection failed its handshake (a CURVE server
+  // that refused our key, or a plain client of a CURVE server) may have no
+  // pipe left to send on: a blocking send would then wait forever. The
+  // send waits within the timeout like the reply.
+  zmq::pollitem_t out{socket_->handle(), 0, ZMQ_POLLOUT, 0};
+  if (zmq::poll(&out, 1, timeout_) == 0 ||
+      !socket_->send(zmq::buffer(bytes), zmq::send_flags::dontwait)) {
+    reconnect();
+    return makeError(ControlErrc::kNoReply, "could not send to the video server at " + endpoint_ +
+                                                " within " + std::to_string(timeout_.count()) +
+                                                " ms (not connected, or refused by CURVE)");
+  }
   zmq::pollitem_t item{socket_->handle(), 0, ZMQ_POLLIN, 0};
   if (zmq::poll(&item, 1, timeout_) == 0) {
     reconnect();

@@ -117,8 +117,10 @@ std::optional<Frame> decodeFrame(const proto::FrameHeader& h, zmq::message_t pix
 }
 
 FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& endpoint,
-                                 const std::string& camera, int queue_frames)
+                                 const std::string& camera, int queue_frames,
+                                 const std::optional<CurveClientKeys>& curve)
     : socket_(context, zmq::socket_type::sub), camera_(camera) {
+  secureClientSocket(socket_, curve);
   // HWM counts message parts; a frame is three.
   socket_.set(zmq::sockopt::rcvhwm, queue_frames * 3);
   socket_.set(zmq::sockopt::linger, 0);

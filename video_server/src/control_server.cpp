@@ -37,6 +37,7 @@ ControlServer::ControlServer(zmq::context_t& context, const std::string& endpoin
   // ZeroMQ drops a bigger message and closes the connection that sent it,
   // before it is buffered whole: the client gets no reply and times out.
   socket_.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(kMaxControlRequestBytes));
+  secureServerSocket(socket_, options_.curve);
   socket_.bind(endpoint);
   bound_endpoint_ = socket_.get(zmq::sockopt::last_endpoint);
   // Unique within the context: several servers may share one.

@@ -14,12 +14,13 @@ std::atomic<int> g_monitor_id{0};
 }  // namespace
 
 FramePublisher::FramePublisher(zmq::context_t& context, const std::string& endpoint,
-                               size_t queue_limit, int subscriber_queue)
+                               size_t queue_limit, int subscriber_queue, const CurveServer* curve)
     : socket_(context, zmq::socket_type::pub),
       monitor_(context, zmq::socket_type::pair),
       queue_limit_(queue_limit) {
   socket_.set(zmq::sockopt::sndhwm, subscriber_queue * 3);  // HWM counts parts
   socket_.set(zmq::sockopt::linger, 0);
+  secureServerSocket(socket_, curve);
   const std::string monitor_endpoint =
       "inproc://picksight-publisher-monitor-" + std::to_string(g_monitor_id++);
   if (zmq_socket_monitor(socket_.handle(), monitor_endpoint.c_str(),

@@ -134,6 +134,24 @@ Result<void> checkUniqueNames(const std::vector<CameraConfig>& cameras) {
   }
   return {};
 }
+
+// The `curve:` map: secret_key (the server's NAME.key_secret) and clients
+// (the allow-list).
+Result<void> curveFromYaml(const YAML::Node& node, ServerConfig& config) {
+  if (!node.IsMap()) return makeError(VideoErrc::kBadConfig, "curve: must be a map");
+  for (const auto& kv : node) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "";
+    if (key != "secret_key" && key != "clients") {
+      return makeError(VideoErrc::kBadConfig,
+                       "curve." + key + ": unknown key (known: secret_key, clients)");
+    }
+    if (!kv.second.IsScalar() || kv.second.Scalar().empty()) {
+      return makeError(VideoErrc::kBadConfig, "curve." + key + ": must be a file name");
+    }
+    (key == "secret_key" ? config.curve_secret_key : config.curve_allow_list) = kv.second.Scalar();
+  }
+  return {};
+}
 }  // namespace
 
 Result<ServerConfig> loadServerConfig(const std::string& path) {
@@ -149,10 +167,15 @@ Result<ServerConfig> loadServerConfig(const std::string& path) {
     if (!kv.first.IsScalar())
       return makeError(VideoErrc::kBadConfig, path + ": keys must be plain names");
     const std::string key = kv.first.Scalar();
-    if (key != "frames" && key != "control" && key != "cameras") {
-      return makeError(VideoErrc::kBadConfig,
-                       path + ": " + key + ": unknown key (known: frames, control, cameras)");
+    if (key != "frames" && key != "control" && key != "cameras" && key != "curve") {
+      return makeError(
+          VideoErrc::kBadConfig,
+          path + ": " + key + ": unknown key (known: frames, control, cameras, curve)");
     }
+  }
+  if (root["curve"]) {
+    if (auto ok = curveFromYaml(root["curve"], config); !ok)
+      return makeError(VideoErrc::kBadConfig, path + ": " + ok.error().message);
   }
   if (root["frames"]) config.frames_endpoint = root["frames"].Scalar();
   if (root["control"]) config.control_endpoint = root["control"].Scalar();
@@ -180,6 +203,8 @@ struct ServerArgs {
   std::string control;
   std::string mode;
   std::string fps;
+  std::string curve_secret_key;
+  std::string curve_allow_list;
 };
 
 // Declares the options on `app`, bound to `a`; both parseServerArgs and
@@ -214,6 +239,15 @@ void defineServerOptions(CLI::App& app, ServerArgs& a) {
         auto f = parseFps(v);
         return f ? std::string() : f.error().message;
       }));
+  app.add_option("--curve-secret-key", a.curve_secret_key,
+                 "encrypt frames and control with CURVE: the server's NAME.key_secret "
+                 "(picksight-keygen; see docs/SECURITY.md)")
+      ->type_name("FILE");
+  app.add_option("--curve-clients", a.curve_allow_list,
+                 "admit only these CURVE clients: a directory of their NAME.key files, or one "
+                 "file of public-key lines (without it any client knowing the server's public "
+                 "key gets in)")
+      ->type_name("DIR|FILE");
   app.footer(
       "Sources (URI):\n"
       "  aravis:<device-id>        GigE Vision / USB3 Vision (empty id: first found)\n"
@@ -276,6 +310,8 @@ Result<ServerConfig> parseServerArgs(const std::vector<std::string>& args, bool*
   }
   if (!a.frames.empty()) config.frames_endpoint = a.frames;
   if (!a.control.empty()) config.control_endpoint = a.control;
+  if (!a.curve_secret_key.empty()) config.curve_secret_key = a.curve_secret_key;
+  if (!a.curve_allow_list.empty()) config.curve_allow_list = a.curve_allow_list;
   if (config.cameras.empty()) {
     CameraConfig c;
     c.name = "cam0";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "picksight/common/log.hpp"
 #include "picksight/video_server/control_errors.hpp"
 #include "picksight/video_server/control_request.hpp"
 #include "picksight/video_server/video_errors.hpp"
@@ -228,9 +229,25 @@ proto::ControlReply notSupported() {
 }  // namespace
 
 VideoServer::VideoServer(const ServerConfig& config, const SourceFactory& make_source) {
+  if (!config.curve_secret_key.empty()) {
+    auto curve = CurveServer::start(context_, config.curve_secret_key, config.curve_allow_list);
+    if (!curve) throw std::runtime_error("CURVE: " + curve.error().message);
+    curve_ = std::move(*curve);
+    if (curve_->restricted()) {
+      logInfo("CURVE: frames and control encrypted; only the clients listed in ",
+              config.curve_allow_list, " get in");
+    } else {
+      logWarning(
+          "CURVE: frames and control encrypted, but without an allow-list every client "
+          "that knows the server's public key gets in");
+    }
+  } else if (!config.curve_allow_list.empty()) {
+    throw std::runtime_error("a CURVE allow-list needs the server's secret key as well");
+  }
   // zmq::error_t alone ("Address already in use") would not say which endpoint.
   try {
-    publisher_ = std::make_unique<FramePublisher>(context_, config.frames_endpoint);
+    publisher_ =
+        std::make_unique<FramePublisher>(context_, config.frames_endpoint, 8, 4, curve_.get());
   } catch (const zmq::error_t& e) {
     throw std::runtime_error("frames endpoint " + config.frames_endpoint + ": " + e.what());
   }
@@ -239,10 +256,12 @@ VideoServer::VideoServer(const ServerConfig& config, const SourceFactory& make_s
     if (!source) throw std::runtime_error("camera " + c.name + ": " + source.error().message);
     cameras_.push_back(std::make_unique<Camera>(c, std::move(*source), *publisher_));
   }
+  ControlServerOptions control_options;
+  control_options.curve = curve_.get();
   try {
     control_ = std::make_unique<ControlServer>(
         context_, config.control_endpoint,
-        [this](const proto::ControlRequest& r) { return handle(r); });
+        [this](const proto::ControlRequest& r) { return handle(r); }, control_options);
   } catch (const zmq::error_t& e) {
     throw std::runtime_error("control endpoint " + config.control_endpoint + ": " + e.what());
   }

@@ -31,6 +31,8 @@ struct RawOptions {
   std::string modbus_unit;
   std::string modbus_allow;
   std::string modbus_word_order;
+  std::string curve_server_key;
+  std::string curve_key;
 };
 
 std::string checkRange(const std::string& v, long long low, long long high) {
@@ -143,6 +145,15 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
       ->check(checkValue([](const std::string& v) {
         return plc::parseWordOrder(v) ? std::string() : "must be ABCD or CDAB, got '" + v + "'";
       }));
+  CLI::Option* server_key =
+      app.add_option("--curve-server-key", raw.curve_server_key,
+                     "talk CURVE to the video server: its public NAME.key (docs/SECURITY.md)")
+          ->type_name("FILE");
+  app.add_option("--curve-key", raw.curve_key,
+                 "this client's NAME.key_secret, for a server with an allow-list "
+                 "(default: a fresh key pair)")
+      ->type_name("FILE")
+      ->needs(server_key);
   app.footer(
       "On start it prints 'robot <port>', 'modbus <port>' (with --modbus-port) and 'ready' on "
       "stdout.");
@@ -219,6 +230,11 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   if (!raw.modbus_allow.empty()) o.plc.server.allow = *AllowList::parse(raw.modbus_allow);
   if (!raw.modbus_word_order.empty())
     o.plc.device.word_order = *plc::parseWordOrder(raw.modbus_word_order);
+  if (!raw.curve_server_key.empty()) {
+    auto keys = loadClientKeys(raw.curve_key, raw.curve_server_key);
+    if (!keys) return keys.error();
+    o.curve = std::move(*keys);
+  }
   return o;
 }
 

@@ -5,8 +5,12 @@
 
 namespace picksight::app {
 
-FrameFeed::FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera)
-    : context_(context), endpoint_(std::move(endpoint)), camera_(std::move(camera)) {}
+FrameFeed::FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
+                     std::optional<CurveClientKeys> curve)
+    : context_(context),
+      endpoint_(std::move(endpoint)),
+      camera_(std::move(camera)),
+      curve_(std::move(curve)) {}
 
 FrameFeed::~FrameFeed() { stop(); }
 
@@ -25,7 +29,7 @@ void FrameFeed::run() {
   try {
     // Only the newest frame matters to a locator: a short queue keeps latency
     // low when processing is slower than the camera.
-    FrameSubscriber subscriber(context_, endpoint_, camera_, 2);
+    FrameSubscriber subscriber(context_, endpoint_, camera_, 2, curve_);
     while (!stop_) {
       auto frame = subscriber.receive(std::chrono::milliseconds(100));
       if (!frame) continue;

@@ -9,11 +9,12 @@ namespace picksight::app {
 
 VideoServerCamera::VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
                                      const std::string& control_endpoint, std::string camera,
-                                     std::chrono::milliseconds frame_timeout)
+                                     std::chrono::milliseconds frame_timeout,
+                                     const std::optional<CurveClientKeys>& curve)
     : camera_(std::move(camera)),
       frame_timeout_(frame_timeout),
-      feed_(context, frames_endpoint, camera_),
-      control_(context, control_endpoint) {}
+      feed_(context, frames_endpoint, camera_, curve),
+      control_(context, control_endpoint, kDefaultControlTimeout, curve) {}
 
 Result<proto::ControlReply> VideoServerCamera::call(const proto::ControlRequest& request) {
   auto reply = control_.call(request);

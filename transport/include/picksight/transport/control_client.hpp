@@ -5,12 +5,14 @@
 #include <chrono>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <zmq.hpp>
 
 #include "picksight.pb.h"
 #include "picksight/common/result.hpp"
+#include "picksight/transport/curve_keys.hpp"
 
 namespace picksight {
 
@@ -37,10 +39,15 @@ PICKSIGHT_ERROR_DOMAIN(ControlErrc, "control")
 // ever comes). call() refuses bigger requests itself, as kBadRequest.
 constexpr size_t kMaxControlRequestBytes = 64 * 1024;
 
+constexpr std::chrono::milliseconds kDefaultControlTimeout{2000};
+
 class ControlClient {
  public:
+  // With `curve` keys the socket talks CURVE: a server that refuses them (or
+  // a plain server) never answers, which is kNoReply.
   ControlClient(zmq::context_t& context, std::string endpoint,
-                std::chrono::milliseconds timeout = std::chrono::milliseconds(2000));
+                std::chrono::milliseconds timeout = kDefaultControlTimeout,
+                std::optional<CurveClientKeys> curve = std::nullopt);
 
   // Sends `request`; the reply when the server answered with code OK, else an
   // Error carrying the server's code and text (or kNoReply).
@@ -54,6 +61,7 @@ class ControlClient {
   zmq::context_t& context_;
   std::string endpoint_;
   std::chrono::milliseconds timeout_;
+  std::optional<CurveClientKeys> curve_;
   std::unique_ptr<zmq::socket_t> socket_;
 };
 

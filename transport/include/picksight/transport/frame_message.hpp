@@ -15,6 +15,7 @@
 
 #include "picksight.pb.h"
 #include "picksight/common/frame.hpp"
+#include "picksight/transport/curve_keys.hpp"
 
 namespace picksight {
 
@@ -48,8 +49,10 @@ class FrameSubscriber {
  public:
   // `queue_frames` bounds the frames ZeroMQ buffers for us: a subscriber that
   // falls behind loses the oldest pending frames beyond it, never slows the server.
+  // With `curve` keys it talks CURVE to a server that does (and nothing to
+  // one that does not, nor a plain subscriber to a CURVE server).
   FrameSubscriber(zmq::context_t& context, const std::string& endpoint, const std::string& camera,
-                  int queue_frames = 4);
+                  int queue_frames = 4, const std::optional<CurveClientKeys>& curve = {});
 
   // The next frame, decoded and stamped with its local receive time, or
   // nullopt on timeout. Malformed messages are skipped and counted, never

@@ -38,12 +38,14 @@
 #include <zmq.hpp>
 
 #include "picksight.pb.h"
+#include "picksight/transport/curve_server.hpp"
 
 namespace picksight::video {
 
 struct ControlServerOptions {
-  size_t workers = 4;       // parallel lanes (cameras) of slow requests
-  size_t max_pending = 64;  // slow requests waiting for a worker
+  size_t workers = 4;                  // parallel lanes (cameras) of slow requests
+  size_t max_pending = 64;             // slow requests waiting for a worker
+  const CurveServer* curve = nullptr;  // makes the ROUTER a CURVE server
 };
 
 class ControlServer {

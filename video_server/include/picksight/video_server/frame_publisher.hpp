@@ -18,6 +18,7 @@
 
 #include <zmq.hpp>
 
+#include "picksight/transport/curve_server.hpp"
 #include "picksight/transport/frame_message.hpp"
 #include "picksight/video_server/camera.hpp"
 
@@ -31,9 +32,10 @@ struct PublisherCounters {
 class FramePublisher : public FrameSink {
  public:
   // Binds at once so a bad endpoint fails at start-up. `queue_limit` frames
-  // wait at most; `subscriber_queue` frames per subscriber in ZeroMQ.
+  // wait at most; `subscriber_queue` frames per subscriber in ZeroMQ. With
+  // `curve` the socket is a CURVE server (the object need not outlive this).
   FramePublisher(zmq::context_t& context, const std::string& endpoint, size_t queue_limit = 8,
-                 int subscriber_queue = 4);
+                 int subscriber_queue = 4, const CurveServer* curve = nullptr);
   ~FramePublisher() override;
 
   // The endpoint actually bound (a wildcard port resolved).

@@ -12,6 +12,11 @@ namespace picksight::video {
 struct ServerConfig {
   std::string frames_endpoint = "tcp://*:5555";
   std::string control_endpoint = "tcp://*:5556";
+  // CURVE (docs/SECURITY.md): with a secret key file both sockets encrypt;
+  // with an allow-list (a *.key directory or a file of public-key lines)
+  // only the listed clients get in. Empty: plain sockets.
+  std::string curve_secret_key;
+  std::string curve_allow_list;
   std::vector<CameraConfig> cameras;
 };
 

@@ -9,6 +9,7 @@
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/plc_port.hpp"
+#include "picksight/transport/curve_keys.hpp"
 
 namespace picksight::app {
 
@@ -25,6 +26,8 @@ struct AppOptions {
   std::optional<RobotServerOptions> setup;
   VisionOptions vision;
   PlcPortOptions plc;  // off unless --modbus-port is given
+  // CURVE keys for the camera link (loaded by parseAppArgs); nullopt: plain.
+  std::optional<CurveClientKeys> curve;
 };
 
 // Parses argv without the program name; errors name the option. With

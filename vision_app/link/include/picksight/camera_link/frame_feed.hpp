@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -18,7 +19,8 @@ namespace picksight::app {
 
 class FrameFeed {
  public:
-  FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera);
+  FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
+            std::optional<CurveClientKeys> curve = std::nullopt);
   ~FrameFeed();
 
   void start();
@@ -39,6 +41,7 @@ class FrameFeed {
   zmq::context_t& context_;
   const std::string endpoint_;
   const std::string camera_;
+  const std::optional<CurveClientKeys> curve_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<uint64_t> received_{0};

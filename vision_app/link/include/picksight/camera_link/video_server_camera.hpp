@@ -5,9 +5,11 @@
 //
 // Threading: as CameraLink; the control socket is used by the caller's
 // thread (VisionService serializes), the frames by the feed's thread.
+// With CURVE keys both sockets are CURVE clients of the video server.
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include <zmq.hpp>
@@ -22,7 +24,8 @@ class VideoServerCamera : public CameraLink {
  public:
   VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
                     const std::string& control_endpoint, std::string camera,
-                    std::chrono::milliseconds frame_timeout);
+                    std::chrono::milliseconds frame_timeout,
+                    const std::optional<CurveClientKeys>& curve = std::nullopt);
   void start() override { feed_.start(); }
   void stop() override { feed_.stop(); }
   Result<std::shared_ptr<const Frame>> freshFrame() override;

@@ -1,0 +1,257 @@
+// CURVE keys and the ZAP handler: key files and their checks, and real
+// sockets of one process (listed, unlisted and plain clients of a CURVE PUB).
+#include <sys/stat.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <thread>
+
+#include "picksight/transport/control_client.hpp"
+#include "picksight/transport/curve_keys.hpp"
+#include "picksight/transport/curve_server.hpp"
+#include "temp_dir.hpp"
+
+using namespace picksight;
+using namespace std::chrono_literals;
+
+namespace {
+
+// Writes NAME.key and NAME.key_secret (0600) into `dir`; the pair.
+CurveKeyPair writePair(const test::TempDir& dir, const std::string& name) {
+  auto keys = generateKeyPair();
+  REQUIRE(keys);
+  dir.write(name + ".key", publicKeyFileText(*keys));
+  const std::string secret = dir.write(name + ".key_secret", secretKeyFileText(*keys));
+  REQUIRE(::chmod(secret.c_str(), 0600) == 0);
+  return *keys;
+}
+
+// Reads whatever arrived on `socket` without waiting; the messages counted.
+int drain(zmq::socket_t& socket) {
+  int n = 0;
+  zmq::message_t message;
+  while (socket.recv(message, zmq::recv_flags::dontwait)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("A key pair survives its files", "[transport][curve]") {
+  test::TempDir dir;
+  const CurveKeyPair keys = writePair(dir, "server");
+  auto pair = loadKeyPair(dir.file("server.key_secret"));
+  REQUIRE(pair);
+  CHECK(pair->public_key == keys.public_key);
+  CHECK(pair->secret_key == keys.secret_key);
+  auto public_key = loadPublicKey(dir.file("server.key"));
+  REQUIRE(public_key);
+  CHECK(*public_key == keys.public_key);
+  CHECK(public_key->size() == kZ85KeyLength);
+}
+
+TEST_CASE("A secret key file others may read is refused naming the file", "[transport][curve]") {
+  test::TempDir dir;
+  writePair(dir, "server");
+  const std::string path = dir.file("server.key_secret");
+  for (mode_t mode : {0640, 0604, 0644, 0610}) {
+    REQUIRE(::chmod(path.c_str(), mode) == 0);
+    auto pair = loadKeyPair(path);
+    REQUIRE_FALSE(pair);
+    CHECK(pair.error().code == CurveErrc::kKeyFileTooOpen);
+    CHECK_THAT(pair.error().message, Catch::Contains(path) && Catch::Contains("chmod 600"));
+  }
+  REQUIRE(::chmod(path.c_str(), 0400) == 0);
+  CHECK(loadKeyPair(path));
+}
+
+TEST_CASE("Malformed key files are errors naming the file", "[transport][curve]") {
+  test::TempDir dir;
+  const CurveKeyPair keys = writePair(dir, "good");
+  const CurveKeyPair other = *generateKeyPair();
+  struct Case {
+    const char* what;
+    std::string text;
+  };
+  const std::vector<Case> cases = {
+      {"empty", ""},
+      {"short key", "public-key = \"abc\"\nsecret-key = \"" + keys.secret_key + "\"\n"},
+      {"not Z85",
+       "public-key = \"" + std::string(40, '~') + "\"\nsecret-key = \"" + keys.secret_key + "\"\n"},
+      {"public only", publicKeyFileText(keys)},
+      {"mismatched pair",
+       "public-key = \"" + other.public_key + "\"\nsecret-key = \"" + keys.secret_key + "\"\n"},
+      {"two public keys", "public-key = \"" + keys.public_key + "\"\n" + secretKeyFileText(keys)},
+      {"binary", std::string("\0\x01\xff garbage", 11)},
+  };
+  for (const auto& c : cases) {
+    INFO(c.what);
+    const std::string path = dir.write("bad.key_secret", c.text);
+    REQUIRE(::chmod(path.c_str(), 0600) == 0);
+    auto pair = loadKeyPair(path);
+    REQUIRE_FALSE(pair);
+    CHECK(pair.error().code == CurveErrc::kBadKeyFile);
+    CHECK_THAT(pair.error().message, Catch::Contains(path));
+  }
+  auto missing = loadPublicKey(dir.file("absent.key"));
+  REQUIRE_FALSE(missing);
+  CHECK_THAT(missing.error().message, Catch::Contains("absent.key"));
+  auto directory = loadPublicKey(dir.path().string());
+  REQUIRE_FALSE(directory);
+  CHECK(directory.error().code == CurveErrc::kBadKeyFile);
+  auto huge = loadPublicKey(dir.write("huge.key", std::string(1 << 20, '#')));
+  REQUIRE_FALSE(huge);
+  CHECK_THAT(huge.error().message, Catch::Contains("too large"));
+}
+
+TEST_CASE("An allow-list is a directory of key files or one file of keys", "[transport][curve]") {
+  test::TempDir dir;
+  std::filesystem::create_directory(dir.path() / "clients");
+  test::TempDir clients;
+  const CurveKeyPair a = writePair(clients, "a");
+  const CurveKeyPair b = writePair(clients, "b");
+  auto from_dir = loadAllowList(clients.path().string());
+  REQUIRE(from_dir);
+  CHECK(*from_dir == std::set<std::string>{a.public_key, b.public_key});
+
+  const std::string file = dir.write("allowed", "# cell 3\npublic-key = \"" + a.public_key +
+                                                    "\"\n\npublic-key = " + b.public_key + "\n");
+  auto from_file = loadAllowList(file);
+  REQUIRE(from_file);
+  CHECK(*from_file == std::set<std::string>{a.public_key, b.public_key});
+
+  auto empty = loadAllowList((dir.path() / "clients").string());
+  REQUIRE_FALSE(empty);
+  CHECK_THAT(empty.error().message, Catch::Contains("admit nobody"));
+  clients.write("c.key", "public-key = \"nonsense\"\n");
+  auto bad = loadAllowList(clients.path().string());
+  REQUIRE_FALSE(bad);
+  CHECK_THAT(bad.error().message, Catch::Contains(clients.file("c.key")));
+}
+
+TEST_CASE("Only allow-listed CURVE clients receive from a CURVE server", "[transport][curve]") {
+  test::TempDir dir;
+  const CurveKeyPair server_keys = writePair(dir, "server");
+  writePair(dir, "listed");
+  const CurveKeyPair stranger = *generateKeyPair();
+  const std::string allow =
+      dir.write("allowed", publicKeyFileText(*loadKeyPair(dir.file("listed.key_secret"))));
+  zmq::context_t context;
+  auto curve = CurveServer::start(context, dir.file("server.key_secret"), allow);
+  REQUIRE(curve);
+  REQUIRE((*curve)->restricted());
+  CHECK((*curve)->publicKey() == server_keys.public_key);
+  // A second handler on the same context is refused, not silently ignored.
+  auto second = CurveServer::start(context, dir.file("server.key_secret"), allow);
+  REQUIRE_FALSE(second);
+  CHECK(second.error().code == CurveErrc::kZapHandlerTaken);
+
+  zmq::socket_t pub(context, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  (*curve)->secure(pub);
+  pub.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = pub.get(zmq::sockopt::last_endpoint);
+
+  auto subscriber = [&](const std::optional<CurveClientKeys>& keys) {
+    zmq::socket_t sub(context, zmq::socket_type::sub);
+    sub.set(zmq::sockopt::linger, 0);
+    sub.set(zmq::sockopt::subscribe, "");
+    secureClientSocket(sub, keys);
+    sub.connect(endpoint);
+    return sub;
+  };
+  // The ones that must get nothing connect first: they have at least the
+  // listed client's time.
+  zmq::socket_t unlisted = subscriber(CurveClientKeys{stranger, server_keys.public_key});
+  zmq::socket_t plain = subscriber(std::nullopt);
+  auto listed_keys = loadClientKeys(dir.file("listed.key_secret"), dir.file("server.key"));
+  REQUIRE(listed_keys);
+  zmq::socket_t listed = subscriber(*listed_keys);
+
+  int listed_got = 0, unlisted_got = 0, plain_got = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < deadline &&
+         (listed_got < 20 || (*curve)->refused() == 0)) {
+    pub.send(zmq::str_buffer("frame"), zmq::send_flags::none);
+    zmq::pollitem_t items[] = {{listed.handle(), 0, ZMQ_POLLIN, 0}};
+    zmq::poll(items, 1, 20ms);
+    listed_got += drain(listed);
+    unlisted_got += drain(unlisted);
+    plain_got += drain(plain);
+  }
+  CHECK(listed_got >= 20);
+  CHECK((*curve)->admitted() >= 1);
+  CHECK((*curve)->refused() >= 1);
+  CHECK(unlisted_got == 0);
+  CHECK(plain_got == 0);
+}
+
+TEST_CASE("Without an allow-list CURVE encrypts but admits any key", "[transport][curve]") {
+  test::TempDir dir;
+  const CurveKeyPair server_keys = writePair(dir, "server");
+  zmq::context_t context;
+  auto curve = CurveServer::start(context, dir.file("server.key_secret"), "");
+  REQUIRE(curve);
+  CHECK_FALSE((*curve)->restricted());
+  zmq::socket_t rep(context, zmq::socket_type::rep);
+  rep.set(zmq::sockopt::linger, 0);
+  (*curve)->secure(rep);
+  rep.bind("tcp://127.0.0.1:*");
+  zmq::socket_t req(context, zmq::socket_type::req);
+  req.set(zmq::sockopt::linger, 0);
+  // Any fresh pair: the server key file alone is enough.
+  auto keys = loadClientKeys("", dir.file("server.key"));
+  REQUIRE(keys);
+  secureClientSocket(req, *keys);
+  req.connect(rep.get(zmq::sockopt::last_endpoint));
+  req.send(zmq::str_buffer("ping"), zmq::send_flags::none);
+  zmq::pollitem_t item{rep.handle(), 0, ZMQ_POLLIN, 0};
+  REQUIRE(zmq::poll(&item, 1, 10s) == 1);
+  zmq::message_t message;
+  REQUIRE(rep.recv(message));
+  CHECK(message.to_string() == "ping");
+}
+
+TEST_CASE("A control client refused by CURVE gets no reply and never blocks",
+          "[transport][curve]") {
+  test::TempDir dir;
+  const CurveKeyPair server_keys = writePair(dir, "server");
+  const CurveKeyPair listed = writePair(dir, "listed");
+  zmq::context_t context;
+  auto curve = CurveServer::start(context, dir.file("server.key_secret"), dir.file("listed.key"));
+  REQUIRE(curve);
+  zmq::socket_t router(context, zmq::socket_type::router);
+  router.set(zmq::sockopt::linger, 0);
+  (*curve)->secure(router);
+  router.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = router.get(zmq::sockopt::last_endpoint);
+  proto::ControlRequest request;
+  request.mutable_list_cameras();
+  ControlClient stranger(context, endpoint, 300ms,
+                         CurveClientKeys{*generateKeyPair(), server_keys.public_key});
+  ControlClient plain(context, endpoint, 300ms);
+  // A call after the refusal is the one that could block on a socket left
+  // without a connection: wait for the refusal first.
+  const auto deadline = std::chrono::steady_clock::now() + 10s;
+  while ((*curve)->refused() == 0 && std::chrono::steady_clock::now() < deadline) {
+    zmq::pollitem_t none{router.handle(), 0, ZMQ_POLLIN, 0};
+    zmq::poll(&none, 1, 10ms);
+  }
+  REQUIRE((*curve)->refused() >= 1);
+  for (int i = 0; i < 4; ++i) {
+    auto refused = stranger.call(request);
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().code == ControlErrc::kNoReply);
+    auto ignored = plain.call(request);
+    REQUIRE_FALSE(ignored);
+    CHECK(ignored.error().code == ControlErrc::kNoReply);
+  }
+  CHECK((*curve)->refused() >= 1);
+  // The listed client reaches the same socket (positive control).
+  zmq::socket_t dealer(context, zmq::socket_type::req);
+  dealer.set(zmq::sockopt::linger, 0);
+  secureClientSocket(dealer, CurveClientKeys{listed, server_keys.public_key});
+  dealer.connect(endpoint);
+  dealer.send(zmq::str_buffer("hello"), zmq::send_flags::none);
+  zmq::pollitem_t item{router.handle(), 0, ZMQ_POLLIN, 0};
+  CHECK(zmq::poll(&item, 1, 10s) == 1);
+}
