@@ -82,14 +82,20 @@ void RobotServer::start() {
 void RobotServer::stop() {
   stop_ = true;
   if (accept_thread_.joinable()) accept_thread_.join();
-  std::lock_guard<std::mutex> lock(mutex_);
-  // Wake connection threads blocked in poll/recv.
-  for (auto& c : connections_) ::shutdown(c.fd, SHUT_RDWR);
-  for (auto& c : connections_) {
+  // Joined outside the lock: a connection thread takes it on its way out.
+  // Splicing keeps the nodes, which the threads still refer to.
+  std::list<Connection> closing;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closing.splice(closing.end(), connections_);
+    // Wake connection threads blocked in poll/recv.
+    for (auto& c : closing) ::shutdown(c.fd, SHUT_RDWR);
+  }
+  for (auto& c : closing) {
     if (c.thread.joinable()) c.thread.join();
     ::close(c.fd);
   }
-  connections_.clear();
+  std::lock_guard<std::mutex> lock(mutex_);
   per_address_.clear();
 }
 
