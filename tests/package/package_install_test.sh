@@ -75,7 +75,8 @@ echo "Depends: $(dpkg-deb -f "$deb" Depends)"
 # --- contents ---------------------------------------------------------------
 dpkg-deb -c "$deb" >"$work/contents"
 for path in ./usr/bin/picksight-video-server ./usr/bin/picksight-vision ./usr/bin/picksight-cam \
-  ./usr/bin/picksight-calib ./usr/lib/systemd/system/picksight-video-server.service \
+  ./usr/bin/picksight-calib ./usr/bin/picksight-robot ./usr/bin/picksight-keygen \
+  ./usr/lib/systemd/system/picksight-video-server.service \
   "./usr/lib/systemd/system/picksight-vision@.service" ./usr/lib/sysusers.d/picksight.conf \
   ./usr/lib/tmpfiles.d/picksight.conf ./etc/picksight/video-server.yaml \
   ./etc/picksight/vision/cam0.yaml ./usr/share/doc/picksight/README.md \
@@ -160,11 +161,9 @@ for pid in "${pids[@]}"; do
   [ "$(stat -c %U "/proc/$pid")" = picksight ] || fail "process $pid does not run as picksight"
 done
 
-exec 3<>"/dev/tcp/127.0.0.1/$port" || fail "cannot connect to the robot port $port"
-printf 'LOCATE 1\n' >&3
-IFS= read -r -t 30 reply <&3 || fail "no reply to LOCATE"
-exec 3>&-
-reply="${reply%$'\r'}"
+# The packaged robot client, as an integrator would use it.
+reply="$(/usr/bin/picksight-robot --port "$port" --timeout 30 'LOCATE 1')" ||
+  fail "picksight-robot LOCATE 1 failed: '$reply'"
 echo "LOCATE 1 -> $reply"
 [[ "$reply" == "OK "* ]] || fail "LOCATE replied '$reply'"
 
