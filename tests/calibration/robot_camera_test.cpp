@@ -246,8 +246,7 @@ TEST_CASE("with coarse points the geometric fit stays close to least squares", "
   CHECK(worst_ratio < 2.0);
 }
 
-TEST_CASE("best keeps the model that predicts left-out points best and names it",
-          "[calibration]") {
+TEST_CASE("best keeps the model that predicts left-out points best and names it", "[calibration]") {
   // BEST compares cross-validated errors: a model with more parameters must
   // predict 20 % better than a simpler one (docs/PROTOCOL.md, COMPUTE).
   const auto parameters = [](Method m) {

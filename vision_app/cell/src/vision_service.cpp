@@ -116,9 +116,8 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& ma
   t.centroid = mapping.toSensor(r.centroid);
   t.moments = mapping.momentsToSensor(r.moments);
   const int margin = std::max(r.bbox.width, r.bbox.height) / 2 + 24;
-  const cv::Rect around =
-      (r.bbox + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
-      cv::Rect(0, 0, grey.cols, grey.rows);
+  const cv::Rect around = (r.bbox + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
+                          cv::Rect(0, 0, grey.cols, grey.rows);
   t.image = grey(around).clone();  // the frame's pixels go with the frame
   t.image_origin = around.tl();
   t.mapping = mapping;

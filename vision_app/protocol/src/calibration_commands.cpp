@@ -57,9 +57,8 @@ std::string calcam(const Request& r, VisionService& vision, CellCalibration& cal
 
 std::string store(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const auto robot = parseNumbers(r.args);
-  if (!robot || robot->size() != 2 || !std::isfinite((*robot)[0]) ||
-      !std::isfinite((*robot)[1]) || std::abs((*robot)[0]) > kMaxRobotMm ||
-      std::abs((*robot)[1]) > kMaxRobotMm)
+  if (!robot || robot->size() != 2 || !std::isfinite((*robot)[0]) || !std::isfinite((*robot)[1]) ||
+      std::abs((*robot)[0]) > kMaxRobotMm || std::abs((*robot)[1]) > kMaxRobotMm)
     return errorReply(ProtocolErrc::kBadArguments,
                       "usage: STORE <x> <y> (robot mm, each within +-1000000)");
   // Checked before a frame is taken: a damaged calibration or a full list
@@ -79,8 +78,7 @@ std::string store(const Request& r, VisionService& vision, CellCalibration& cali
   if (looksLikeDisc(target->moments)) {
     if (auto disc = measuredDisc(*target)) centre = disc->centre;
   }
-  const calibration::PointPair pair{geometry->vision.toMm(centre),
-                                    {(*robot)[0], (*robot)[1]}};
+  const calibration::PointPair pair{geometry->vision.toMm(centre), {(*robot)[0], (*robot)[1]}};
   auto id = calibration.addPoint(pair);
   if (!id) return reply(id.error());
   return "OK " + std::to_string(*id);

@@ -8,8 +8,8 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
-#include "picksight/vision_app/plc_port.hpp"
 #include "picksight/transport/curve_keys.hpp"
+#include "picksight/vision_app/plc_port.hpp"
 
 namespace picksight::app {
 
