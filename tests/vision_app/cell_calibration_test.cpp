@@ -186,3 +186,25 @@ TEST_CASE("clearing a sound calibration removes its file", "[vision_app][calibra
   CHECK(c.summary().points == 0);
   CHECK(c.clear());  // nothing to clear is fine
 }
+
+TEST_CASE("Temporaries of an interrupted calibration write are removed at load",
+          "[vision_app]") {
+  test::TempDir dir;
+  const std::string path = dir.file("calibration.yaml");
+  {
+    CellCalibration c(path);
+    REQUIRE(c.load());
+    storeSquare(c);
+  }
+  const std::string before = *readFile(path);
+  // What a process killed between its write and its rename leaves behind.
+  std::FILE* torn = std::fopen((path + ".tmp.4242").c_str(), "w");
+  REQUIRE(torn);
+  std::fputs("format_version: 2\npoints:\n  - id: 1\n    vis", torn);
+  std::fclose(torn);
+  CellCalibration c(path);
+  REQUIRE(c.load());
+  CHECK_FALSE(std::filesystem::exists(path + ".tmp.4242"));
+  CHECK(*readFile(path) == before);
+  CHECK(c.points().size() == 4);
+}

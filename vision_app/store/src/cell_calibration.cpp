@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "picksight/common/atomic_file.hpp"
+#include "picksight/common/log.hpp"
 
 namespace picksight::app {
 
@@ -100,6 +101,16 @@ CellCalibration::CellCalibration(std::string path, Fit fit)
 Result<void> CellCalibration::load() {
   std::lock_guard<std::mutex> lock(mutex_);
   ++revision_;
+  // Left by a write that a crash interrupted; this process owns the data
+  // directory (the models/ directory is cleaned by the model library).
+  const std::string directory = std::filesystem::path(store_.path()).parent_path().string();
+  if (auto removed = removeStaleTemporaries(directory.empty() ? "." : directory)) {
+    for (const auto& name : *removed) {
+      logInfo(directory, ": removed ", name, " (left by an interrupted write)");
+    }
+  } else {
+    logError(removed.error().message);
+  }
   auto ok = store_.load();
   damaged_ = ok ? std::string() : ok.error().message;
   if (ok) {
