@@ -8,6 +8,7 @@ python3-protobuf and python3-numpy.
 from picksight.frames import Frame, FrameSubscriber, decode_frame
 from picksight.robot import RobotClient, RobotError
 from picksight.control import CameraControl, ControlError, ControlTimeout
+from picksight.curve import CurveKeys
 
 __all__ = [
     "Frame",
@@ -18,4 +19,5 @@ __all__ = [
     "CameraControl",
     "ControlError",
     "ControlTimeout",
+    "CurveKeys",
 ]

@@ -43,9 +43,11 @@ class CameraControl(SocketOwner):
     protobuf messages of proto/picksight.proto; `snap` returns a Frame. One
     thread uses a client at a time."""
 
-    def __init__(self, endpoint, timeout=2.0, context=None):
+    def __init__(self, endpoint, timeout=2.0, context=None, curve=None):
+        """`curve`: a picksight.CurveKeys for a video server with CURVE."""
         self.endpoint = endpoint
         self.timeout = timeout
+        self._curve = curve
         self._context = context or zmq.Context.instance()
         self._socket = None
         self._connect()
@@ -55,6 +57,8 @@ class CameraControl(SocketOwner):
             self._socket.close(linger=0)
         self._socket = self._context.socket(zmq.REQ)
         self._socket.setsockopt(zmq.LINGER, 0)
+        if self._curve is not None:
+            self._curve.apply(self._socket)
         self._socket.connect(self.endpoint)
 
     def call(self, request, timeout=None):

@@ -75,9 +75,12 @@ class FrameSubscriber(SocketOwner):
     `malformed` (messages skipped). One thread uses a subscriber at a time,
     like the ZeroMQ socket inside it."""
 
-    def __init__(self, endpoint, camera="", queue_frames=4, context=None):
+    def __init__(self, endpoint, camera="", queue_frames=4, context=None, curve=None):
+        """`curve`: a picksight.CurveKeys for a video server with CURVE."""
         self._context = context or zmq.Context.instance()
         self._socket = self._context.socket(zmq.SUB)
+        if curve is not None:
+            curve.apply(self._socket)
         # The high-water mark counts message parts; a frame is three.
         self._socket.setsockopt(zmq.RCVHWM, queue_frames * 3)
         self._socket.setsockopt(zmq.LINGER, 0)
