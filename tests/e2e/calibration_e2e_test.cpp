@@ -46,7 +46,8 @@ std::string ask(LineClient& robot, const std::string& request) {
 }
 
 // What the robot does: picksight-cam moves its target (or takes it away).
-void holdTarget(const VideoServerProcess& server, std::optional<cv::Point2d> at_mm) {
+void holdTarget(const VideoServerProcess& server, std::optional<cv::Point2d> at_mm,
+                const std::string& target = "disc radius 5 mm") {
   std::vector<std::string> argv = {binPath("picksight-cam"),
                                    "--control",
                                    server.control,
@@ -62,7 +63,7 @@ void holdTarget(const VideoServerProcess& server, std::optional<cv::Point2d> at_
   }
   const CommandResult r = run(argv);
   REQUIRE(r.exit_code == 0);
-  CHECK(r.out.rfind("cam0: target disc radius 5 mm", 0) == 0);
+  CHECK(r.out.rfind("cam0: target " + target, 0) == 0);
 }
 
 }  // namespace
@@ -118,6 +119,30 @@ TEST_CASE("a synthetic cell is calibrated through the protocol with its simulate
   // The robot takes the target away: nothing to store.
   holdTarget(server, std::nullopt);
   CHECK(ask(robot, "STORE 1 2").rfind("ERROR 1 ", 0) == 0);
+}
+
+TEST_CASE("CALCAM GRID measures the scale on a grid of dots through a resized camera",
+          "[e2e][calibration]") {
+  // A grid of 5 x 4 dots 12 mm apart at 0.25 mm/px, published at 3/4 size:
+  // the scale comes back in sensor pixels, as CALCAM's disc gives it.
+  VideoServerProcess server(
+      {"--source",
+       "cam0=synthetic:width=1280,height=960,parts=0,seed=3,mm_per_px=0.25,rz=178.7,dx=330.5,"
+       "dy=-612.25,target=grid,grid=5x4,grid_pitch=12,target_radius=3",
+       "--mode", "trigger"});
+  REQUIRE(run({binPath("picksight-cam"), "--control", server.control, "size", "cam0", "--scale",
+               "0.75"})
+              .exit_code == 0);
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  CHECK(ask(robot, "CALCAM GRID").rfind("ERROR 11 ", 0) == 0);
+  CHECK(ask(robot, "CALCAM GRID -3").rfind("ERROR 11 ", 0) == 0);
+  CHECK(ask(robot, "CALCAM GRID 12").rfind("ERROR 3 ", 0) == 0);  // no grid held yet
+  holdTarget(server, robotAt({620.2, 470.7}), "grid");
+  const auto scale = replyNumbers(ask(robot, "CALCAM GRID 12"), 2);
+  CHECK(scale[0] == Approx(kMmPerPx).epsilon(0.001));
+  CHECK(scale[1] == Approx(kMmPerPx).epsilon(0.001));
+  CHECK(ask(robot, "STATUS").find(" scale=" + formatFixed(scale[0], 6)) != std::string::npos);
 }
 
 TEST_CASE("picksight-cam target refuses bad positions and cameras without a robot and sets parts",

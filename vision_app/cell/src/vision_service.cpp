@@ -196,6 +196,13 @@ Result<TargetOutcome> VisionService::target() {
   return outcome;
 }
 
+Result<std::pair<cv::Mat, SensorMapping>> VisionService::greyFrame() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto frame = freshFrame();
+  if (!frame) return frame.error();
+  return std::make_pair(greyImage(**frame).clone(), (*frame)->mapping);
+}
+
 std::optional<FrameInfo> VisionService::lastFrame() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return last_frame_;

@@ -37,7 +37,27 @@ Result<calibration::DiscMeasurement> measuredDisc(const TargetOutcome& t) {
   return disc;
 }
 
+// CALCAM GRID <pitch_mm>: the scale on X and on Y from a grid of dots.
+std::string calcamGrid(const Request& r, VisionService& vision, CellCalibration& calibration) {
+  const std::vector<std::string> rest(r.args.begin() + 1, r.args.end());
+  const auto pitch = parseNumbers(rest);
+  if (!pitch || pitch->size() != 1 || !((*pitch)[0] > 0) || (*pitch)[0] > kMaxRadiusMm)
+    return errorReply(ProtocolErrc::kBadArguments,
+                      "usage: CALCAM GRID <pitch_mm> (a number in (0, 10000])");
+  auto frame = vision.greyFrame();
+  if (!frame) return reply(frame.error());
+  auto grid = calibration::measureDotGrid(frame->first, (*pitch)[0]);
+  if (!grid) return errorReply(VisionErrc::kNotADisc, grid.error().message);
+  // Measured in frame pixels; a frame pixel is 1/scale sensor pixels.
+  calibration::PixelScale scale = grid->scale;
+  scale.mm_per_px_x *= frame->second.scale_x;
+  scale.mm_per_px_y *= frame->second.scale_y;
+  if (auto ok = calibration.setScale(scale); !ok) return reply(ok.error());
+  return "OK " + formatFixed(scale.mm_per_px_x, 6) + " " + formatFixed(scale.mm_per_px_y, 6);
+}
+
 std::string calcam(const Request& r, VisionService& vision, CellCalibration& calibration) {
+  if (!r.args.empty() && toUpper(r.args[0]) == "GRID") return calcamGrid(r, vision, calibration);
   const auto radius = parseNumbers(r.args);
   if (!radius || radius->size() != 1 || !((*radius)[0] > 0) || (*radius)[0] > kMaxRadiusMm)
     return errorReply(ProtocolErrc::kBadArguments,
@@ -110,7 +130,7 @@ std::optional<calibration::Method> parseMethod(const std::vector<std::string>& a
 
 void addCalibrationCommands(CommandTable& table, VisionService& vision,
                             CellCalibration& calibration) {
-  table.add("CALCAM", "CALCAM <radius_mm>",
+  table.add("CALCAM", "CALCAM <radius_mm> or CALCAM GRID <pitch_mm>",
             [&](const Request& r) { return calcam(r, vision, calibration); });
   table.add("STORE", "STORE <x> <y>",
             [&](const Request& r) { return store(r, vision, calibration); });

@@ -133,6 +133,10 @@ class VisionService {
   Result<std::vector<vision::BlobFeatures>> blobs();
   // The single calibration target in a fresh frame.
   Result<TargetOutcome> target();
+  // A fresh frame's grey pixels (a copy the caller owns) and their mapping
+  // to sensor pixels, for measurements that need the whole image (a grid of
+  // calibration dots).
+  Result<std::pair<cv::Mat, SensorMapping>> greyFrame();
   // Runs `fn(CameraLink&)` between requests (camera settings: they share
   // the link's control socket with the triggers) and returns its result.
   template <typename Fn>
