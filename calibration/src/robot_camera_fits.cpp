@@ -297,8 +297,10 @@ std::optional<RobustFit> robustFit(const std::vector<PointPair>& pts, TransformM
   const size_t p = sampleSize(model);
   if (n < p) return std::nullopt;
   // Rousseeuw's order statistic for p-point samples: robust to just under
-  // half the points being wrong.
-  const size_t h = std::min(n - 1, n / 2 + (p + 1) / 2 - 1);
+  // half the points being wrong. Never one of the sample's own p residuals,
+  // which are zero: with few points (3 for a similarity) the scale would be
+  // zero and every point outside the sample an outlier.
+  const size_t h = std::min(n - 1, std::max(p, n / 2 + (p + 1) / 2 - 1));
   double best_score = std::numeric_limits<double>::max();
   std::optional<PlaneTransform> best;
   const auto handedness = model == TransformModel::kHomography ? std::vector<bool>{false}

@@ -104,16 +104,18 @@ inline CalibrationCell makeCalibrationCell(const CellSpec& spec) {
   std::uniform_real_distribution<double> within(0, 1);
   for (int i = 0; i < spec.points; ++i) {
     const int g = grid[static_cast<size_t>(i) % grid.size()];
-    const cv::Point2d plane(((g % cols) + within(rng)) / cols * spec.field_w - spec.field_w / 2,
-                            ((g / cols) + within(rng)) / rows * spec.field_h - spec.field_h / 2);
+    // Braces: the draws happen left to right with every compiler (the order
+    // of a call's arguments is unspecified), so every build sees the same cells.
+    const cv::Point2d plane{((g % cols) + within(rng)) / cols * spec.field_w - spec.field_w / 2,
+                            ((g / cols) + within(rng)) / rows * spec.field_h - spec.field_h / 2};
     const cv::Point2d v = cell.toVision(plane);
-    cv::Point2d robot = cell.truth(v) + cv::Point2d(rn(rng), rn(rng));
+    cv::Point2d robot = cell.truth(v) + cv::Point2d{rn(rng), rn(rng)};
     const bool bad = i < spec.outliers;
     if (bad) {
       const double d = off(rng), ang = dir(rng);
       robot += cv::Point2d(d * std::cos(ang), d * std::sin(ang));
     }
-    cell.points.push_back({v + cv::Point2d(vn(rng), vn(rng)), robot});
+    cell.points.push_back({v + cv::Point2d{vn(rng), vn(rng)}, robot});
     cell.outlier.push_back(bad);
   }
   return cell;
