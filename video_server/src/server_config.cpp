@@ -3,6 +3,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <chrono>
+#include <cmath>
 #include <optional>
 #include <set>
 
@@ -53,8 +55,9 @@ Result<std::vector<int>> intList(const YAML::Node& node, size_t n) {
 Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& where) {
   if (!node.IsMap()) return makeError(VideoErrc::kBadConfig, where + ": must be a map");
   CameraConfig c;
-  static const std::set<std::string> kKeys = {"name", "source", "mode",  "fps",     "format",
-                                              "roi",  "size",   "scale", "features"};
+  static const std::set<std::string> kKeys = {
+      "name", "source", "mode",  "fps",      "format",
+      "roi",  "size",   "scale", "features", "no_frame_timeout"};
   for (const auto& kv : node) {
     // as<std::string>() throws on a key that is a list or a map.
     if (!kv.first.IsScalar())
@@ -80,6 +83,14 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
     auto f = parseFps(node["fps"].Scalar());
     if (!f) return makeError(VideoErrc::kBadConfig, where + ".fps: " + f.error().message);
     c.fps = *f;
+  }
+  if (node["no_frame_timeout"]) {
+    auto t = parseDouble(node["no_frame_timeout"].Scalar());
+    if (!t || !(*t >= 0.1 && *t <= 3600)) {
+      return makeError(VideoErrc::kBadConfig,
+                       where + ".no_frame_timeout: must be seconds in [0.1, 3600]");
+    }
+    c.no_frame_timeout = std::chrono::milliseconds(std::llround(*t * 1000));
   }
   if (node["format"]) {
     auto f = parseFormat(node["format"].Scalar());
