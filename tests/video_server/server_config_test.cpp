@@ -142,6 +142,11 @@ TEST_CASE("loadServerConfig reads endpoints and cameras with their output", "[vi
   CHECK(top.no_frame_timeout == std::chrono::milliseconds(1500));
   const auto& side = config->cameras[1];
   CHECK(side.no_frame_timeout == std::chrono::milliseconds(5000));
+  // Only what was written is asked of a camera: its own rate and trigger stay.
+  CHECK(top.mode_asked);
+  CHECK(top.fps_asked);
+  CHECK_FALSE(side.mode_asked);
+  CHECK_FALSE(side.fps_asked);
   CHECK(side.mode == AcquisitionMode::kFreeRun);
   CHECK(side.output.format == OutputFormat::kBgr8);
   CHECK(side.output.roi == cv::Rect(10, 20, 300, 200));

@@ -34,7 +34,9 @@ Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& s
       sink_(sink),
       output_(config_.output),
       mode_(config_.mode),
-      fps_(config_.fps) {
+      fps_(config_.fps),
+      mode_asked_(config_.mode_asked),
+      fps_asked_(config_.fps_asked) {
   status_.name = config_.name;
   status_.uri = config_.uri;
   status_.state = "stopped";
@@ -101,7 +103,11 @@ Result<void> Camera::setMode(AcquisitionMode mode, double fps) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     mode_ = mode;
-    if (fps > 0) fps_ = fps;
+    mode_asked_ = true;
+    if (fps > 0) {
+      fps_ = fps;
+      fps_asked_ = true;
+    }
     if (mode == AcquisitionMode::kFreeRun) pending_triggers_ = 0;
     reconfigure_ = true;
   }
@@ -329,10 +335,9 @@ void Camera::waitWhileClosed(std::unique_lock<std::mutex>& lock) {
 void Camera::applyAcquisitionSettings(std::unique_lock<std::mutex>& lock) {
   reconfigure_ = false;
   waiting_since_.reset();  // the wait for a frame starts again
-  const AcquisitionMode mode = mode_;
-  const double fps = fps_;
+  const AcquisitionRequest request{mode_, fps_, mode_asked_, fps_asked_};
   lock.unlock();
-  const Result<void> configured = source_->configureAcquisition(mode, fps);
+  const Result<void> configured = source_->configureAcquisition(request);
   lock.lock();
   if (!configured) {
     status_.last_error = configured.error().message;

@@ -34,6 +34,11 @@ struct CameraConfig {
   OutputSettings output;
   AcquisitionMode mode = AcquisitionMode::kFreeRun;
   double fps = 10;
+  // Whether the configuration gave the mode or the rate: a streaming device
+  // keeps its own trigger and frame-rate settings unless asked (a request
+  // from a client asks too).
+  bool mode_asked = false;
+  bool fps_asked = false;
   // Feature values applied, in order, every time the device is (re)opened:
   // a camera that was power-cycled has forgotten them.
   std::vector<std::pair<std::string, std::string>> features;
@@ -193,6 +198,8 @@ class Camera {
   OutputSettings output_;
   AcquisitionMode mode_;
   double fps_;
+  bool mode_asked_;
+  bool fps_asked_;
   uint64_t next_sequence_ = 1;
   uint64_t pending_triggers_ = 0;
   CameraStatus status_;
