@@ -3,6 +3,7 @@
 // every published frame, output settings applied from the next frame, and
 // retries of a source that is not there yet.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -104,6 +106,50 @@ bool waitForState(const Camera& camera, const std::string& state) {
 }
 
 using picksight::test::TempDir;
+
+// A streaming camera that delivers `good` frames after each open, then only
+// bad frames (`bad`) or nothing: a stream that stops reaching the host.
+class StallingSource : public picksight::video::Source {
+ public:
+  struct Counters {
+    std::atomic<int> opens{0};
+  };
+  StallingSource(int good, bool bad, std::shared_ptr<Counters> counters)
+      : good_(good), bad_(bad), counters_(std::move(counters)) {}
+  picksight::Result<void> open() override {
+    ++counters_->opens;
+    delivered_ = 0;
+    return {};
+  }
+  void close() override {}
+  picksight::video::SourceInfo info() const override {
+    picksight::video::SourceInfo i;
+    i.sensor_width = 8;
+    i.sensor_height = 8;
+    return i;
+  }
+  bool streams() const override { return true; }
+  picksight::Result<picksight::video::SourceFrame> grab(
+      std::chrono::milliseconds timeout) override {
+    using picksight::video::SourceErrc;
+    if (delivered_ < good_) {
+      ++delivered_;
+      picksight::video::SourceFrame f;
+      f.image = cv::Mat(8, 8, CV_8UC1, cv::Scalar(delivered_));
+      return f;
+    }
+    // A device's grab blocks until its timeout; a short one keeps the test quick.
+    std::this_thread::sleep_for(std::min<std::chrono::milliseconds>(timeout, 10ms));
+    if (bad_) return picksight::makeError(SourceErrc::kBadValue, "frame 7 incomplete");
+    return picksight::makeError(SourceErrc::kTimeout, "no frame");
+  }
+
+ private:
+  const int good_;
+  const bool bad_;
+  const std::shared_ptr<Counters> counters_;
+  int delivered_ = 0;
+};
 
 uint64_t maxSequence(const std::vector<Frame>& frames) {
   uint64_t m = 0;
@@ -379,4 +425,44 @@ TEST_CASE("Camera in an outage refuses triggers at once and never bursts afterwa
   const auto closed = camera->trigger();
   REQUIRE_FALSE(closed);
   CHECK(closed.error().code == picksight::video::VideoErrc::kCameraClosed);
+}
+
+TEST_CASE("Camera that stops delivering frames is reported and reopened until frames return",
+          "[video_server]") {
+  auto counters = std::make_shared<StallingSource::Counters>();
+  CollectingSink sink;
+  CameraConfig c = config(AcquisitionMode::kFreeRun);
+  c.no_frame_timeout = 300ms;
+  Camera camera(c, std::make_unique<StallingSource>(3, false, counters), sink);
+  camera.start();
+  REQUIRE(sink.waitForCount(3));
+  // Silence: said, counted, and the device reopened, which delivers again.
+  REQUIRE(waitForStatus(camera, [](const auto& s) {
+    return s.state == "reconnecting" && s.last_error.find("no good frame for 0.3 s") == 0;
+  }));
+  CHECK(camera.status().acquisition_errors >= 1);
+  REQUIRE(sink.waitForCount(4));
+  CHECK(counters->opens >= 2);
+  CHECK(waitForStatus(camera, [](const auto& s) { return s.reconnects >= 1; }));
+  camera.stop();
+}
+
+TEST_CASE("Camera delivering only bad frames is reported and reopened with back-off",
+          "[video_server]") {
+  auto counters = std::make_shared<StallingSource::Counters>();
+  CollectingSink sink;
+  CameraConfig c = config(AcquisitionMode::kFreeRun);
+  c.no_frame_timeout = 200ms;
+  Camera camera(c, std::make_unique<StallingSource>(0, true, counters), sink);
+  camera.start();
+  // The stall names the last bad frame, and the reason stays while the
+  // reopened device still delivers nothing good.
+  REQUIRE(waitForStatus(camera, [&](const auto& s) {
+    return counters->opens >= 3 && s.state == "reconnecting" &&
+           s.last_error.find("no good frame") == 0 &&
+           s.last_error.find("frame 7 incomplete") != std::string::npos;
+  }));
+  CHECK(camera.status().acquisition_errors >= 3);
+  CHECK(camera.status().frames_acquired == 0);
+  camera.stop();
 }

@@ -1,5 +1,6 @@
 // Pins the video server's configuration: command-line defaults and flags,
 // and YAML files whose errors name the file and the key path.
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -46,6 +47,7 @@ cameras:
     source: "synthetic:width=320,height=240"
     mode: trigger
     fps: 25
+    no_frame_timeout: 1.5
   - name: side
     source: file:/data/side.png
     format: bgr8
@@ -137,7 +139,14 @@ TEST_CASE("loadServerConfig reads endpoints and cameras with their output", "[vi
   CHECK(top.uri == "synthetic:width=320,height=240");
   CHECK(top.mode == AcquisitionMode::kTrigger);
   CHECK(top.fps == 25);
+  CHECK(top.no_frame_timeout == std::chrono::milliseconds(1500));
   const auto& side = config->cameras[1];
+  CHECK(side.no_frame_timeout == std::chrono::milliseconds(5000));
+  // Only what was written is asked of a camera: its own rate and trigger stay.
+  CHECK(top.mode_asked);
+  CHECK(top.fps_asked);
+  CHECK_FALSE(side.mode_asked);
+  CHECK_FALSE(side.fps_asked);
   CHECK(side.mode == AcquisitionMode::kFreeRun);
   CHECK(side.output.format == OutputFormat::kBgr8);
   CHECK(side.output.roi == cv::Rect(10, 20, 300, 200));
@@ -168,6 +177,10 @@ TEST_CASE("loadServerConfig errors name the key path", "[video_server]") {
              Catch::Contains("cameras[1].fps"));
   CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'synthetic:', fps: 0}\n"),
              Catch::Contains("cameras[0].fps"));
+  CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'synthetic:', no_frame_timeout: 0}\n"),
+             Catch::Contains("cameras[0].no_frame_timeout"));
+  CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'synthetic:', no_frame_timeout: x}\n"),
+             Catch::Contains("cameras[0].no_frame_timeout"));
   CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'synthetic:', mode: burst}\n"),
              Catch::Contains("cameras[0].mode"));
   CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'synthetic:', format: rgb565}\n"),

@@ -24,6 +24,8 @@ constexpr std::chrono::milliseconds kMaxBackoff{5000};
 constexpr std::chrono::milliseconds kGrabSlice{200};
 constexpr std::chrono::milliseconds kCommandTimeout{5000};
 constexpr std::chrono::milliseconds kTriggerPatience{2000};
+// Bad frames come at the frame rate: one warning per this interval at most.
+constexpr std::chrono::seconds kBadFrameLogInterval{10};
 }  // namespace
 
 Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& sink)
@@ -32,7 +34,9 @@ Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& s
       sink_(sink),
       output_(config_.output),
       mode_(config_.mode),
-      fps_(config_.fps) {
+      fps_(config_.fps),
+      mode_asked_(config_.mode_asked),
+      fps_asked_(config_.fps_asked) {
   status_.name = config_.name;
   status_.uri = config_.uri;
   status_.state = "stopped";
@@ -99,7 +103,11 @@ Result<void> Camera::setMode(AcquisitionMode mode, double fps) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     mode_ = mode;
-    if (fps > 0) fps_ = fps;
+    mode_asked_ = true;
+    if (fps > 0) {
+      fps_ = fps;
+      fps_asked_ = true;
+    }
     if (mode == AcquisitionMode::kFreeRun) pending_triggers_ = 0;
     reconfigure_ = true;
   }
@@ -276,10 +284,15 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
   ever_opened_ = true;
   open_ = true;
   reconfigure_ = true;
-  backoff_ = std::chrono::milliseconds(100);
+  waiting_since_.reset();
   status_.info = info;
   status_.state = "streaming";
-  status_.last_error.clear();
+  // A camera reopened because it delivered nothing says so until it does:
+  // opening is not streaming.
+  if (!stalled_) {
+    status_.last_error.clear();
+    backoff_ = std::chrono::milliseconds(100);
+  }
   return true;
 }
 
@@ -301,6 +314,7 @@ void Camera::run() {
 
     const uint64_t sequence = next_sequence_++;
     const OutputSettings output = output_;
+    if (!waiting_since_) waiting_since_ = Clock::now();
     lock.unlock();
     Grab grab = grabAndConvert(*triggered, streams, output);
     lock.lock();
@@ -320,10 +334,10 @@ void Camera::waitWhileClosed(std::unique_lock<std::mutex>& lock) {
 
 void Camera::applyAcquisitionSettings(std::unique_lock<std::mutex>& lock) {
   reconfigure_ = false;
-  const AcquisitionMode mode = mode_;
-  const double fps = fps_;
+  waiting_since_.reset();  // the wait for a frame starts again
+  const AcquisitionRequest request{mode_, fps_, mode_asked_, fps_asked_};
   lock.unlock();
-  const Result<void> configured = source_->configureAcquisition(mode, fps);
+  const Result<void> configured = source_->configureAcquisition(request);
   lock.lock();
   if (!configured) {
     status_.last_error = configured.error().message;
@@ -386,32 +400,73 @@ void Camera::handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequ
   // The sequence number was not used: give it back so a gap means a lost frame.
   if (next_sequence_ == sequence + 1) next_sequence_ = sequence;
   if (triggered) ++pending_triggers_;  // the trigger is still owed a frame
-  if (error.code == SourceErrc::kTimeout) {
-    // A streaming camera with nothing to deliver yet; not an error.
-    if (triggered) ++status_.acquisition_errors;
+  if (error.code == SourceErrc::kUnavailable) {
+    ++status_.acquisition_errors;
+    logWarning("camera ", config_.name, ": ", error.message);
+    status_.last_error = error.message;
+    startOutage(lock);
     return;
   }
-  ++status_.acquisition_errors;
-  const bool repeated = status_.last_error == error.message;
-  status_.last_error = error.message;
-  if (error.code == SourceErrc::kUnavailable) {
-    logWarning("camera ", config_.name, ": ", error.message);
-    closeSource(lock);
-    status_.state = "reconnecting";
-    // Owed frames are not delivered after the outage; their clients time
-    // out, and new triggers are refused until the camera is back.
-    pending_triggers_ = 0;
-    waitBackoff(lock);
+  if (error.code == SourceErrc::kTimeout) {
+    // A streaming camera with nothing to deliver yet: an error only once
+    // it lasts (below), or when a trigger waits for it.
+    if (triggered) ++status_.acquisition_errors;
   } else {
-    // A bad frame (a corrupt buffer, settings too big for it): drop it and
-    // go on; logged once while the reason stays the same.
-    if (!repeated) logWarning("camera ", config_.name, ": frame dropped: ", error.message);
+    // A bad frame (a corrupt buffer, settings too big for it): drop it and go on.
+    ++status_.acquisition_errors;
+    status_.last_error = error.message;
+    logBadFrame(error);
   }
+  if (!waiting_since_ || Clock::now() - *waiting_since_ < config_.no_frame_timeout) return;
+  // Silence or only bad frames: a stream that never reaches us (firewall,
+  // wrong interface, a camera left in trigger mode) or a hung device.
+  // Reopening is the one remedy the server has.
+  ++status_.acquisition_errors;
+  const auto ms = config_.no_frame_timeout.count();
+  std::string why = "no good frame for " + std::to_string(ms / 1000) + "." +
+                    std::to_string(ms % 1000 / 100) + " s";
+  if (error.code != SourceErrc::kTimeout) why += " (last: " + error.message + ")";
+  // Logged once per silence, however many reopenings it takes.
+  if (!stalled_) logWarning("camera ", config_.name, ": ", why, "; reopening the device");
+  stalled_ = true;
+  status_.last_error = why;
+  startOutage(lock);
+}
+
+void Camera::startOutage(std::unique_lock<std::mutex>& lock) {
+  closeSource(lock);
+  status_.state = "reconnecting";
+  waiting_since_.reset();
+  // Owed frames are not delivered after the outage; their clients time
+  // out, and new triggers are refused until the camera is back.
+  pending_triggers_ = 0;
+  waitBackoff(lock);
+}
+
+void Camera::logBadFrame(const Error& error) {
+  ++bad_frames_unlogged_;
+  const auto now = Clock::now();
+  if (bad_frame_logged_ && now - *bad_frame_logged_ < kBadFrameLogInterval) return;
+  if (bad_frames_unlogged_ > 1) {
+    logWarning("camera ", config_.name, ": ", bad_frames_unlogged_,
+               " frames dropped in the last seconds, the last: ", error.message);
+  } else {
+    logWarning("camera ", config_.name, ": frame dropped: ", error.message);
+  }
+  bad_frames_unlogged_ = 0;
+  bad_frame_logged_ = now;
 }
 
 void Camera::publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool triggered,
                      Grab grab) {
   trigger_sent_.reset();
+  waiting_since_.reset();
+  if (stalled_) {
+    stalled_ = false;
+    status_.last_error.clear();
+    logInfo("camera ", config_.name, ": frames again");
+  }
+  backoff_ = std::chrono::milliseconds(100);
   Frame frame;
   const OutputFrame& out = *grab.out;
   frame.image = out.image;

@@ -3,6 +3,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <chrono>
+#include <cmath>
 #include <optional>
 #include <set>
 
@@ -53,8 +55,9 @@ Result<std::vector<int>> intList(const YAML::Node& node, size_t n) {
 Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& where) {
   if (!node.IsMap()) return makeError(VideoErrc::kBadConfig, where + ": must be a map");
   CameraConfig c;
-  static const std::set<std::string> kKeys = {"name", "source", "mode",  "fps",     "format",
-                                              "roi",  "size",   "scale", "features"};
+  static const std::set<std::string> kKeys = {
+      "name", "source", "mode",  "fps",      "format",
+      "roi",  "size",   "scale", "features", "no_frame_timeout"};
   for (const auto& kv : node) {
     // as<std::string>() throws on a key that is a list or a map.
     if (!kv.first.IsScalar())
@@ -75,11 +78,21 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
     auto m = parseMode(node["mode"].Scalar());
     if (!m) return makeError(VideoErrc::kBadConfig, where + ".mode: " + m.error().message);
     c.mode = *m;
+    c.mode_asked = true;
   }
   if (node["fps"]) {
     auto f = parseFps(node["fps"].Scalar());
     if (!f) return makeError(VideoErrc::kBadConfig, where + ".fps: " + f.error().message);
     c.fps = *f;
+    c.fps_asked = true;
+  }
+  if (node["no_frame_timeout"]) {
+    auto t = parseDouble(node["no_frame_timeout"].Scalar());
+    if (!t || !(*t >= 0.1 && *t <= 3600)) {
+      return makeError(VideoErrc::kBadConfig,
+                       where + ".no_frame_timeout: must be seconds in [0.1, 3600]");
+    }
+    c.no_frame_timeout = std::chrono::milliseconds(std::llround(*t * 1000));
   }
   if (node["format"]) {
     auto f = parseFormat(node["format"].Scalar());
@@ -233,7 +246,9 @@ void defineServerOptions(CLI::App& app, ServerArgs& a) {
         auto m = parseMode(v);
         return m ? std::string() : m.error().message;
       }));
-  app.add_option("--fps", a.fps, "free-run frame rate of the --source cameras (default 10)")
+  app.add_option("--fps", a.fps,
+                 "free-run frame rate of the --source cameras (default: a camera's own, 10 for "
+                 "the others)")
       ->type_name("F")
       ->check(checkValue([](const std::string& v) {
         auto f = parseFps(v);
@@ -297,8 +312,14 @@ Result<ServerConfig> parseServerArgs(const std::vector<std::string>& args, bool*
   if (!a.mode.empty()) mode = *parseMode(a.mode);  // checked by the option
   if (!a.fps.empty()) fps = *parseFps(a.fps);
   auto apply = [&](CameraConfig& c) {
-    if (mode) c.mode = *mode;
-    if (fps) c.fps = *fps;
+    if (mode) {
+      c.mode = *mode;
+      c.mode_asked = true;
+    }
+    if (fps) {
+      c.fps = *fps;
+      c.fps_asked = true;
+    }
   };
   for (const std::string& source : a.sources) {
     const size_t eq = source.find('=');

@@ -11,6 +11,7 @@
 #include "fake_gv_camera.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/transport/frame_message.hpp"
+#include "temp_dir.hpp"
 
 using namespace picksight;
 using namespace std::chrono_literals;
@@ -227,4 +228,30 @@ TEST_CASE("a killed Aravis camera is reconnected and resumes on the same topic",
   const auto reply = call(client, stats).statistics();
   REQUIRE(reply.cameras_size() == 1);
   CHECK(reply.cameras(0).reconnects() >= 1);
+}
+
+TEST_CASE("configured frame rate and hardware trigger of an Aravis camera survive its opening",
+          "[aravis][video_server]") {
+  FakeGvCamera fake;
+  picksight::test::TempDir dir;
+  // No `fps:` and no `mode:`: the camera's own settings, from features.
+  const std::string config = dir.write("server.yaml", std::string(R"(
+cameras:
+  - name: cam0
+    source: "aravis:)") + FakeGvCamera::kDeviceId + R"("
+    # Triggered by a line nothing drives: no frames, and none expected yet.
+    no_frame_timeout: 600
+    features:
+      AcquisitionFrameRate: 7.5
+      TriggerMode: "On"
+      TriggerSource: Line0
+)");
+  e2e::VideoServerProcess server{{"--config", config}};
+  zmq::context_t context;
+  ControlClient client{context, server.control, 10s};
+  REQUIRE(waitForState(client, "streaming"));
+  const auto rate = call(client, getFeature("AcquisitionFrameRate")).feature().feature();
+  CHECK(std::stod(rate.value()) == Approx(7.5));
+  CHECK(call(client, getFeature("TriggerMode")).feature().feature().value() == "On");
+  CHECK(call(client, getFeature("TriggerSource")).feature().feature().value() == "Line0");
 }

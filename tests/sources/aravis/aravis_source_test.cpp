@@ -168,7 +168,7 @@ TEST_CASE("aravis source reads and writes GenICam features by type", "[aravis]")
 TEST_CASE("aravis source streams Mono8 frames with the fake camera's ramp", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kFreeRun, 20));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
   uint64_t last_timestamp = 0;
   for (int i = 0; i < 10; ++i) {
     auto frame = nextFrame(*source);
@@ -185,7 +185,7 @@ TEST_CASE("aravis source streams Mono8 frames with the fake camera's ramp", "[ar
 TEST_CASE("aravis source follows a region of interest set through features", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kFreeRun, 20));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
   REQUIRE(nextFrame(*source));
   // While acquiring: the source stops, resizes its buffers and restarts.
   mustSet(*source, "Width", "256");
@@ -213,7 +213,7 @@ TEST_CASE("aravis source follows a region of interest set through features", "[a
 TEST_CASE("aravis source delivers Bayer and Mono16 frames with their layout", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kFreeRun, 20));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
   const std::vector<std::pair<std::string, PixelLayout>> formats = {
       {"BayerRG8", PixelLayout::kBayerRG8}, {"BayerGR8", PixelLayout::kBayerGR8},
       {"BayerGB8", PixelLayout::kBayerGB8}, {"BayerBG8", PixelLayout::kBayerBG8},
@@ -246,7 +246,7 @@ TEST_CASE("aravis source delivers Bayer and Mono16 frames with their layout", "[
 TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kTrigger, 10));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kTrigger, 10, true, true}));
   CHECK(mustGet(*source, "TriggerMode").value == "On");
   CHECK(mustGet(*source, "TriggerSource").value == "Software");
   // No trigger, no frame (the fake camera would stream at 25 fps otherwise).
@@ -273,7 +273,7 @@ TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames",
     CHECK_FALSE(extra);
   }
   // Back to free-run: frames without triggers.
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kFreeRun, 20));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
   CHECK(mustGet(*source, "TriggerMode").value == "Off");
   REQUIRE(nextFrame(*source));
   REQUIRE(nextFrame(*source));
@@ -282,7 +282,7 @@ TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames",
 TEST_CASE("aravis source reports a killed camera as unavailable and reopens it", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kFreeRun, 20));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
   REQUIRE(nextFrame(*source));
   fake.kill();
   bool unavailable = false;
@@ -297,8 +297,42 @@ TEST_CASE("aravis source reports a killed camera as unavailable and reopens it",
 
   fake.start();
   REQUIRE(source->open());
-  REQUIRE(source->configureAcquisition(AcquisitionMode::kFreeRun, 20));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
   auto frame = nextFrame(*source);
   REQUIRE(frame);
   CHECK(isDiagonalRamp(frame->image));
+}
+
+TEST_CASE("aravis source keeps the configured frame rate unless fps is asked", "[aravis]") {
+  FakeGvCamera fake;
+  auto source = openFake();
+  // As a camera's `features:` set it, with no `fps:`.
+  mustSet(*source, "AcquisitionFrameRate", "7.5");
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, false, false}));
+  CHECK(std::stod(mustGet(*source, "AcquisitionFrameRate").value) == Approx(7.5));
+  REQUIRE(nextFrame(*source));
+  // Asked: set.
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, false, true}));
+  CHECK(std::stod(mustGet(*source, "AcquisitionFrameRate").value) == Approx(20));
+}
+
+TEST_CASE("aravis source keeps a configured hardware trigger unless free-run is asked",
+          "[aravis]") {
+  FakeGvCamera fake;
+  auto source = openFake();
+  const Feature trigger_source = mustGet(*source, "TriggerSource");
+  const auto line = std::find_if(trigger_source.choices.begin(), trigger_source.choices.end(),
+                                 [](const std::string& c) { return c.rfind("Line", 0) == 0; });
+  INFO("TriggerSource choices: " << trigger_source.choices.size());
+  REQUIRE(line != trigger_source.choices.end());
+  const std::string input = *line;
+  mustSet(*source, "TriggerMode", "On");
+  mustSet(*source, "TriggerSource", input);
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, false, false}));
+  CHECK(mustGet(*source, "TriggerMode").value == "On");
+  CHECK(mustGet(*source, "TriggerSource").value == input);
+  // Free-run asked explicitly (the configuration's `mode:`, a request): off.
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, true, false}));
+  CHECK(mustGet(*source, "TriggerMode").value == "Off");
+  REQUIRE(nextFrame(*source));
 }

@@ -345,11 +345,11 @@ TEST_CASE("v4l2 frame rate: the URI's until the camera's changes at run time",
   REQUIRE(rig.source->open());
   CHECK(rig.sim->state().fps == 15);
   // The camera passes its configured default first: the URI's rate holds.
-  REQUIRE(rig.source->configureAcquisition(AcquisitionMode::kFreeRun, 10));
+  REQUIRE(rig.source->configureAcquisition({AcquisitionMode::kFreeRun, 10, true, true}));
   CHECK(rig.sim->state().fps == 15);
   const int streamons = rig.sim->state().streamons;
   // A change at run time: applied, restarting the stream (S_PARM is refused while streaming).
-  REQUIRE(rig.source->configureAcquisition(AcquisitionMode::kFreeRun, 30));
+  REQUIRE(rig.source->configureAcquisition({AcquisitionMode::kFreeRun, 30, true, true}));
   CHECK(rig.sim->state().fps == 30);
   CHECK(rig.sim->state().streamons == streamons + 1);
   CHECK(rig.sim->state().streaming);
@@ -363,7 +363,7 @@ TEST_CASE("v4l2 frame rate: the URI's until the camera's changes at run time",
 TEST_CASE("v4l2 software trigger returns a frame captured after it", "[video_server][v4l2]") {
   Rig rig;
   REQUIRE(rig.source->open());
-  REQUIRE(rig.source->configureAcquisition(AcquisitionMode::kTrigger, 10));
+  REQUIRE(rig.source->configureAcquisition({AcquisitionMode::kTrigger, 10, true, true}));
   CHECK(uniformLevel(grabOk(*rig.source)) == SimulatedV4l2Device::level(0));
   rig.sim->captureNow(2);            // frames 1 and 2 wait in the driver, older than the trigger
   std::this_thread::sleep_for(2ms);  // so the trigger's timestamp is after theirs

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <set>
+#include <thread>
 
 #include "genicam_features.hpp"
 
@@ -161,6 +162,7 @@ void AravisSource::close() {
   stream_.reset();  // frees the buffers still queued in it
   buffer_size_ = 0;
   mode_.reset();
+  configure_error_.reset();
   if (camera_ && control_lost_handler_ != 0) {
     g_signal_handler_disconnect(arv_camera_get_device(camera_.get()), control_lost_handler_);
   }
@@ -244,16 +246,31 @@ Result<void> AravisSource::checkDevice() {
   return {};
 }
 
-Result<void> AravisSource::configureAcquisition(AcquisitionMode mode, double fps) {
+Result<void> AravisSource::configureAcquisition(const AcquisitionRequest& request) {
   if (!camera_) return lost("not open");
   stopAcquisition();
+  mode_.reset();
+  configure_error_ = configureTriggerAndRate(request);
+  if (configure_error_) return *configure_error_;
+  mode_ = request.mode;
+  return startAcquisition();
+}
+
+std::optional<Error> AravisSource::configureTriggerAndRate(const AcquisitionRequest& request) {
   GErrorSlot error;
-  if (mode == AcquisitionMode::kFreeRun) {
-    arv_camera_clear_triggers(camera_.get(), error.out());
-    if (error)
-      return makeError(SourceErrc::kNotSupported,
-                       label() + ": cannot leave trigger mode: " + error.message());
-    const bool has_rate = arv_camera_is_frame_rate_available(camera_.get(), error.out());
+  const double fps = request.fps;
+  if (request.mode == AcquisitionMode::kFreeRun) {
+    // Free-run by default leaves the trigger alone: a camera configured for
+    // a hardware trigger (TriggerMode On, TriggerSource Line1) keeps it.
+    if (request.mode_asked) {
+      // Sets TriggerMode Off under every TriggerSelector.
+      arv_camera_clear_triggers(camera_.get(), error.out());
+      if (error)
+        return makeError(SourceErrc::kNotSupported,
+                         label() + ": free-run: cannot set TriggerMode to Off: " + error.message());
+    }
+    const bool has_rate =
+        request.fps_asked && arv_camera_is_frame_rate_available(camera_.get(), error.out());
     if (has_rate && fps > 0) {
       double lo = 0;
       double hi = 0;
@@ -271,10 +288,12 @@ Result<void> AravisSource::configureAcquisition(AcquisitionMode mode, double fps
     arv_camera_set_trigger(camera_.get(), "Software", error.out());
     if (error)
       return makeError(SourceErrc::kNotSupported,
-                       label() + ": cannot set software trigger: " + error.message());
+                       label() +
+                           ": trigger: cannot set TriggerMode On with TriggerSource "
+                           "Software: " +
+                           error.message());
   }
-  mode_ = mode;
-  return startAcquisition();
+  return std::nullopt;
 }
 
 Result<void> AravisSource::softwareTrigger() {
@@ -303,9 +322,17 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
   returnHeldBuffer();
   if (control_lost_->load())
     return lost("control lost (the camera stopped answering its heartbeat)");
+  if (configure_error_) {
+    // The mode asked for could not be set: no frames, as from a silent
+    // camera, so the camera reports it (with this reason) and reopens at
+    // its pace rather than at the loop's.
+    std::this_thread::sleep_for(timeout);
+    return *configure_error_;
+  }
   if (!acquiring_) {
     if (!mode_) {
-      if (auto configured = configureAcquisition(AcquisitionMode::kFreeRun, 0); !configured) {
+      // Nothing asked: the device streams as it is configured.
+      if (auto configured = configureAcquisition(AcquisitionRequest{}); !configured) {
         return configured.error();
       }
     } else if (auto started = startAcquisition(); !started) {

@@ -42,7 +42,7 @@ class AravisSource : public Source {
   Result<SourceFrame> grab(std::chrono::milliseconds timeout) override;
 
   bool streams() const override { return true; }
-  Result<void> configureAcquisition(AcquisitionMode mode, double fps) override;
+  Result<void> configureAcquisition(const AcquisitionRequest& request) override;
   Result<void> softwareTrigger() override;
 
   std::vector<Feature> features() override;
@@ -55,6 +55,8 @@ class AravisSource : public Source {
   // Creates the stream and its buffer pool for the current payload size.
   Result<void> createStream();
   Result<void> startAcquisition();
+  // Writes the trigger mode and frame rate `request` asks for, and no more.
+  std::optional<Error> configureTriggerAndRate(const AcquisitionRequest& request);
   void stopAcquisition();
   // Gives the buffer the last frame borrowed back to the stream.
   void returnHeldBuffer();
@@ -70,6 +72,9 @@ class AravisSource : public Source {
   size_t buffer_size_ = 0;
   bool acquiring_ = false;
   std::optional<AcquisitionMode> mode_;  // as last configured
+  // Why the last configureAcquisition failed: grab() answers with it rather
+  // than streaming in a mode nobody asked for.
+  std::optional<Error> configure_error_;
   SourceInfo info_;
 
   // Set from Aravis's heartbeat thread when the device stops answering. Shared

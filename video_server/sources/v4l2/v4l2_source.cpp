@@ -68,8 +68,9 @@ Result<void> V4l2Source::openDevice() {
       (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
   if (!(caps & V4L2_CAP_VIDEO_CAPTURE) || !(caps & V4L2_CAP_STREAMING)) {
     // A UVC camera also registers a metadata node (often /dev/video1).
-    return makeError(SourceErrc::kBadConfig, "v4l2:" + options_.path + " (" + kernelString(cap.card) +
-                                           ") is not a streaming video capture device");
+    return makeError(SourceErrc::kBadConfig, "v4l2:" + options_.path + " (" +
+                                                 kernelString(cap.card) +
+                                                 ") is not a streaming video capture device");
   }
   card_ = kernelString(cap.card);
   driver_ = kernelString(cap.driver);
@@ -143,8 +144,9 @@ Result<void> V4l2Source::applyFrameRate(double fps) {
   return {};
 }
 
-Result<void> V4l2Source::configureAcquisition(AcquisitionMode mode, double fps) {
-  trigger_mode_ = mode == AcquisitionMode::kTrigger;
+Result<void> V4l2Source::configureAcquisition(const AcquisitionRequest& request) {
+  const double fps = request.fps;
+  trigger_mode_ = request.mode == AcquisitionMode::kTrigger;
   trigger_pending_ = false;
   // The URI's fps holds until the camera's rate changes at run time: the
   // first rate the camera passes is its configured default, not a request.

@@ -39,7 +39,7 @@ class V4l2Source : public Source {
   SourceInfo info() const override;
   Result<SourceFrame> grab(std::chrono::milliseconds timeout) override;
   bool streams() const override { return true; }
-  Result<void> configureAcquisition(AcquisitionMode mode, double fps) override;
+  Result<void> configureAcquisition(const AcquisitionRequest& request) override;
   Result<void> softwareTrigger() override;
 
   // Controls, named from their V4L2 names lower-cased with underscores

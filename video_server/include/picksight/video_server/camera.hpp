@@ -34,9 +34,17 @@ struct CameraConfig {
   OutputSettings output;
   AcquisitionMode mode = AcquisitionMode::kFreeRun;
   double fps = 10;
+  // Whether the configuration gave the mode or the rate: a streaming device
+  // keeps its own trigger and frame-rate settings unless asked (a request
+  // from a client asks too).
+  bool mode_asked = false;
+  bool fps_asked = false;
   // Feature values applied, in order, every time the device is (re)opened:
   // a camera that was power-cycled has forgotten them.
   std::vector<std::pair<std::string, std::string>> features;
+  // No good frame for this long while frames are expected (free-run, or a
+  // trigger owed one): the camera reports it and reopens the source.
+  std::chrono::milliseconds no_frame_timeout{5000};
 };
 
 // Where a camera's frames go: Frames whose image the camera made for them
@@ -59,6 +67,8 @@ struct CameraStatus {
   // "opening", "streaming", "reconnecting", "closed" (stream closed on
   // request, device released), "stopped" (thread not running)
   std::string state;
+  // Why it fails; a camera reopened for delivering no good frame keeps it
+  // until a good frame comes.
   std::string last_error;
   bool open_requested = true;
   AcquisitionMode mode = AcquisitionMode::kFreeRun;
@@ -67,6 +77,7 @@ struct CameraStatus {
   SourceInfo info;
   OutputSettings output;
   uint64_t frames_acquired = 0;
+  // Failed grabs: bad frames, outages, no frame for no_frame_timeout.
   uint64_t acquisition_errors = 0;
   uint64_t reconnects = 0;
   uint64_t last_sequence = 0;
@@ -146,6 +157,10 @@ class Camera {
   bool ensureOpen(std::unique_lock<std::mutex>& lock);
   void closeSource(std::unique_lock<std::mutex>& lock);
   void waitBackoff(std::unique_lock<std::mutex>& lock);
+  // Closes the source and waits before reopening it: an outage.
+  void startOutage(std::unique_lock<std::mutex>& lock);
+  // A frame that could not be used: counted, logged at a bounded rate.
+  void logBadFrame(const Error& error);
   void runCommands(std::unique_lock<std::mutex>& lock);
   // Runs `fn` on the acquisition thread and waits for it.
   template <typename T>
@@ -159,6 +174,12 @@ class Camera {
   std::optional<Clock::time_point> trigger_sent_;
   Clock::time_point next_due_;  // of the next free-run frame (acquisition thread only)
   uint64_t last_frame_ns_ = 0;  // host time of the last frame (acquisition thread only)
+  // Since when a frame is expected and none good came (acquisition thread only).
+  std::optional<Clock::time_point> waiting_since_;
+  // Bad frames since the last warning about them, and when it was written
+  // (acquisition thread only).
+  uint64_t bad_frames_unlogged_ = 0;
+  std::optional<Clock::time_point> bad_frame_logged_;
 
   mutable std::mutex mutex_;  // guards everything below
   std::condition_variable wake_;
@@ -171,10 +192,14 @@ class Camera {
   std::optional<Frame> last_frame_;
   cv::Size frame_size_;  // of the frames the device delivers (sensor pixels)
   bool ever_opened_ = false;
+  // No good frame since a reopening for silence: reported until one comes.
+  bool stalled_ = false;
   std::chrono::milliseconds backoff_{100};
   OutputSettings output_;
   AcquisitionMode mode_;
   double fps_;
+  bool mode_asked_;
+  bool fps_asked_;
   uint64_t next_sequence_ = 1;
   uint64_t pending_triggers_ = 0;
   CameraStatus status_;

@@ -22,6 +22,16 @@ namespace picksight::video {
 
 enum class AcquisitionMode { kFreeRun, kTrigger };
 
+// The acquisition a camera wants. A streaming source writes to the device
+// only what was asked: a trigger or a frame rate the device was configured
+// with (its own settings, or features) survives otherwise.
+struct AcquisitionRequest {
+  AcquisitionMode mode = AcquisitionMode::kFreeRun;
+  double fps = 10;          // the rate; on-demand sources are paced at it regardless
+  bool mode_asked = false;  // free-run asked explicitly: leave any trigger mode
+  bool fps_asked = false;   // the rate asked explicitly: set the device's
+};
+
 // How a source's frame bytes are laid out. Mono10/12/16 arrive unpacked in
 // 16-bit words (CV_16UC1), YUYV/UYVY as CV_8UC2, MJPEG as one row of bytes
 // (CV_8UC1, 1 x size); the rest as their OpenCV 8-bit equivalents.
@@ -142,8 +152,8 @@ class Source {
   // (a camera); the Camera then does not pace free-run itself.
   virtual bool streams() const { return false; }
   // Called after open() and whenever the mode or rate changes. A streaming
-  // source sets its trigger mode (software) and frame rate here.
-  virtual Result<void> configureAcquisition(AcquisitionMode /*mode*/, double /*fps*/) { return {}; }
+  // source sets its trigger mode (software) and frame rate here, as asked.
+  virtual Result<void> configureAcquisition(const AcquisitionRequest& /*request*/) { return {}; }
   // In trigger mode, asks the device for one frame; grab() then returns it.
   virtual Result<void> softwareTrigger() { return {}; }
 
