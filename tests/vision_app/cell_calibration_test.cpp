@@ -187,8 +187,7 @@ TEST_CASE("clearing a sound calibration removes its file", "[vision_app][calibra
   CHECK(c.clear());  // nothing to clear is fine
 }
 
-TEST_CASE("Temporaries of an interrupted calibration write are removed at load",
-          "[vision_app]") {
+TEST_CASE("Temporaries of an interrupted calibration write are removed at load", "[vision_app]") {
   test::TempDir dir;
   const std::string path = dir.file("calibration.yaml");
   {
