@@ -14,6 +14,7 @@
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/log.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/video_server/pixel_format.hpp"
 
 namespace picksight::video {
@@ -422,9 +423,9 @@ void Camera::handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequ
   // wrong interface, a camera left in trigger mode) or a hung device.
   // Reopening is the one remedy the server has.
   ++status_.acquisition_errors;
-  const auto ms = config_.no_frame_timeout.count();
-  std::string why = "no good frame for " + std::to_string(ms / 1000) + "." +
-                    std::to_string(ms % 1000 / 100) + " s";
+  std::string why =
+      "no good frame for " +
+      formatFixed(std::chrono::duration<double>(config_.no_frame_timeout).count(), 1) + " s";
   if (error.code != SourceErrc::kTimeout) why += " (last: " + error.message + ")";
   // Logged once per silence, however many reopenings it takes.
   if (!stalled_) logWarning("camera ", config_.name, ": ", why, "; reopening the device");

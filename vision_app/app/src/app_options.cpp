@@ -41,6 +41,12 @@ std::string checkRange(const std::string& v, long long low, long long high) {
   return "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "], got '" + v + "'";
 }
 
+// The robot port's and the Modbus port's --*-allow: one syntax, one check.
+std::string checkAllowList(const std::string& v) {
+  auto list = AllowList::parse(v);
+  return list ? std::string() : list.error().message;
+}
+
 std::string checkThreshold(const std::string& v) {
   if (v == "adaptive" || v == "otsu") return "";
   if (v.rfind("fixed:", 0) == 0) {
@@ -78,10 +84,7 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
                  "addresses or networks allowed to connect, e.g. '10.0.0.0/8 192.168.1.7' "
                  "(default: any)")
       ->type_name("LIST")
-      ->check(checkValue([](const std::string& v) {
-        auto list = AllowList::parse(v);
-        return list ? std::string() : list.error().message;
-      }));
+      ->check(checkValue(checkAllowList));
   app.add_flag("--robot-read-only", o.robot_read_only,
                "the robot port refuses requests that change models, calibration or camera");
   app.add_option("--robot-idle-timeout", raw.robot_idle_timeout,
@@ -135,10 +138,7 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
   app.add_option("--modbus-allow", raw.modbus_allow,
                  "PLCs that may connect: addresses or networks (default any)")
       ->type_name("LIST")
-      ->check(checkValue([](const std::string& v) {
-        auto list = AllowList::parse(v);
-        return list ? std::string() : list.error().message;
-      }));
+      ->check(checkValue(checkAllowList));
   app.add_option("--modbus-word-order", raw.modbus_word_order,
                  "32-bit values: high word first (ABCD, default) or low word first (CDAB)")
       ->type_name("ABCD|CDAB")
