@@ -34,6 +34,8 @@ PACKAGES=(
   libmodbus-dev python3-pymodbus
   # pymodbus imports its serial client with every client (a Recommends of python3-pymodbus)
   python3-serial-asyncio
+  # calibration: Fisher's F distribution for COMPUTE BEST's model test (header-only Boost.Math)
+  libboost-math-dev
 )
 
 missing=()

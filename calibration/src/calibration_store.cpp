@@ -15,8 +15,8 @@
 
 namespace picksight::calibration {
 namespace {
-// Version 2 adds the transform's model (similarity, homography); version 1
-// files (rigid transforms) are still read.
+// Version 2 adds the transform's model (similarity, tilt, homography);
+// version 1 files (rigid transforms) are still read.
 constexpr int kFormatVersion = 2;
 
 // A finite number under `key`; errors name the key with its section, since
@@ -44,7 +44,7 @@ PlaneTransform transformFromYaml(const YAML::Node& t) {
     if (!(scale > 0)) throw std::runtime_error("transform.scale must be positive");
     return PlaneTransform::similarity(rigid, scale);
   }
-  if (model == "homography") {
+  if (model == "homography" || model == "tilt") {
     const auto m = t["matrix"] ? t["matrix"].as<std::vector<double>>() : std::vector<double>{};
     if (m.size() != 9) throw std::runtime_error("transform.matrix must have 9 values");
     cv::Matx33d h;
@@ -55,14 +55,15 @@ PlaneTransform transformFromYaml(const YAML::Node& t) {
     }
     auto p = PlaneTransform::homography(h);
     if (!p) throw std::runtime_error("transform.matrix: " + p.error().message);
+    if (model == "tilt") p->model = TransformModel::kTilt;
     return *p;
   }
-  throw std::runtime_error("transform.model must be rigid, similarity or homography");
+  throw std::runtime_error("transform.model must be rigid, similarity, tilt or homography");
 }
 
 Method methodFromName(const std::string& name) {
-  for (Method m :
-       {Method::kGeometric, Method::kLeastSquares, Method::kSimilarity, Method::kHomography}) {
+  for (Method m : {Method::kGeometric, Method::kLeastSquares, Method::kSimilarity, Method::kTilt,
+                   Method::kHomography}) {
     if (name == methodName(m)) return m;
   }
   throw std::runtime_error("transform.method '" + name + "' is unknown");
@@ -82,7 +83,12 @@ std::string CalibrationStore::serialize() const {
     out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << id << YAML::Key
         << "vision_x" << YAML::Value << p.vision.x << YAML::Key << "vision_y" << YAML::Value
         << p.vision.y << YAML::Key << "robot_x" << YAML::Value << p.robot.x << YAML::Key
-        << "robot_y" << YAML::Value << p.robot.y << YAML::EndMap;
+        << "robot_y" << YAML::Value << p.robot.y;
+    if (const auto px = pixels_.find(id); px != pixels_.end()) {
+      out << YAML::Key << "pixel_x" << YAML::Value << px->second.x << YAML::Key << "pixel_y"
+          << YAML::Value << px->second.y;
+    }
+    out << YAML::EndMap;
   }
   out << YAML::EndSeq;
   if (transform_) {
@@ -93,7 +99,7 @@ std::string CalibrationStore::serialize() const {
         << YAML::Value << t.mirrored;
     out << YAML::Key << "model" << YAML::Value << modelName(t.model);
     out << YAML::Key << "scale" << YAML::Value << t.scale;
-    if (t.model == TransformModel::kHomography) {
+    if (t.model == TransformModel::kHomography || t.model == TransformModel::kTilt) {
       out << YAML::Key << "matrix" << YAML::Value << YAML::Flow << YAML::BeginSeq;
       for (int i = 0; i < 9; ++i) out << t.matrix.val[i];
       out << YAML::EndSeq;
@@ -147,6 +153,8 @@ Result<void> CalibrationStore::load() {
       const std::string where = "point " + std::to_string(id) + " ";
       loaded.points_[id] = PointPair{{number(p, "vision_x", where), number(p, "vision_y", where)},
                                      {number(p, "robot_x", where), number(p, "robot_y", where)}};
+      if (p["pixel_x"] || p["pixel_y"])
+        loaded.pixels_[id] = {number(p, "pixel_x", where), number(p, "pixel_y", where)};
       loaded.next_id_ = std::max(loaded.next_id_, id + 1);
     }
     if (const auto t = root["transform"]) {
@@ -190,10 +198,11 @@ Result<void> CalibrationStore::load() {
   return {};
 }
 
-Result<int> CalibrationStore::addPoint(const PointPair& pair) {
+Result<int> CalibrationStore::addPoint(const PointPair& pair, std::optional<cv::Point2d> pixel) {
   CalibrationStore next = *this;
   const int id = next.next_id_++;
   next.points_[id] = pair;
+  if (pixel) next.pixels_[id] = *pixel;
   if (auto ok = next.save(); !ok) return ok.error();
   *this = std::move(next);
   return id;
@@ -203,6 +212,7 @@ Result<void> CalibrationStore::deletePoint(int id) {
   if (!points_.count(id)) return systemError(ENOENT, "no point with id " + std::to_string(id));
   CalibrationStore next = *this;
   next.points_.erase(id);
+  next.pixels_.erase(id);
   if (auto ok = next.save(); !ok) return ok;
   *this = std::move(next);
   return {};

@@ -154,7 +154,9 @@ std::vector<double> squaredResiduals(const PlaneTransform& t, const std::vector<
   return r;
 }
 
-size_t sampleSize(TransformModel model) { return model == TransformModel::kHomography ? 4 : 2; }
+size_t sampleSize(TransformModel model) {
+  return model == TransformModel::kHomography ? 4 : model == TransformModel::kTilt ? 3 : 2;
+}
 }  // namespace
 
 std::vector<PointPair> select(const std::vector<PointPair>& pts, const std::vector<bool>& use) {
@@ -207,6 +209,55 @@ std::optional<PlaneTransform> homography(const std::vector<PointPair>& pts) {
     const cv::Vec3d q = t->matrix * cv::Vec3d(p.x, p.y, 1);
     if (!(q[2] > 0)) return std::nullopt;
   }
+  return *t;
+}
+
+// A camera tilted by t about an axis in the plane sees the plane through the
+// homography K R K^-1 (K: its focal length f, R: the tilt): to first order
+// in t, an identity whose last row is (w, 1) with |w| = t / f, plus a shift.
+// What is left of the 2 x 2 block departs from a similarity by t^2 / 2 (6e-4
+// at 2 degrees), and the shift times w is of the same order once both
+// frames are taken about their points' centroids. So about the centroids:
+// robot = (s R vision + t) / (1 + w . vision), linear in (s R, t, w) once
+// multiplied out: 6 unknowns, least squares. Two fewer parameters than the
+// full homography, which then bends less to the noise of a few points.
+std::optional<PlaneTransform> tilt(const std::vector<PointPair>& pts, bool mirrored) {
+  if (pts.size() < 3) return std::nullopt;
+  const Moments m = crossMoments(pts, mirrored);
+  // Unit spread (sqrt 2 on average) for a well-conditioned system.
+  const double spread = std::sqrt(m.vision_var / static_cast<double>(pts.size()) / 2);
+  if (!(spread > 0)) return std::nullopt;
+  const double k = 1.0 / spread;
+  cv::Mat a(static_cast<int>(2 * pts.size()), 6, CV_64F), b(a.rows, 1, CV_64F);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const cv::Point2d v = (mirror(pts[i].vision, mirrored) - m.vision_mean) * k;
+    const cv::Point2d r = (pts[i].robot - m.robot_mean) * k;
+    const int row = static_cast<int>(2 * i);
+    const double ex[6] = {v.x, -v.y, 1, 0, -r.x * v.x, -r.x * v.y};
+    const double ey[6] = {v.y, v.x, 0, 1, -r.y * v.x, -r.y * v.y};
+    for (int c = 0; c < 6; ++c) {
+      a.at<double>(row, c) = ex[c];
+      a.at<double>(row + 1, c) = ey[c];
+    }
+    b.at<double>(row) = r.x;
+    b.at<double>(row + 1) = r.y;
+  }
+  cv::Mat x;
+  if (!cv::solve(a, b, x, cv::DECOMP_SVD)) return std::nullopt;
+  const auto q = [&](int i) { return x.at<double>(i); };
+  // Centred, unit-spread vision -> centred, unit-spread robot; then undo both.
+  const cv::Matx33d centred(q(0), -q(1), q(2), q(1), q(0), q(3), q(4), q(5), 1);
+  const double mv = mirrored ? -1.0 : 1.0;
+  const cv::Matx33d from_vision(k, 0, -k * m.vision_mean.x, 0, k * mv, -k * m.vision_mean.y, 0, 0,
+                                1);
+  const cv::Matx33d to_robot(spread, 0, m.robot_mean.x, 0, spread, m.robot_mean.y, 0, 0, 1);
+  auto t = PlaneTransform::homography(to_robot * centred * from_vision);
+  if (!t) return std::nullopt;
+  for (const auto& p : pts) {
+    const cv::Vec3d h = t->matrix * cv::Vec3d(p.vision.x, p.vision.y, 1);
+    if (!(h[2] > 0)) return std::nullopt;
+  }
+  t->model = TransformModel::kTilt;
   return *t;
 }
 
@@ -286,6 +337,8 @@ std::optional<PlaneTransform> fitModel(const std::vector<PointPair>& pts, Transf
       return PlaneTransform::rigid(rigid(pts, mirrored));
     case TransformModel::kSimilarity:
       return similarity(pts, mirrored);
+    case TransformModel::kTilt:
+      return tilt(pts, mirrored);
     case TransformModel::kHomography:
       return homography(pts);
   }
@@ -328,11 +381,12 @@ std::optional<RobustFit> robustFit(const std::vector<PointPair>& pts, TransformM
   // tighter than that.
   const double cut2 = std::pow(std::max(2.5 * scale, 0.1), 2);
   // Refit on the core and decide inliers against the refit, not the
-  // minimal-sample hypothesis. A homography from 4 noisy points
+  // minimal-sample hypothesis. A homography from 4 noisy points (or a tilt from 3)
   // extrapolates poorly: its core takes every point within 3 cuts, so that
   // a genuine point far from the sample is not judged by a fit made without
   // it (the mis-touched points it must reject are millimetres off).
-  const double core2 = model == TransformModel::kHomography ? 9 * cut2 : cut2;
+  const double core2 =
+      model == TransformModel::kHomography || model == TransformModel::kTilt ? 9 * cut2 : cut2;
   RobustFit fit;
   fit.inliers.assign(n, false);
   const auto r0 = squaredResiduals(*best, pts);

@@ -19,6 +19,10 @@ RigidTransform rigid(const std::vector<PointPair>& pts, bool mirrored);
 PlaneTransform similarity(const std::vector<PointPair>& pts, bool mirrored);
 // Normalized direct linear transform; nullopt when the points are degenerate.
 std::optional<PlaneTransform> homography(const std::vector<PointPair>& pts);
+// The similarity followed by a perspective division (a slightly tilted
+// camera, 6 parameters), about the points' centroids; at least 3 points;
+// nullopt when they are degenerate.
+std::optional<PlaneTransform> tilt(const std::vector<PointPair>& pts, bool mirrored);
 
 // The paper's geometric method on all of `pts` (rigid). At most a fixed
 // number of point pairs take part, so the time stays bounded.

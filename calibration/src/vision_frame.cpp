@@ -10,6 +10,12 @@ namespace picksight::calibration {
 VisionFrame::VisionFrame(PixelScale scale, std::optional<LensModel> lens)
     : scale_(scale), lens_(std::move(lens)), calibrated_(true) {}
 
+VisionFrame VisionFrame::pixels(std::optional<LensModel> lens) {
+  VisionFrame f;
+  f.lens_ = std::move(lens);
+  return f;
+}
+
 cv::Point2d VisionFrame::toMm(cv::Point2d pixel) const {
   if (lens_) pixel = lens_->undistort({pixel}).front();
   return {pixel.x * scale_.mm_per_px_x, -pixel.y * scale_.mm_per_px_y};

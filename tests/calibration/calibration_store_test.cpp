@@ -28,7 +28,7 @@ TEST_CASE("calibration points, transform, scale and lens survive a reload",
     REQUIRE(store.load());
     CHECK(*store.addPoint({{1.5, -2.25}, {300.125, 40}}) == 1);
     CHECK(*store.addPoint({{10, 20}, {310, 60}}) == 2);
-    CHECK(*store.addPoint({{30, 5}, {330, 45}}) == 3);
+    CHECK(*store.addPoint({{30, 5}, {330, 45}}, cv::Point2d(120.25, -20.5)) == 3);
     REQUIRE(store.deletePoint(2));
     CalibrationResult r;
     r.transform = PlaneTransform::rigid({300.1234567891, 41.5, -12.25, false});
@@ -48,6 +48,10 @@ TEST_CASE("calibration points, transform, scale and lens survive a reload",
   REQUIRE(again.points().size() == 2);
   CHECK(again.points().at(1).robot.x == 300.125);
   CHECK(again.points().at(3).vision.y == 5);
+  // The sensor pixel a point was measured at, when given.
+  REQUIRE(again.pixels().count(3));
+  CHECK(again.pixels().at(3) == cv::Point2d(120.25, -20.5));
+  CHECK_FALSE(again.pixels().count(1));
   CHECK_FALSE(again.points().count(2));
   REQUIRE(again.transform());
   CHECK(again.transform()->transform.dx == 300.1234567891);
@@ -105,7 +109,7 @@ TEST_CASE("the vision frame flips y so that a camera looking down is right-hande
   CHECK(VisionFrame::angleToImage(VisionFrame::angleToVision(123)) == Approx(123));
 }
 
-TEST_CASE("similarity and homography transforms survive a reload", "[calibration][store]") {
+TEST_CASE("similarity, tilt and homography transforms survive a reload", "[calibration][store]") {
   TempDir dir;
   const std::string file = dir.file("calibration.yaml");
   const cv::Matx33d h(0.998, -0.061, 328.4, 0.0605, 0.9975, -614.4, 1.2e-6, -3.4e-6, 1);
@@ -134,6 +138,15 @@ TEST_CASE("similarity and homography transforms survive a reload", "[calibration
   REQUIRE(third.transform());
   CHECK(third.transform()->transform.model == TransformModel::kHomography);
   CHECK(third.transform()->transform.matrix == r.transform.matrix);
+  r.transform.model = TransformModel::kTilt;
+  r.method = Method::kTilt;
+  REQUIRE(third.setTransform(r));
+  CalibrationStore fourth(file);
+  REQUIRE(fourth.load());
+  REQUIRE(fourth.transform());
+  CHECK(fourth.transform()->method == Method::kTilt);
+  CHECK(fourth.transform()->transform.model == TransformModel::kTilt);
+  CHECK(fourth.transform()->transform.matrix == r.transform.matrix);
 }
 
 TEST_CASE("a version 1 calibration file is still read", "[calibration][store]") {

@@ -24,13 +24,13 @@ int main(int argc, char** argv) {
       ->type_name("FILE")
       ->required();
   const std::vector<calibration::Method> all{
-      calibration::Method::kBest, calibration::Method::kGeometric,
+      calibration::Method::kBest,         calibration::Method::kGeometric,
       calibration::Method::kLeastSquares, calibration::Method::kSimilarity,
-      calibration::Method::kHomography};
+      calibration::Method::kTilt,         calibration::Method::kHomography};
   std::vector<std::string> names;
   for (auto m : all) names.push_back(calibration::methodName(m));
   app.add_option("--method", method_name, "how to fit the transform")
-      ->type_name("best|geometric|lsq|similarity|homography")
+      ->type_name("best|geometric|lsq|similarity|tilt|homography")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
   if (auto exit_code = parseMainArgs(app, argc, argv)) return *exit_code;
@@ -92,7 +92,8 @@ int main(int argc, char** argv) {
                 r.inlier ? "" : "outlier");
   }
   // Every model side by side: the origin, rotation and scale each reads,
-  // its RMS and its cross-validated error (what BEST compares).
+  // its RMS (BEST tests the residual sums of squares, docs/PROTOCOL.md) and
+  // its cross-validated error.
   std::printf("\n%-10s %10s %10s %9s %9s %8s %8s %7s\n", "fit", "dx", "dy", "rz", "scale", "rms",
               "cv_rms", "inliers");
   for (auto m : all) {

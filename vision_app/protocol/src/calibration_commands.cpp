@@ -99,7 +99,7 @@ std::string store(const Request& r, VisionService& vision, CellCalibration& cali
     if (auto disc = measuredDisc(*target)) centre = disc->centre;
   }
   const calibration::PointPair pair{geometry->vision.toMm(centre), {(*robot)[0], (*robot)[1]}};
-  auto id = calibration.addPoint(pair);
+  auto id = calibration.addPoint(pair, centre);
   if (!id) return reply(id.error());
   return "OK " + std::to_string(*id);
 }
@@ -123,6 +123,7 @@ std::optional<calibration::Method> parseMethod(const std::vector<std::string>& a
   if (m == "LSQ") return calibration::Method::kLeastSquares;
   if (m == "GEOMETRIC") return calibration::Method::kGeometric;
   if (m == "SIMILARITY") return calibration::Method::kSimilarity;
+  if (m == "TILT") return calibration::Method::kTilt;
   if (m == "HOMOGRAPHY") return calibration::Method::kHomography;
   return std::nullopt;
 }
@@ -143,7 +144,7 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
   });
   table.add(
       "LIST", "LIST", [&](const Request& r) { return list(r, calibration); }, neverChanges);
-  constexpr const char* kComputeUsage = "COMPUTE [BEST|LSQ|GEOMETRIC|SIMILARITY|HOMOGRAPHY]";
+  constexpr const char* kComputeUsage = "COMPUTE [BEST|LSQ|GEOMETRIC|SIMILARITY|TILT|HOMOGRAPHY]";
   table.add("COMPUTE", kComputeUsage, [&](const Request& r) {
     const auto method = parseMethod(r.args);
     if (!method)

@@ -37,12 +37,27 @@ Error storageError(const Error& e) {
 
 bool finite(cv::Point2d p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
-// The geometry of a loaded store.
+// The geometry of a loaded store. The lens model applies wherever it
+// exists, with or without a scale.
 CellGeometry geometryOf(const calibration::CalibrationStore& store) {
   CellGeometry g;
-  if (store.scale()) g.vision = calibration::VisionFrame(*store.scale(), store.lens());
+  g.vision = store.scale() ? calibration::VisionFrame(*store.scale(), store.lens())
+                           : calibration::VisionFrame::pixels(store.lens());
   if (store.transform()) g.transform = store.transform()->transform;
   return g;
+}
+
+// The stored points as the fit sees them: a point stored with its sensor
+// pixel is placed again through the current scale and lens model (a CALCAM
+// or lens calibration after STORE then needs no new STORE); older points
+// keep the vision coordinates they were stored with.
+std::map<int, calibration::PointPair> currentPoints(const calibration::CalibrationStore& store) {
+  std::map<int, calibration::PointPair> out = store.points();
+  const calibration::VisionFrame vision = geometryOf(store).vision;
+  for (const auto& [id, pixel] : store.pixels()) {
+    if (auto p = out.find(id); p != out.end()) p->second.vision = vision.toMm(pixel);
+  }
+  return out;
 }
 
 // Why a loaded store cannot be used, or empty. Checked through what LOCATE
@@ -50,7 +65,7 @@ CellGeometry geometryOf(const calibration::CalibrationStore& store) {
 // rather than field by field, so a non-finite value anywhere in the scale,
 // the lens or the transform is caught whatever their form.
 std::string unusable(const calibration::CalibrationStore& store) {
-  for (const auto& [id, pair] : store.points()) {
+  for (const auto& [id, pair] : currentPoints(store)) {
     if (!finite(pair.vision) || !finite(pair.robot)) {
       return "point " + std::to_string(id) + " has a non-finite coordinate";
     }
@@ -167,7 +182,7 @@ CalibrationSummary CellCalibration::summary() const {
 
 std::map<int, calibration::PointPair> CellCalibration::points() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return store_.points();
+  return currentPoints(store_);
 }
 
 Result<void> CellCalibration::setScale(const calibration::PixelScale& scale) {
@@ -188,17 +203,18 @@ Result<void> CellCalibration::setLens(const calibration::LensModel& lens) {
   return {};
 }
 
-Result<int> CellCalibration::addPoint(const calibration::PointPair& pair) {
+Result<int> CellCalibration::addPoint(const calibration::PointPair& pair,
+                                      std::optional<cv::Point2d> pixel) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!damaged_.empty()) return blocked();
-  if (!finite(pair.vision) || !finite(pair.robot)) {
+  if (!finite(pair.vision) || !finite(pair.robot) || (pixel && !finite(*pixel))) {
     return makeError(calibration::CalibrationErrc::kBadInput, "a point must be finite");
   }
   if (store_.points().size() >= kMaxPoints) {
     return makeError(CellCalibrationErrc::kTooManyPoints,
                      std::to_string(kMaxPoints) + " points are stored already (DELETE some)");
   }
-  auto id = store_.addPoint(pair);
+  auto id = store_.addPoint(pair, pixel);
   if (!id) return storageError(id.error());
   ++revision_;
   return id;
@@ -222,7 +238,7 @@ Result<calibration::CalibrationResult> CellCalibration::compute(calibration::Met
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!damaged_.empty()) return blocked();
-    for (const auto& [id, pair] : store_.points()) pairs.push_back(pair);
+    for (const auto& [id, pair] : currentPoints(store_)) pairs.push_back(pair);
     revision = revision_;
   }
   // The fit may take long with many points: LOCATE and STATUS go on meanwhile.

@@ -30,9 +30,14 @@ class CalibrationStore {
   // and the problem; the store then stays empty and the file is left alone.
   Result<void> load();
 
-  Result<int> addPoint(const PointPair& pair);  // the new id
-  Result<void> deletePoint(int id);             // error names the missing id
+  // The new id. `pixel`: the sensor pixel the vision point was measured at,
+  // kept so that the vision point can be derived again with a later camera
+  // scale or lens model.
+  Result<int> addPoint(const PointPair& pair, std::optional<cv::Point2d> pixel = std::nullopt);
+  Result<void> deletePoint(int id);  // error names the missing id
   const std::map<int, PointPair>& points() const { return points_; }
+  // Sensor pixels of the points stored with one (by id).
+  const std::map<int, cv::Point2d>& pixels() const { return pixels_; }
 
   Result<void> setTransform(const CalibrationResult& result);
   const std::optional<CalibrationResult>& transform() const { return transform_; }
@@ -51,6 +56,7 @@ class CalibrationStore {
 
   std::string path_;
   std::map<int, PointPair> points_;
+  std::map<int, cv::Point2d> pixels_;
   int next_id_ = 1;
   std::optional<CalibrationResult> transform_;
   std::optional<PixelScale> scale_;

@@ -46,11 +46,11 @@ struct RigidTransform {
   double applyToAngleDeg(double vision_deg) const;
 };
 
-enum class TransformModel { kRigid, kSimilarity, kHomography };
+enum class TransformModel { kRigid, kSimilarity, kHomography, kTilt };
 
-// Any of the three models as a 3x3 matrix on homogeneous points, with its
+// Any of the models as a 3x3 matrix on homogeneous points, with its
 // reading at the vision origin: for rigid and similarity transforms these
-// are their exact parameters; for a homography the local ones there.
+// are their exact parameters; for a tilt or a homography the local ones there.
 struct PlaneTransform {
   TransformModel model = TransformModel::kRigid;
   cv::Matx33d matrix = cv::Matx33d::eye();  // robot ~ matrix * (vision, 1)
@@ -71,7 +71,7 @@ struct PlaneTransform {
   double applyToAngleDeg(double vision_deg, cv::Point2d at = {0, 0}) const;
 };
 
-enum class Method { kBest, kGeometric, kLeastSquares, kSimilarity, kHomography };
+enum class Method { kBest, kGeometric, kLeastSquares, kSimilarity, kHomography, kTilt };
 
 struct Residual {
   double dx = 0;  // robot-frame error of the point: transform(vision) - robot
@@ -87,11 +87,12 @@ struct CalibrationResult {
   std::vector<Residual> residuals;        // one per input point, same order
   int inliers = 0;
   // Expected error at a point not fitted (mm): the RMS of each inlier
-  // predicted by the fit of the others (cross-validation). What kBest compares.
+  // predicted by the fit of the others (cross-validation). What kBest
+  // compares between the two rigid estimators.
   double predicted_error = 0;
 };
 
-// Least fit points for each model: rigid 3, similarity 3, homography 6.
+// Least fit points for each method: rigid 3, similarity 3, tilt 4, homography 6.
 int minimumPoints(Method method);
 
 // Estimates the transform. Outliers (a mis-touched point) are found by
@@ -100,20 +101,20 @@ int minimumPoints(Method method);
 // in the number of points) and left out of the fit.
 //
 // kBest finds the outliers with the most general model the points allow
-// (the homography from 8 points, else the similarity), fits every model to
-// the same inliers and keeps the one that best predicts points it was not
-// fitted to: each inlier left out in turn (10 folds beyond 30 inliers), the
-// RMS of its prediction by the fit of the others. That penalizes the
-// degrees of freedom where they cost: a homography fitted to a few points
-// bends to their noise and mispredicts the point left out, which the plain
-// residual (always lowest for the most general model) never shows. A more
-// general model must also predict 20 % better than a simpler one (points
-// left out lie among the others; parts also lie beyond them); the
-// homography competes from 8 inliers.
+// (the homography from 8 points, the tilt from 6, else the similarity) and
+// fits the models to the same inliers, the most general being the
+// homography from 8 inliers, else the tilt from 6, else the similarity.
+// From the most general down, a stiffer model replaces the one kept when it
+// fits as well up to the noise: an F-test on the rise of the residual sum
+// of squares against the kept model's own noise estimate, at a 0.1 %
+// false-alarm rate whatever the noise level and the number of points. Of
+// the two rigid estimators, the one that better predicts points left out
+// of its fit.
 Result<CalibrationResult> calibrate(const std::vector<PointPair>& points,
                                     Method method = Method::kBest);
 
-const char* methodName(Method method);  // "best", "geometric", "lsq", "similarity", "homography"
-const char* modelName(TransformModel model);  // "rigid", "similarity", "homography"
+// "best", "geometric", "lsq", "similarity", "tilt", "homography"
+const char* methodName(Method method);
+const char* modelName(TransformModel model);  // "rigid", "similarity", "tilt", "homography"
 
 }  // namespace picksight::calibration

@@ -19,6 +19,9 @@ class VisionFrame {
  public:
   VisionFrame() = default;  // 1 mm per pixel, no lens model
   VisionFrame(PixelScale scale, std::optional<LensModel> lens = std::nullopt);
+  // No scale yet (1 unit per pixel, calibrated() false), but pixels are
+  // undistorted by `lens` when set: a lens model is used wherever it exists.
+  static VisionFrame pixels(std::optional<LensModel> lens);
 
   // Sensor pixels (undistorted first when a lens model is set) to mm.
   cv::Point2d toMm(cv::Point2d pixel) const;

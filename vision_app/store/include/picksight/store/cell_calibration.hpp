@@ -1,5 +1,6 @@
 // The cell's calibration as the robot protocol sees it: the camera scale
-// (CALCAM), the lens model, the robot-camera point pairs (STORE, DELETE,
+// (CALCAM), the lens model (applied to every pixel: stored points and
+// located parts), the robot-camera point pairs (STORE, DELETE,
 // LIST) and transform (COMPUTE), persisted in <data dir>/calibration.yaml,
 // and the coordinate frame LOCATE replies in, which follows from them.
 //
@@ -90,13 +91,18 @@ class CellCalibration {
   // The geometry LOCATE replies with; kDamaged while the file is damaged.
   Result<CellGeometry> geometry() const;
   CalibrationSummary summary() const;
+  // The stored points with their vision coordinates as COMPUTE fits them:
+  // those stored with a sensor pixel through the current scale and lens model.
   std::map<int, calibration::PointPair> points() const;
 
   // Each change is written before it takes effect (CellCalibrationErrc::kCalibrationStorage).
   Result<void> setScale(const calibration::PixelScale& scale);
   Result<void> setLens(const calibration::LensModel& lens);
-  // Refuses non-finite coordinates, and a point past kMaxPoints.
-  Result<int> addPoint(const calibration::PointPair& pair);
+  // Refuses non-finite coordinates, and a point past kMaxPoints. `pixel`:
+  // the sensor pixel `pair.vision` was measured at (STORE), so that a later
+  // CALCAM or lens model places the point again.
+  Result<int> addPoint(const calibration::PointPair& pair,
+                       std::optional<cv::Point2d> pixel = std::nullopt);
   Result<void> deletePoint(int id);  // CellCalibrationErrc::kNoSuchPoint names the id
   // Fits the transform to a copy of the stored points, outside the lock,
   // and stores it, unless a STORE or DELETE came meanwhile (kPointsChanged).
