@@ -6,8 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
+#include <string>
 
+#include "calibration_cell.hpp"
 #include "picksight/calibration/robot_camera.hpp"
+#include "picksight/common/angles.hpp"
 #include "picksight/tool_support/subprocess.hpp"
 
 using namespace picksight;
@@ -29,6 +33,39 @@ Run calib(const std::vector<std::string>& args) {
   REQUIRE(status);
   r.code = WIFEXITED(*status) ? WEXITSTATUS(*status) : -1;
   return r;
+}
+
+struct FitRow {
+  std::string model;
+  double dx = 0, dy = 0, rz = 0, scale = 0, rms = 0, cv_rms = 0;
+  int inliers = 0;
+};
+
+// The row of `fit` in picksight-calib's side-by-side table, or nullopt.
+std::optional<FitRow> fitRow(const std::string& out, const std::string& fit) {
+  const size_t table = out.find("\nfit ");
+  if (table == std::string::npos) return std::nullopt;
+  const size_t at = out.find("\n" + fit + " ", table + 1);
+  if (at == std::string::npos) return std::nullopt;
+  FitRow r;
+  char model[32] = "";
+  if (std::sscanf(out.c_str() + at + 1 + fit.size(), " %31s %lf %lf %lf %lf %lf %lf %d", model,
+                  &r.dx, &r.dy, &r.rz, &r.scale, &r.rms, &r.cv_rms, &r.inliers) != 8)
+    return std::nullopt;
+  r.model = model;
+  return r;
+}
+
+// A CSV of the cell's points (vision in mm), as a robot program would log them.
+std::string cellCsv(const test::CalibrationCell& cell) {
+  std::string csv = "robot_x,robot_y,vision_x,vision_y\n";
+  for (const auto& p : cell.points) {
+    char row[160];
+    std::snprintf(row, sizeof(row), "%.6f,%.6f,%.6f,%.6f\n", p.robot.x, p.robot.y, p.vision.x,
+                  p.vision.y);
+    csv += row;
+  }
+  return csv;
 }
 
 std::string tempCsv(const std::string& content) {
@@ -99,5 +136,58 @@ TEST_CASE("picksight-calib prints every model's fit beside the chosen one", "[ca
   CHECK(r.out.find("rz -179.0000") != std::string::npos);
   for (const char* fit : {"\nlsq ", "\ngeometric ", "\nsimilarity ", "\nhomography "})
     CHECK(r.out.find(fit) != std::string::npos);
+  std::remove(path.c_str());
+}
+
+TEST_CASE("picksight-calib reads a known tilted camera from a CSV with every fit side by side",
+          "[calibration][cli]") {
+  // A camera tilted 2 degrees with its scale 0.3 % off, the robot frame at
+  // the paper's origin and rotation, 12 exact points: the homography reads
+  // the truth; the rigid fits (least squares and the paper's geometric
+  // method) and the similarity cannot, and say so by their residuals.
+  test::CellSpec spec;
+  spec.robot = {328.4, -614.4, -179.0, false};
+  spec.points = 12;
+  spec.robot_noise = 0;
+  spec.scale_error = 0.003;
+  spec.tilt_deg = 2;
+  const auto cell = test::makeCalibrationCell(spec);
+  const auto truth = *calibration::PlaneTransform::homography(cell.vision_to_robot);
+  const std::string path = tempCsv(cellCsv(cell));
+  const Run r = calib({"--csv", path});
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("method homography") != std::string::npos);
+  const auto lsq = fitRow(r.out, "lsq"), geometric = fitRow(r.out, "geometric"),
+             similarity = fitRow(r.out, "similarity"), tilt = fitRow(r.out, "tilt"),
+             homography = fitRow(r.out, "homography");
+  REQUIRE(lsq);
+  REQUIRE(geometric);
+  REQUIRE(similarity);
+  REQUIRE(tilt);
+  REQUIRE(homography);
+  CHECK(lsq->model == "rigid");
+  CHECK(geometric->model == "rigid");
+  CHECK(similarity->model == "similarity");
+  CHECK(tilt->model == "tilt");
+  CHECK(homography->model == "homography");
+  // The homography: the truth's origin, rotation and local scale, no residual.
+  CHECK(homography->dx == Approx(truth.dx).margin(2e-3));
+  CHECK(homography->dy == Approx(truth.dy).margin(2e-3));
+  CHECK(picksight::angleDiffDeg(homography->rz, truth.rz_deg) < 2e-3);
+  CHECK(homography->scale == Approx(truth.scale).margin(2e-5));
+  CHECK(homography->rms < 1e-3);
+  CHECK(homography->inliers == 12);
+  // The rigid fits keep the scale at 1 and miss by tenths of a millimetre.
+  CHECK(lsq->scale == 1.0);
+  CHECK(geometric->scale == 1.0);
+  CHECK(lsq->rms > 0.1);
+  CHECK(geometric->rms > 0.1);
+  // The similarity reads a scale but not the tilt; the tilt model nearly all.
+  CHECK(similarity->rms > 0.1);
+  CHECK(tilt->rms < similarity->rms / 3);
+  // Every fit reads the rotation to a tenth of a degree.
+  for (const auto& row : {*lsq, *geometric, *similarity, *tilt, *homography})
+    CHECK(picksight::angleDiffDeg(row.rz, -179.0) < 0.1);
   std::remove(path.c_str());
 }

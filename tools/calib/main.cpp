@@ -94,18 +94,19 @@ int main(int argc, char** argv) {
   // Every model side by side: the origin, rotation and scale each reads,
   // its RMS (BEST tests the residual sums of squares, docs/PROTOCOL.md) and
   // its cross-validated error.
-  std::printf("\n%-10s %10s %10s %9s %9s %8s %8s %7s\n", "fit", "dx", "dy", "rz", "scale", "rms",
-              "cv_rms", "inliers");
+  std::printf("\n%-10s %-10s %10s %10s %9s %9s %8s %8s %7s\n", "fit", "model", "dx", "dy", "rz",
+              "scale", "rms", "cv_rms", "inliers");
   for (auto m : all) {
     if (m == calibration::Method::kBest) continue;
     auto r = calibration::calibrate(points, m);
     if (!r) {
-      std::printf("%-10s %s\n", calibration::methodName(m), r.error().message.c_str());
+      std::printf("%-10s %-10s %s\n", calibration::methodName(m), "-", r.error().message.c_str());
       continue;
     }
     const auto& f = r->transform;
-    std::printf("%-10s %10.4f %10.4f %9.4f %9.6f %8.4f %8.4f %7d\n", calibration::methodName(m),
-                f.dx, f.dy, f.rz_deg, f.scale, r->rms, r->predicted_error, r->inliers);
+    std::printf("%-10s %-10s %10.4f %10.4f %9.4f %9.6f %8.4f %8.4f %7d\n",
+                calibration::methodName(m), calibration::modelName(f.model), f.dx, f.dy, f.rz_deg,
+                f.scale, r->rms, r->predicted_error, r->inliers);
   }
   return 0;
 }
