@@ -325,3 +325,43 @@ TEST_CASE("the results topic is the vision app's name", "[e2e][results]") {
   CHECK(r.parts_size() == 3);
   CHECK(r.request_id() > 1);
 }
+
+TEST_CASE("a part with no free grasp shows its blocked finger and the region under it",
+          "[e2e][results]") {
+  Scene scene;
+  VideoServerProcess server({"--source", "cam0=file:" + scene.path, "--mode", "trigger"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  Canvas ell;
+  ell.ell({320, 260}, 10);
+  scene.show(ell.image());
+  REQUIRE(ask(robot, "LEARN 1 ell").rfind("OK", 0) == 0);
+  // No calibration: vision units are pixels, y up. One finger 60 px above
+  // the part's centroid (about (308.4, 245.9) in the image).
+  REQUIRE(ask(robot, "GRASP 1 ADD 0 0 0") == "OK 1");
+  REQUIRE(ask(robot, "GRIPPER 1 FINGER 0 60 20 20") == "OK 1");
+  REQUIRE(parseLocateReply(ask(robot, "LOCATE 1")).size() == 1);  // nothing in the way yet
+  Results results(vision.results_endpoint);
+  results.join(robot, "LOCATE 1");
+  ell.disc({308.4, 185.9}, 12);
+  scene.show(ell.image());
+  CHECK(ask(robot, "LOCATE 1") == "OK 0");
+  const auto r = results.after("LOCATE");
+  REQUIRE(r.parts_size() == 1);
+  REQUIRE(r.regions_size() == 2);
+  const auto& part = r.parts(0);
+  CHECK_FALSE(part.offered());
+  CHECK(part.grasp_style() == -1);
+  REQUIRE(part.fingers_size() == 1);
+  const auto& finger = part.fingers(0);
+  CHECK(finger.blocked());
+  CHECK(finger.footprint().points_size() == 4);
+  const int disc = part.region() == 0 ? 1 : 0;
+  REQUIRE(finger.blocked_by_size() == 1);
+  CHECK(finger.blocked_by(0) == disc);
+  bool no_grasp = false;
+  for (const auto& rejection : r.rejections())
+    no_grasp = no_grasp || (rejection.region() == part.region() && rejection.test() == "no grasp");
+  CHECK(no_grasp);
+  CHECK(ask(robot, "WHY").find(" no free grasp of type 1") != std::string::npos);
+}

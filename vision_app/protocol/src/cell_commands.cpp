@@ -255,6 +255,9 @@ std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int ty
   record->options = options;
   if (located) {
     record->locate = std::move(located->outcome);
+    // Nothing published or explained reads the mask: a connection's last
+    // LOCATE (kept for WHY) holds no frame-sized buffer.
+    record->locate->scene.mask.release();
     record->pick = std::move(located->pick);
     record->grasps = std::move(located->grasps);
     record->geometry = std::move(located->geometry);
