@@ -63,6 +63,14 @@ struct Scene : SceneFile {
   Scene() : SceneFile(Canvas().image()) {}
 };
 
+// A file camera in trigger mode, a vision app on it, a robot connected.
+struct FileCell {
+  Scene scene;
+  VideoServerProcess server{{"--source", "cam0=file:" + scene.path, "--mode", "trigger"}};
+  VisionProcess vision{server};
+  LineClient robot = vision.connect();
+};
+
 std::string ask(LineClient& robot, const std::string& request) {
   auto reply = robot.request(request, 20s);
   REQUIRE(reply);
@@ -138,11 +146,11 @@ cv::Mat mixedScene() {
 
 TEST_CASE("a LOCATE's result reaches a subscriber with the reply's parts and outlines",
           "[e2e][results]") {
-  Scene scene;
-  VideoServerProcess server({"--source", "cam0=file:" + scene.path, "--mode", "trigger"});
-  VisionProcess vision(server);
+  FileCell cell;
+  const Scene& scene = cell.scene;
+  VisionProcess& vision = cell.vision;
+  LineClient& robot = cell.robot;
   REQUIRE(vision.results_endpoint.rfind("tcp://127.0.0.1:", 0) == 0);
-  auto robot = vision.connect();
   Results results(vision.results_endpoint);
   results.join(robot, "BLOBS");
   teach(robot, scene);
@@ -192,10 +200,10 @@ TEST_CASE("a LOCATE's result reaches a subscriber with the reply's parts and out
 }
 
 TEST_CASE("WHY and the rejections name the test a region failed", "[e2e][results]") {
-  Scene scene;
-  VideoServerProcess server({"--source", "cam0=file:" + scene.path, "--mode", "trigger"});
-  VisionProcess vision(server);
-  auto robot = vision.connect();
+  FileCell cell;
+  const Scene& scene = cell.scene;
+  VisionProcess& vision = cell.vision;
+  LineClient& robot = cell.robot;
   CHECK(ask(robot, "WHY") == "OK 0 no LOCATE yet");
   Results results(vision.results_endpoint);
   results.join(robot, "BLOBS");
@@ -248,10 +256,9 @@ TEST_CASE("WHY and the rejections name the test a region failed", "[e2e][results
 }
 
 TEST_CASE("LOCATE ALL labels each part with its type in one pass", "[e2e][results]") {
-  Scene scene;
-  VideoServerProcess server({"--source", "cam0=file:" + scene.path, "--mode", "trigger"});
-  VisionProcess vision(server);
-  auto robot = vision.connect();
+  FileCell cell;
+  const Scene& scene = cell.scene;
+  LineClient& robot = cell.robot;
   teach(robot, scene);
   scene.show(mixedScene());
   const std::string reply = ask(robot, "LOCATE ALL");
@@ -328,10 +335,10 @@ TEST_CASE("the results topic is the vision app's name", "[e2e][results]") {
 
 TEST_CASE("a part with no free grasp shows its blocked finger and the region under it",
           "[e2e][results]") {
-  Scene scene;
-  VideoServerProcess server({"--source", "cam0=file:" + scene.path, "--mode", "trigger"});
-  VisionProcess vision(server);
-  auto robot = vision.connect();
+  FileCell cell;
+  const Scene& scene = cell.scene;
+  VisionProcess& vision = cell.vision;
+  LineClient& robot = cell.robot;
   Canvas ell;
   ell.ell({320, 260}, 10);
   scene.show(ell.image());
