@@ -114,3 +114,22 @@ TEST_CASE("A config file that is not a map of options is refused", "[vision_app]
   REQUIRE_FALSE(missing);
   CHECK_THAT(missing.error().message, Catch::Contains("/nonexistent/picksight/cell.yaml"));
 }
+
+TEST_CASE("The results stream's endpoint and topic are options and config keys",
+          "[vision_app][config]") {
+  auto defaults = parse({});
+  REQUIRE(defaults);
+  CHECK(defaults->results_bind == "tcp://127.0.0.1:*");
+  CHECK(defaults->name.empty());  // the camera's name
+  TempDir dir;
+  const std::string path =
+      dir.write("cell.yaml", "results-bind: tcp://127.0.0.1:5610\nname: line1-left\n");
+  auto o = parse({"--config", path});
+  REQUIRE(o);
+  CHECK(o->results_bind == "tcp://127.0.0.1:5610");
+  CHECK(o->name == "line1-left");
+  auto off = parse({"--results-bind", "none"});
+  REQUIRE(off);
+  CHECK(off->results_bind == "none");
+  CHECK(configError("name: ''\n").find("name") != std::string::npos);
+}

@@ -3,6 +3,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <future>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -216,4 +218,36 @@ TEST_CASE("64 idle connections lock robots out only until the idle timeout",
     if (!served) std::this_thread::sleep_for(50ms);
   }
   CHECK(served);
+}
+
+TEST_CASE("a session's after-reply work runs once the reply is sent", "[robot_server]") {
+  // The after-reply step waits until the client has read its reply: the
+  // reply cannot be waiting behind it.
+  std::promise<void> reply_read;
+  std::shared_future<void> read = reply_read.get_future().share();
+  std::atomic<int> ran{0};
+  std::string client;
+  std::string seen_reply;
+  app::RobotServer server(loopback(), [&](std::string_view line, app::Session& session) {
+    client = session.client;
+    if (line == "LOCATE") {
+      session.after_reply = [&, read](const std::string& reply) {
+        read.wait();
+        seen_reply = reply;
+        ++ran;
+      };
+    }
+    return "OK " + std::string(line);
+  });
+  server.start();
+  auto c = LineClient::connect("127.0.0.1", server.port(), 2s);
+  REQUIRE(c);
+  CHECK(*c->request("LOCATE", 5s) == "OK LOCATE");
+  CHECK(ran == 0);
+  reply_read.set_value();
+  // The connection's next request is served after that step.
+  CHECK(*c->request("PING", 5s) == "OK PING");
+  CHECK(ran == 1);
+  CHECK(seen_reply == "OK LOCATE");
+  CHECK(client.rfind("robot 127.0.0.1:", 0) == 0);
 }
