@@ -22,6 +22,8 @@ PACKAGES=(
   # network namespaces and veth pairs: the two-host test (deploy/two-hosts) and
   # the fake GigE camera tests (tests/support/run_in_netns.sh)
   iproute2
+  # dropping a fake GigE camera's stream packets inside a test's own namespace
+  iptables
   # container images without a registry (deploy/containers, opt-in test)
   mmdebstrap podman
   # tests

@@ -184,6 +184,30 @@ TEST_CASE("mode and format send the enum values", "[cam]") {
     CHECK(request.set_mode().mode() == proto::TRIGGER);
     CHECK(request.set_mode().fps() == 0.0);
   }
+  SECTION("hardware trigger on a line, with its edge and timeout") {
+    const Run run = runAt(context, server,
+                          {"mode", "cam0", "hardware", "--line", "Line2", "--activation", "falling",
+                           "--trigger-timeout", "30000"});
+    CHECK(run.code == 0);
+    CHECK(run.out == "cam0: mode set to hardware on Line2 (FallingEdge)\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetMode);
+    CHECK(request.set_mode().mode() == proto::HARDWARE_TRIGGER);
+    CHECK(request.set_mode().trigger_line() == "Line2");
+    CHECK(request.set_mode().trigger_activation() == "FallingEdge");
+    CHECK(request.set_mode().trigger_timeout_ms() == 30000);
+  }
+  SECTION("hardware trigger with the server's defaults, JSON") {
+    const Run run = runAt(context, server, {"--json", "mode", "cam0", "hardware"});
+    CHECK(run.code == 0);
+    CHECK(run.out ==
+          "{\"ok\":true,\"camera\":\"cam0\",\"mode\":\"hardware\",\"trigger_line\":\"Line1\"}\n");
+    const proto::ControlRequest request = onlyRequest(server);
+    REQUIRE(request.request_case() == proto::ControlRequest::kSetMode);
+    CHECK(request.set_mode().trigger_line().empty());
+    CHECK(request.set_mode().trigger_activation().empty());
+    CHECK(request.set_mode().trigger_timeout_ms() == 0);
+  }
   SECTION("format") {
     const Run run = runAt(context, server, {"format", "cam0", "bgr8"});
     CHECK(run.code == 0);
@@ -246,6 +270,10 @@ TEST_CASE("stats prints an aligned table with right-aligned numbers, or JSON", "
   s->set_reconnects(1);
   s->set_fps(29.97);
   s->set_last_sequence(1199);
+  s->set_driver_incomplete_buffers(4);
+  s->set_driver_missing_packets(17);
+  s->set_driver_resent_packets(9);
+  s->set_frames_skipped_stale(3);
   FakeServer server(context, reply);
 
   SECTION("all cameras, text") {
@@ -254,6 +282,9 @@ TEST_CASE("stats prints an aligned table with right-aligned numbers, or JSON", "
     CHECK(run.out ==
           "CAMERA  ACQUIRED  PUBLISHED  DROPPED  ERRORS  RECONNECTS   FPS  LAST SEQ\n"
           "cam0        1200       1198        2       0           1  30.0      1199\n"
+          "\n"
+          "CAMERA  INCOMPLETE  MISSING PKTS  RESENT PKTS  UNDERRUNS  SEQ GAPS  SKIPPED OLD\n"
+          "cam0             4            17            9          0         0            3\n"
           "subscribers: 3\n");
     const proto::ControlRequest request = onlyRequest(server);
     REQUIRE(request.request_case() == proto::ControlRequest::kStatistics);
@@ -264,7 +295,10 @@ TEST_CASE("stats prints an aligned table with right-aligned numbers, or JSON", "
     CHECK(run.code == 0);
     CHECK(run.out == R"({"subscribers":3,"cameras":[{"camera":"cam0","frames_acquired":1200,)"
                      R"("frames_published":1198,"frames_dropped":2,"acquisition_errors":0,)"
-                     R"("reconnects":1,"fps":29.97,"last_sequence":1199}]})"
+                     R"("reconnects":1,"fps":29.97,"last_sequence":1199,)"
+                     R"("driver_incomplete_buffers":4,"driver_missing_packets":17,)"
+                     R"("driver_resent_packets":9,"driver_underruns":0,"driver_sequence_gaps":0,)"
+                     R"("frames_skipped_stale":3}]})"
                      "\n");
     const proto::ControlRequest request = onlyRequest(server);
     REQUIRE(request.request_case() == proto::ControlRequest::kStatistics);

@@ -78,7 +78,8 @@ for path in ./usr/bin/picksight-video-server ./usr/bin/picksight-vision ./usr/bi
   ./usr/bin/picksight-calib ./usr/bin/picksight-robot ./usr/bin/picksight-keygen \
   ./usr/lib/systemd/system/picksight-video-server.service \
   "./usr/lib/systemd/system/picksight-vision@.service" ./usr/lib/sysusers.d/picksight.conf \
-  ./usr/lib/tmpfiles.d/picksight.conf ./etc/picksight/video-server.yaml \
+  ./usr/lib/tmpfiles.d/picksight.conf ./usr/lib/udev/rules.d/99-picksight-u3v.rules \
+  ./etc/picksight/video-server.yaml ./usr/share/doc/picksight/CAMERAS.md \
   ./etc/picksight/vision/cam0.yaml ./usr/share/doc/picksight/README.md \
   ./usr/share/doc/picksight/copyright; do
   awk '{print $6}' "$work/contents" | grep -qxF "$path" || fail "package lacks $path"
@@ -190,7 +191,7 @@ if [ "${#left[@]}" -gt 0 ]; then
 fi
 # Where a package's files go (not the whole disk: container images of the
 # package may be stored under /var/lib).
-stray="$(find /etc /usr/bin /usr/lib/systemd /usr/lib/sysusers.d /usr/lib/tmpfiles.d \
+stray="$(find /etc /usr/bin /usr/lib/systemd /usr/lib/sysusers.d /usr/lib/tmpfiles.d /usr/lib/udev \
            /usr/share/doc /var/lib/dpkg/info -name '*picksight*' -print 2>/dev/null
          find /var/lib -maxdepth 1 -name '*picksight*' -print)"
 [ -n "$stray" ] && { printf '%s\n' "$stray" >&2; fail "files named picksight left after purge"; }

@@ -46,7 +46,8 @@ if [ "${PICKSIGHT_NO_NETNS:-0}" != 1 ] && make_namespace; then
   trap 'ip netns delete "$name" 2>/dev/null' EXIT
   trap 'exit 143' TERM
   trap 'exit 130' INT
-  ip netns exec "$name" "$@"
+  # The test may change the namespace's own firewall: it knows it is in one.
+  ip netns exec "$name" env PICKSIGHT_TEST_NETNS="$name" "$@"
   exit $?
 fi
 exec "$@"

@@ -113,9 +113,24 @@ class StallingSource : public picksight::video::Source {
  public:
   struct Counters {
     std::atomic<int> opens{0};
+    std::atomic<int> grabs{0};
+    std::atomic<bool> hardware_configured{false};
   };
   StallingSource(int good, bool bad, std::shared_ptr<Counters> counters)
       : good_(good), bad_(bad), counters_(std::move(counters)) {}
+  // A camera with a trigger input, as Aravis cameras have.
+  bool hardwareTrigger() const override { return true; }
+  picksight::Result<void> configureAcquisition(
+      const picksight::video::AcquisitionRequest& request) override {
+    counters_->hardware_configured =
+        request.mode == AcquisitionMode::kHardwareTrigger && request.input.line == "Line2";
+    return {};
+  }
+  picksight::video::DriverCounters driverCounters() const override {
+    picksight::video::DriverCounters d;
+    d.missing_packets = static_cast<uint64_t>(counters_->grabs.load());
+    return d;
+  }
   picksight::Result<void> open() override {
     ++counters_->opens;
     delivered_ = 0;
@@ -132,6 +147,7 @@ class StallingSource : public picksight::video::Source {
   picksight::Result<picksight::video::SourceFrame> grab(
       std::chrono::milliseconds timeout) override {
     using picksight::video::SourceErrc;
+    ++counters_->grabs;
     if (delivered_ < good_) {
       ++delivered_;
       picksight::video::SourceFrame f;
@@ -465,4 +481,49 @@ TEST_CASE("Camera delivering only bad frames is reported and reopened with back-
   CHECK(camera.status().acquisition_errors >= 3);
   CHECK(camera.status().frames_acquired == 0);
   camera.stop();
+}
+
+TEST_CASE("Camera waiting for a hardware trigger is not silent and never reopened",
+          "[video_server]") {
+  auto counters = std::make_shared<StallingSource::Counters>();
+  CollectingSink sink;
+  CameraConfig c = config(AcquisitionMode::kHardwareTrigger);
+  c.mode_asked = true;
+  c.hardware.input.line = "Line2";
+  c.no_frame_timeout = 100ms;
+  Camera camera(c, std::make_unique<StallingSource>(1, false, counters), sink);
+  camera.start();
+  REQUIRE(sink.waitForCount(1));
+  CHECK(counters->hardware_configured);
+  // A free-run camera would have been reopened several times over by the
+  // time the source was asked this often (10 ms per grab: 6 timeouts' worth).
+  REQUIRE(waitForStatus(camera, [&](const auto&) { return counters->grabs >= 60; }));
+  const auto status = camera.status();
+  CHECK(counters->opens == 1);
+  CHECK(status.state == "streaming");
+  CHECK(status.last_error.empty());
+  CHECK(status.reconnects == 0);
+  CHECK(status.acquisition_errors == 0);
+  CHECK(status.mode == AcquisitionMode::kHardwareTrigger);
+  CHECK(status.hardware.input.line == "Line2");
+  // The driver's counters reach the status.
+  CHECK(status.driver.missing_packets >= 1);
+  // A request in this mode waits for the next frame the line brings.
+  const auto ticket = camera.trigger();
+  REQUIRE(ticket);
+  CHECK_FALSE(ticket->triggered);
+  CHECK(ticket->sequence == 2);
+  camera.stop();
+}
+
+TEST_CASE("Camera without a trigger input refuses the hardware trigger mode", "[video_server]") {
+  CollectingSink sink;
+  auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 20), sink);
+  camera->start();
+  const auto refused = camera->setMode(AcquisitionMode::kHardwareTrigger, 0);
+  REQUIRE_FALSE(refused);
+  CHECK(refused.error().code == picksight::video::SourceErrc::kNotSupported);
+  CHECK(refused.error().message.find("no hardware trigger input") != std::string::npos);
+  CHECK(camera->status().mode == AcquisitionMode::kFreeRun);
+  camera->stop();
 }

@@ -211,3 +211,32 @@ TEST_CASE("settings accepted before the sensor was known drop frames they would 
   s.scale = 2;
   CHECK(picksight::video::applyOutputSettings(frame, s));
 }
+
+TEST_CASE("decodeRequest checks the hardware trigger's line, edge and timeout",
+          "[video_server][control]") {
+  proto::ControlRequest r = setMode(0);
+  auto* m = r.mutable_set_mode();
+  m->set_mode(proto::HARDWARE_TRIGGER);
+  m->set_trigger_line("Line1");
+  for (const char* edge : {"", "RisingEdge", "FallingEdge", "AnyEdge", "LevelHigh", "LevelLow"}) {
+    m->set_trigger_activation(edge);
+    CHECK(roundTrip(r));
+  }
+  m->set_trigger_activation("rising");
+  auto edge = roundTrip(r);
+  REQUIRE_FALSE(edge);
+  CHECK(edge.error().code == VideoErrc::kOutOfRange);
+  CHECK_THAT(edge.error().message,
+             Catch::Contains("set_mode.trigger_activation") && Catch::Contains("'rising'"));
+  m->set_trigger_activation("");
+  m->set_trigger_timeout_ms(3600001);
+  auto timeout = roundTrip(r);
+  REQUIRE_FALSE(timeout);
+  CHECK_THAT(timeout.error().message, Catch::Contains("set_mode.trigger_timeout_ms"));
+  m->set_trigger_timeout_ms(3600000);
+  CHECK(roundTrip(r));
+  m->set_trigger_line(std::string(300, 'L'));
+  auto line = roundTrip(r);
+  REQUIRE_FALSE(line);
+  CHECK_THAT(line.error().message, Catch::Contains("set_mode.trigger_line"));
+}

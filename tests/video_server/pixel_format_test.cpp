@@ -1,6 +1,7 @@
 // Pins format standardization pixel by pixel: mono bit depths, the GenICam to
 // OpenCV Bayer naming (on hand-made mosaics), RGB/BGR order, YUV 4:2:2 and
 // MJPEG decoding, and broken buffers as error values.
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "picksight/video_server/mjpeg_frame.hpp"
 #include "picksight/video_server/pixel_format.hpp"
 
 using picksight::video::OutputFormat;
@@ -175,6 +177,71 @@ TEST_CASE("MJPEG decodes to the encoded image", "[video_server][formats]") {
   CHECK(toOutputFormat(padded_raw, PixelLayout::kMJPEG, OutputFormat::kMono8));
 }
 
+namespace {
+// The JPEG without its DHT segments, as a UVC webcam sends MJPEG.
+std::vector<uint8_t> withoutHuffmanTables(const std::vector<uint8_t>& jpeg) {
+  std::vector<uint8_t> out(jpeg.begin(), jpeg.begin() + 2);
+  size_t pos = 2;
+  while (pos + 4 <= jpeg.size() && jpeg[pos + 1] != 0xDA) {
+    const size_t length = (size_t{jpeg[pos + 2]} << 8) | jpeg[pos + 3];
+    if (jpeg[pos + 1] != 0xC4) {
+      out.insert(out.end(), jpeg.begin() + static_cast<long>(pos),
+                 jpeg.begin() + static_cast<long>(pos + 2 + length));
+    }
+    pos += 2 + length;
+  }
+  out.insert(out.end(), jpeg.begin() + static_cast<long>(pos), jpeg.end());
+  return out;
+}
+
+size_t countMarker(const std::vector<uint8_t>& bytes, uint8_t marker) {
+  size_t n = 0;
+  for (size_t i = 0; i + 1 < bytes.size(); ++i) n += bytes[i] == 0xFF && bytes[i + 1] == marker;
+  return n;
+}
+}  // namespace
+
+TEST_CASE("MJPEG frames without Huffman tables or with bytes after the end decode exactly",
+          "[video_server][formats]") {
+  cv::Mat image(40, 56, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  std::vector<uint8_t> jpeg;
+  // Not optimized: the encoder's tables are the standard ones, as in MJPEG.
+  REQUIRE(cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80}));
+  const cv::Mat whole(1, static_cast<int>(jpeg.size()), CV_8UC1, jpeg.data());
+  const cv::Mat expected_bgr = convertOk(whole, PixelLayout::kMJPEG, OutputFormat::kBgr8);
+  const cv::Mat expected_grey = convertOk(whole, PixelLayout::kMJPEG, OutputFormat::kMono8);
+
+  std::vector<uint8_t> bare = withoutHuffmanTables(jpeg);
+  REQUIRE(countMarker(jpeg, 0xC4) >= 1);
+  REQUIRE(countMarker(bare, 0xC4) == 0);
+  // Padding a phone app's HTTP server leaves: a CRLF, a stray boundary, zeros.
+  const std::string tail = "\r\n--boundary\r\n";
+  std::vector<uint8_t> padded = jpeg;
+  padded.insert(padded.end(), tail.begin(), tail.end());
+  padded.resize(padded.size() + 7, 0);
+  std::vector<uint8_t> both = bare;
+  both.insert(both.end(), tail.begin(), tail.end());
+
+  for (std::vector<uint8_t>* bytes : {&bare, &padded, &both}) {
+    const cv::Mat raw(1, static_cast<int>(bytes->size()), CV_8UC1, bytes->data());
+    const cv::Mat bgr = convertOk(raw, PixelLayout::kMJPEG, OutputFormat::kBgr8);
+    const cv::Mat grey = convertOk(raw, PixelLayout::kMJPEG, OutputFormat::kMono8);
+    REQUIRE(bgr.size() == image.size());
+    CHECK(cv::norm(bgr, expected_bgr, cv::NORM_INF) == 0);
+    CHECK(cv::norm(grey, expected_grey, cv::NORM_INF) == 0);
+  }
+  // The completed frame: the tables in front of the scan, the tail gone.
+  auto completed = picksight::video::completeMjpegFrame(
+      cv::Mat(1, static_cast<int>(both.size()), CV_8UC1, both.data()));
+  REQUIRE(completed);
+  const std::vector<uint8_t> fixed(completed->ptr<uint8_t>(),
+                                   completed->ptr<uint8_t>() + completed->total());
+  CHECK(countMarker(fixed, 0xC4) == 1);
+  CHECK(fixed[fixed.size() - 2] == 0xFF);
+  CHECK(fixed.back() == 0xD9);
+}
+
 TEST_CASE("corrupt and truncated MJPEG frames are errors, not crashes", "[video_server][formats]") {
   cv::Mat image(64, 64, CV_8UC1, cv::Scalar(90));
   std::vector<uint8_t> jpeg;
@@ -209,4 +276,77 @@ TEST_CASE("a buffer that does not match its layout is an error naming it",
   CHECK_THAT(out.error().message, Catch::Contains("Mono12"));
   out = toOutputFormat(cv::Mat(), PixelLayout::kBGR8, OutputFormat::kMono8);
   CHECK_FALSE(out);
+}
+
+TEST_CASE("packed Mono10p, Mono12p, Mono10Packed and Mono12Packed unpack exactly",
+          "[video_server][formats]") {
+  // Values whose 8-bit result is exact (0, a third, two thirds, full scale),
+  // packed by hand as the camera sends them.
+  struct Case {
+    PixelLayout layout;
+    std::vector<uint8_t> row;   // the packed bytes of one row
+    std::vector<int> expected;  // 8-bit grey of each pixel
+  };
+  // Mono10p: 0, 1023, 341, 682 -> 0x000, 0x3FF, 0x155, 0x2AA, bits LSB first:
+  //   b0 = 0x00, b1 = 0xFC (p1 low 6 bits << 2), b2 = 0x5F (p1 high 4 | p2 low 4 << 4),
+  //   b3 = 0x95 (p2 high 6 | p3 low 2 << 6), b4 = 0xAA (p3 high 8).
+  // Mono12p: 4095, 1365 -> b0 = 0xFF, b1 = 0x5F, b2 = 0x55.
+  // Mono10Packed: 1023, 341 -> b0 = 0xFF, b1 = 0x13 (0b11 | 0b01 << 4), b2 = 0x55.
+  // Mono12Packed: 4095, 2730 -> b0 = 0xFF, b1 = 0xAF, b2 = 0xAA.
+  const std::vector<Case> cases = {
+      {PixelLayout::kMono10p, {0x00, 0xFC, 0x5F, 0x95, 0xAA}, {0, 255, 85, 170}},
+      {PixelLayout::kMono12p, {0xFF, 0x5F, 0x55}, {255, 85}},
+      {PixelLayout::kMono10Packed, {0xFF, 0x13, 0x55}, {255, 85}},
+      {PixelLayout::kMono12Packed, {0xFF, 0xAF, 0xAA}, {255, 170}},
+  };
+  for (const Case& c : cases) {
+    INFO(picksight::video::pixelLayoutName(c.layout));
+    // Two rows: the second is the first repeated, so rows are unpacked one by one.
+    cv::Mat raw(2, static_cast<int>(c.row.size()), CV_8UC1);
+    for (int y = 0; y < 2; ++y) std::copy(c.row.begin(), c.row.end(), raw.ptr<uint8_t>(y));
+    auto grey = toOutputFormat(raw, c.layout, OutputFormat::kMono8);
+    REQUIRE(grey);
+    REQUIRE(grey->size() == cv::Size(static_cast<int>(c.expected.size()), 2));
+    for (int y = 0; y < 2; ++y) {
+      for (size_t x = 0; x < c.expected.size(); ++x) {
+        CHECK(grey->at<uint8_t>(y, static_cast<int>(x)) == c.expected[x]);
+      }
+    }
+    auto bgr = toOutputFormat(raw, c.layout, OutputFormat::kBgr8);
+    REQUIRE(bgr);
+    CHECK(bgr->at<cv::Vec3b>(1, 0) == cv::Vec3b::all(static_cast<uint8_t>(c.expected[0])));
+  }
+  // A row that is not whole groups is a mismatch, naming the layout.
+  auto odd = toOutputFormat(cv::Mat(1, 4, CV_8UC1, cv::Scalar(0)), PixelLayout::kMono10p,
+                            OutputFormat::kMono8);
+  REQUIRE_FALSE(odd);
+  CHECK_THAT(odd.error().message, Catch::Contains("Mono10p"));
+}
+
+TEST_CASE("Bayer 10, 12 and 16 bit mosaics demosaic like their 8-bit pattern",
+          "[video_server][formats]") {
+  struct Case {
+    PixelLayout layout;
+    double max;
+  };
+  for (const Case& c : {Case{PixelLayout::kBayerRG10, 1023}, Case{PixelLayout::kBayerRG12, 4095},
+                        Case{PixelLayout::kBayerRG16, 65535}}) {
+    INFO(picksight::video::pixelLayoutName(c.layout));
+    // Red full scale, green a third, blue zero: exactly 255, 85, 0 in 8 bits.
+    const cv::Mat eight = mosaic("RGGB", 8, 3, 1, 0);
+    cv::Mat wide;
+    eight.convertTo(wide, CV_16U, c.max / 3);
+    const cv::Mat bgr = convertOk(wide, c.layout, OutputFormat::kBgr8);
+    // Away from the border, where demosaicing sees whole cells.
+    CHECK(maxDiff(bgr(cv::Rect(2, 2, 4, 4)), cv::Scalar(0, 85, 255)) == 0);
+    // The same as the 8-bit layout of the same pattern.
+    cv::Mat eight_scaled;
+    eight.convertTo(eight_scaled, CV_8U, 85);
+    const cv::Mat reference = convertOk(eight_scaled, PixelLayout::kBayerRG8, OutputFormat::kBgr8);
+    CHECK(cv::norm(bgr, reference, cv::NORM_INF) == 0);
+  }
+  auto narrow = toOutputFormat(cv::Mat(4, 4, CV_8UC1, cv::Scalar(0)), PixelLayout::kBayerGB12,
+                               OutputFormat::kBgr8);
+  REQUIRE_FALSE(narrow);
+  CHECK_THAT(narrow.error().message, Catch::Contains("BayerGB12"));
 }

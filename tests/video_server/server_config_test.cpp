@@ -213,6 +213,39 @@ TEST_CASE("loadServerConfig errors name the key path", "[video_server]") {
              Catch::Contains("'twin'") && Catch::Contains("twice"));
 }
 
+TEST_CASE("loadServerConfig reads a hardware trigger's line, edge and timeout", "[video_server]") {
+  TempDir dir;
+  const std::string path = dir.write("server.yaml",
+                                     "cameras:\n"
+                                     "  - name: gige\n"
+                                     "    source: 'aravis:Basler-123'\n"
+                                     "    mode: hardware\n"
+                                     "    trigger_line: Line2\n"
+                                     "    trigger_activation: FallingEdge\n"
+                                     "    trigger_timeout: 2.5\n"
+                                     "  - {name: plain, source: 'aravis:', mode: hardware}\n");
+  auto config = loadServerConfig(path);
+  REQUIRE(config);
+  const auto& gige = config->cameras[0];
+  CHECK(gige.mode == AcquisitionMode::kHardwareTrigger);
+  CHECK(gige.mode_asked);
+  CHECK(gige.hardware.input.line == "Line2");
+  CHECK(gige.hardware.input.activation == "FallingEdge");
+  CHECK(gige.hardware.timeout == std::chrono::milliseconds(2500));
+  // The defaults: Line1, the camera's own edge, 10 s.
+  const auto& plain = config->cameras[1];
+  CHECK(plain.hardware.input.line == "Line1");
+  CHECK(plain.hardware.input.activation.empty());
+  CHECK(plain.hardware.timeout == std::chrono::milliseconds(10000));
+
+  CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'aravis:', trigger_activation: up}\n"),
+             Catch::Contains("cameras[0].trigger_activation"));
+  CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'aravis:', trigger_timeout: 0}\n"),
+             Catch::Contains("cameras[0].trigger_timeout"));
+  CHECK_THAT(yamlError("cameras:\n  - {name: a, source: 'aravis:', trigger_line: ''}\n"),
+             Catch::Contains("cameras[0].trigger_line"));
+}
+
 TEST_CASE("loadServerConfig rejects unreadable or malformed files naming the file",
           "[video_server]") {
   TempDir dir;

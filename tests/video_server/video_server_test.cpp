@@ -278,6 +278,28 @@ TEST_CASE("VideoServer handle rejects out-of-range size, format and mode", "[vid
   CHECK(server.handle(mode).error().code() == proto::Error::OUT_OF_RANGE);
 
   CHECK(server.handle(proto::ControlRequest{}).error().code() == proto::Error::NOT_SUPPORTED);
+
+  // A synthetic camera has no trigger input: said, and the mode unchanged.
+  mode.mutable_set_mode()->set_fps(0);
+  mode.mutable_set_mode()->set_mode(proto::HARDWARE_TRIGGER);
+  const proto::ControlReply hardware = server.handle(mode);
+  CHECK(hardware.error().code() == proto::Error::NOT_SUPPORTED);
+  CHECK_THAT(hardware.error().text(), Catch::Contains("no hardware trigger input"));
+  proto::ControlRequest describe;
+  describe.mutable_describe_camera()->set_camera("cam1");
+  CHECK(server.handle(describe).describe_camera().summary().mode() != proto::HARDWARE_TRIGGER);
+}
+
+TEST_CASE("VideoServer refuses a configured hardware trigger on a camera without one",
+          "[video_server]") {
+  ServerConfig config = testConfig();
+  config.cameras[1].mode = picksight::video::AcquisitionMode::kHardwareTrigger;
+  try {
+    VideoServer server(config);
+    FAIL("accepted a hardware trigger on a synthetic camera");
+  } catch (const std::runtime_error& e) {
+    CHECK_THAT(e.what(), Catch::Contains("cam10") && Catch::Contains("hardware trigger"));
+  }
 }
 
 TEST_CASE("VideoServer handle statistics counts each camera's frames", "[video_server]") {

@@ -52,7 +52,10 @@ const std::vector<CommandSpec>& commandSpecs() {
       {"mode",
        {"CAM", "MODE"},
        {"FPS"},
-       {{"mode CAM freerun|trigger [FPS]", "acquisition mode, and frame rate"}}},
+       {{"mode CAM freerun|trigger [FPS]", "acquisition mode, and frame rate"},
+        {"mode CAM hardware [--line L] [--activation EDGE] [--trigger-timeout MS]",
+         "\none frame per pulse on the camera's input L (default Line1);\nEDGE rising, falling, "
+         "any, high or low; a snap waits MS for the pulse"}}},
       {"format", {"CAM", "FORMAT"}, {}, {{"format CAM mono8|bgr8", "output pixel format"}}},
       {"trigger", {"CAM"}, {}, {{"trigger CAM", "acquire one frame; prints its sequence number"}}},
       {"stats", {}, {"CAM"}, {{"stats [CAM]", "frames, drops, errors, reconnects, fps"}}},
@@ -132,6 +135,13 @@ bool looksLikeOption(const std::string& word) {
          (word[1] == '-' || std::isalpha(static_cast<unsigned char>(word[1])));
 }
 
+// The option of mode's argument LINE, ACTIVATION or TRIGGER_TIMEOUT.
+std::string triggerOptionName(const std::string& arg) {
+  if (arg == "LINE") return "line";
+  if (arg == "ACTIVATION") return "activation";
+  return "trigger-timeout";
+}
+
 // "CMD: missing arguments; usage: ..." for the command CLI11 was parsing.
 Error missingArguments(const std::string& command) {
   return usageError(command + ": missing arguments; usage: " + kProgram + " " +
@@ -204,6 +214,8 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
   std::map<std::string, CLI::Option*> positionals;
   std::string scale;
   bool hide = false;
+  // mode ... hardware: stored under these argument names when given.
+  std::map<std::string, std::string> trigger_options;
   for (const CommandSpec& spec : commandSpecs()) {
     CLI::App* sub = app.add_subcommand(spec.name, spec.usage.front().help);
     sub->set_help_flag();  // --help after a command is the tool's help
@@ -218,6 +230,11 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
     }
     if (std::string(spec.name) == "size") sub->add_option("--scale", scale)->type_name("S");
     if (std::string(spec.name) == "target") sub->add_flag("--hide", hide);
+    if (std::string(spec.name) == "mode") {
+      sub->add_option("--line", trigger_options["LINE"])->type_name("L");
+      sub->add_option("--activation", trigger_options["ACTIVATION"])->type_name("EDGE");
+      sub->add_option("--trigger-timeout", trigger_options["TRIGGER_TIMEOUT"])->type_name("MS");
+    }
   }
 
   try {
@@ -266,6 +283,15 @@ Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
       options.command.args["S"] = scale;
     } else if (!options.command.has("H")) {
       return missingArguments(name);
+    }
+  }
+  if (name == "mode") {
+    for (const auto& [arg, value] : trigger_options) {
+      if (selected.front()->get_option("--" + triggerOptionName(arg))->count() == 0) continue;
+      if (options.command.arg("MODE") != "hardware") {
+        return usageError("mode: --" + triggerOptionName(arg) + " goes with the hardware mode");
+      }
+      options.command.args[arg] = value;
     }
   }
   if (name == "target") {

@@ -44,6 +44,8 @@ const char* modeName(proto::AcquisitionMode mode) {
       return "freerun";
     case proto::TRIGGER:
       return "trigger";
+    case proto::HARDWARE_TRIGGER:
+      return "hardware";
     default:
       return "unspecified";
   }
@@ -315,6 +317,11 @@ void printInfo(const proto::DescribeCameraReply& d, bool as_json, std::ostream& 
                  {"fps", d.fps()},
                  {"source_formats",
                   std::vector<std::string>(d.source_formats().begin(), d.source_formats().end())}};
+    if (s.mode() == proto::HARDWARE_TRIGGER) {
+      json["trigger_line"] = d.trigger_line();
+      json["trigger_activation"] = d.trigger_activation();
+      json["trigger_timeout_ms"] = d.trigger_timeout_ms();
+    }
     if (d.has_simulated_robot()) json["simulated_robot"] = robotJson(d.simulated_robot());
     out << toJson(json) << '\n';
     return;
@@ -335,6 +342,13 @@ void printInfo(const proto::DescribeCameraReply& d, bool as_json, std::ostream& 
       {"pixel format", formatName(d.pixel_format())},
       {"fps", formatFixed(d.fps(), 1)},
       {"source formats", formats}};
+  if (s.mode() == proto::HARDWARE_TRIGGER) {
+    lines.emplace_back("trigger",
+                       d.trigger_line() + " " +
+                           (d.trigger_activation().empty() ? std::string("(camera's edge)")
+                                                           : d.trigger_activation()) +
+                           ", snap waits " + std::to_string(d.trigger_timeout_ms()) + " ms");
+  }
   if (d.has_simulated_robot()) {
     lines.emplace_back("simulated robot", transformText(d.simulated_robot()));
     lines.emplace_back("target", targetText(d.simulated_robot()));
@@ -370,7 +384,13 @@ void printStats(const proto::StatisticsReply& reply, bool as_json, std::ostream&
                          {"acquisition_errors", c.acquisition_errors()},
                          {"reconnects", c.reconnects()},
                          {"fps", c.fps()},
-                         {"last_sequence", c.last_sequence()}});
+                         {"last_sequence", c.last_sequence()},
+                         {"driver_incomplete_buffers", c.driver_incomplete_buffers()},
+                         {"driver_missing_packets", c.driver_missing_packets()},
+                         {"driver_resent_packets", c.driver_resent_packets()},
+                         {"driver_underruns", c.driver_underruns()},
+                         {"driver_sequence_gaps", c.driver_sequence_gaps()},
+                         {"frames_skipped_stale", c.frames_skipped_stale()}});
     }
     out << toJson({{"subscribers", reply.subscribers()}, {"cameras", std::move(cameras)}}) << '\n';
     return;
@@ -392,6 +412,25 @@ void printStats(const proto::StatisticsReply& reply, bool as_json, std::ostream&
               {"FPS", true},
               {"LAST SEQ", true}},
              rows);
+  // The driver's own counters: where frames were lost below the server.
+  std::vector<std::vector<std::string>> driver_rows;
+  for (const auto& c : reply.cameras()) {
+    driver_rows.push_back(
+        {c.camera(), std::to_string(c.driver_incomplete_buffers()),
+         std::to_string(c.driver_missing_packets()), std::to_string(c.driver_resent_packets()),
+         std::to_string(c.driver_underruns()), std::to_string(c.driver_sequence_gaps()),
+         std::to_string(c.frames_skipped_stale())});
+  }
+  out << '\n';
+  printTable(out,
+             {{"CAMERA", false},
+              {"INCOMPLETE", true},
+              {"MISSING PKTS", true},
+              {"RESENT PKTS", true},
+              {"UNDERRUNS", true},
+              {"SEQ GAPS", true},
+              {"SKIPPED OLD", true}},
+             driver_rows);
   out << "subscribers: " << reply.subscribers() << '\n';
 }
 
@@ -430,6 +469,16 @@ void printSetConfirmation(const proto::ControlRequest& request, bool as_json, st
       json["camera"] = r.camera();
       json["mode"] = modeName(r.mode());
       text << r.camera() << ": mode set to " << modeName(r.mode());
+      if (r.mode() == proto::HARDWARE_TRIGGER) {
+        // The server's defaults for what was not given.
+        const std::string line = r.trigger_line().empty() ? "Line1" : r.trigger_line();
+        json["trigger_line"] = line;
+        text << " on " << line;
+        if (!r.trigger_activation().empty()) {
+          json["trigger_activation"] = r.trigger_activation();
+          text << " (" << r.trigger_activation() << ")";
+        }
+      }
       if (r.fps() > 0) {
         json["fps"] = r.fps();
         text << " at " << formatShortest(r.fps()) << " fps";

@@ -100,6 +100,20 @@ Result<proto::ControlRequest> buildSize(const CamCommand& c, const ArgReader& a,
   return request;
 }
 
+// The GenICam TriggerActivation for a short word (rising...) or the name itself.
+Result<std::string> triggerActivation(const std::string& word) {
+  static const std::pair<const char*, const char*> kEdges[] = {{"rising", "RisingEdge"},
+                                                               {"falling", "FallingEdge"},
+                                                               {"any", "AnyEdge"},
+                                                               {"high", "LevelHigh"},
+                                                               {"low", "LevelLow"}};
+  for (const auto& [short_name, genicam] : kEdges) {
+    if (word == short_name || word == genicam) return std::string(genicam);
+  }
+  return usageError("mode: --activation must be rising, falling, any, high or low, got '" + word +
+                    "'");
+}
+
 Result<proto::ControlRequest> buildMode(const CamCommand& c, const ArgReader& a,
                                         const std::string& camera) {
   proto::ControlRequest request;
@@ -110,8 +124,26 @@ Result<proto::ControlRequest> buildMode(const CamCommand& c, const ArgReader& a,
     mode->set_mode(proto::FREERUN);
   } else if (word == "trigger") {
     mode->set_mode(proto::TRIGGER);
+  } else if (word == "hardware") {
+    mode->set_mode(proto::HARDWARE_TRIGGER);
+    if (c.has("LINE")) {
+      auto line = a.word("LINE");
+      if (!line) return line.error();
+      mode->set_trigger_line(*line);
+    }
+    if (c.has("ACTIVATION")) {
+      auto edge = triggerActivation(c.arg("ACTIVATION"));
+      if (!edge) return edge.error();
+      mode->set_trigger_activation(*edge);
+    }
+    if (c.has("TRIGGER_TIMEOUT")) {
+      auto ms = a.uint32("TRIGGER_TIMEOUT");
+      if (!ms) return ms.error();
+      if (*ms == 0) return usageError("mode: --trigger-timeout must be positive");
+      mode->set_trigger_timeout_ms(*ms);
+    }
   } else {
-    return usageError("mode: mode must be 'freerun' or 'trigger', got '" + word + "'");
+    return usageError("mode: mode must be 'freerun', 'trigger' or 'hardware', got '" + word + "'");
   }
   if (c.has("FPS")) {
     auto fps = a.positive("FPS");

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <future>
+#include <set>
 
 #include "picksight/common/clock.hpp"
 #include "picksight/common/log.hpp"
@@ -29,12 +30,19 @@ constexpr std::chrono::milliseconds kTriggerPatience{2000};
 constexpr std::chrono::seconds kBadFrameLogInterval{10};
 }  // namespace
 
+bool isTriggerActivation(const std::string& name) {
+  static const std::set<std::string> kNames = {"RisingEdge", "FallingEdge", "AnyEdge", "LevelHigh",
+                                               "LevelLow"};
+  return kNames.count(name) > 0;
+}
+
 Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& sink)
     : config_(std::move(config)),
       source_(std::move(source)),
       sink_(sink),
       output_(config_.output),
       mode_(config_.mode),
+      hardware_(config_.hardware),
       fps_(config_.fps),
       mode_asked_(config_.mode_asked),
       fps_asked_(config_.fps_asked) {
@@ -74,6 +82,7 @@ CameraStatus Camera::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   CameraStatus s = status_;
   s.mode = mode_;
+  s.hardware = hardware_;
   s.fps_setting = fps_;
   s.output = output_;
   s.open_requested = open_requested_;
@@ -97,19 +106,31 @@ OutputSettings Camera::output() const {
   return output_;
 }
 
-Result<void> Camera::setMode(AcquisitionMode mode, double fps) {
+Result<void> Camera::setMode(AcquisitionMode mode, double fps,
+                             const std::optional<HardwareTrigger>& hardware) {
   // Written so that NaN fails too.
   if (!(fps >= 0 && fps <= kMaxFps))
     return makeError(VideoErrc::kOutOfRange, "fps must be in (0, 1000]");
+  // A constant of the driver: asking it here does not race the acquisition thread.
+  if (mode == AcquisitionMode::kHardwareTrigger && !source_->hardwareTrigger()) {
+    return makeError(SourceErrc::kNotSupported, "camera '" + config_.name + "' (" + config_.uri +
+                                                    ") has no hardware trigger input");
+  }
+  if (hardware && (hardware->input.line.empty() || hardware->timeout.count() <= 0 ||
+                   hardware->timeout > kMaxTriggerTimeout)) {
+    return makeError(VideoErrc::kOutOfRange,
+                     "hardware trigger: a line and a timeout in (0, 3600000] ms are needed");
+  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (hardware) hardware_ = *hardware;
     mode_ = mode;
     mode_asked_ = true;
     if (fps > 0) {
       fps_ = fps;
       fps_asked_ = true;
     }
-    if (mode == AcquisitionMode::kFreeRun) pending_triggers_ = 0;
+    if (mode != AcquisitionMode::kTrigger) pending_triggers_ = 0;
     reconfigure_ = true;
   }
   wake_.notify_all();
@@ -143,6 +164,10 @@ Result<TriggerTicket> Camera::trigger() {
       ticket.sequence = next_sequence_ + pending_triggers_;
       ticket.triggered = true;
       ++pending_triggers_;
+    } else if (mode_ == AcquisitionMode::kHardwareTrigger && grab_sequence_) {
+      // The grab under way waits for the next pulse: the first frame
+      // delivered after this request carries its number.
+      ticket.sequence = *grab_sequence_;
     } else {
       // Sequence numbers are taken when a grab starts, so next_sequence_ is
       // a frame whose acquisition begins after this request.
@@ -316,9 +341,12 @@ void Camera::run() {
     const uint64_t sequence = next_sequence_++;
     const OutputSettings output = output_;
     if (!waiting_since_) waiting_since_ = Clock::now();
+    grab_sequence_ = sequence;
     lock.unlock();
     Grab grab = grabAndConvert(*triggered, streams, output);
     lock.lock();
+    grab_sequence_.reset();
+    status_.driver = grab.counters;
     if (!grab.out) {
       handleGrabFailure(lock, sequence, *triggered, grab.out.error());
       continue;
@@ -336,7 +364,7 @@ void Camera::waitWhileClosed(std::unique_lock<std::mutex>& lock) {
 void Camera::applyAcquisitionSettings(std::unique_lock<std::mutex>& lock) {
   reconfigure_ = false;
   waiting_since_.reset();  // the wait for a frame starts again
-  const AcquisitionRequest request{mode_, fps_, mode_asked_, fps_asked_};
+  const AcquisitionRequest request{mode_, fps_, mode_asked_, fps_asked_, hardware_.input};
   lock.unlock();
   const Result<void> configured = source_->configureAcquisition(request);
   lock.lock();
@@ -390,6 +418,7 @@ Camera::Grab Camera::grabAndConvert(bool triggered, bool streams, const OutputSe
   grab.grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
                        : Result<SourceFrame>(asked.error());
   grab.host_ns = realtimeNs();
+  grab.counters = source_->driverCounters();
   // Standardize, then ROI and resize, in the pipeline's one step.
   grab.out = grab.grabbed ? applyOutputSettings(*grab.grabbed, output)
                           : Result<OutputFrame>(grab.grabbed.error());
@@ -409,6 +438,12 @@ void Camera::handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequ
     return;
   }
   if (error.code == SourceErrc::kTimeout) {
+    if (mode_ == AcquisitionMode::kHardwareTrigger) {
+      // Waiting for a pulse on the line: nothing is owed, so no silence.
+      // The source still checks that the device answers.
+      waiting_since_.reset();
+      return;
+    }
     // A streaming camera with nothing to deliver yet: an error only once
     // it lasts (below), or when a trigger waits for it.
     if (triggered) ++status_.acquisition_errors;

@@ -40,11 +40,25 @@ Result<void> checkNumbers(const proto::ControlRequest& request) {
   using R = proto::ControlRequest;
   switch (request.request_case()) {
     case R::kSetMode: {
-      const double fps = request.set_mode().fps();
+      const auto& m = request.set_mode();
+      const double fps = m.fps();
       // 0 leaves the rate as it is.
       if (!(fps >= 0 && fps <= kMaxFps)) {
         return makeError(VideoErrc::kOutOfRange, "set_mode.fps must be 0 (unchanged) or in (0, " +
                                                      shown(kMaxFps) + "], got " + shown(fps));
+      }
+      if (auto ok = checkName(m.trigger_line(), "set_mode.trigger_line"); !ok) return ok;
+      if (!m.trigger_activation().empty() && !isTriggerActivation(m.trigger_activation())) {
+        return makeError(VideoErrc::kOutOfRange,
+                         std::string("set_mode.trigger_activation must be one of ") +
+                             kTriggerActivations + ", got '" +
+                             m.trigger_activation().substr(0, kMaxControlName) + "'");
+      }
+      if (m.trigger_timeout_ms() > kMaxTriggerTimeout.count()) {
+        return makeError(VideoErrc::kOutOfRange, "set_mode.trigger_timeout_ms must be at most " +
+                                                     std::to_string(kMaxTriggerTimeout.count()) +
+                                                     ", got " +
+                                                     std::to_string(m.trigger_timeout_ms()));
       }
       return {};
     }

@@ -1,10 +1,13 @@
 // Pixel format standardization: every source layout to mono8 or bgr8.
 #include "picksight/video_server/pixel_format.hpp"
 
+#include "picksight/video_server/mjpeg_frame.hpp"
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace picksight::video {
@@ -25,8 +28,49 @@ struct BayerCodes {
   int to_bgr;
   int to_gray;
 };
-BayerCodes bayerCodes(PixelLayout layout) {
+// A Bayer layout's 2x2 pattern (as its 8-bit layout) and the full scale of
+// its values; nullopt for layouts that are not Bayer.
+struct BayerInfo {
+  PixelLayout pattern;
+  double max;
+};
+std::optional<BayerInfo> bayerInfo(PixelLayout layout) {
   switch (layout) {
+    case PixelLayout::kBayerRG8:
+    case PixelLayout::kBayerGR8:
+    case PixelLayout::kBayerBG8:
+    case PixelLayout::kBayerGB8:
+      return BayerInfo{layout, 255.0};
+    case PixelLayout::kBayerRG10:
+      return BayerInfo{PixelLayout::kBayerRG8, 1023.0};
+    case PixelLayout::kBayerGR10:
+      return BayerInfo{PixelLayout::kBayerGR8, 1023.0};
+    case PixelLayout::kBayerBG10:
+      return BayerInfo{PixelLayout::kBayerBG8, 1023.0};
+    case PixelLayout::kBayerGB10:
+      return BayerInfo{PixelLayout::kBayerGB8, 1023.0};
+    case PixelLayout::kBayerRG12:
+      return BayerInfo{PixelLayout::kBayerRG8, 4095.0};
+    case PixelLayout::kBayerGR12:
+      return BayerInfo{PixelLayout::kBayerGR8, 4095.0};
+    case PixelLayout::kBayerBG12:
+      return BayerInfo{PixelLayout::kBayerBG8, 4095.0};
+    case PixelLayout::kBayerGB12:
+      return BayerInfo{PixelLayout::kBayerGB8, 4095.0};
+    case PixelLayout::kBayerRG16:
+      return BayerInfo{PixelLayout::kBayerRG8, 65535.0};
+    case PixelLayout::kBayerGR16:
+      return BayerInfo{PixelLayout::kBayerGR8, 65535.0};
+    case PixelLayout::kBayerBG16:
+      return BayerInfo{PixelLayout::kBayerBG8, 65535.0};
+    case PixelLayout::kBayerGB16:
+      return BayerInfo{PixelLayout::kBayerGB8, 65535.0};
+    default:
+      return std::nullopt;
+  }
+}
+BayerCodes bayerCodes(PixelLayout pattern) {
+  switch (pattern) {
     case PixelLayout::kBayerRG8:
       return {cv::COLOR_BayerBG2BGR, cv::COLOR_BayerBG2GRAY};
     case PixelLayout::kBayerGR8:
@@ -36,6 +80,57 @@ BayerCodes bayerCodes(PixelLayout layout) {
     default:
       return {cv::COLOR_BayerGR2BGR, cv::COLOR_BayerGR2GRAY};  // kBayerGB8
   }
+}
+
+// Packed mono rows to 16-bit words: each row holds whole groups of
+// `pixels` pixels in `bytes` bytes.
+struct Packing {
+  int bytes;
+  int pixels;
+};
+Packing packingOf(PixelLayout layout) {
+  return layout == PixelLayout::kMono10p ? Packing{5, 4} : Packing{3, 2};
+}
+void unpackGroup(PixelLayout layout, const uint8_t* b, uint16_t* p) {
+  const auto u = [](unsigned v) { return static_cast<uint16_t>(v); };
+  switch (layout) {
+    case PixelLayout::kMono10p:  // 4 pixels, 40 bits, least significant first
+      p[0] = u(b[0] | (b[1] & 0x03u) << 8);
+      p[1] = u(b[1] >> 2 | (b[2] & 0x0Fu) << 6);
+      p[2] = u(b[2] >> 4 | (b[3] & 0x3Fu) << 4);
+      p[3] = u(b[3] >> 6 | b[4] << 2);
+      break;
+    case PixelLayout::kMono12p:  // 2 pixels, 24 bits, least significant first
+      p[0] = u(b[0] | (b[1] & 0x0Fu) << 8);
+      p[1] = u(b[1] >> 4 | b[2] << 4);
+      break;
+    case PixelLayout::kMono10Packed:  // high 8 bits outside, low 2 bits at 0-1 and 4-5
+      p[0] = u(b[0] << 2 | (b[1] & 0x03u));
+      p[1] = u(b[2] << 2 | (b[1] >> 4 & 0x03u));
+      break;
+    default:  // kMono12Packed: high 8 bits outside, low 4 bits in the nibbles
+      p[0] = u(b[0] << 4 | (b[1] & 0x0Fu));
+      p[1] = u(b[2] << 4 | b[1] >> 4);
+      break;
+  }
+}
+Result<cv::Mat> unpackMono(const cv::Mat& raw, PixelLayout layout) {
+  const Packing packing = packingOf(layout);
+  if (raw.type() != CV_8UC1 || raw.cols % packing.bytes != 0) {
+    return mismatch(
+        layout, raw,
+        packing.bytes == 5 ? "CV_8UC1 rows of 5-byte groups" : "CV_8UC1 rows of 3-byte groups");
+  }
+  const int groups = raw.cols / packing.bytes;
+  cv::Mat out(raw.rows, groups * packing.pixels, CV_16UC1);
+  for (int y = 0; y < raw.rows; ++y) {
+    const uint8_t* in = raw.ptr<uint8_t>(y);
+    uint16_t* o = out.ptr<uint16_t>(y);
+    for (int g = 0; g < groups; ++g) {
+      unpackGroup(layout, in + g * packing.bytes, o + g * packing.pixels);
+    }
+  }
+  return out;
 }
 
 // Full-scale value of the unpacked 16-bit mono layouts.
@@ -50,28 +145,15 @@ double monoMax(PixelLayout layout) {
   }
 }
 
-// A truncated JPEG decodes "successfully" in libjpeg (the missing rows come
-// out grey, with only a warning on stderr), so a frame cut short by a USB or
-// network hiccup is caught here by its missing end-of-image marker. Some
-// webcams pad the payload with zeros after the marker.
-bool jpegLooksComplete(const cv::Mat& raw) {
-  const auto* bytes = raw.ptr<uint8_t>();
-  size_t n = raw.total();
-  if (n < 4 || bytes[0] != 0xFF || bytes[1] != 0xD8) return false;
-  while (n > 2 && bytes[n - 1] == 0x00) --n;
-  return bytes[n - 2] == 0xFF && bytes[n - 1] == 0xD9;
-}
-
 Result<cv::Mat> decodeJpeg(const cv::Mat& raw, bool mono) {
   if (raw.type() != CV_8UC1 || !raw.isContinuous() || raw.empty()) {
     return mismatch(PixelLayout::kMJPEG, raw, "one continuous row of bytes");
   }
-  if (!jpegLooksComplete(raw)) {
-    return makeError(SourceErrc::kBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
-                                                " bytes): no JPEG start or end marker");
-  }
+  // Tables put in where the camera left them out, padding cut off.
+  const Result<cv::Mat> jpeg = completeMjpegFrame(raw);
+  if (!jpeg) return jpeg.error();
   // Decoding to grey skips the colour planes entirely (libjpeg reads Y only).
-  cv::Mat out = cv::imdecode(raw, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+  cv::Mat out = cv::imdecode(*jpeg, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
   if (out.empty()) {
     return makeError(SourceErrc::kBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
                                                 " bytes): not decodable");
@@ -87,6 +169,15 @@ Result<cv::Mat> convert(const cv::Mat& raw, PixelLayout layout, bool mono) {
       if (mono) return raw;
       cv::cvtColor(raw, out, cv::COLOR_GRAY2BGR);
       return out;
+    case PixelLayout::kMono10p:
+    case PixelLayout::kMono12p:
+    case PixelLayout::kMono10Packed:
+    case PixelLayout::kMono12Packed: {
+      const Result<cv::Mat> words = unpackMono(raw, layout);
+      if (!words) return words;
+      const bool ten = layout == PixelLayout::kMono10p || layout == PixelLayout::kMono10Packed;
+      return convert(*words, ten ? PixelLayout::kMono10 : PixelLayout::kMono12, mono);
+    }
     case PixelLayout::kMono10:
     case PixelLayout::kMono12:
     case PixelLayout::kMono16: {
@@ -101,12 +192,30 @@ Result<cv::Mat> convert(const cv::Mat& raw, PixelLayout layout, bool mono) {
     case PixelLayout::kBayerRG8:
     case PixelLayout::kBayerGR8:
     case PixelLayout::kBayerBG8:
-    case PixelLayout::kBayerGB8: {
-      if (raw.type() != CV_8UC1 || raw.cols < 2 || raw.rows < 2) {
-        return mismatch(layout, raw, "CV_8UC1, at least 2x2");
+    case PixelLayout::kBayerGB8:
+    case PixelLayout::kBayerRG10:
+    case PixelLayout::kBayerGR10:
+    case PixelLayout::kBayerBG10:
+    case PixelLayout::kBayerGB10:
+    case PixelLayout::kBayerRG12:
+    case PixelLayout::kBayerGR12:
+    case PixelLayout::kBayerBG12:
+    case PixelLayout::kBayerGB12:
+    case PixelLayout::kBayerRG16:
+    case PixelLayout::kBayerGR16:
+    case PixelLayout::kBayerBG16:
+    case PixelLayout::kBayerGB16: {
+      const BayerInfo info = *bayerInfo(layout);
+      const bool wide = info.max > 255;
+      if (raw.type() != (wide ? CV_16UC1 : CV_8UC1) || raw.cols < 2 || raw.rows < 2) {
+        return mismatch(layout, raw, wide ? "CV_16UC1, at least 2x2" : "CV_8UC1, at least 2x2");
       }
-      const BayerCodes codes = bayerCodes(layout);
-      cv::cvtColor(raw, out, mono ? codes.to_gray : codes.to_bgr);
+      // Scaled to 8 bits first: demosaicing is linear, and an 8-bit mosaic
+      // is a third of the work of a 16-bit one.
+      cv::Mat mosaic = raw;
+      if (wide) raw.convertTo(mosaic, CV_8U, 255.0 / info.max);
+      const BayerCodes codes = bayerCodes(info.pattern);
+      cv::cvtColor(mosaic, out, mono ? codes.to_gray : codes.to_bgr);
       return out;
     }
     case PixelLayout::kRGB8:
@@ -167,6 +276,38 @@ const char* pixelLayoutName(PixelLayout layout) {
       return "UYVY";
     case PixelLayout::kMJPEG:
       return "MJPEG";
+    case PixelLayout::kMono10p:
+      return "Mono10p";
+    case PixelLayout::kMono12p:
+      return "Mono12p";
+    case PixelLayout::kMono10Packed:
+      return "Mono10Packed";
+    case PixelLayout::kMono12Packed:
+      return "Mono12Packed";
+    case PixelLayout::kBayerRG10:
+      return "BayerRG10";
+    case PixelLayout::kBayerGR10:
+      return "BayerGR10";
+    case PixelLayout::kBayerBG10:
+      return "BayerBG10";
+    case PixelLayout::kBayerGB10:
+      return "BayerGB10";
+    case PixelLayout::kBayerRG12:
+      return "BayerRG12";
+    case PixelLayout::kBayerGR12:
+      return "BayerGR12";
+    case PixelLayout::kBayerBG12:
+      return "BayerBG12";
+    case PixelLayout::kBayerGB12:
+      return "BayerGB12";
+    case PixelLayout::kBayerRG16:
+      return "BayerRG16";
+    case PixelLayout::kBayerGR16:
+      return "BayerGR16";
+    case PixelLayout::kBayerBG16:
+      return "BayerBG16";
+    case PixelLayout::kBayerGB16:
+      return "BayerGB16";
   }
   return "unknown";
 }

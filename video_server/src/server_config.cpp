@@ -18,7 +18,9 @@ namespace {
 Result<AcquisitionMode> parseMode(const std::string& text) {
   if (text == "freerun") return AcquisitionMode::kFreeRun;
   if (text == "trigger") return AcquisitionMode::kTrigger;
-  return makeError(VideoErrc::kBadConfig, "must be freerun or trigger, got '" + text + "'");
+  if (text == "hardware") return AcquisitionMode::kHardwareTrigger;
+  return makeError(VideoErrc::kBadConfig,
+                   "must be freerun, trigger or hardware, got '" + text + "'");
 }
 
 Result<OutputFormat> parseFormat(const std::string& text) {
@@ -52,12 +54,45 @@ Result<std::vector<int>> intList(const YAML::Node& node, size_t n) {
   return out;
 }
 
+// trigger_line, trigger_activation (GenICam names) and trigger_timeout
+// (seconds) of one camera.
+Result<void> hardwareTriggerFromYaml(const YAML::Node& node, const std::string& where,
+                                     HardwareTrigger& out) {
+  if (const YAML::Node line = node["trigger_line"]) {
+    if (!line.IsScalar() || line.Scalar().empty() || line.Scalar().size() > 64) {
+      return makeError(VideoErrc::kBadConfig,
+                       where + ".trigger_line: must be the camera's input, e.g. Line1");
+    }
+    out.input.line = line.Scalar();
+  }
+  if (const YAML::Node edge = node["trigger_activation"]) {
+    if (!edge.IsScalar() || !isTriggerActivation(edge.Scalar())) {
+      return makeError(VideoErrc::kBadConfig,
+                       where + ".trigger_activation: must be one of " + kTriggerActivations);
+    }
+    out.input.activation = edge.Scalar();
+  }
+  if (const YAML::Node timeout = node["trigger_timeout"]) {
+    auto t = parseDouble(timeout.Scalar());
+    if (!timeout.IsScalar() || !t || !(*t >= 0.01 && *t <= 3600)) {
+      return makeError(VideoErrc::kBadConfig,
+                       where + ".trigger_timeout: must be seconds in [0.01, 3600]");
+    }
+    out.timeout = std::chrono::milliseconds(std::llround(*t * 1000));
+  }
+  return {};
+}
+
 Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& where) {
   if (!node.IsMap()) return makeError(VideoErrc::kBadConfig, where + ": must be a map");
   CameraConfig c;
-  static const std::set<std::string> kKeys = {
-      "name", "source", "mode",  "fps",      "format",
-      "roi",  "size",   "scale", "features", "no_frame_timeout"};
+  static const std::set<std::string> kKeys = {"name",           "source",
+                                              "mode",           "fps",
+                                              "format",         "roi",
+                                              "size",           "scale",
+                                              "features",       "no_frame_timeout",
+                                              "trigger_line",   "trigger_activation",
+                                              "trigger_timeout"};
   for (const auto& kv : node) {
     // as<std::string>() throws on a key that is a list or a map.
     if (!kv.first.IsScalar())
@@ -94,6 +129,7 @@ Result<CameraConfig> cameraFromYaml(const YAML::Node& node, const std::string& w
     }
     c.no_frame_timeout = std::chrono::milliseconds(std::llround(*t * 1000));
   }
+  if (auto ok = hardwareTriggerFromYaml(node, where, c.hardware); !ok) return ok.error();
   if (node["format"]) {
     auto f = parseFormat(node["format"].Scalar());
     if (!f) return makeError(VideoErrc::kBadConfig, where + ".format: " + f.error().message);
@@ -241,7 +277,7 @@ void defineServerOptions(CLI::App& app, ServerArgs& a) {
   app.add_option("--control", a.control, "control REP endpoint (default tcp://*:5556)")
       ->type_name("ENDPOINT");
   app.add_option("--mode", a.mode, "acquisition mode of the --source cameras (default freerun)")
-      ->type_name("freerun|trigger")
+      ->type_name("freerun|trigger|hardware")
       ->check(checkValue([](const std::string& v) {
         auto m = parseMode(v);
         return m ? std::string() : m.error().message;

@@ -13,8 +13,19 @@
 namespace picksight::video {
 namespace {
 proto::AcquisitionMode toProto(AcquisitionMode m) {
-  return m == AcquisitionMode::kTrigger ? proto::TRIGGER : proto::FREERUN;
+  switch (m) {
+    case AcquisitionMode::kTrigger:
+      return proto::TRIGGER;
+    case AcquisitionMode::kHardwareTrigger:
+      return proto::HARDWARE_TRIGGER;
+    default:
+      return proto::FREERUN;
+  }
 }
+
+// The snap of a camera waiting for a pulse waits as long as its trigger
+// timeout says; the others, for a frame they were sent or stream anyway.
+std::chrono::milliseconds snapTimeout(const CameraStatus& s);
 
 constexpr std::chrono::milliseconds kSnapTimeout{3000};
 
@@ -80,6 +91,9 @@ proto::ControlReply describeCamera(Camera& camera) {
   d->set_pixel_format(s.output.format == OutputFormat::kBgr8 ? proto::BGR8 : proto::MONO8);
   d->set_fps(s.fps_setting);
   for (const auto& f : s.info.formats) d->add_source_formats(f);
+  d->set_trigger_line(s.hardware.input.line);
+  d->set_trigger_activation(s.hardware.input.activation);
+  d->set_trigger_timeout_ms(static_cast<uint32_t>(s.hardware.timeout.count()));
   // Only synthetic sources have one; the others answer kNotSupported.
   if (auto robot = camera.simulatedRobot())
     fillSimulatedRobot(*robot, d->mutable_simulated_robot());
@@ -124,12 +138,31 @@ proto::ControlReply setFormat(Camera& camera, const proto::SetFormatRequest& req
 }
 
 proto::ControlReply setMode(Camera& camera, const proto::SetModeRequest& request) {
-  if (request.mode() != proto::FREERUN && request.mode() != proto::TRIGGER) {
-    return errorReply(makeError(VideoErrc::kOutOfRange, "mode must be freerun or trigger"));
+  std::optional<HardwareTrigger> hardware;
+  AcquisitionMode mode = AcquisitionMode::kFreeRun;
+  switch (request.mode()) {
+    case proto::FREERUN:
+      break;
+    case proto::TRIGGER:
+      mode = AcquisitionMode::kTrigger;
+      break;
+    case proto::HARDWARE_TRIGGER: {
+      mode = AcquisitionMode::kHardwareTrigger;
+      // Unset fields keep the defaults (Line1, the camera's edge, 10 s).
+      HardwareTrigger h;
+      if (!request.trigger_line().empty()) h.input.line = request.trigger_line();
+      h.input.activation = request.trigger_activation();
+      if (request.trigger_timeout_ms() > 0) {
+        h.timeout = std::chrono::milliseconds(request.trigger_timeout_ms());
+      }
+      hardware = h;
+      break;
+    }
+    default:
+      return errorReply(
+          makeError(VideoErrc::kOutOfRange, "mode must be freerun, trigger or hardware_trigger"));
   }
-  const AcquisitionMode mode =
-      request.mode() == proto::TRIGGER ? AcquisitionMode::kTrigger : AcquisitionMode::kFreeRun;
-  if (auto ok = camera.setMode(mode, request.fps()); !ok) {
+  if (auto ok = camera.setMode(mode, request.fps(), hardware); !ok) {
     return errorReply(ok.error());
   }
   return okReply();
@@ -173,11 +206,18 @@ proto::ControlReply snap(Camera& camera) {
   }
   const auto t = camera.trigger();
   if (!t) return errorReply(t.error());
-  auto frame = camera.waitForFrame(t->sequence, kSnapTimeout);
+  const CameraStatus status = camera.status();
+  const std::chrono::milliseconds timeout = snapTimeout(status);
+  auto frame = camera.waitForFrame(t->sequence, timeout);
   if (!frame) {
-    return errorReply(makeError(VideoErrc::kNoFrame, "no frame from camera '" + name + "' within " +
-                                                         std::to_string(kSnapTimeout.count()) +
-                                                         " ms"));
+    const std::string waited = " within " + std::to_string(timeout.count()) + " ms";
+    if (status.mode == AcquisitionMode::kHardwareTrigger) {
+      return errorReply(makeError(VideoErrc::kNoFrame, "no hardware trigger on " +
+                                                           status.hardware.input.line +
+                                                           " of camera '" + name + "'" + waited));
+    }
+    return errorReply(
+        makeError(VideoErrc::kNoFrame, "no frame from camera '" + name + "'" + waited));
   }
   proto::ControlReply reply = okReply();
   auto* out = reply.mutable_snap();
@@ -223,6 +263,10 @@ proto::ControlReply setTarget(Camera& camera, const proto::SetTargetRequest& req
   return reply;
 }
 
+std::chrono::milliseconds snapTimeout(const CameraStatus& s) {
+  return s.mode == AcquisitionMode::kHardwareTrigger ? s.hardware.timeout : kSnapTimeout;
+}
+
 proto::ControlReply notSupported() {
   return errorReply(makeError(VideoErrc::kNotSupported, "request not supported by this server"));
 }
@@ -254,6 +298,10 @@ VideoServer::VideoServer(const ServerConfig& config, const SourceFactory& make_s
   for (const auto& c : config.cameras) {
     auto source = make_source(c.uri);
     if (!source) throw std::runtime_error("camera " + c.name + ": " + source.error().message);
+    if (c.mode == AcquisitionMode::kHardwareTrigger && !(*source)->hardwareTrigger()) {
+      throw std::runtime_error("camera " + c.name + ": mode hardware: " + c.uri +
+                               " has no hardware trigger input");
+    }
     cameras_.push_back(std::make_unique<Camera>(c, std::move(*source), *publisher_));
   }
   ControlServerOptions control_options;
@@ -318,6 +366,12 @@ proto::ControlReply VideoServer::statistics(const proto::StatisticsRequest& requ
     cs->set_last_sequence(s.last_sequence);
     cs->set_state(s.state);
     cs->set_last_error(s.last_error);
+    cs->set_driver_incomplete_buffers(s.driver.incomplete_buffers);
+    cs->set_driver_missing_packets(s.driver.missing_packets);
+    cs->set_driver_resent_packets(s.driver.resent_packets);
+    cs->set_driver_underruns(s.driver.underruns);
+    cs->set_driver_sequence_gaps(s.driver.sequence_gaps);
+    cs->set_frames_skipped_stale(s.driver.skipped_stale);
   }
   return reply;
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 #include <thread>
 
 #include "fake_gv_camera.hpp"
@@ -73,6 +74,15 @@ TEST_CASE("aravis source describes the fake camera", "[aravis]") {
   REQUIRE(first);
   REQUIRE((*first)->open());
   CHECK((*first)->info().serial == "GV01");
+  (*first)->close();
+
+  // The serial alone, as on the camera's label.
+  auto by_serial = makeSource("aravis:GV01");
+  REQUIRE(by_serial);
+  auto opened = (*by_serial)->open();
+  INFO((opened ? std::string() : opened.error().message));
+  REQUIRE(opened);
+  CHECK((*by_serial)->info().model == "Fake");
 }
 
 TEST_CASE("aravis source reports an absent camera as unavailable, naming it", "[aravis]") {
@@ -168,7 +178,7 @@ TEST_CASE("aravis source reads and writes GenICam features by type", "[aravis]")
 TEST_CASE("aravis source streams Mono8 frames with the fake camera's ramp", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
   uint64_t last_timestamp = 0;
   for (int i = 0; i < 10; ++i) {
     auto frame = nextFrame(*source);
@@ -185,7 +195,7 @@ TEST_CASE("aravis source streams Mono8 frames with the fake camera's ramp", "[ar
 TEST_CASE("aravis source follows a region of interest set through features", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
   REQUIRE(nextFrame(*source));
   // While acquiring: the source stops, resizes its buffers and restarts.
   mustSet(*source, "Width", "256");
@@ -213,7 +223,7 @@ TEST_CASE("aravis source follows a region of interest set through features", "[a
 TEST_CASE("aravis source delivers Bayer and Mono16 frames with their layout", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
   const std::vector<std::pair<std::string, PixelLayout>> formats = {
       {"BayerRG8", PixelLayout::kBayerRG8}, {"BayerGR8", PixelLayout::kBayerGR8},
       {"BayerGB8", PixelLayout::kBayerGB8}, {"BayerBG8", PixelLayout::kBayerBG8},
@@ -246,7 +256,7 @@ TEST_CASE("aravis source delivers Bayer and Mono16 frames with their layout", "[
 TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kTrigger, 10, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kTrigger, 10, true, true, {}}));
   CHECK(mustGet(*source, "TriggerMode").value == "On");
   CHECK(mustGet(*source, "TriggerSource").value == "Software");
   // No trigger, no frame (the fake camera would stream at 25 fps otherwise).
@@ -273,7 +283,7 @@ TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames",
     CHECK_FALSE(extra);
   }
   // Back to free-run: frames without triggers.
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
   CHECK(mustGet(*source, "TriggerMode").value == "Off");
   REQUIRE(nextFrame(*source));
   REQUIRE(nextFrame(*source));
@@ -282,7 +292,7 @@ TEST_CASE("aravis source in trigger mode delivers exactly the triggered frames",
 TEST_CASE("aravis source reports a killed camera as unavailable and reopens it", "[aravis]") {
   FakeGvCamera fake;
   auto source = openFake();
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
   REQUIRE(nextFrame(*source));
   fake.kill();
   bool unavailable = false;
@@ -297,7 +307,7 @@ TEST_CASE("aravis source reports a killed camera as unavailable and reopens it",
 
   fake.start();
   REQUIRE(source->open());
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
   auto frame = nextFrame(*source);
   REQUIRE(frame);
   CHECK(isDiagonalRamp(frame->image));
@@ -308,11 +318,11 @@ TEST_CASE("aravis source keeps the configured frame rate unless fps is asked", "
   auto source = openFake();
   // As a camera's `features:` set it, with no `fps:`.
   mustSet(*source, "AcquisitionFrameRate", "7.5");
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, false, false}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, false, false, {}}));
   CHECK(std::stod(mustGet(*source, "AcquisitionFrameRate").value) == Approx(7.5));
   REQUIRE(nextFrame(*source));
   // Asked: set.
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, false, true}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, false, true, {}}));
   CHECK(std::stod(mustGet(*source, "AcquisitionFrameRate").value) == Approx(20));
 }
 
@@ -328,11 +338,108 @@ TEST_CASE("aravis source keeps a configured hardware trigger unless free-run is 
   const std::string input = *line;
   mustSet(*source, "TriggerMode", "On");
   mustSet(*source, "TriggerSource", input);
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, false, false}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, false, false, {}}));
   CHECK(mustGet(*source, "TriggerMode").value == "On");
   CHECK(mustGet(*source, "TriggerSource").value == input);
   // Free-run asked explicitly (the configuration's `mode:`, a request): off.
-  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, true, false}));
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 10, true, false, {}}));
   CHECK(mustGet(*source, "TriggerMode").value == "Off");
   REQUIRE(nextFrame(*source));
+}
+
+TEST_CASE("aravis source in hardware trigger mode waits for its line and names a refused input",
+          "[aravis]") {
+  FakeGvCamera fake;
+  auto source = openFake();
+  CHECK(source->hardwareTrigger());
+  // The fake camera has an input Line0 (never pulsed) and no Line1.
+  TriggerInput missing;
+  missing.line = "Line1";
+  auto refused =
+      source->configureAcquisition({AcquisitionMode::kHardwareTrigger, 10, true, false, missing});
+  REQUIRE_FALSE(refused);
+  CHECK(refused.error().code == SourceErrc::kNotSupported);
+  CHECK_THAT(refused.error().message, Catch::Contains("TriggerSource") &&
+                                          Catch::Contains("Line1") && Catch::Contains("Line0"));
+  // The error is an answer, not a loop: grab says it too.
+  auto grabbed = source->grab(50ms);
+  REQUIRE_FALSE(grabbed);
+  CHECK_THAT(grabbed.error().message, Catch::Contains("TriggerSource"));
+
+  TriggerInput line0;
+  line0.line = "Line0";
+  line0.activation = "RisingEdge";
+  REQUIRE(
+      source->configureAcquisition({AcquisitionMode::kHardwareTrigger, 10, true, false, line0}));
+  CHECK(mustGet(*source, "TriggerSelector").value == "FrameStart");
+  CHECK(mustGet(*source, "TriggerMode").value == "On");
+  CHECK(mustGet(*source, "TriggerSource").value == "Line0");
+  CHECK(mustGet(*source, "TriggerActivation").value == "RisingEdge");
+  // No pulse, no frame; the camera is still there (timeouts, not unavailable).
+  for (int i = 0; i < 3; ++i) {
+    auto none = source->grab(200ms);
+    REQUIRE_FALSE(none);
+    CHECK(none.error().code == SourceErrc::kTimeout);
+  }
+  // Back to free-run: frames again.
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
+  CHECK(mustGet(*source, "TriggerMode").value == "Off");
+  REQUIRE(nextFrame(*source));
+}
+
+TEST_CASE("aravis source reports the stream's own counters", "[aravis]") {
+  FakeGvCamera fake;
+  auto source = openFake();
+  if (std::getenv("PICKSIGHT_TEST_NETNS") != nullptr &&
+      std::system("command -v iptables >/dev/null 2>&1") == 0) {
+    // Alone in a network namespace: drop a few stream packets (GVSP; the
+    // control channel, UDP 3956, untouched) and see the driver count them.
+    REQUIRE(std::system("iptables -A INPUT -p udp ! --sport 3956 ! --dport 3956 "
+                        "-m statistic --mode random --probability 0.02 -j DROP") == 0);
+    REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (source->driverCounters().missing_packets == 0 &&
+           std::chrono::steady_clock::now() < deadline) {
+      (void)source->grab(200ms);
+    }
+    CHECK(source->driverCounters().missing_packets > 0);
+    REQUIRE(std::system("iptables -F INPUT") == 0);
+  } else {
+    WARN("not in a network namespace of its own, or no iptables: no packets dropped");
+  }
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 20, true, true, {}}));
+  for (int i = 0; i < 3; ++i) REQUIRE(nextFrame(*source));
+  // Loopback loses nothing as a rule; the counters exist and survive a
+  // remade stream (the payload changes with the width).
+  const DriverCounters before = source->driverCounters();
+  mustSet(*source, "Width", "256");
+  REQUIRE(nextFrame(*source));
+  const DriverCounters after = source->driverCounters();
+  CHECK(after.incomplete_buffers >= before.incomplete_buffers);
+  CHECK(after.missing_packets >= before.missing_packets);
+  CHECK(after.underruns >= before.underruns);
+  source->close();
+  CHECK(source->driverCounters().missing_packets == after.missing_packets);
+}
+
+TEST_CASE("aravis source in free-run hands over the newest frame, not the oldest queued",
+          "[aravis]") {
+  FakeGvCamera fake;
+  auto source = openFake();
+  REQUIRE(source->configureAcquisition({AcquisitionMode::kFreeRun, 25, true, true, {}}));
+  auto first = nextFrame(*source);
+  REQUIRE(first);
+  // A consumer that falls behind: frames queue up meanwhile, and the next
+  // grab passes over all but the newest.
+  uint64_t last_timestamp = first->device_timestamp_ns;
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (source->driverCounters().skipped_stale == 0 &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(200ms);  // the slow consumer, not a wait for a condition
+    auto frame = nextFrame(*source);
+    REQUIRE(frame);
+    CHECK(frame->device_timestamp_ns > last_timestamp);
+    last_timestamp = frame->device_timestamp_ns;
+  }
+  CHECK(source->driverCounters().skipped_stale >= 1);
 }

@@ -201,6 +201,9 @@ int SimulatedV4l2Device::poll(pollfd* fds, nfds_t count, int timeout_ms) {
 }
 
 void SimulatedV4l2Device::fill(uint32_t index) {
+  // A lost frame still takes its number, as a driver's sequence counts it.
+  frames_ += static_cast<uint64_t>(lost_frames_);
+  lost_frames_ = 0;
   const uint64_t n = frames_++;
   Buffer& b = buffers_[index];
   const uint8_t y = level(n);
@@ -465,6 +468,18 @@ void SimulatedV4l2Device::injectDqbufEagain(int n) {
 void SimulatedV4l2Device::injectErrorFrames(int n) {
   std::lock_guard<std::mutex> lock(mutex_);
   error_frames_ = n;
+}
+std::string SimulatedV4l2Device::serialNumber(const std::string& path) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return path == kPath ? serial_ : std::string();
+}
+void SimulatedV4l2Device::setSerial(const std::string& serial) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  serial_ = serial;
+}
+void SimulatedV4l2Device::injectLostFrames(int n) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  lost_frames_ = n;
 }
 void SimulatedV4l2Device::setPaused(bool paused) {
   std::lock_guard<std::mutex> lock(mutex_);

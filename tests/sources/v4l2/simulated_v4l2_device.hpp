@@ -32,6 +32,7 @@ class SimulatedV4l2Device : public V4l2Device {
   void* mmap(size_t length, int prot, int flags, int fd, off_t offset) override;
   int munmap(void* address, size_t length) override;
   int poll(pollfd* fds, nfds_t count, int timeout_ms) override;
+  std::string serialNumber(const std::string& path) override;
 
   // --- Test controls, safe from any thread.
   void setGrantedBuffers(uint32_t n);  // what REQBUFS grants at most
@@ -39,11 +40,13 @@ class SimulatedV4l2Device : public V4l2Device {
   void injectPollEintr(int n);
   void injectDqbufEagain(int n);  // poll says readable, DQBUF says EAGAIN
   void injectErrorFrames(int n);  // the next n frames carry V4L2_BUF_FLAG_ERROR
+  void injectLostFrames(int n);   // the next n frames are numbered but never delivered
   void setPaused(bool paused);    // no frames: poll times out
   // Unplugs: every call fails with ENODEV (poll too when `poll_fails`, else
   // poll reports POLLERR and DQBUF fails).
   void unplug(bool poll_fails);
   void replug();
+  void setSerial(const std::string& serial);  // what sysfs would say ("" = none)
   // Fills up to n queued buffers now, as frames captured before whatever comes next.
   void captureNow(int n);
 
@@ -102,6 +105,8 @@ class SimulatedV4l2Device : public V4l2Device {
   int poll_eintr_ = 0;
   int dqbuf_eagain_ = 0;
   int error_frames_ = 0;
+  int lost_frames_ = 0;
+  std::string serial_;
   bool paused_ = false;
   bool gone_ = false;
   bool poll_fails_ = false;

@@ -3,7 +3,8 @@
 //
 // Threading: like every Source, called from its Camera's acquisition thread
 // only. Aravis receives frames on its own stream thread, which only fills
-// buffers from our pool and queues them (no callback of ours runs there); the
+// buffers from our pool and queues them; our one callback there asks for
+// real-time scheduling when the thread starts and sets an atomic. The
 // heartbeat thread's "control-lost" signal only sets an atomic flag.
 //
 // Buffers: a pool of kBufferCount buffers of the camera's payload size. grab()
@@ -29,8 +30,10 @@ namespace picksight::video {
 
 class AravisSource : public Source {
  public:
-  // `device_id` as Aravis names devices ("Aravis-Fake-GV01", a serial, an IP
-  // address); empty = the first device found.
+  // `device_id` as Aravis names devices ("Aravis-Fake-GV01", a MAC or IP
+  // address, a USB3 Vision GUID) or the camera's serial number ("GV01", as
+  // printed on its label; looked up in the device list); empty = the first
+  // device found.
   explicit AravisSource(std::string device_id);
   ~AravisSource() override;
   AravisSource(const AravisSource&) = delete;
@@ -44,6 +47,8 @@ class AravisSource : public Source {
   bool streams() const override { return true; }
   Result<void> configureAcquisition(const AcquisitionRequest& request) override;
   Result<void> softwareTrigger() override;
+  bool hardwareTrigger() const override { return true; }
+  DriverCounters driverCounters() const override;
 
   std::vector<Feature> features() override;
   Result<Feature> feature(const std::string& name) override;
@@ -57,7 +62,15 @@ class AravisSource : public Source {
   Result<void> startAcquisition();
   // Writes the trigger mode and frame rate `request` asks for, and no more.
   std::optional<Error> configureTriggerAndRate(const AcquisitionRequest& request);
+  // TriggerSelector FrameStart, TriggerSource, TriggerActivation (if given),
+  // TriggerMode On; the error names the feature the camera refused.
+  std::optional<Error> configureHardwareTrigger(const TriggerInput& input);
   void stopAcquisition();
+  // Free-run: swaps `buffer` for the newest complete one queued behind it,
+  // giving the older back to the stream.
+  void takeNewest(GObjectPtr<ArvBuffer>& buffer);
+  // Drops the stream, its counters added to retired_.
+  void retireStream();
   // Gives the buffer the last frame borrowed back to the stream.
   void returnHeldBuffer();
   // A real control read: fails when the device is gone.
@@ -70,6 +83,12 @@ class AravisSource : public Source {
   GObjectPtr<ArvStream> stream_;
   GObjectPtr<ArvBuffer> held_;  // popped buffer the last SourceFrame borrows
   size_t buffer_size_ = 0;
+  DriverCounters retired_;      // counters of the streams dropped so far
+  uint64_t skipped_stale_ = 0;  // frames passed over for a newer one
+  // Set on the stream thread: 1 real-time scheduling granted, -1 refused.
+  std::atomic<int> stream_priority_{0};
+  bool socket_buffer_warned_ = false;  // the rmem_max warning is written once
+  bool priority_logged_ = false;       // and the stream thread's priority once
   bool acquiring_ = false;
   std::optional<AcquisitionMode> mode_;  // as last configured
   // Why the last configureAcquisition failed: grab() answers with it rather

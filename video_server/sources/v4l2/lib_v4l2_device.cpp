@@ -3,6 +3,10 @@
 
 #include <libv4l2.h>
 
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
 namespace picksight::video {
 
 int LibV4l2Device::open(const std::string& path, int flags) {
@@ -25,6 +29,23 @@ int LibV4l2Device::munmap(void* address, size_t length) { return v4l2_munmap(add
 // device's, and its readiness is the device's.
 int LibV4l2Device::poll(pollfd* fds, nfds_t count, int timeout_ms) {
   return ::poll(fds, count, timeout_ms);
+}
+
+// /sys/class/video4linux/videoN/device is the USB interface the node belongs
+// to; its parent, the USB device, holds the iSerialNumber string as `serial`.
+std::string LibV4l2Device::serialNumber(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path node = fs::canonical(path, ec);  // follows /dev/v4l/by-id links
+  if (ec) return {};
+  const fs::path device = fs::path("/sys/class/video4linux") / node.filename() / "device";
+  const fs::path usb = fs::canonical(device, ec).parent_path();
+  if (ec) return {};
+  std::ifstream in(usb / "serial");
+  std::string serial;
+  std::getline(in, serial);
+  while (!serial.empty() && (serial.back() == ' ' || serial.back() == '\r')) serial.pop_back();
+  return serial;
 }
 
 }  // namespace picksight::video

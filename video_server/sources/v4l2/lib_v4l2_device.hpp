@@ -14,6 +14,7 @@ class LibV4l2Device : public V4l2Device {
   void* mmap(size_t length, int prot, int flags, int fd, off_t offset) override;
   int munmap(void* address, size_t length) override;
   int poll(pollfd* fds, nfds_t count, int timeout_ms) override;
+  std::string serialNumber(const std::string& path) override;
 };
 
 }  // namespace picksight::video

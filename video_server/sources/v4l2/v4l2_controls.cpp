@@ -3,10 +3,13 @@
 
 #include <strings.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <vector>
 
+#include "picksight/common/log.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::video {
@@ -28,6 +31,44 @@ std::string controlName(const std::string& label) {
 
 std::string range(const v4l2_queryctrl& c) {
   return "[" + std::to_string(c.minimum) + ", " + std::to_string(c.maximum) + "]";
+}
+
+// A control's names over the kernel's history, the current first: uvcvideo
+// renamed several labels (Linux 5.x: "Exposure, Auto" -> "Auto Exposure"), and
+// names are made from labels, so a configuration written on one kernel uses
+// either. Looked up by the control's id, which never changed.
+struct ControlNames {
+  uint32_t id;
+  std::vector<const char*> names;
+};
+const std::vector<ControlNames>& controlAliases() {
+  static const std::vector<ControlNames> kAliases = {
+      {V4L2_CID_EXPOSURE_AUTO, {"auto_exposure", "exposure_auto"}},
+      {V4L2_CID_EXPOSURE_ABSOLUTE, {"exposure_time_absolute", "exposure_absolute"}},
+      {V4L2_CID_EXPOSURE_AUTO_PRIORITY, {"exposure_dynamic_framerate", "exposure_auto_priority"}},
+      {V4L2_CID_AUTO_WHITE_BALANCE, {"white_balance_automatic", "white_balance_temperature_auto"}},
+      {V4L2_CID_FOCUS_AUTO, {"focus_automatic_continuous", "focus_auto"}},
+      {V4L2_CID_AUTOGAIN, {"gain_automatic", "gain_auto"}},
+  };
+  return kAliases;
+}
+
+// The automatic mode that overrides a manual control, and its value for
+// "manual": writing the manual control while the mode is automatic is
+// refused or silently ignored by UVC cameras, so the mode is switched first.
+struct AutoMode {
+  uint32_t manual;
+  uint32_t automatic;
+  int32_t manual_value;
+};
+const std::vector<AutoMode>& autoModes() {
+  static const std::vector<AutoMode> kModes = {
+      {V4L2_CID_EXPOSURE_ABSOLUTE, V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_MANUAL},
+      {V4L2_CID_WHITE_BALANCE_TEMPERATURE, V4L2_CID_AUTO_WHITE_BALANCE, 0},
+      {V4L2_CID_FOCUS_ABSOLUTE, V4L2_CID_FOCUS_AUTO, 0},
+      {V4L2_CID_GAIN, V4L2_CID_AUTOGAIN, 0},
+  };
+  return kModes;
 }
 
 Error unknownFeature(const std::string& name, const std::string& card) {
@@ -75,8 +116,35 @@ std::vector<v4l2_queryctrl> V4l2Source::queryControls() {
 }
 
 std::optional<v4l2_queryctrl> V4l2Source::findControl(const std::string& name) {
-  for (const auto& q : queryControls()) {
+  const std::vector<v4l2_queryctrl> controls = queryControls();
+  for (const auto& q : controls) {
     if (controlName(kernelString(q.name)) == name) return q;
+  }
+  // Another kernel's name for the same control.
+  for (const ControlNames& alias : controlAliases()) {
+    if (std::find(alias.names.begin(), alias.names.end(), name) == alias.names.end()) continue;
+    for (const auto& q : controls) {
+      if (q.id == alias.id) return q;
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> V4l2Source::leaveAutoMode(const v4l2_queryctrl& manual) {
+  for (const AutoMode& mode : autoModes()) {
+    if (mode.manual != manual.id) continue;
+    v4l2_control c{};
+    c.id = mode.automatic;
+    // No such control, or already manual: nothing to do.
+    if (xioctl(VIDIOC_G_CTRL, &c) < 0 || c.value == mode.manual_value) return std::nullopt;
+    v4l2_queryctrl q{};
+    q.id = mode.automatic;
+    const std::string automatic =
+        xioctl(VIDIOC_QUERYCTRL, &q) == 0 ? controlName(kernelString(q.name)) : "its auto mode";
+    c.value = mode.manual_value;
+    if (xioctl(VIDIOC_S_CTRL, &c) < 0) return std::nullopt;  // the write below then says why
+    switched_to_manual_.insert(manual.id);
+    return automatic;
   }
   return std::nullopt;
 }
@@ -99,6 +167,9 @@ Result<Feature> V4l2Source::describeControl(const v4l2_queryctrl& q) {
   f.name = controlName(kernelString(q.name));
   f.description = kernelString(q.name);
   if (q.flags & V4L2_CTRL_FLAG_INACTIVE) f.description += " (inactive: set by an automatic mode)";
+  if (switched_to_manual_.count(q.id) > 0) {
+    f.description += " (its automatic mode was switched to manual when a value was written)";
+  }
   f.writable = !(q.flags & V4L2_CTRL_FLAG_READ_ONLY);
   if (q.id == V4L2_CID_EXPOSURE_ABSOLUTE) f.unit = "100us";
 
@@ -181,16 +252,17 @@ Result<void> V4l2Source::setFeature(const std::string& name, const std::string& 
         value = *parsed;
       } else {
         return makeError(SourceErrc::kBadValue, "feature '" + name + "' is an integer " + range(q) +
-                                              ", got '" + text + "'");
+                                                    ", got '" + text + "'");
       }
       if (value < q.minimum || value > q.maximum) {
         return makeError(SourceErrc::kBadValue,
                          "feature '" + name + "' value " + text + " out of range " + range(q));
       }
       if (q.step > 1 && (value - q.minimum) % q.step != 0) {
-        return makeError(SourceErrc::kBadValue, "feature '" + name + "' value " + text + " is not " +
-                                              std::to_string(q.minimum) + " plus a multiple of " +
-                                              std::to_string(q.step) + " in " + range(q));
+        return makeError(SourceErrc::kBadValue, "feature '" + name + "' value " + text +
+                                                    " is not " + std::to_string(q.minimum) +
+                                                    " plus a multiple of " +
+                                                    std::to_string(q.step) + " in " + range(q));
       }
       break;
     default: {  // menus: a choice by its name, or by its index
@@ -207,10 +279,15 @@ Result<void> V4l2Source::setFeature(const std::string& name, const std::string& 
         std::string choices;
         for (const auto& c : menu) choices += (choices.empty() ? "" : ", ") + c.second;
         return makeError(SourceErrc::kBadValue, "feature '" + name + "' has no choice '" + text +
-                                              "' (choices: " + choices + ")");
+                                                    "' (choices: " + choices + ")");
       }
       break;
     }
+  }
+  // A manual value under an automatic mode would be refused or ignored.
+  if (const auto automatic = leaveAutoMode(q)) {
+    logInfo("v4l2:", options_.path, ": ", *automatic, " switched to manual so that ", name, " = ",
+            text, " applies");
   }
   v4l2_control c{};
   c.id = q.id;

@@ -26,6 +26,10 @@ class V4l2Device {
   virtual void* mmap(size_t length, int prot, int flags, int fd, off_t offset) = 0;
   virtual int munmap(void* address, size_t length) = 0;
   virtual int poll(pollfd* fds, nfds_t count, int timeout_ms) = 0;
+  // The serial number the device behind `path` (a /dev/videoN or a
+  // /dev/v4l/by-id link to one) reports, from sysfs; empty when it has
+  // none, as many cheap webcams.
+  virtual std::string serialNumber(const std::string& path) = 0;
 };
 
 // A fixed-size, maybe unterminated kernel string.

@@ -26,19 +26,26 @@ Result<V4l2Options> parseV4l2Options(const std::string& text) {
     const size_t eq = pair.find('=');
     const std::string key = pair.substr(0, eq);
     const std::string value = eq == std::string::npos ? "" : pair.substr(eq + 1);
-    if (key == "width" || key == "height" || key == "buffers") {
-      const bool buffers = key == "buffers";
+    if (key == "width" || key == "height" || key == "buffers" || key == "skip") {
+      // The bounds of each count.
+      const long long lo = key == "buffers" ? 2 : key == "skip" ? 0 : 1;
+      const long long hi = key == "buffers" ? 32 : key == "skip" ? 100 : 16384;
       const auto n = parseInt(value);
-      if (!n || *n < (buffers ? 2 : 1) || *n > (buffers ? 32 : 16384)) {
-        return makeError(SourceErrc::kBadConfig, "v4l2: " + key + " must be " +
-                                               (buffers ? "2..32" : "1..16384") + ", got '" +
-                                               value + "'");
+      if (!n || *n < lo || *n > hi) {
+        return makeError(SourceErrc::kBadConfig, "v4l2: " + key + " must be " + std::to_string(lo) +
+                                                     ".." + std::to_string(hi) + ", got '" + value +
+                                                     "'");
       }
-      (key == "width" ? o.width : key == "height" ? o.height : o.buffers) = static_cast<int>(*n);
+      int& field = key == "width"     ? o.width
+                   : key == "height"  ? o.height
+                   : key == "buffers" ? o.buffers
+                                      : o.skip;
+      field = static_cast<int>(*n);
     } else if (key == "fps") {
       o.fps = parseDouble(value).value_or(0);
       if (!(o.fps > 0 && o.fps <= 1000)) {
-        return makeError(SourceErrc::kBadConfig, "v4l2: fps must be in (0, 1000], got '" + value + "'");
+        return makeError(SourceErrc::kBadConfig,
+                         "v4l2: fps must be in (0, 1000], got '" + value + "'");
       }
     } else if (key == "format") {
       std::string lower;
@@ -55,8 +62,9 @@ Result<V4l2Options> parseV4l2Options(const std::string& text) {
                          "v4l2: unknown format '" + value + "' (known: " + known + ")");
       }
     } else {
-      return makeError(SourceErrc::kBadConfig, "v4l2: unknown option '" + key +
-                                             "' (known: width, height, format, fps, buffers)");
+      return makeError(
+          SourceErrc::kBadConfig,
+          "v4l2: unknown option '" + key + "' (known: width, height, format, fps, buffers, skip)");
     }
   }
   if ((o.width == 0) != (o.height == 0)) {

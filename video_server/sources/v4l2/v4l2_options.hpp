@@ -16,6 +16,8 @@ namespace picksight::video {
 // requested fps. fps: the initial frame rate, which the camera's own
 // frame-rate setting then overrides only when it changes at run time.
 // buffers: mmap buffers to request (2..32, default 4; the driver may grant another count).
+// skip: frames dropped after every start of streaming (0..100, default 3):
+// a webcam's first frames come before its automatic exposure settles.
 struct V4l2Options {
   std::string path;
   int width = 0;
@@ -23,6 +25,7 @@ struct V4l2Options {
   uint32_t fourcc = 0;  // 0 = choose
   double fps = 0;       // 0 = the camera's setting
   int buffers = 4;
+  int skip = 3;
 };
 
 // The error names the key or value that is wrong.

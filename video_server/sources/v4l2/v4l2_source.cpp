@@ -75,6 +75,7 @@ Result<void> V4l2Source::openDevice() {
   card_ = kernelString(cap.card);
   driver_ = kernelString(cap.driver);
   bus_ = kernelString(cap.bus_info);
+  serial_ = device_->serialNumber(options_.path);
 
   if (auto r = chooseFormat(); !r) return r;
   // A replugged device starts at its default rate.
@@ -83,6 +84,7 @@ Result<void> V4l2Source::openDevice() {
   if (auto r = startStreaming(); !r) return r;
   trigger_pending_ = false;
   dropped_ = 0;
+  switched_to_manual_.clear();  // a reopened device may be back in its auto modes
   return {};
 }
 
@@ -108,7 +110,9 @@ SourceInfo V4l2Source::info() const {
   SourceInfo i;
   i.vendor = driver_;
   i.model = card_;
-  i.serial = bus_;
+  // bus_info names the USB port, not the camera: a stand-in, said as such,
+  // for cameras without a serial number.
+  i.serial = !serial_.empty() ? serial_ : "none (port " + bus_ + ")";
   i.sensor_width = static_cast<int>(format_.width);
   i.sensor_height = static_cast<int>(format_.height);
   i.formats = formats_;
@@ -145,6 +149,11 @@ Result<void> V4l2Source::applyFrameRate(double fps) {
 }
 
 Result<void> V4l2Source::configureAcquisition(const AcquisitionRequest& request) {
+  if (request.mode == AcquisitionMode::kHardwareTrigger) {
+    // V4L2 has no trigger input: UVC webcams stream at their own pace.
+    return makeError(SourceErrc::kNotSupported,
+                     "v4l2 cameras have no hardware trigger input; use freerun or trigger");
+  }
   const double fps = request.fps;
   trigger_mode_ = request.mode == AcquisitionMode::kTrigger;
   trigger_pending_ = false;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,8 +25,9 @@ namespace picksight::video {
 //
 // Software trigger: a webcam has none. In trigger mode it keeps streaming and
 // softwareTrigger() marks the moment; grab() then returns the first frame
-// captured after it (by the buffer's monotonic timestamp), dropping older
-// ones that were waiting in the driver.
+// stamped at least one frame interval after it (the buffer's monotonic
+// timestamp marks the end of exposure, not its start), dropping older ones
+// that were waiting in the driver.
 class V4l2Source : public Source {
  public:
   // `device` is the system interface; null means libv4l2.
@@ -50,6 +52,9 @@ class V4l2Source : public Source {
 
   // Frames dropped since open(): flagged bad by the driver, or short.
   uint64_t droppedFrames() const { return dropped_; }
+  // Since construction: those drops (incomplete_buffers) and the frames
+  // missing from the driver's sequence numbers (sequence_gaps).
+  DriverCounters driverCounters() const override { return counters_; }
 
  private:
   // ioctl, retried while interrupted by a signal.
@@ -66,8 +71,17 @@ class V4l2Source : public Source {
   Result<void> queueBuffer(uint32_t index);
   Result<void> applyFrameRate(double fps);
   void drainReadyBuffers();
+  // One frame interval at the rate set: the margin a triggered frame's
+  // timestamp must keep after the trigger.
+  uint64_t frameIntervalNs() const;
+  // Counts a jump in the buffers' sequence numbers as lost frames.
+  void countSequence(uint32_t sequence);
   std::vector<v4l2_queryctrl> queryControls();
+  // By the name made from the kernel's label, or another kernel's name for it.
   std::optional<v4l2_queryctrl> findControl(const std::string& name);
+  // Switches the automatic mode overriding `manual` (auto_exposure for
+  // exposure_time_absolute...) to manual; the mode's name if it did.
+  std::optional<std::string> leaveAutoMode(const v4l2_queryctrl& manual);
   Result<Feature> describeControl(const v4l2_queryctrl& control);
   // A menu control's choices by index, by name (integer menus: by value).
   std::vector<std::pair<int32_t, std::string>> menuChoices(const v4l2_queryctrl& control);
@@ -81,6 +95,7 @@ class V4l2Source : public Source {
   std::string card_;
   std::string driver_;
   std::string bus_;
+  std::string serial_;                // the device's own, from sysfs; empty when it has none
   std::vector<std::string> formats_;  // what the device offers, by fourcc
   v4l2_pix_format format_{};          // as the driver set it
   PixelLayout layout_ = PixelLayout::kYUYV;
@@ -93,6 +108,11 @@ class V4l2Source : public Source {
   bool timestamps_monotonic_ = false;  // as the last buffer said
   uint64_t trigger_ns_ = 0;            // CLOCK_MONOTONIC at the trigger
   uint64_t dropped_ = 0;
+  DriverCounters counters_;
+  int skip_left_ = 0;  // frames still to drop since STREAMON
+  std::optional<uint32_t> last_device_sequence_;
+  std::set<uint32_t> switched_to_manual_;  // controls whose auto mode a write turned off  // of the
+                                           // last buffer since STREAMON
 };
 
 }  // namespace picksight::video

@@ -33,7 +33,8 @@ Result<void> V4l2Source::startStreaming() {
     // always being copied while the device has nowhere to write.
     if (req.count < 2) {
       return makeError(SourceErrc::kUnavailable, "v4l2:" + options_.path + ": driver granted " +
-                                               std::to_string(req.count) + " buffers, need 2");
+                                                     std::to_string(req.count) +
+                                                     " buffers, need 2");
     }
     for (uint32_t i = 0; i < req.count; ++i) {
       v4l2_buffer buf{};
@@ -53,6 +54,8 @@ Result<void> V4l2Source::startStreaming() {
   int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   if (xioctl(VIDIOC_STREAMON, &type) < 0) return deviceError("VIDIOC_STREAMON");
   streaming_ = true;
+  last_device_sequence_.reset();  // the driver numbers from 0 again
+  skip_left_ = options_.skip;
   return {};
 }
 
@@ -64,6 +67,16 @@ void V4l2Source::stopStreaming() {
   streaming_ = false;
 }
 
+void V4l2Source::countSequence(uint32_t sequence) {
+  // The driver numbers every frame it captured, delivered or not: a jump is
+  // frames it lost (no free buffer, a USB hiccup). Wraps at 2^32.
+  if (last_device_sequence_) {
+    const uint32_t step = sequence - *last_device_sequence_;
+    if (step > 1 && step < (1u << 31)) counters_.sequence_gaps += step - 1;
+  }
+  last_device_sequence_ = sequence;
+}
+
 void V4l2Source::drainReadyBuffers() {
   for (size_t n = 0; n < buffers_.size(); ++n) {
     v4l2_buffer buf{};
@@ -72,6 +85,12 @@ void V4l2Source::drainReadyBuffers() {
     if (xioctl(VIDIOC_DQBUF, &buf) < 0) return;  // EAGAIN: none waiting; errors show in grab()
     if (!queueBuffer(buf.index)) return;
   }
+}
+
+uint64_t V4l2Source::frameIntervalNs() const {
+  // The rate set on the device; a webcam that never told runs at 30 fps or less.
+  const double fps = applied_fps_ > 0 ? applied_fps_ : 30.0;
+  return static_cast<uint64_t>(1e9 / fps);
 }
 
 Result<void> V4l2Source::softwareTrigger() {
@@ -103,7 +122,7 @@ Result<SourceFrame> V4l2Source::grab(std::chrono::milliseconds timeout) {
     }
     if (ready == 0) {
       return makeError(SourceErrc::kTimeout, "v4l2:" + options_.path + ": no frame within " +
-                                           std::to_string(timeout.count()) + " ms");
+                                                 std::to_string(timeout.count()) + " ms");
     }
     v4l2_buffer buf{};
     buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -119,6 +138,7 @@ Result<SourceFrame> V4l2Source::grab(std::chrono::milliseconds timeout) {
       errno = EIO;
       return deviceError("VIDIOC_DQBUF returned buffer " + std::to_string(buf.index), true);
     }
+    countSequence(buf.sequence);
     const V4l2Mapping& mapping = buffers_[buf.index];
     timestamps_monotonic_ =
         (buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
@@ -129,7 +149,11 @@ Result<SourceFrame> V4l2Source::grab(std::chrono::milliseconds timeout) {
     const size_t used = std::min<size_t>(buf.bytesused, mapping.length());
     const V4l2PixelFormat* info = findPixelFormat(format_.pixelformat);
     cv::Mat image;
-    const bool before_trigger = trigger_pending_ && device_ns != 0 && device_ns < trigger_ns_;
+    // The timestamp marks the frame's first USB packet, after its exposure:
+    // a frame stamped less than one frame interval after the trigger may
+    // have been exposed partly before it.
+    const bool before_trigger =
+        trigger_pending_ && device_ns != 0 && device_ns < trigger_ns_ + frameIntervalNs();
     bool usable =
         !(buf.flags & V4L2_BUF_FLAG_ERROR) && !before_trigger;  // error flag: a corrupted transfer
     if (usable && info->cv_type < 0) {
@@ -150,7 +174,15 @@ Result<SourceFrame> V4l2Source::grab(std::chrono::milliseconds timeout) {
     // Back to the driver at once: it owns few buffers and drops frames without them.
     if (!queueBuffer(buf.index)) return deviceError("VIDIOC_QBUF", true);
     if (!usable) {
-      if (!before_trigger) ++dropped_;
+      if (!before_trigger) {
+        ++dropped_;
+        ++counters_.incomplete_buffers;
+      }
+      continue;
+    }
+    if (skip_left_ > 0) {
+      // Taken before the camera's automatic exposure settled.
+      --skip_left_;
       continue;
     }
     trigger_pending_ = false;

@@ -28,6 +28,18 @@ namespace picksight::video {
 // The highest frame rate a camera may be set to.
 constexpr double kMaxFps = 1000;
 
+// Hardware trigger settings: the camera's input, and how long a client that
+// asked for a frame waits for a pulse (the camera itself waits for ever: no
+// pulse is not silence, and the no-frame timeout does not apply).
+struct HardwareTrigger {
+  TriggerInput input;
+  std::chrono::milliseconds timeout{10000};
+};
+constexpr std::chrono::milliseconds kMaxTriggerTimeout{3600000};
+// GenICam's standard TriggerActivation values, the ones accepted.
+constexpr const char* kTriggerActivations = "RisingEdge, FallingEdge, AnyEdge, LevelHigh, LevelLow";
+bool isTriggerActivation(const std::string& name);
+
 struct CameraConfig {
   std::string name;
   std::string uri;
@@ -45,6 +57,7 @@ struct CameraConfig {
   // No good frame for this long while frames are expected (free-run, or a
   // trigger owed one): the camera reports it and reopens the source.
   std::chrono::milliseconds no_frame_timeout{5000};
+  HardwareTrigger hardware;
 };
 
 // Where a camera's frames go: Frames whose image the camera made for them
@@ -72,6 +85,7 @@ struct CameraStatus {
   std::string last_error;
   bool open_requested = true;
   AcquisitionMode mode = AcquisitionMode::kFreeRun;
+  HardwareTrigger hardware;
   double fps_setting = 0;
   double fps_measured = 0;
   SourceInfo info;
@@ -81,6 +95,7 @@ struct CameraStatus {
   uint64_t acquisition_errors = 0;
   uint64_t reconnects = 0;
   uint64_t last_sequence = 0;
+  DriverCounters driver;  // as of the last grab
 };
 
 class Camera {
@@ -100,10 +115,16 @@ class Camera {
   // sensor size once the source has been opened.
   Result<void> setOutput(const OutputSettings& output);
   OutputSettings output() const;
-  Result<void> setMode(AcquisitionMode mode, double fps);
+  // fps 0 leaves the rate. `hardware` replaces the hardware trigger settings
+  // (kHardwareTrigger); a source without a trigger input refuses that mode
+  // with kNotSupported.
+  Result<void> setMode(AcquisitionMode mode, double fps,
+                       const std::optional<HardwareTrigger>& hardware = std::nullopt);
 
   // In trigger mode queues one frame and returns its sequence number. In
-  // free-run returns the first sequence number acquired after this call.
+  // free-run returns the first sequence number acquired after this call; in
+  // hardware trigger mode, that of the first frame delivered after it (the
+  // next pulse's, unless one was in flight).
   // A closed camera (kCameraClosed) or one in an outage (SourceErrc::
   // kUnavailable, state "reconnecting") refuses at once; triggers still owed
   // when an outage starts are dropped, never served in a burst afterwards.
@@ -139,6 +160,7 @@ class Camera {
     Result<SourceFrame> grabbed = Error{};
     Result<OutputFrame> out = Error{};
     uint64_t host_ns = 0;
+    DriverCounters counters;  // the source's, right after the grab
   };
 
   // The acquisition loop and its steps; the steps called with `lock` return
@@ -197,10 +219,12 @@ class Camera {
   std::chrono::milliseconds backoff_{100};
   OutputSettings output_;
   AcquisitionMode mode_;
+  HardwareTrigger hardware_;
   double fps_;
   bool mode_asked_;
   bool fps_asked_;
   uint64_t next_sequence_ = 1;
+  std::optional<uint64_t> grab_sequence_;  // the number of the grab under way, if one is
   uint64_t pending_triggers_ = 0;
   CameraStatus status_;
   std::optional<SimulatedRobot> robot_;  // the source's simulated robot, if it has one

@@ -20,7 +20,16 @@
 
 namespace picksight::video {
 
-enum class AcquisitionMode { kFreeRun, kTrigger };
+// kTrigger: one frame per software trigger. kHardwareTrigger: one frame per
+// pulse on the camera's trigger input (Aravis cameras); the device decides
+// when a frame comes, so waiting for one is not silence.
+enum class AcquisitionMode { kFreeRun, kTrigger, kHardwareTrigger };
+
+// The camera input a hardware trigger comes on, as GenICam names it.
+struct TriggerInput {
+  std::string line = "Line1";  // TriggerSource
+  std::string activation;      // TriggerActivation; empty = as the camera is set
+};
 
 // The acquisition a camera wants. A streaming source writes to the device
 // only what was asked: a trigger or a frame rate the device was configured
@@ -30,11 +39,28 @@ struct AcquisitionRequest {
   double fps = 10;          // the rate; on-demand sources are paced at it regardless
   bool mode_asked = false;  // free-run asked explicitly: leave any trigger mode
   bool fps_asked = false;   // the rate asked explicitly: set the device's
+  TriggerInput input;       // kHardwareTrigger only
 };
 
-// How a source's frame bytes are laid out. Mono10/12/16 arrive unpacked in
-// 16-bit words (CV_16UC1), YUYV/UYVY as CV_8UC2, MJPEG as one row of bytes
-// (CV_8UC1, 1 x size); the rest as their OpenCV 8-bit equivalents.
+// The driver's own counters of what went wrong below us, summed over the
+// source's lifetime (reopenings included). 0 where the driver has none.
+struct DriverCounters {
+  uint64_t incomplete_buffers = 0;  // buffers the driver flagged bad or incomplete
+  uint64_t missing_packets = 0;     // GigE Vision: packets never received
+  uint64_t resent_packets = 0;      // GigE Vision: packets asked for again
+  uint64_t underruns = 0;           // frames lost for want of a free buffer
+  uint64_t sequence_gaps = 0;       // frames the device numbered but never delivered
+  // Complete frames passed over because a newer one was already waiting
+  // (free-run hands over the newest): latency avoided, not a fault.
+  uint64_t skipped_stale = 0;
+};
+
+// How a source's frame bytes are laid out. Mono10/12/16 and Bayer**10/12/16
+// arrive unpacked in 16-bit words (CV_16UC1, the value in the low bits),
+// YUYV/UYVY as CV_8UC2, MJPEG as one row of bytes (CV_8UC1, 1 x size); the
+// packed mono formats as CV_8UC1 rows of their packed bytes (a row holds
+// whole pixel groups: 4 pixels in 5 bytes for Mono10p, 2 in 3 bytes for the
+// others); the rest as their OpenCV 8-bit equivalents.
 enum class PixelLayout {
   kMono8,
   kMono10,
@@ -49,6 +75,25 @@ enum class PixelLayout {
   kYUYV,
   kUYVY,
   kMJPEG,
+  // GenICam PFNC packing: bits of consecutive pixels, least significant first.
+  kMono10p,
+  kMono12p,
+  // GigE Vision's older packing: two pixels in three bytes, high bits in the
+  // outer bytes and the low bits of both in the middle one.
+  kMono10Packed,
+  kMono12Packed,
+  kBayerRG10,
+  kBayerGR10,
+  kBayerBG10,
+  kBayerGB10,
+  kBayerRG12,
+  kBayerGR12,
+  kBayerBG12,
+  kBayerGB12,
+  kBayerRG16,
+  kBayerGR16,
+  kBayerBG16,
+  kBayerGB16,
 };
 
 const char* pixelLayoutName(PixelLayout layout);
@@ -156,6 +201,11 @@ class Source {
   virtual Result<void> configureAcquisition(const AcquisitionRequest& /*request*/) { return {}; }
   // In trigger mode, asks the device for one frame; grab() then returns it.
   virtual Result<void> softwareTrigger() { return {}; }
+  // Whether configureAcquisition() can take kHardwareTrigger: a property of
+  // the driver, constant, so any thread may ask.
+  virtual bool hardwareTrigger() const { return false; }
+  // The driver's counters as of now.
+  virtual DriverCounters driverCounters() const { return {}; }
 
   // --- Features by name. Values travel as text and are checked by type and
   // range; errors name the feature and, for a range, the range.
