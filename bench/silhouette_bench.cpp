@@ -28,7 +28,6 @@
 namespace {
 namespace ps = picksight::synthetic;
 namespace pv = picksight::vision;
-using Clock = std::chrono::steady_clock;
 
 // A result this close to a drawn part's centroid is about that part.
 constexpr double kMatchRadiusPx = 12;
