@@ -55,8 +55,10 @@ constexpr int kSparseFitStride = 3;
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
 constexpr double kMirrorMargin = 0.03;
-// Parts that touch share at most their contact pixels; a part lies in its blob.
-constexpr double kMaxOverlap = 0.04;
+// Parts that touch share at most their contact pixels, parts that overlap
+// (one lying on another, a quarter of its outline hidden) a fifth of their
+// area; a part lies in its blob.
+constexpr double kMaxOverlap = 0.2;
 constexpr double kMaxOutside = 0.06;
 // Edge samples this close to a primitive's end see the neighbouring edge.
 constexpr double kCornerClearancePx = 2.0;
@@ -249,6 +251,33 @@ std::vector<BoundarySample> sparseSamples(const std::vector<BoundarySample>& all
   std::vector<BoundarySample> out;
   for (size_t i = stride / 2; i < all.size(); i += stride) out.push_back(all[i]);
   return out;
+}
+
+// A part lying partly under another shows less of its boundary: what is
+// not on an edge may lie on the other part's body, never on the background.
+// It then needs this much of its boundary on edges, and the verify fraction
+// of what is not hidden.
+constexpr double kMinVisible = 0.7;
+
+// Whether the boundary a pose leaves off the edges lies on the blob's body
+// (hidden by a part lying on it) enough to explain the score.
+bool hiddenUnderOthers(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
+                       const Coverage& coverage, double score) {
+  if (score < kMinVisible) return false;
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  const double flip = pose.mirrored ? -1.0 : 1.0;
+  double on = 0;
+  double missing = 0;
+  for (const auto& sample : m.samples) {
+    const cv::Point2d p = pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s);
+    if (edges.at(p) <= m.edge_tolerance) {
+      on += sample.weight;
+    } else if (coverage.at(p) < 0.5) {
+      missing += sample.weight;
+    }
+  }
+  return on + missing > 0 && on / (on + missing) * 100 >= m.verify_percent;
 }
 
 struct Candidate {
@@ -574,9 +603,13 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
               cv::CMP_GE);
   cv::Mat claimed(inside.size(), CV_8UC1, cv::Scalar(0));
   cv::Mat shape(inside.size(), CV_8UC1);
+  const Coverage coverage(region);
   for (const auto& c : direct) {
     const PartModel& m = *c.model;
-    if (c.score * 100 < m.verify_percent) continue;
+    if (c.score * 100 < m.verify_percent &&
+        !hiddenUnderOthers(m, c.pose, edges, coverage, c.score)) {
+      continue;
+    }
     const bool mirror_as_good = std::any_of(mirror.begin(), mirror.end(), [&](const Candidate& q) {
       return q.model == c.model &&
              std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
@@ -584,14 +617,25 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     });
     if (mirror_as_good) continue;
-    shape.setTo(0);
-    cv::fillPoly(shape, placedOutline(m, c.pose, origin), cv::Scalar(255));
-    const int drawn = cv::countNonZero(shape);
+    // Only the placed part's box of the canvas is read and written.
+    const auto outline = placedOutline(m, c.pose, origin);
+    cv::Rect box;
+    for (const auto& poly : outline) box |= cv::boundingRect(poly);
+    box = (box + cv::Size(1, 1)) & cv::Rect(cv::Point(0, 0), shape.size());
+    if (box.empty()) continue;
+    cv::Mat drawn_here = shape(box);
+    drawn_here.setTo(0);
+    cv::fillPoly(drawn_here, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
+    const int drawn = cv::countNonZero(drawn_here);
     if (drawn <= 0) continue;
-    const double outside = cv::countNonZero(shape & ~inside);
-    const double overlap = cv::countNonZero(shape & claimed);
+    cv::Mat scratch;
+    cv::bitwise_and(drawn_here, ~inside(box), scratch);
+    const double outside = cv::countNonZero(scratch);
+    cv::bitwise_and(drawn_here, claimed(box), scratch);
+    const double overlap = cv::countNonZero(scratch);
     if (overlap > kMaxOverlap * drawn || outside > kMaxOutside * drawn) continue;
-    claimed |= shape;
+    cv::Mat claimed_here = claimed(box);
+    cv::bitwise_or(claimed_here, drawn_here, claimed_here);
     Match match;
     match.model = c.model;
     match.region = index;
