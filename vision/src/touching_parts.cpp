@@ -33,7 +33,7 @@ constexpr double kGlanceSlack = 0.1;
 // Curved outlines break into many primitives: the hypotheses come from the
 // most telling few, so that the cost does not grow with their number. A
 // part is found from any one of its corners or arcs that shows.
-constexpr size_t kMaxModelCorners = 24;
+constexpr size_t kMaxModelCorners = 32;
 constexpr size_t kMaxModelArcs = 4;
 // The rotation scan about an arc first steps this far at the model's rim.
 constexpr double kCoarseScanStepPx = 4.0;
@@ -42,11 +42,11 @@ constexpr double kCoarseScanStepPx = 4.0;
 constexpr double kCoarseSlack = 0.25;
 // Rotation scan about an arc's centre: the largest step at the model's rim.
 constexpr double kScanStepPx = 1.5;
-constexpr int kMaxRefinedPerModel = 6;
+constexpr int kMaxRefinedPerModel = 8;
 // Poses refined per blob, for each part the blob can hold: the best
 // screened hypotheses of all models, so that a blob costs about the same
 // whatever the number of trained types.
-constexpr int kRefinedPerPart = 8;
+constexpr int kRefinedPerPart = 12;
 constexpr int kMaxRefinedPerBlob = 48;
 // Edge-fit iterations before the last two read every third edge sample:
 // the pose is still settling there.
