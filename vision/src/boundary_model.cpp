@@ -334,35 +334,97 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
   return samples;
 }
 
+double primitiveDistance(const Primitive& prim, cv::Point2d p) {
+  double d = std::min(std::hypot(p.x - prim.start.x, p.y - prim.start.y),
+                      std::hypot(p.x - prim.end.x, p.y - prim.end.y));
+  if (prim.kind == PrimitiveKind::kLine) {
+    const cv::Point2d v = prim.end - prim.start;
+    const double n2 = v.dot(v);
+    if (n2 > 0) {
+      const double t = (p - prim.start).dot(v) / n2;
+      if (t > 0 && t < 1) d = std::min(d, pointLineDistance(p, prim.start, prim.end));
+    }
+  } else {
+    // On the arc when the point's direction from the centre lies within
+    // the sweep, walked the arc's way from its start.
+    const cv::Point2d r = p - prim.centre;
+    double along = angleOf(r) - angleOf(prim.start - prim.centre);
+    if (prim.sweep_deg < 0) along = -along;
+    along = along - 360.0 * std::floor(along / 360.0);
+    if (along <= std::abs(prim.sweep_deg)) {
+      d = std::min(d, std::abs(std::hypot(r.x, r.y) - prim.radius));
+    }
+  }
+  return d;
+}
+
 double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p) {
   double best = std::numeric_limits<double>::infinity();
   for (const auto& loop : loops) {
-    for (const auto& prim : loop.primitives) {
-      const double to_ends = std::min(std::hypot(p.x - prim.start.x, p.y - prim.start.y),
-                                      std::hypot(p.x - prim.end.x, p.y - prim.end.y));
-      double d = to_ends;
-      if (prim.kind == PrimitiveKind::kLine) {
-        const cv::Point2d v = prim.end - prim.start;
-        const double n2 = v.dot(v);
-        if (n2 > 0) {
-          const double t = (p - prim.start).dot(v) / n2;
-          if (t > 0 && t < 1) d = std::min(d, pointLineDistance(p, prim.start, prim.end));
-        }
-      } else {
-        // On the arc when the point's direction from the centre lies within
-        // the sweep, walked the arc's way from its start.
-        const cv::Point2d r = p - prim.centre;
-        double along = angleOf(r) - angleOf(prim.start - prim.centre);
-        if (prim.sweep_deg < 0) along = -along;
-        along = along - 360.0 * std::floor(along / 360.0);
-        if (along <= std::abs(prim.sweep_deg)) {
-          d = std::min(d, std::abs(std::hypot(r.x, r.y) - prim.radius));
-        }
-      }
-      best = std::min(best, d);
-    }
+    for (const auto& prim : loop.primitives) best = std::min(best, primitiveDistance(prim, p));
   }
   return best;
+}
+
+BoundaryDistanceMap::BoundaryDistanceMap(const std::vector<BoundaryLoop>& loops, double reach,
+                                         double cell)
+    : inv_cell_(1.0 / cell), reach_(static_cast<float>(reach)) {
+  cv::Point2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  cv::Point2d hi = -lo;
+  for (const auto& s : sampleBoundary(loops, cell)) {
+    lo = {std::min(lo.x, s.point.x), std::min(lo.y, s.point.y)};
+    hi = {std::max(hi.x, s.point.x), std::max(hi.y, s.point.y)};
+  }
+  if (!(lo.x <= hi.x)) return;
+  const double margin = reach + 2 * cell;
+  origin_ = lo - cv::Point2d(margin, margin);
+  distance_.create(static_cast<int>(std::ceil((hi.y - lo.y + 2 * margin) * inv_cell_)) + 2,
+                   static_cast<int>(std::ceil((hi.x - lo.x + 2 * margin) * inv_cell_)) + 2, CV_32F);
+  distance_.setTo(reach_);
+  // Each primitive writes its exact distance over its box grown by the
+  // reach: work in proportion to the boundary's length, not the box's area.
+  for (const auto& loop : loops) {
+    for (const auto& prim : loop.primitives) {
+      cv::Point2d a(std::min(prim.start.x, prim.end.x), std::min(prim.start.y, prim.end.y));
+      cv::Point2d b(std::max(prim.start.x, prim.end.x), std::max(prim.start.y, prim.end.y));
+      if (prim.kind == PrimitiveKind::kArc) {
+        // The arc's extreme points may lie beyond its ends: its samples.
+        for (int i = 1; i < 16; ++i) {
+          const cv::Point2d q = prim.pointAt(i / 16.0);
+          a = {std::min(a.x, q.x), std::min(a.y, q.y)};
+          b = {std::max(b.x, q.x), std::max(b.y, q.y)};
+        }
+      }
+      const int x0 =
+          std::max(0, static_cast<int>(std::floor((a.x - reach - origin_.x) * inv_cell_)));
+      const int y0 =
+          std::max(0, static_cast<int>(std::floor((a.y - reach - origin_.y) * inv_cell_)));
+      const int x1 = std::min(distance_.cols - 1,
+                              static_cast<int>(std::ceil((b.x + reach - origin_.x) * inv_cell_)));
+      const int y1 = std::min(distance_.rows - 1,
+                              static_cast<int>(std::ceil((b.y + reach - origin_.y) * inv_cell_)));
+      for (int y = y0; y <= y1; ++y) {
+        float* row = distance_.ptr<float>(y);
+        for (int x = x0; x <= x1; ++x) {
+          const cv::Point2d p = origin_ + cv::Point2d(x * cell, y * cell);
+          row[x] = std::min(row[x], static_cast<float>(primitiveDistance(prim, p)));
+        }
+      }
+    }
+  }
+}
+
+float BoundaryDistanceMap::at(cv::Point2d p) const {
+  const double x = (p.x - origin_.x) * inv_cell_;
+  const double y = (p.y - origin_.y) * inv_cell_;
+  const int x0 = static_cast<int>(std::floor(x));
+  const int y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= distance_.cols || y0 + 1 >= distance_.rows) return reach_;
+  const float fx = static_cast<float>(x - x0);
+  const float fy = static_cast<float>(y - y0);
+  const float* r0 = distance_.ptr<float>(y0) + x0;
+  const float* r1 = distance_.ptr<float>(y0 + 1) + x0;
+  return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
 }
 
 EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
@@ -450,6 +512,17 @@ double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centr
     if (d <= tolerance) on += w;
   });
   return total > 0 ? on / total : 0;
+}
+
+double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
+                        double angle_deg, const EdgeDistance& edges, double clip, bool mirrored) {
+  double sum = 0;
+  double total = 0;
+  forPlaced(samples, centre, angle_deg, edges, mirrored, [&](double w, double d) {
+    total += w;
+    sum += w * std::min<double>(d, clip);
+  });
+  return total > 0 ? sum / total : clip;
 }
 
 }  // namespace picksight::vision

@@ -108,6 +108,9 @@ HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const Image
   const double oc = std::cos(other.angle_deg * kRadPerDeg);
   const double os = std::sin(other.angle_deg * kRadPerDeg);
   const double clip = 2 * m.edge_tolerance;
+  // A map built for a smaller tolerance than the model's now cannot say.
+  const BoundaryDistanceMap* map =
+      m.boundary_map && m.boundary_map->reach() >= clip ? m.boundary_map.get() : nullptr;
   HandEvidence e;
   for (const auto& sample : m.samples) {
     const double py = pose.mirrored ? -sample.point.y : sample.point.y;
@@ -117,8 +120,8 @@ HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const Image
     const cv::Point2d d = x - other.centre;
     cv::Point2d u(oc * d.x + os * d.y, -os * d.x + oc * d.y);
     if (other.mirrored) u.y = -u.y;
-    const double w =
-        sample.weight * handednessWeight(boundaryDistance(m.loops, u), m.edge_tolerance);
+    const double separation = map ? map->at(u) : boundaryDistance(m.loops, u);
+    const double w = sample.weight * handednessWeight(separation, m.edge_tolerance);
     if (w <= 0) continue;
     const double at = edges.at(x);
     e.weight += w;
@@ -164,7 +167,11 @@ bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOp
 
 double huDistance(const BodyModel& body, const HuArray& log_hu) {
   double d = 0;
-  for (size_t i = 0; i < log_hu.size(); ++i) {
+  // Not the 7th invariant: the only one a mirror changes (its sign), and on
+  // a nearly mirror-symmetric part so small that lighting and resampling
+  // set its sign. Which hand a region shows is decided on its boundary
+  // (showsMirrorImage).
+  for (size_t i = 0; i + 1 < log_hu.size(); ++i) {
     if (body.hu_used[i]) d += std::abs(body.log_hu[i] - log_hu[i]);
   }
   return d;
@@ -175,6 +182,10 @@ void prepareModel(PartModel& model) {
   model.radius = 0;
   for (const auto& s : model.samples)
     model.radius = std::max(model.radius, std::hypot(s.point.x, s.point.y));
+  // Farther than twice the tolerance, every distance weighs the same
+  // (handednessWeight).
+  model.boundary_map =
+      std::make_shared<const BoundaryDistanceMap>(model.loops, 2 * model.edge_tolerance + 1.0);
 }
 
 const char* errorName(PartModelErrc e) {

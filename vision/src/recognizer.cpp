@@ -1,11 +1,12 @@
-// Recognition: separated parts through body gates (holes, area, Hu distance,
-// the sign of the 7th invariant), rotation candidates from complex moments
+// Recognition: separated parts through body gates (holes, area, Hu distance),
+// rotation candidates from complex moments
 // and the boundary model verified at each candidate pose; blobs that match
 // no model whole go to the locator of touching parts.
 #include "picksight/vision/recognizer.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include "picksight/common/angles.hpp"
@@ -37,6 +38,16 @@ struct Best {
   double angle_deg = 0;
 };
 
+// The moments' phase is as good as the part's direction is marked: on a
+// nearly symmetric or nearly round part it is off by a degree or more,
+// pixels at the rim. The best candidate is refined by descending the mean
+// edge distance in ever finer turns.
+constexpr double kRefineSpanDeg = 2.0;
+constexpr double kRefineFinestDeg = 0.05;
+// Candidates this far below the verify fraction are not worth refining.
+constexpr double kRefineSlack = 0.3;
+constexpr double kKeepMomentsDeg = 1.0;
+
 Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
             const EdgeDistance& edges, bool mirrored) {
   Best best;
@@ -44,15 +55,62 @@ Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2
     const double s = verifyScore(model.samples, centre, t, edges, model.edge_tolerance, mirrored);
     if (s > best.score) best = {s, t};
   }
+  if (best.score * 100 < model.verify_percent - 100 * kRefineSlack) return best;
+  const double clip = 2 * model.edge_tolerance;
+  const auto cost = [&](double t) {
+    return meanEdgeDistance(model.samples, centre, t, edges, clip, mirrored);
+  };
+  double at = best.angle_deg;
+  double here = cost(at);
+  for (double step = kRefineSpanDeg / 2; step >= kRefineFinestDeg; step /= 2) {
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (double next : {at - step, at + step}) {
+        const double c = cost(next);
+        if (c < here - 1e-12) {
+          here = c;
+          at = next;
+          moved = true;
+        }
+      }
+      if (std::abs(at - best.angle_deg) > kRefineSpanDeg) break;
+    }
+  }
+  // The verification is of the best pose; but where the moments were
+  // close, their angle is the finer estimate (every pixel of the part,
+  // against a distance map on the pixel grid, biased by tenths of a
+  // degree) and is the one reported.
+  const double s = verifyScore(model.samples, centre, at, edges, model.edge_tolerance, mirrored);
+  if (s <= best.score) return best;
+  best.score = s;
+  if (std::abs(at - best.angle_deg) >= kKeepMomentsDeg) best.angle_deg = normalizeDeg(at);
   return best;
 }
 
-// What the recognizer needs of a region, computed on first use.
+// What the recognizer needs of a region, computed on first use: models
+// sharing an orientation order share the region's phase, and all share its
+// edges.
 struct RegionCache {
   bool hu_ready = false;
   HuArray log_hu{};
   std::unique_ptr<EdgeDistance> edges;
+  std::map<int, double> phase_deg;  // by orientation order
 };
+
+double phaseOf(const Region& r, RegionCache& cache, int k) {
+  if (k <= 0) return 0.0;
+  const auto it = cache.phase_deg.find(k);
+  if (it != cache.phase_deg.end()) return it->second;
+  return cache.phase_deg[k] = regionPhaseDeg(r, k);
+}
+
+const HuArray& logHuOf(const Region& r, RegionCache& cache) {
+  if (!cache.hu_ready) {
+    cache.log_hu = logHu(huInvariants(r.moments));
+    cache.hu_ready = true;
+  }
+  return cache.log_hu;
+}
 
 const EdgeDistance& edgesOf(const Region& r, RegionCache& cache, double margin) {
   if (!cache.edges) {
@@ -66,6 +124,35 @@ const EdgeDistance& edgesOf(const Region& r, RegionCache& cache, double margin) 
         2 * margin);
   }
   return *cache.edges;
+}
+}  // namespace
+
+namespace {
+// A region whose body looks like a model's (holes, Hu invariants) at an area
+// between these squared scales is checked for a scaled copy of that model.
+constexpr double kMinCopyScale = 0.6;
+constexpr double kMaxCopyScale = 1.6;
+
+// Whether the region is the model (either hand) scaled by `scale`: its
+// boundary, scaled, verifies on the region's edges.
+bool isScaledCopy(const Region& r, RegionCache& cache, const PartModel& model, double scale,
+                  double max_tolerance) {
+  std::vector<BoundarySample> scaled = model.samples;
+  for (auto& s : scaled) {
+    s.point *= scale;
+  }
+  const EdgeDistance& edges = edgesOf(r, cache, max_tolerance);
+  const int k = model.orientation_order;
+  const double phase = phaseOf(r, cache, k);
+  for (const bool mirrored : {false, true}) {
+    const double model_phase =
+        mirrored ? -model.orientation_phase_deg : model.orientation_phase_deg;
+    for (double t : candidates(phase, model_phase, k)) {
+      const double v = verifyScore(scaled, r.centroid, t, edges, model.edge_tolerance, mirrored);
+      if (v * 100 >= model.verify_percent) return true;
+    }
+  }
+  return false;
 }
 }  // namespace
 
@@ -83,25 +170,26 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
   const Region& r = regions[i];
   RegionCache cache;
   Match best;
+  // The region is one whole part, though of no model as trained (its
+  // mirror image, or a copy of other size): no touching parts to look for.
+  bool whole_part = false;
   for (const PartModel* model : models) {
     const BodyModel& body = model->body;
     if (r.holes != body.holes) continue;
-    if (std::abs(r.area - body.area) > body.area_tolerance * body.area) continue;
-    if (!cache.hu_ready) {
-      cache.log_hu = logHu(huInvariants(r.moments));
-      cache.hu_ready = true;
-    }
-    const double distance = huDistance(body, cache.log_hu);
-    if (distance > body.hu_tolerance) continue;
-    // The 7th invariant changes sign in a mirror: where the model's is
-    // stable, a part with the other sign is the mirror image.
-    if (!body.mirror_symmetric && body.hu_used[6] &&
-        (cache.log_hu[6] >= 0) != (body.log_hu[6] >= 0))
+    const double area_ratio = r.area / body.area;
+    if (std::abs(area_ratio - 1) > body.area_tolerance) {
+      if (!whole_part && area_ratio >= kMinCopyScale * kMinCopyScale &&
+          area_ratio <= kMaxCopyScale * kMaxCopyScale &&
+          huDistance(body, logHuOf(r, cache)) <= body.hu_tolerance) {
+        whole_part = isScaledCopy(r, cache, *model, std::sqrt(area_ratio), max_tolerance);
+      }
       continue;
-
+    }
+    const double distance = huDistance(body, logHuOf(r, cache));
+    if (distance > body.hu_tolerance) continue;
     const EdgeDistance& edges = edgesOf(r, cache, max_tolerance);
     const int k = model->orientation_order;
-    const double phase = k > 0 ? regionPhaseDeg(r, k) : 0.0;
+    const double phase = phaseOf(r, cache, k);
     const Best direct = bestOf(candidates(phase, model->orientation_phase_deg, k), *model,
                                r.centroid, edges, false);
     if (direct.score * 100 < model->verify_percent) continue;
@@ -112,6 +200,7 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
                                  r.centroid, edges, true);
       if (showsMirrorImage(*model, {r.centroid, direct.angle_deg, false},
                            {r.centroid, mirror.angle_deg, true}, edges)) {
+        whole_part = true;
         continue;
       }
     }
@@ -128,6 +217,7 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
     best.body_distance = distance;
   }
   if (best.model) return {best};
+  if (whole_part) return {};
   // No model explains the blob whole: parts that touch, or none.
   return locateInBlob(regions, i, models);
 }

@@ -23,20 +23,42 @@ constexpr double kMinEdgePx = 4;
 constexpr double kMaxChamferPx = 12;
 constexpr double kMinArcSweepDeg = 50;
 constexpr double kMinArcRadiusPx = 4;
-// Hypotheses are screened on this many boundary samples before a full check.
+// Hypotheses are screened on this many boundary samples before a full check,
+// after a first look at a quarter of them.
 constexpr size_t kSparseSamples = 64;
+constexpr size_t kGlanceSamples = 16;
+// The first look's score may fall this far below the screening threshold
+// (16 samples judge a pose more roughly).
+constexpr double kGlanceSlack = 0.1;
+// Curved outlines break into many primitives: the hypotheses come from the
+// most telling few, so that the cost does not grow with their number. A
+// part is found from any one of its corners or arcs that shows.
+constexpr size_t kMaxModelCorners = 32;
+constexpr size_t kMaxModelArcs = 4;
+// The rotation scan about an arc first steps this far at the model's rim.
+constexpr double kCoarseScanStepPx = 4.0;
 // Screening score a hypothesis needs, below the verify fraction: a pose from
 // one corner is a few degrees off, which costs verification at the rim.
 constexpr double kCoarseSlack = 0.25;
 // Rotation scan about an arc's centre: the largest step at the model's rim.
 constexpr double kScanStepPx = 1.5;
-constexpr int kMaxRefinedPerModel = 16;
+constexpr int kMaxRefinedPerModel = 8;
+// Poses refined per blob, for each part the blob can hold: the best
+// screened hypotheses of all models, so that a blob costs about the same
+// whatever the number of trained types.
+constexpr int kRefinedPerPart = 12;
+constexpr int kMaxRefinedPerBlob = 48;
+// Edge-fit iterations before the last two read every third edge sample:
+// the pose is still settling there.
+constexpr int kSparseFitStride = 3;
 // A mirror-image candidate that verifies within this of the direct one
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
 constexpr double kMirrorMargin = 0.03;
-// Parts that touch share at most their contact pixels; a part lies in its blob.
-constexpr double kMaxOverlap = 0.04;
+// Parts that touch share at most their contact pixels, parts that overlap
+// (one lying on another, a quarter of its outline hidden) a fifth of their
+// area; a part lies in its blob.
+constexpr double kMaxOverlap = 0.2;
 constexpr double kMaxOutside = 0.06;
 // Edge samples this close to a primitive's end see the neighbouring edge.
 constexpr double kCornerClearancePx = 2.0;
@@ -83,6 +105,7 @@ struct CornerAnchor {
 struct ArcAnchor {
   cv::Point2d centre;
   double radius = 0;
+  double length = 0;
 };
 
 void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
@@ -123,7 +146,7 @@ void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>
     for (const auto& p : prims) {
       if (p.kind == PrimitiveKind::kArc && std::abs(p.sweep_deg) >= kMinArcSweepDeg &&
           p.radius >= kMinArcRadiusPx) {
-        arcs->push_back({p.centre, p.radius});
+        arcs->push_back({p.centre, p.radius, p.length()});
       }
     }
   }
@@ -223,11 +246,38 @@ std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point
   return best;
 }
 
-std::vector<BoundarySample> sparseSamples(const std::vector<BoundarySample>& all) {
-  const size_t stride = std::max<size_t>(1, all.size() / kSparseSamples);
+std::vector<BoundarySample> sparseSamples(const std::vector<BoundarySample>& all, size_t count) {
+  const size_t stride = std::max<size_t>(1, all.size() / count);
   std::vector<BoundarySample> out;
   for (size_t i = stride / 2; i < all.size(); i += stride) out.push_back(all[i]);
   return out;
+}
+
+// A part lying partly under another shows less of its boundary: what is
+// not on an edge may lie on the other part's body, never on the background.
+// It then needs this much of its boundary on edges, and the verify fraction
+// of what is not hidden.
+constexpr double kMinVisible = 0.7;
+
+// Whether the boundary a pose leaves off the edges lies on the blob's body
+// (hidden by a part lying on it) enough to explain the score.
+bool hiddenUnderOthers(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
+                       const Coverage& coverage, double score) {
+  if (score < kMinVisible) return false;
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  const double flip = pose.mirrored ? -1.0 : 1.0;
+  double on = 0;
+  double missing = 0;
+  for (const auto& sample : m.samples) {
+    const cv::Point2d p = pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s);
+    if (edges.at(p) <= m.edge_tolerance) {
+      on += sample.weight;
+    } else if (coverage.at(p) < 0.5) {
+      missing += sample.weight;
+    }
+  }
+  return on + missing > 0 && on / (on + missing) * 100 >= m.verify_percent;
 }
 
 struct Candidate {
@@ -268,6 +318,23 @@ std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Imag
   return polys;
 }
 
+// The most telling anchors of a model: its sharpest corners and its
+// longest arcs.
+void keepTelling(std::vector<CornerAnchor>* corners, std::vector<ArcAnchor>* arcs) {
+  if (corners->size() > kMaxModelCorners) {
+    std::stable_sort(corners->begin(), corners->end(),
+                     [](const CornerAnchor& a, const CornerAnchor& b) {
+                       return std::abs(180 - a.opening_deg) > std::abs(180 - b.opening_deg);
+                     });
+    corners->resize(kMaxModelCorners);
+  }
+  if (arcs->size() > kMaxModelArcs) {
+    std::stable_sort(arcs->begin(), arcs->end(),
+                     [](const ArcAnchor& a, const ArcAnchor& b) { return a.length > b.length; });
+    arcs->resize(kMaxModelArcs);
+  }
+}
+
 // Screens the poses proposed for one model (direct or mirrored) in a blob.
 void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnchor>& image_corners,
              const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
@@ -275,39 +342,55 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
   std::vector<CornerAnchor> corners;
   std::vector<ArcAnchor> arcs;
   anchorsOf(model.loops, &corners, &arcs);
-  const auto sparse = sparseSamples(model.samples);
+  keepTelling(&corners, &arcs);
+  const auto sparse = sparseSamples(model.samples, kSparseSamples);
+  const auto glance = sparseSamples(model.samples, kGlanceSamples);
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double f = mirrored ? -1.0 : 1.0;
-  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle) {
+  // The pose putting model point `model_point` on `image_point` turned by
+  // `angle`, scored on `samples`.
+  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
+                          const std::vector<BoundarySample>& samples) {
     const double c = std::cos(angle * kRadPerDeg);
     const double s = std::sin(angle * kRadPerDeg);
     const cv::Point2d centre = image_point - rotate({model_point.x, f * model_point.y}, c, s);
-    const double score = verifyScore(sparse, centre, angle, edges, model.edge_tolerance, mirrored);
+    const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, mirrored);
     return Candidate{&model, ImagePose{centre, normalizeDeg(angle), mirrored}, score, 0};
   };
   for (const auto& mc : corners) {
     for (const auto& ic : image_corners) {
       if (mc.convex != ic.convex) continue;
       if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
-      const Candidate c = screen(mc.at, ic.at, ic.bisector_deg - f * mc.bisector_deg);
+      const double angle = ic.bisector_deg - f * mc.bisector_deg;
+      if (screen(mc.at, ic.at, angle, glance).score < threshold - kGlanceSlack) continue;
+      const Candidate c = screen(mc.at, ic.at, angle, sparse);
       if (c.score >= threshold) out->push_back(c);
     }
   }
-  // An arc fixes where its centre goes; the rotation about it is scanned,
-  // keeping the local maxima of the screening score.
-  const double step = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
-  const int steps = static_cast<int>(std::ceil(360.0 / step));
-  std::vector<Candidate> scan(static_cast<size_t>(steps));
+  // An arc fixes where its centre goes; the rotation about it is scanned
+  // coarsely at a glance, and around each promising step finely.
+  const double fine = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
+  const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
+  const int steps = static_cast<int>(std::ceil(360.0 / coarse));
+  std::vector<double> scan(static_cast<size_t>(steps));
   for (const auto& ma : arcs) {
     for (const auto& ia : image_arcs) {
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
-      for (int k = 0; k < steps; ++k) scan[k] = screen(ma.centre, ia.centre, k * 360.0 / steps);
+      for (int k = 0; k < steps; ++k)
+        scan[k] = screen(ma.centre, ia.centre, k * 360.0 / steps, glance).score;
       for (int k = 0; k < steps; ++k) {
-        const double s = scan[k].score;
-        if (s >= threshold && s >= scan[(k + steps - 1) % steps].score &&
-            s > scan[(k + 1) % steps].score) {
-          out->push_back(scan[k]);
+        const double s = scan[k];
+        if (s < threshold - kGlanceSlack || s < scan[(k + steps - 1) % steps] ||
+            s <= scan[(k + 1) % steps]) {
+          continue;
         }
+        Candidate best;
+        best.score = -1;
+        for (double a = k * 360.0 / steps - coarse; a <= k * 360.0 / steps + coarse; a += fine) {
+          const Candidate c = screen(ma.centre, ia.centre, a, sparse);
+          if (c.score > best.score) best = c;
+        }
+        if (best.score >= threshold) out->push_back(best);
       }
     }
   }
@@ -338,7 +421,9 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     double found = 0;
     double sum2 = 0;
     int used = 0;
-    for (const auto& e : samples) {
+    const size_t stride = it < iterations - 2 ? kSparseFitStride : 1;
+    for (size_t i = 0; i < samples.size(); i += stride) {
+      const EdgeSample& e = samples[i];
       const cv::Point2d r = rotate({e.point.x, flip * e.point.y}, c, s);
       const cv::Point2d n = rotate({e.normal.x, flip * e.normal.y}, c, s);
       const auto crossing = edgeCrossing(cov, fit.pose.centre + r, n, window, offset, step);
@@ -355,7 +440,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     if (used < 8) return fit;
     const double rms = std::sqrt(sum2 / used);
     fit.rms_px = rms;
-    fit.inlier_fraction = found / total;
+    fit.inlier_fraction = found * static_cast<double>(stride) / total;
     if (measure_only) break;
     cv::Vec4d x;
     if (!cv::solve(a, b, x, cv::DECOMP_CHOLESKY)) return fit;
@@ -458,35 +543,48 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   std::vector<ArcAnchor> image_arcs;
   anchorsOf(fitLoops(loops2d, conformity), &image_corners, &image_arcs);
 
-  std::vector<Candidate> direct;
-  std::vector<Candidate> mirror;
+  // The best screened poses of each model and hand, then the best of all.
+  std::vector<Candidate> screened;
+  double smallest = region.area;
   for (const PartModel* m : fitting) {
+    smallest = std::min(smallest, m->body.area);
     for (const bool mirrored : {false, true}) {
       if (mirrored && m->body.mirror_symmetric) continue;
       std::vector<Candidate> proposed;
       propose(*m, mirrored, image_corners, image_arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-      std::vector<ImagePose> tried;
-      std::vector<Candidate> refined;
+      std::vector<ImagePose> kept;
       for (const auto& p : proposed) {
-        if (static_cast<int>(tried.size()) >= kMaxRefinedPerModel) break;
+        if (static_cast<int>(kept.size()) >= kMaxRefinedPerModel) break;
         const auto near = [&](const ImagePose& q) { return samePose(*m, p.pose, q, 2.0, 3.0); };
-        if (std::any_of(tried.begin(), tried.end(), near)) continue;
-        tried.push_back(p.pose);
-        const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
-        if (!fit.ok) continue;
-        const auto same = [&](const Candidate& q) {
-          return samePose(*m, fit.pose, q.pose, 1.0, 1.0);
-        };
-        if (std::any_of(refined.begin(), refined.end(), same)) continue;
-        const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
-                                         m->edge_tolerance, mirrored);
-        refined.push_back({m, fit.pose, score, fit.rms_px});
+        if (std::any_of(kept.begin(), kept.end(), near)) continue;
+        kept.push_back(p.pose);
+        screened.push_back(p);
       }
-      auto& to = mirrored ? mirror : direct;
-      to.insert(to.end(), refined.begin(), refined.end());
     }
+  }
+  std::stable_sort(screened.begin(), screened.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  const int parts = std::max(1, static_cast<int>(region.area / std::max(smallest, 1.0)));
+  const auto budget =
+      static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
+  if (screened.size() > budget) screened.resize(budget);
+
+  std::vector<Candidate> direct;
+  std::vector<Candidate> mirror;
+  for (const auto& p : screened) {
+    const PartModel* m = p.model;
+    const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
+    if (!fit.ok) continue;
+    auto& to = p.pose.mirrored ? mirror : direct;
+    const auto same = [&](const Candidate& q) {
+      return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
+    };
+    if (std::any_of(to.begin(), to.end(), same)) continue;
+    const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
+                                     m->edge_tolerance, p.pose.mirrored);
+    to.push_back({m, fit.pose, score, fit.rms_px});
   }
 
   // Best first; among equal scores the closer fit to the grey-level edges.
@@ -505,9 +603,13 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
               cv::CMP_GE);
   cv::Mat claimed(inside.size(), CV_8UC1, cv::Scalar(0));
   cv::Mat shape(inside.size(), CV_8UC1);
+  const Coverage coverage(region);
   for (const auto& c : direct) {
     const PartModel& m = *c.model;
-    if (c.score * 100 < m.verify_percent) continue;
+    if (c.score * 100 < m.verify_percent &&
+        !hiddenUnderOthers(m, c.pose, edges, coverage, c.score)) {
+      continue;
+    }
     const bool mirror_as_good = std::any_of(mirror.begin(), mirror.end(), [&](const Candidate& q) {
       return q.model == c.model &&
              std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
@@ -515,14 +617,25 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     });
     if (mirror_as_good) continue;
-    shape.setTo(0);
-    cv::fillPoly(shape, placedOutline(m, c.pose, origin), cv::Scalar(255));
-    const int drawn = cv::countNonZero(shape);
+    // Only the placed part's box of the canvas is read and written.
+    const auto outline = placedOutline(m, c.pose, origin);
+    cv::Rect box;
+    for (const auto& poly : outline) box |= cv::boundingRect(poly);
+    box = (box + cv::Size(1, 1)) & cv::Rect(cv::Point(0, 0), shape.size());
+    if (box.empty()) continue;
+    cv::Mat drawn_here = shape(box);
+    drawn_here.setTo(0);
+    cv::fillPoly(drawn_here, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
+    const int drawn = cv::countNonZero(drawn_here);
     if (drawn <= 0) continue;
-    const double outside = cv::countNonZero(shape & ~inside);
-    const double overlap = cv::countNonZero(shape & claimed);
+    cv::Mat scratch;
+    cv::bitwise_and(drawn_here, ~inside(box), scratch);
+    const double outside = cv::countNonZero(scratch);
+    cv::bitwise_and(drawn_here, claimed(box), scratch);
+    const double overlap = cv::countNonZero(scratch);
     if (overlap > kMaxOverlap * drawn || outside > kMaxOutside * drawn) continue;
-    claimed |= shape;
+    cv::Mat claimed_here = claimed(box);
+    cv::bitwise_or(claimed_here, drawn_here, claimed_here);
     Match match;
     match.model = c.model;
     match.region = index;

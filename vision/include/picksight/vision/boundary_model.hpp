@@ -84,6 +84,28 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
 // for comparing a model with itself turned or mirrored.
 double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p);
 
+// Distance (pixels) from `p` to one primitive.
+double primitiveDistance(const Primitive& prim, cv::Point2d p);
+
+// boundaryDistance on a grid, for asking it of many points: exact at the
+// grid nodes up to `reach` pixels from the boundary (`reach` farther, and
+// outside the grid), bilinear between nodes `cell` pixels apart. Built once
+// per model; immutable, so any number of threads may read it.
+class BoundaryDistanceMap {
+ public:
+  BoundaryDistanceMap() = default;
+  BoundaryDistanceMap(const std::vector<BoundaryLoop>& loops, double reach, double cell = 0.5);
+  float at(cv::Point2d p) const;
+  bool empty() const { return distance_.empty(); }
+  float reach() const { return reach_; }
+
+ private:
+  cv::Mat distance_;  // CV_32F
+  cv::Point2d origin_;
+  double inv_cell_ = 2.0;
+  float reach_ = 0;
+};
+
 // Distance to the nearest boundary pixel of a set of contours, over a region
 // of interest; the image edges a pose is verified against.
 class EdgeDistance {
@@ -108,5 +130,12 @@ class EdgeDistance {
 // moved to `centre`. `mirrored` reflects the samples (y -> -y) first.
 double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
                    const EdgeDistance& edges, double tolerance, bool mirrored = false);
+
+// The weighted mean of the samples' edge distances, each clipped at `clip`,
+// at the same pose as verifyScore: unlike the verified fraction it changes
+// smoothly with the pose, for searching the best one.
+double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
+                        double angle_deg, const EdgeDistance& edges, double clip,
+                        bool mirrored = false);
 
 }  // namespace picksight::vision

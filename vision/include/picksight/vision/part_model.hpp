@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,10 +30,9 @@ struct BodyModel {
   double hu_tolerance = 1.0;  // on sum_i |H_i(a) - H_i(b)| over the used invariants
   // A part that equals its mirror image (after a turn): its boundary and the
   // mirror image's, lined up, lie apart by less than 3 px of length. A part
-  // that does not is never matched to its mirror image: the 7th invariant
-  // changes sign (where it is stable), and where the two boundaries differ,
-  // however little of the outline that is, the mirror image fits the edges
-  // better (showsMirrorImage).
+  // that does not is never matched to its mirror image: where the two
+  // boundaries differ, however little of the outline that is, the mirror
+  // image fits the edges better (showsMirrorImage).
   bool mirror_symmetric = false;
 };
 
@@ -65,6 +65,11 @@ struct PartModel {
   // Derived by prepareModel (not stored).
   std::vector<BoundarySample> samples;
   double radius = 0;  // of the boundary about the origin
+  // Distance to the boundary in the model frame, up to twice the edge
+  // tolerance: what tells the two hands apart (showsMirrorImage), at the
+  // cost of a lookup however many primitives the boundary has. Shared
+  // between copies of the model; read-only.
+  std::shared_ptr<const BoundaryDistanceMap> boundary_map;
 
   // Period of the reported rotation: 360 / symmetry order, 0 for any.
   double symmetryDeg() const { return symmetry_order == 0 ? 0.0 : 360.0 / symmetry_order; }
@@ -117,7 +122,8 @@ bool showsMirrorImage(const PartModel& model, const ImagePose& direct, const Ima
 // what is wrong.
 Result<void> validateModel(const PartModel& model);
 
-// Sum |H_i(a) - H_i(b)| over the invariants the model uses.
+// Sum |H_i(a) - H_i(b)| over the invariants the model uses, the 7th (the
+// mirror's sign) left out.
 double huDistance(const BodyModel& body, const HuArray& log_hu);
 
 }  // namespace picksight::vision
