@@ -131,7 +131,6 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
                cv::Size(std::max(1, grey.cols / reduce), std::max(1, grey.rows / reduce)), 0, 0,
                cv::INTER_AREA);
   }
-  if (window <= 0) window = std::min(grey.cols, grey.rows) / 6;
   const int k = std::max(3, (window / reduce) | 1);
   cv::Mat background;
   cv::dilate(small, background, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)),
@@ -185,6 +184,18 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
 }
 }  // namespace
 
+int adaptiveWindow(cv::Size size, const BinarizeOptions& options) {
+  return options.adaptive_window > 0 ? options.adaptive_window
+                                     : std::min(size.width, size.height) / 6;
+}
+
+int windowForPart(double radius) {
+  // The maximum filter reaches half a window from a pixel, and the blur after
+  // it averages over another window: a margin of a quarter of the part keeps
+  // the blurred estimate on the background level.
+  return static_cast<int>(std::ceil(2.5 * std::max(radius, 0.0))) + 8;
+}
+
 cv::Mat binarize(const cv::Mat& grey, const BinarizeOptions& options) {
   CV_Assert(grey.type() == CV_8UC1);
   // Light parts on a dark background are dark parts on a light one, inverted.
@@ -208,7 +219,7 @@ cv::Mat binarize(const cv::Mat& grey, const BinarizeOptions& options) {
       cv::threshold(input, mask, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
       break;
     case ThresholdMethod::kAdaptive:
-      mask = adaptive(input, options.adaptive_window);
+      mask = adaptive(input, adaptiveWindow(input.size(), options));
       break;
   }
   return mask;

@@ -214,12 +214,21 @@ Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& n
         PartModelErrc::kSeveralParts,
         std::to_string(regions.size()) + " parts in the image, training needs exactly one");
   }
-  const Region& r = regions.front();
+  return trainModelFromRegion(grey, regions.front(), type, name, options);
+}
+
+Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int type,
+                                       const std::string& name, const TrainOptions& options) {
+  if (grey.empty() || grey.type() != CV_8UC1) {
+    return makeError(PartModelErrc::kNotGrey, "the training image must be 8-bit grey");
+  }
   PartModel m;
   m.type = type;
   m.name = name;
   m.trained_centroid = r.centroid;
   m.trained_angle_deg = r.angle_deg;
+  m.min_region_area = options.regions.min_area;
+  m.min_hole_area = options.regions.min_hole_area;
   m.conformity = options.conformity;
   m.verify_percent = options.verify_percent;
   m.edge_tolerance = options.conformity + 1.0;
@@ -322,6 +331,32 @@ Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& n
   return m;
 }
 
+PartModel scaledModel(const PartModel& model, double scale) {
+  PartModel m = model;
+  const double area = scale * scale;
+  m.body.area *= area;
+  m.min_region_area *= area;
+  m.min_hole_area *= area;
+  for (auto& loop : m.loops) {
+    for (auto& p : loop.primitives) {
+      p.start *= scale;
+      p.end *= scale;
+      p.centre *= scale;
+      p.radius *= scale;
+    }
+  }
+  const auto scaled = [scale](Range r) { return Range{r.min * scale, r.max * scale}; };
+  for (auto& c : m.corners) {
+    c.at *= scale;
+    c.length_in = scaled(c.length_in);
+    c.length_out = scaled(c.length_out);
+    c.radius_in = scaled(c.radius_in);
+    c.radius_out = scaled(c.radius_out);
+  }
+  prepareModel(m);
+  return m;
+}
+
 namespace {
 // What is wrong with a model; empty when nothing is.
 std::string modelProblem(const PartModel& m) {
@@ -332,6 +367,10 @@ std::string modelProblem(const PartModel& m) {
     return "area tolerance must be in (0, 1)";
   }
   if (m.body.holes < 0 || m.body.holes > 10000) return "hole count out of range";
+  if (!finite(m.min_region_area) || m.min_region_area < 0 || !finite(m.min_hole_area) ||
+      m.min_hole_area < 0) {
+    return "minimum region and hole areas must be numbers >= 0";
+  }
   for (double h : m.body.log_hu) {
     if (!finite(h)) return "log Hu invariants must be finite";
   }

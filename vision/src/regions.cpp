@@ -282,8 +282,11 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
       r.touches_border =
           bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
       r.outer = std::move(contours[i]);
-      for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0])
+      for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
+        if (options.min_hole_area > 0 && cv::contourArea(contours[h]) < options.min_hole_area)
+          continue;
         r.hole_boundaries.push_back(std::move(contours[h]));
+      }
       r.holes = static_cast<int>(r.hole_boundaries.size());
 
       if (!grey.empty() && greyMoments(grey(box), own, mask(box), box, &r.moments, &r.centroid,

@@ -26,6 +26,7 @@ struct RawOptions {
   std::string polarity;
   std::string window;
   std::string min_area;
+  std::string min_hole_area;
   std::string config_file;
   std::string modbus_port;
   std::string modbus_unit;
@@ -135,6 +136,14 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
         auto m = parseDouble(v);
         return m && *m >= 1 ? std::string() : "must be a number >= 1, got '" + v + "'";
       }));
+  app.add_option("--min-hole-area", raw.min_hole_area,
+                 "smallest hole (sensor pixels) counted in a part (default 0: every hole)")
+      ->type_name("PIXELS")
+      ->check(checkValue([](const std::string& v) {
+        auto m = parseDouble(v);
+        return m && *m >= 0 && *m <= 1e9 ? std::string()
+                                         : "must be a number in [0, 1e9], got '" + v + "'";
+      }));
   app.add_option("--modbus-port", raw.modbus_port,
                  "TCP port of the PLC (Modbus TCP) server; absent = no PLC port, 0 = any free")
       ->type_name("PORT")
@@ -235,6 +244,7 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   if (!raw.window.empty())
     o.vision.binarize.adaptive_window = static_cast<int>(*parseInt(raw.window));
   if (!raw.min_area.empty()) o.vision.regions.min_area = *parseDouble(raw.min_area);
+  if (!raw.min_hole_area.empty()) o.vision.regions.min_hole_area = *parseDouble(raw.min_hole_area);
   o.plc.enabled = !raw.modbus_port.empty();
   if (o.plc.enabled) o.plc.server.port = static_cast<uint16_t>(*parseInt(raw.modbus_port));
   if (!raw.modbus_unit.empty())

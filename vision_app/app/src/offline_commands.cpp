@@ -173,23 +173,22 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
         err << "picksight-vision learn: name must be 1-32 of A-Z a-z 0-9 _ - .\n";
         return 2;
       }
-      vision::TrainOptions train;
-      train.binarize = options->vision.binarize;
-      train.regions = options->vision.regions;
-      const auto trained = vision::trainModel(grey, type, name, train);
-      if (!trained) {
-        out << errorReply(trained.error()) << "\n";
+      // As LEARN does it: the whole image binarized the way LOCATE will see it.
+      const SensorMapping full;
+      const auto learned =
+          learnInImage(grey, full, options->vision, library.snapshot(), type, name, std::nullopt);
+      if (!learned) {
+        out << errorReply(learned.error()) << "\n";
         return 1;
       }
-      auto stored = library.store(*trained);
+      auto stored = library.store(learned->model);
       if (!stored) {
         out << errorReply(VisionErrc::kStorageFailed,
                           "cannot store the model: " + stored.error().message)
             << "\n";
         return 1;
       }
-      out << "OK " << modelSummary(*trained) << " " << (trained->body.mirror_symmetric ? "1" : "0")
-          << "\n";
+      out << learnReply(*learned) << "\n";
     } else if (command == "locate") {
       // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
       const LocateOutcome outcome =

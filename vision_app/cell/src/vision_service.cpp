@@ -5,7 +5,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 
+#include "picksight/common/text.hpp"
 #include "picksight/vision/recognizer.hpp"
 
 namespace picksight::app {
@@ -22,6 +24,12 @@ const char* errorName(VisionErrc e) {
       return "unknown type";
     case VisionErrc::kStorageFailed:
       return "storage failed";
+    case VisionErrc::kOutsideFrame:
+      return "outside the frame";
+    case VisionErrc::kNoPartInRectangle:
+      return "no part in the rectangle";
+    case VisionErrc::kSeveralPartsInRectangle:
+      return "several parts in the rectangle";
   }
   return "unknown";
 }
@@ -83,13 +91,57 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
   return parts;
 }
 
+namespace {
+// Frame pixels per sensor pixel along no particular axis.
+double frameScale(const SensorMapping& mapping) {
+  return std::sqrt(mapping.scale_x * mapping.scale_y);
+}
+
+// Below this relative change a resize is none: the models are used as they are.
+constexpr double kSameScale = 1e-9;
+}  // namespace
+
+std::shared_ptr<const ModelList> modelsForFrame(std::shared_ptr<const ModelList> models,
+                                                const SensorMapping& mapping) {
+  if (!models) return std::make_shared<const ModelList>();
+  const double scale = frameScale(mapping);
+  if (std::abs(scale - 1.0) < kSameScale || models->empty()) return models;
+  auto scaled = std::make_shared<ModelList>();
+  scaled->reserve(models->size());
+  for (const auto& m : *models) scaled->push_back(vision::scaledModel(m, scale));
+  return scaled;
+}
+
+VisionOptions frameOptions(const VisionOptions& options, const SensorMapping& mapping,
+                           cv::Size image, const ModelList& frame_models) {
+  VisionOptions o = options;
+  const double area = mapping.scale_x * mapping.scale_y;
+  o.regions.min_area *= area;
+  o.regions.min_hole_area *= area;
+  if (o.binarize.adaptive_window > 0) {
+    o.binarize.adaptive_window = std::max(
+        8, static_cast<int>(std::lround(o.binarize.adaptive_window * frameScale(mapping))));
+  }
+  double radius = 0;
+  for (const auto& m : frame_models) radius = std::max(radius, m.radius);
+  // The automatic window is a share of the image, which a crop shrinks
+  // below the parts it still shows.
+  if (radius > 0) {
+    o.binarize.adaptive_window =
+        std::max(vision::adaptiveWindow(image, o.binarize), vision::windowForPart(radius));
+  }
+  return o;
+}
+
 LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
                             std::shared_ptr<const ModelList> models, int type) {
   LocateOutcome outcome;
   outcome.frame = frame.info;
-  outcome.scene.models = models ? std::move(models) : std::make_shared<const ModelList>();
-  outcome.parts = locateInImage(greyImage(frame), frame.mapping, options, *outcome.scene.models,
-                                type, &outcome.scene);
+  outcome.scene.models = modelsForFrame(std::move(models), frame.mapping);
+  const cv::Mat grey = greyImage(frame);
+  outcome.parts = locateInImage(
+      grey, frame.mapping, frameOptions(options, frame.mapping, grey.size(), *outcome.scene.models),
+      *outcome.scene.models, type, &outcome.scene);
   return outcome;
 }
 
@@ -159,21 +211,150 @@ Result<LocateOutcome> VisionService::locate(int type) {
   return locateInFrame(**frame, options_, models, type);
 }
 
-Result<vision::PartModel> VisionService::learn(int type, const std::string& name) {
+Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
+                                          const std::optional<cv::Rect>& at) {
   if (!models_) return makeError(VisionErrc::kStorageFailed, "no model library");
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  vision::TrainOptions train;
-  train.binarize = options_.binarize;
-  train.regions = options_.regions;
-  auto trained = vision::trainModel(greyImage(**frame), type, name, train);
-  if (!trained) return trained.error();
-  auto stored = models_->store(*trained);
+  auto learned = learnInImage(greyImage(**frame), (*frame)->mapping, options_, models_->snapshot(),
+                              type, name, at);
+  if (!learned) return learned.error();
+  auto stored = models_->store(learned->model);
   if (!stored)
     return makeError(VisionErrc::kStorageFailed,
                      "cannot store the model: " + stored.error().message);
-  return trained;
+  return learned;
+}
+
+namespace {
+// A region counts as inside LEARN's rectangle when this share of its box is.
+constexpr double kInsideShare = 0.5;
+// Holes below this share of the part's area look like noise or phantom holes.
+constexpr double kSmallHoleShare = 0.005;
+// A part under this many times the minimum region area is barely resolved.
+constexpr double kSmallPartFactor = 10;
+
+// A rectangle of sensor pixels as the frame pixels it covers, clipped to
+// the image (empty when it covers none).
+cv::Rect frameRect(const cv::Rect& sensor, const SensorMapping& m, cv::Size image) {
+  // Pixel edges: sensor edge x - 0.5 is frame edge (x - roi_x) * scale - 0.5.
+  const auto lo = [](double v) { return static_cast<int>(std::floor(v + 1e-9)); };
+  const auto hi = [](double v) { return static_cast<int>(std::ceil(v - 1e-9)); };
+  const int u0 = lo((sensor.x - m.roi_x) * m.scale_x);
+  const int v0 = lo((sensor.y - m.roi_y) * m.scale_y);
+  const int u1 = hi((sensor.x + sensor.width - m.roi_x) * m.scale_x);
+  const int v1 = hi((sensor.y + sensor.height - m.roi_y) * m.scale_y);
+  return cv::Rect(u0, v0, u1 - u0, v1 - v0) & cv::Rect(cv::Point(0, 0), image);
+}
+
+// The regions (indices) inside `rect`: those clear of the frame border, or
+// when there are none, those touching it.
+std::vector<size_t> regionsInside(const std::vector<vision::Region>& regions,
+                                  const cv::Rect& rect) {
+  std::vector<size_t> clear;
+  std::vector<size_t> border;
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const cv::Rect& box = regions[i].bbox;
+    if ((box & rect).area() < kInsideShare * box.area()) continue;
+    (regions[i].touches_border ? border : clear).push_back(i);
+  }
+  return clear.empty() ? border : clear;
+}
+
+double farthestBoundary(const vision::Region& r) {
+  double reach = 0;
+  for (const auto& p : r.outer)
+    reach = std::max(reach, std::hypot(p.x - r.centroid.x, p.y - r.centroid.y));
+  return reach;
+}
+
+std::string sensorRectText(const cv::Rect& r) {
+  return std::to_string(r.x) + " " + std::to_string(r.y) + " " + std::to_string(r.width) + " " +
+         std::to_string(r.height);
+}
+
+// What looks wrong with a part about to be learned (sensor pixels in the text).
+std::vector<std::string> learnWarnings(const vision::Region& r, const SensorMapping& mapping,
+                                       const VisionOptions& options) {
+  std::vector<std::string> warnings;
+  const double small_hole = kSmallHoleShare * r.area;
+  int small = 0;
+  for (const auto& hole : r.hole_boundaries) small += cv::contourArea(hole) < small_hole ? 1 : 0;
+  if (small > 0) {
+    warnings.push_back(std::to_string(small) + (small == 1 ? " hole" : " holes") +
+                       " smaller than " +
+                       std::to_string(std::lround(mapping.areaToSensor(small_hole))) +
+                       " px (noise or uneven light? every LOCATE needs the same count)");
+  }
+  if (r.touches_border) warnings.push_back("the part touches the frame border");
+  const double area = mapping.areaToSensor(r.area);
+  if (area < kSmallPartFactor * std::max(1.0, options.regions.min_area)) {
+    warnings.push_back("area " + std::to_string(std::lround(area)) + " px is under " +
+                       formatFixed(kSmallPartFactor, 0) + " times the minimum region area");
+  }
+  return warnings;
+}
+}  // namespace
+
+Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapping,
+                                  const VisionOptions& options,
+                                  std::shared_ptr<const ModelList> models, int type,
+                                  const std::string& name, const std::optional<cv::Rect>& at) {
+  const cv::Rect rect = at ? frameRect(*at, mapping, grey.size()) : cv::Rect({0, 0}, grey.size());
+  if (rect.empty()) {
+    return makeError(VisionErrc::kOutsideFrame,
+                     "LEARN AT " + sensorRectText(*at) +
+                         ": the rectangle holds no pixel of the frame (sensor " +
+                         sensorRectText(mapping.boxToSensor(cv::Rect({0, 0}, grey.size()))) + ")");
+  }
+  const auto frame_models = modelsForFrame(std::move(models), mapping);
+  VisionOptions o = frameOptions(options, mapping, grey.size(), *frame_models);
+  o.regions.keep_border_regions = true;
+  for (int pass = 0;; ++pass) {
+    const auto regions = vision::findRegions(vision::binarize(grey, o.binarize), o.regions, grey);
+    const auto inside = regionsInside(regions, rect);
+    if (inside.empty()) {
+      if (!at) return makeError(vision::PartModelErrc::kNoPart, "no part in the frame");
+      return makeError(VisionErrc::kNoPartInRectangle,
+                       "no part inside LEARN AT " + sensorRectText(*at));
+    }
+    if (inside.size() > 1) {
+      const std::string count = std::to_string(inside.size()) + " parts";
+      if (!at) {
+        return makeError(vision::PartModelErrc::kSeveralParts,
+                         count + " in the frame, LEARN needs exactly one (or LEARN ... AT)");
+      }
+      return makeError(
+          VisionErrc::kSeveralPartsInRectangle,
+          count + " inside LEARN AT " + sensorRectText(*at) + ", it needs exactly one");
+    }
+    const vision::Region& r = regions[inside.front()];
+    // A window narrower than the part (a tight crop, a small image) breaks
+    // its middle into phantom holes: binarize again with one that fits it,
+    // as LOCATE will once the model exists.
+    const int needed = vision::windowForPart(farthestBoundary(r));
+    if (pass == 0 && o.binarize.method == vision::ThresholdMethod::kAdaptive &&
+        vision::adaptiveWindow(grey.size(), o.binarize) < needed) {
+      o.binarize.adaptive_window = needed;
+      continue;
+    }
+    vision::TrainOptions train;
+    train.binarize = o.binarize;
+    train.regions = o.regions;
+    auto trained = vision::trainModelFromRegion(grey, r, type, name, train);
+    if (!trained) return trained.error();
+    LearnOutcome out;
+    const double scale = frameScale(mapping);
+    out.model = std::abs(scale - 1.0) < kSameScale ? std::move(*trained)
+                                                   : vision::scaledModel(*trained, 1.0 / scale);
+    out.model.trained_centroid = mapping.toSensor(r.centroid);
+    out.model.trained_angle_deg = mapping.directionToSensor(r.angle_deg);
+    out.model.min_region_area = options.regions.min_area;
+    out.model.min_hole_area = options.regions.min_hole_area;
+    out.warnings = learnWarnings(r, mapping, options);
+    return out;
+  }
 }
 
 Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {

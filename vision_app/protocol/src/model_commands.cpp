@@ -1,7 +1,10 @@
 // LEARN, MODELS, FORGET and BLOBS.
 #include "picksight/protocol/model_commands.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <optional>
+#include <vector>
 
 #include "picksight/common/text.hpp"
 
@@ -21,6 +24,14 @@ std::string modelSummary(const vision::PartModel& m) {
          std::to_string(m.body.holes) + " " + formatFixed(m.symmetryDeg());
 }
 
+std::string learnReply(const LearnOutcome& learned) {
+  std::string reply =
+      "OK " + modelSummary(learned.model) + " " + (learned.model.body.mirror_symmetric ? "1" : "0");
+  // Robots read the fields up to the first ';' and may ignore the rest.
+  for (const auto& w : learned.warnings) reply += " ; warning: " + w;
+  return reply;
+}
+
 std::string blobSummary(const vision::BlobFeatures& b) {
   std::string s = formatFixed(b.centroid.x) + " " + formatFixed(b.centroid.y) + " " +
                   formatFixed(b.angle_deg) + " " + formatFixed(b.area) + " " +
@@ -32,25 +43,59 @@ std::string blobSummary(const vision::BlobFeatures& b) {
   return s;
 }
 
+namespace {
+// Bound on LEARN AT's numbers: larger than any sensor, small enough that
+// no sum of them overflows.
+constexpr int kMaxSensorPx = 65535;
+
+// Four integers from args[first]: x y w h, bounded (see kMaxSensorPx).
+std::optional<cv::Rect> parseRect(const std::vector<std::string>& args, size_t first) {
+  int v[4];
+  for (size_t i = 0; i < 4; ++i) {
+    const auto n = parseInt(args[first + i]);
+    if (!n || *n < (i < 2 ? 0 : 1) || *n > kMaxSensorPx) return std::nullopt;
+    v[i] = static_cast<int>(*n);
+  }
+  return cv::Rect(v[0], v[1], v[2], v[3]);
+}
+}  // namespace
+
 void addModelCommands(CommandTable& table, VisionService& vision) {
-  table.add("LEARN", "LEARN <type> [name]", [&vision](const Request& r) {
-    if (r.args.empty() || r.args.size() > 2)
-      return errorReply(ProtocolErrc::kBadArguments, "usage: LEARN <type> [name]");
-    const auto type = parseType(r.args[0]);
+  table.add("LEARN", "LEARN <type> [name] [AT <x> <y> <w> <h>]", [&vision](const Request& r) {
+    constexpr const char* kUsage = "usage: LEARN <type> [name] [AT <x> <y> <w> <h>]";
+    // "AT" and its four numbers close the line; a name comes before them.
+    std::vector<std::string> args = r.args;
+    std::optional<cv::Rect> at;
+    const auto keyword = std::find(args.begin(), args.end(), "AT");
+    if (keyword != args.end()) {
+      if (args.end() - keyword != 5) {
+        return errorReply(ProtocolErrc::kBadArguments, "LEARN: AT needs <x> <y> <w> <h>");
+      }
+      const auto rect = parseRect(args, static_cast<size_t>(keyword - args.begin()) + 1);
+      if (!rect) {
+        return errorReply(ProtocolErrc::kBadArguments,
+                          "LEARN: AT x y in [0, " + std::to_string(kMaxSensorPx) +
+                              "], w h in [1, " + std::to_string(kMaxSensorPx) + "] sensor pixels");
+      }
+      at = rect;
+      args.erase(keyword, args.end());
+    }
+    if (args.empty() || args.size() > 2) return errorReply(ProtocolErrc::kBadArguments, kUsage);
+    const auto type = parseType(args[0]);
     if (!type) {
       return errorReply(
           ProtocolErrc::kBadArguments,
-          "LEARN: type must be an integer in [0, 9999], got '" + printable(r.args[0]) + "'");
+          "LEARN: type must be an integer in [0, 9999], got '" + printable(args[0]) + "'");
     }
-    const std::string name = r.args.size() > 1 ? r.args[1] : "type" + std::to_string(*type);
+    const std::string name = args.size() > 1 ? args[1] : "type" + std::to_string(*type);
     if (!validModelName(name)) {
       return errorReply(
           ProtocolErrc::kBadArguments,
           "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" + printable(name) + "'");
     }
-    auto model = vision.learn(*type, name);
-    if (!model) return errorReply(model.error());
-    return "OK " + modelSummary(*model) + " " + (model->body.mirror_symmetric ? "1" : "0");
+    auto learned = vision.learn(*type, name, at);
+    if (!learned) return errorReply(learned.error());
+    return learnReply(*learned);
   });
   table.add(
       "MODELS", "MODELS",

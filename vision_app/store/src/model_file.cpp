@@ -86,6 +86,12 @@ std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   out << YAML::Key << "angle_deg" << YAML::Value << m.trained_angle_deg;
   out << YAML::EndMap;
 
+  // Optional on reading: files written before it count every region and hole.
+  out << YAML::Key << "regions" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "min_area" << YAML::Value << m.min_region_area;
+  out << YAML::Key << "min_hole_area" << YAML::Value << m.min_hole_area;
+  out << YAML::EndMap;
+
   out << YAML::Key << "body" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "area" << YAML::Value << m.body.area;
   out << YAML::Key << "area_tolerance" << YAML::Value << m.body.area_tolerance;
@@ -235,6 +241,12 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
     const YAML::Node trained = need(root, "trained");
     m.trained_centroid = asPoint(trained, "centroid");
     m.trained_angle_deg = as<double>(trained, "angle_deg");
+
+    if (root["regions"]) {
+      const YAML::Node regions = root["regions"];
+      m.min_region_area = as<double>(regions, "min_area");
+      m.min_hole_area = as<double>(regions, "min_hole_area");
+    }
 
     const YAML::Node body = need(root, "body");
     m.body.area = as<double>(body, "area");

@@ -22,4 +22,14 @@ struct BinarizeOptions {
 // Returns a CV_8UC1 mask, 255 on parts. `grey` is CV_8UC1.
 cv::Mat binarize(const cv::Mat& grey, const BinarizeOptions& options);
 
+// The adaptive window (pixels) binarize uses on an image of `size`: the
+// option, or its default (a sixth of the smaller side).
+int adaptiveWindow(cv::Size size, const BinarizeOptions& options);
+
+// The smallest adaptive window that keeps a part whole: its interior must
+// lie within half a window of background, or the illumination estimate there
+// is the part's own level and its middle breaks into holes. `radius`: the
+// part's farthest boundary point from its centroid (pixels).
+int windowForPart(double radius);
+
 }  // namespace picksight::vision

@@ -54,6 +54,10 @@ struct PartModel {
   // frame is the trained pose with the centroid at the origin).
   cv::Point2d trained_centroid;
   double trained_angle_deg = 0;
+  // The region settings it was trained with (pixels): regions and holes
+  // smaller than these were not part of the image it learned from.
+  double min_region_area = 0;
+  double min_hole_area = 0;
   // Boundary: primitives in the model frame, their corners, and the
   // verification settings.
   double conformity = 1.0;      // pixels
@@ -97,8 +101,22 @@ PICKSIGHT_ERROR_DOMAIN(PartModelErrc, "part model")
 Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& name,
                              const TrainOptions& options = {});
 
+// Trains from one region of a grey image, found by findRegions on the whole
+// image with `options` (the way recognition will see the part): the other
+// regions are left out. Errors as trainModel's, except kNoPart and
+// kSeveralParts.
+Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& region, int type,
+                                       const std::string& name, const TrainOptions& options = {});
+
 // Fills the derived members; call after training or loading.
 void prepareModel(PartModel& model);
+
+// The model as an image `scale` times the size of its own sees it (frame
+// pixels of a resized camera from sensor pixels, and back with 1 / scale):
+// lengths, areas and boundary scaled, prepared. The edge tolerance and the
+// conformity stay in pixels of the new image: edges are found there to the
+// same fraction of a pixel whatever the scale.
+PartModel scaledModel(const PartModel& model, double scale);
 
 // Where a model lies in the image, in pixels (not grasp::Pose, which is in
 // millimetres in the vision frame): model point m lands at

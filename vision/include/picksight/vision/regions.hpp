@@ -35,7 +35,11 @@ struct Region {
 };
 
 struct RegionOptions {
-  double min_area = 50;              // smaller regions are noise
+  double min_area = 50;  // smaller regions are noise
+  // Holes whose area (pixels, inside their boundary trace) is below this are
+  // not counted: sensor noise or dust, never a feature a model may rely on
+  // (the hole count must match exactly).
+  double min_hole_area = 0;
   bool keep_border_regions = false;  // a part cut by the image edge cannot be located
 };
 

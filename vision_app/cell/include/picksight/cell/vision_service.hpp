@@ -28,11 +28,14 @@ namespace picksight::app {
 // Why a vision request failed (besides the camera link's CameraErrc and
 // training's vision::PartModelErrc).
 enum class VisionErrc {
-  kNoTarget = 1,    // STORE, CALCAM: no target in the frame
-  kSeveralTargets,  // STORE, CALCAM: more than one
-  kNotADisc,        // CALCAM: the target is not a disc
-  kUnknownType,     // no model for that type
-  kStorageFailed,   // a model file could not be written or removed
+  kNoTarget = 1,             // STORE, CALCAM: no target in the frame
+  kSeveralTargets,           // STORE, CALCAM: more than one
+  kNotADisc,                 // CALCAM: the target is not a disc
+  kUnknownType,              // no model for that type
+  kStorageFailed,            // a model file could not be written or removed
+  kOutsideFrame,             // LEARN AT: the rectangle holds no pixel of the frame
+  kNoPartInRectangle,        // LEARN AT: no part inside the rectangle
+  kSeveralPartsInRectangle,  // LEARN AT: more than one
 };
 const char* errorName(VisionErrc e);
 PICKSIGHT_ERROR_DOMAIN(VisionErrc, "vision")
@@ -93,6 +96,35 @@ struct VisionOptions {
 // The frame's image as 8-bit grey: the image itself, or a converted copy.
 cv::Mat greyImage(const Frame& frame);
 
+// Models are in sensor pixels; a resized frame sees them scaled. The same
+// list when the frame is not resized, else a scaled copy (frame pixels).
+std::shared_ptr<const ModelList> modelsForFrame(std::shared_ptr<const ModelList> models,
+                                                const SensorMapping& mapping);
+
+// The settings of one frame's vision pass on an `image` of that size: the
+// cell's areas and adaptive window are in sensor pixels and follow a resize,
+// and the window is at least wide enough for the largest of `frame_models`
+// (frame pixels, see modelsForFrame), or that part's middle would break into
+// phantom holes.
+VisionOptions frameOptions(const VisionOptions& options, const SensorMapping& mapping,
+                           cv::Size image, const ModelList& frame_models);
+
+// A model trained by LEARN, in sensor pixels, and what looks suspicious
+// about it (phrases for the reply, e.g. "12 holes smaller than 60 px").
+struct LearnOutcome {
+  vision::PartModel model;
+  std::vector<std::string> warnings;
+};
+
+// LEARN on one grey frame: binarizes the whole frame as LOCATE would (with
+// `models`, sensor pixels, widening the window), then trains from the one
+// part inside `at` (sensor pixels; none: the whole frame). Parts touching
+// the frame border are taken only when there is no other.
+Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapping,
+                                  const VisionOptions& options,
+                                  std::shared_ptr<const ModelList> models, int type,
+                                  const std::string& name, const std::optional<cv::Rect>& at);
+
 // LOCATE on one frame, as the robot server, the offline tool and the
 // benchmarks run it: the parts of `type` (-1: all types) recognized with
 // `models` (every region when there are none), with the scene kept for
@@ -129,8 +161,10 @@ class VisionService {
   // this call (every region when no model exists; VisionErrc::kUnknownType
   // when models exist but none of `type`).
   Result<LocateOutcome> locate(int type);
-  // Trains type `type` from the single part in a fresh frame and stores it.
-  Result<vision::PartModel> learn(int type, const std::string& name);
+  // Trains type `type` from the single part in a fresh frame (inside `at`,
+  // sensor pixels, when given; the camera's ROI is left alone) and stores it.
+  Result<LearnOutcome> learn(int type, const std::string& name,
+                             const std::optional<cv::Rect>& at = std::nullopt);
   // Blob features of every region in a fresh frame, sensor pixels.
   Result<std::vector<vision::BlobFeatures>> blobs();
   // The single calibration target in a fresh frame.

@@ -2,8 +2,8 @@
 // FORGET, BLOBS (docs/PROTOCOL.md).
 #pragma once
 
-#include "picksight/protocol/command_table.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/command_table.hpp"
 
 namespace picksight::app {
 
@@ -12,6 +12,9 @@ void addModelCommands(CommandTable& table, VisionService& vision);
 
 // The reply fields of one model ("<type> <name> <area> <holes> <symmetry>").
 std::string modelSummary(const vision::PartModel& model);
+// LEARN's reply: "OK <type> <name> <area> <holes> <symmetry> <mirror 0/1>",
+// then " ; warning: <text>" for each warning.
+std::string learnReply(const LearnOutcome& learned);
 // The reply fields of one region's features (see BLOBS).
 std::string blobSummary(const vision::BlobFeatures& blob);
 
