@@ -205,9 +205,20 @@ int main(int argc, char** argv) {
 
   // 1. LOCATE with and without viewers.
   std::vector<double> ignored;
-  // A model, so that LOCATE does its whole pass.
+  // A model, so that LOCATE does its whole pass: taught from one part alone
+  // on the table, as an integrator would.
+  const auto setParts = [&](int parts) {
+    picksight::ControlClient client(context, server.control, 5000ms);
+    picksight::proto::ControlRequest request;
+    request.mutable_set_feature()->set_camera("cam0");
+    request.mutable_set_feature()->set_name("Parts");
+    request.mutable_set_feature()->set_value(std::to_string(parts));
+    return client.call(request).ok();
+  };
+  setParts(1);
   if (auto learned = robot->request("LEARN 1", 30s); !learned || learned->rfind("OK", 0) != 0)
     std::printf("LEARN failed: LOCATE finds no part\n");
+  setParts(args.parts);
   for (int i = 0; i < 10; ++i) locate(ignored);
   std::vector<double> alone;
   std::vector<double> watched;

@@ -15,6 +15,7 @@
 
 #include "picksight/transport/control_client.hpp"
 #include "results.pb.h"
+#include "temp_dir.hpp"
 #include "web_fixture.hpp"
 
 namespace picksight::webtest {
@@ -269,6 +270,9 @@ TEST_CASE("events carry results published on a vision app's results stream", "[w
   result.set_elapsed_ms(12.5);
   result.set_camera("cam0");
   result.set_frame_sequence(42);
+  result.mutable_binarize()->set_method("fixed");
+  result.mutable_binarize()->set_threshold(100);
+  result.mutable_binarize()->set_dark_parts(true);
   auto* part = result.add_parts();
   part->set_type(1);
   part->mutable_position()->set_x(100.5);
@@ -298,6 +302,19 @@ TEST_CASE("events carry results published on a vision app's results stream", "[w
   CHECK(apps[0]["camera"] == "cam0");
   CHECK(apps[0]["connected"] == true);
   CHECK(apps[0]["last_result_id"] == 7);
+  // The app's camera binarized with the result's settings.
+  REQUIRE(pollUntil([&] {
+    auto png = web.client().Get("/snapshot/cam0.png");
+    return png && png->status == 200;
+  }));
+  auto binary = web.client().Get("/binary/cell1.png");
+  REQUIRE(binary);
+  CHECK(binary->status == 200);
+  const cv::Mat mask = cv::imdecode(
+      std::vector<unsigned char>(binary->body.begin(), binary->body.end()), cv::IMREAD_UNCHANGED);
+  REQUIRE(mask.type() == CV_8UC1);
+  CHECK(mask.size() == cv::Size(320, 240));
+  CHECK(cv::countNonZero((mask != 0) & (mask != 255)) == 0);
   auto metrics = web.client().Get("/metrics");
   REQUIRE(metrics);
   CHECK(metrics->body.find("picksight_vision_results_total{app=\"cell1\",request=\"LOCATE\"}") !=
@@ -428,6 +445,46 @@ TEST_CASE("metrics count the camera's frames", "[web]") {
         "picksight_web_viewers{camera=\"cam0\"}",
         "picksight_web_jpeg_encode_seconds_total{camera=\"cam0\"}"})
     CHECK(res->body.find(name) != std::string::npos);
+  // Nobody watched: no JPEG was made. A snapshot is a PNG and makes none either.
+  REQUIRE(pollUntil([&] {
+    auto png = web.client().Get("/snapshot/cam0.png");
+    return png && png->status == 200;
+  }));
+  res = web.client().Get("/metrics");
+  REQUIRE(res);
+  CHECK(res->body.find("picksight_web_jpeg_encode_seconds_total{camera=\"cam0\"} 0.000000\n") !=
+        std::string::npos);
+  auto jpg = web.client().Get("/frame/cam0.jpg");
+  REQUIRE(jpg);
+  REQUIRE(jpg->status == 200);
+  res = web.client().Get("/metrics");
+  REQUIRE(res);
+  CHECK(res->body.find("picksight_web_jpeg_encode_seconds_total{camera=\"cam0\"} 0.000000\n") ==
+        std::string::npos);
+}
+
+TEST_CASE("the page and its files come from the assets directory", "[web]") {
+  test::TempDir assets;
+  assets.write("index.html", "<!doctype html><title>PickSight</title>");
+  assets.write("app.js", "console.log(1);");
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  auto args = videoServerArgs(server);
+  args.insert(args.end(), {"--assets", assets.path().string()});
+  WebProcess web(args);
+  auto page = web.client().Get("/");
+  REQUIRE(page);
+  CHECK(page->status == 200);
+  CHECK(page->get_header_value("Content-Type").rfind("text/html", 0) == 0);
+  CHECK(page->body.find("PickSight") != std::string::npos);
+  auto script = web.client().Get("/static/app.js");
+  REQUIRE(script);
+  CHECK(script->status == 200);
+  CHECK(script->get_header_value("Content-Type").rfind("text/javascript", 0) == 0);
+  for (const char* path : {"/static/missing.js", "/static/../web.yaml", "/static/%2e%2e/x"}) {
+    auto res = web.client().Get(path);
+    REQUIRE(res);
+    CHECK((res->status == 404 || res->status == 400));
+  }
 }
 
 }  // namespace picksight::webtest
