@@ -329,6 +329,8 @@ void WebServer::Impl::events(httplib::Response& res) {
     std::shared_ptr<EventQueue> queue;
     std::atomic<int>& streams;
     bool greeted = false;
+    std::chrono::steady_clock::time_point next_keepalive =
+        std::chrono::steady_clock::now() + kKeepalive;
   };
   auto client = std::make_shared<Client>(events_.subscribe(), streams_);
   res.set_header("Cache-Control", "no-store");
@@ -343,9 +345,17 @@ void WebServer::Impl::events(httplib::Response& res) {
               "retry: 2000\nevent: cameras\ndata: " + cameras_->cameras().dump() + "\n\n";
           return sink.write(first.data(), first.size());
         }
-        auto event = client->queue->pop(kKeepalive);
+        // A comment every kKeepalive whatever the traffic: proxies and
+        // browsers see the connection alive, and a dead peer is noticed.
+        const auto now = std::chrono::steady_clock::now();
+        if (now >= client->next_keepalive) {
+          client->next_keepalive = now + kKeepalive;
+          return sink.write(": keepalive\n\n", 13);
+        }
+        auto event = client->queue->pop(
+            std::chrono::duration_cast<std::chrono::milliseconds>(client->next_keepalive - now));
         if (stopping_ || client->queue->closed()) return false;
-        if (!event) return sink.write(": keepalive\n\n", 13);
+        if (!event) return true;  // keepalive time: written on the next call
         return sink.write(event->data(), event->size());
       },
       [client](bool) {});
