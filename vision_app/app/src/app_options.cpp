@@ -1,13 +1,12 @@
 // picksight-vision option parsing, with CLI11.
 #include "picksight/vision_app/app_options.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <CLI/CLI.hpp>
 #include <set>
 
 #include "picksight/common/allow_list.hpp"
 #include "picksight/common/command_line.hpp"
+#include "picksight/common/config_file.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
@@ -196,14 +195,8 @@ std::string appUsage() {
 
 namespace {
 
-// What one parse of argument words found besides the options themselves.
-struct ParseExtras {
-  std::string config_file;
-  std::set<std::string> given;  // long names (without dashes) on the line
-};
-
 Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
-                              ParseExtras* extras) {
+                              ConfigParseExtras* extras) {
   CLI::App app = visionApp();
   AppOptions o;
   RawOptions raw;
@@ -211,10 +204,7 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   if (auto ok = parseArgs(app, args, help); !ok) return ok.error();
   if (extras) {
     extras->config_file = raw.config_file;
-    for (const CLI::Option* opt : app.get_options()) {
-      if (opt->count() > 0)
-        for (const auto& name : opt->get_lnames()) extras->given.insert(name);
-    }
+    extras->given = givenOptions(app);
   }
   // The validators accepted these: the conversions cannot fail.
   if (!raw.robot_port.empty()) o.robot.port = static_cast<uint16_t>(*parseInt(raw.robot_port));
@@ -260,83 +250,14 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   return o;
 }
 
-Error configError(const std::string& path, const std::string& key, const std::string& message) {
-  return makeError(CommandLineErrc::kBadOption, path + ": " + key + ": " + message);
-}
+}  // namespace
 
-// The YAML map of `path` as argument words ("--key=value"), for the keys
-// not in `skip`. Keys are checked against the options themselves, so an
-// option added to defineAppOptions is a config key with no further code.
-Result<std::vector<std::string>> configWords(const std::string& path,
-                                             const std::set<std::string>& skip) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    return makeError(CommandLineErrc::kBadOption, "--config " + path + ": " + e.what());
-  }
-  if (root.IsNull()) return std::vector<std::string>();  // an empty file
-  if (!root.IsMap()) {
-    return makeError(CommandLineErrc::kBadOption,
-                     path + ": must be a map of option names to values");
-  }
+Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help) {
   CLI::App app = visionApp();
   AppOptions unused;
   RawOptions raw;
   defineAppOptions(app, unused, raw);
-  std::vector<std::string> words;
-  std::set<std::string> seen;
-  for (const auto& kv : root) {
-    if (!kv.first.IsScalar()) {
-      return makeError(CommandLineErrc::kBadOption, path + ": keys must be plain option names");
-    }
-    const std::string key = kv.first.Scalar();
-    const CLI::Option* opt = key == "config" || key == "help" || key.rfind('-', 0) == 0
-                                 ? nullptr
-                                 : app.get_option_no_throw("--" + key);
-    if (!opt) return configError(path, key, "unknown key (keys are the options without dashes)");
-    if (!seen.insert(key).second) return configError(path, key, "given twice");
-    if (skip.count(key)) continue;  // the command line wins
-    const YAML::Node& value = kv.second;
-    if (opt->get_type_size() == 0) {  // a flag: true or false
-      bool on = false;
-      if (!value.IsScalar() || !YAML::convert<bool>::decode(value, on)) {
-        return configError(path, key, "must be true or false");
-      }
-      if (on) words.push_back("--" + key);
-    } else if (value.IsScalar()) {
-      words.push_back("--" + key + "=" + value.Scalar());
-    } else if (value.IsSequence() && opt->get_items_expected_max() > 1) {
-      for (const auto& item : value) {
-        if (!item.IsScalar()) {
-          return configError(path, key, "must be a list of values");
-        }
-        words.push_back("--" + key + "=" + item.Scalar());
-      }
-    } else {
-      return configError(path, key,
-                         value.IsSequence() ? "takes one value, not a list" : "must be a value");
-    }
-  }
-  return words;
-}
-
-}  // namespace
-
-Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help) {
-  ParseExtras line;
-  auto options = parseWords(args, help, &line);
-  if (!options || (help && *help) || line.config_file.empty()) return options;
-  auto words = configWords(line.config_file, line.given);
-  if (!words) return words.error();
-  // The file alone first, so that a bad value is reported as its key.
-  if (auto from_file = parseWords(*words, nullptr, nullptr); !from_file) {
-    std::string message = from_file.error().message;
-    if (message.rfind("--", 0) == 0) message.erase(0, 2);
-    return makeError(CommandLineErrc::kBadOption, line.config_file + ": " + message);
-  }
-  words->insert(words->end(), args.begin(), args.end());
-  return parseWords(*words, nullptr, nullptr);
+  return parseWithConfigFile<AppOptions>(args, help, app, parseWords);
 }
 
 }  // namespace picksight::app
