@@ -34,6 +34,8 @@ PACKAGES=(
   libmodbus-dev python3-pymodbus
   # pymodbus imports its serial client with every client (a Recommends of python3-pymodbus)
   python3-serial-asyncio
+  # the web HMI page's tests in a real browser: headless Chromium driven by Selenium
+  chromium chromium-driver python3-selenium
 )
 
 missing=()
