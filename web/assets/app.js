@@ -145,7 +145,21 @@
   }
   ps.showFrame = showFrame;
 
+  // The frame as large as the column and the window allow, keeping its
+  // aspect (the overlay layers follow the image element's box).
+  function fitFrame() {
+    const img = $("frame");
+    if (!img.naturalWidth || !img.naturalHeight) return;
+    const top = $("viewer").getBoundingClientRect().top + window.scrollY;
+    const maxW = $("view-column").clientWidth;
+    const maxH = Math.max(200, window.innerHeight - top - 48);
+    const w = Math.floor(Math.min(maxW, maxH * img.naturalWidth / img.naturalHeight));
+    if (img.style.width !== w + "px") img.style.width = w + "px";
+  }
+  ps.fitFrame = fitFrame;
+
   function sizeLayers() {
+    fitFrame();
     const m = ps.mapping();
     const box = "0 0 " + m.frameW + " " + m.frameH;
     for (const id of ["overlay", "tool"]) {
@@ -176,7 +190,9 @@
   function selectApp(name) {
     ps.app = name || null;
     fillSelect($("app-select"), appsOfCamera(), ps.app);
-    if (ps.app && !ps.latest[ps.app]) {
+    // Only an app that has results: a 404 would be a console error.
+    const entry = ps.apps.find((a) => a.name === ps.app);
+    if (entry && Number(entry.last_result_id || 0) > 0 && !ps.latest[ps.app]) {
       ps.get("/api/results/" + encodeURIComponent(ps.app) + "/latest").then((r) => {
         if (r.ok && !ps.latest[ps.app]) { ps.latest[ps.app] = r.body; emit("result", r.body); }
       });

@@ -7,8 +7,9 @@
 (function () {
   const ps = window.picksight;
   const $ = ps.$;
-  const ARROW_PX_PER_MM = 200;  // residuals are hundredths of a mm: magnify them to be seen
-  const cal = { points: [], residuals: {}, mmPerPx: [1, 1], rz: 0 };
+  // Residuals are hundredths of a mm: the largest is drawn this long.
+  const LONGEST_ARROW_PX = 40;
+  const cal = { points: [], residuals: {}, mmPerPx: [1, 1], rz: 0, pxPerMm: 1 };
 
   async function say(line) {
     const reply = await ps.command(line);
@@ -50,6 +51,9 @@
         cal.residuals[id] = { dx, dy, dist };
       }
     }
+    const largest = Math.max(0, ...Object.values(cal.residuals).map((r) => r.dist));
+    cal.pxPerMm = largest > 0 ? LONGEST_ARROW_PX / largest : 1;
+    $("cal-arrow-gain").textContent = cal.pxPerMm >= 10 ? cal.pxPerMm.toFixed(0) : cal.pxPerMm.toPrecision(2);
     const tbody = $("cal-points").querySelector("tbody");
     tbody.textContent = "";
     for (const p of cal.points) {
@@ -87,7 +91,7 @@
       if (!res) continue;
       const vx = res.dx * Math.cos(back) - res.dy * Math.sin(back);
       const vy = res.dx * Math.sin(back) + res.dy * Math.cos(back);
-      const ex = c[0] + vx * ARROW_PX_PER_MM * m.scaleX, ey = c[1] - vy * ARROW_PX_PER_MM * m.scaleY;
+      const ex = c[0] + vx * cal.pxPerMm * m.scaleX, ey = c[1] - vy * cal.pxPerMm * m.scaleY;
       ps.svg(g, "line", { class: "residual", x1: c[0], y1: c[1], x2: ex, y2: ey });
       ps.svg(g, "circle", { class: "residual-tip", cx: ex, cy: ey, r: 2 });
     }
@@ -165,7 +169,6 @@
   const val = (id) => Number($(id).value) || 0;
 
   document.addEventListener("DOMContentLoaded", () => {
-    $("cal-arrow-gain").textContent = ARROW_PX_PER_MM;
     ps.toolDrawers.push(drawPoints);
     ps.on("tab", (tab) => { if (tab === "calibrate") refreshPoints(); });
     $("cal-status").addEventListener("click", status);
