@@ -28,12 +28,15 @@
     return part.grasp_position ? pt(part.grasp_position) : pt(part.position);
   }
 
-  function drawPart(g, m, part, index, size, drawn) {
+  function drawPart(g, m, result, part, index, size, drawn) {
     const svg = ps.svg;
     const cls = part.offered ? "part" : "part not-offered";
     const group = svg(g, "g", { class: cls, "data-index": index });
-    if (part.outline && part.outline.length) {
-      svg(group, "path", { class: "outline", d: polygonPath(m, part.outline), "fill-rule": "evenodd" });
+    // A part without a model (type -1) has its region's outline.
+    const region = (result.regions || []).find((r) => num(r.index) === num(part.region));
+    const outline = part.outline && part.outline.length ? part.outline : region ? [region.outline] : [];
+    if (outline.length) {
+      svg(group, "path", { class: "outline", d: polygonPath(m, outline), "fill-rule": "evenodd" });
     }
     for (const finger of part.fingers || []) {
       svg(group, "path", {
@@ -99,7 +102,7 @@
       }
     }
     for (const rej of result.rejections || []) drawRejection(g, m, result, rej, size, drawn);
-    (result.parts || []).forEach((part, i) => drawPart(g, m, part, i, size, drawn));
+    (result.parts || []).forEach((part, i) => drawPart(g, m, result, part, i, size, drawn));
     svgRoot.dataset.parts = String(drawn.parts.length);
     svgRoot.dataset.requestId = drawn.request_id;
   }

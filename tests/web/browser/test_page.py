@@ -164,6 +164,31 @@ def test_overlay_shows_the_located_parts(cell, browser):
     assert reply.startswith("OK "), reply
     overlay = overlay_after(browser, before)
     check_overlay_matches(cell, browser, reply, overlay)
+    browser.screenshot("live-regions")
+    assert browser.severe() == []
+
+
+def test_overlay_follows_a_cropped_and_resized_camera(cell, browser):
+    """Results are in sensor pixels; the page maps them through the camera's
+    current ROI and scale."""
+    if not cell.has_results:
+        pytest.skip("this vision app has no results stream (--results-bind) yet")
+    select_tab(browser, "live")
+    for action, body in (("roi", {"x": 64, "y": 32, "width": 512, "height": 416}), ("size", {"scale": 0.5})):
+        status, reply = cell.http("POST", f"/api/cameras/{CAMERA}/{action}", body)
+        assert status == 200, reply
+    try:
+        wait_until(lambda: frame_box(browser)["natural_width"] == 256 and cell.camera()["width"] == 256 and
+                   browser.js("return window.picksight.mapping().scaleX") == 0.5,
+                   what="half-size cropped frames on the page")
+        reply, before = locate_on_page(browser, "1")  # no model yet: every region
+        assert reply.startswith("OK ") and poses(reply), reply
+        check_overlay_matches(cell, browser, reply, overlay_after(browser, before))
+        browser.screenshot("live-cropped")
+    finally:
+        for action, body in (("size", {"width": 0, "height": 0}), ("roi", {"x": 0, "y": 0, "width": 0, "height": 0})):
+            cell.http("POST", f"/api/cameras/{CAMERA}/{action}", body)
+        wait_until(lambda: cell.camera()["width"] == 640, what="the full frame again")
     assert browser.severe() == []
 
 
