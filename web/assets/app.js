@@ -135,7 +135,11 @@
     const img = $("frame");
     if (binaryTimer) { clearInterval(binaryTimer); binaryTimer = null; }
     if (!ps.camera) { img.removeAttribute("src"); return; }
-    if (ps.binaryWanted && ps.app) {
+    // The server binarizes the frame of the app's camera with the settings
+    // of its latest result: none before the app's first vision request.
+    const binary = ps.binaryWanted && ps.app && ps.latest[ps.app];
+    $("live-binary-note").textContent = ps.binaryWanted && !binary ? "after the app's first vision request" : "";
+    if (binary) {
       const load = () => { img.src = "/binary/" + encodeURIComponent(ps.app) + ".png?t=" + Date.now(); };
       load();
       binaryTimer = setInterval(load, 1000);
@@ -269,7 +273,9 @@
       let result;
       try { result = JSON.parse(e.data); } catch (err) { console.warn("picksight: result event", err); return; }
       if (!result.app) return;
+        const first = !ps.latest[result.app];
       ps.latest[result.app] = result;
+      if (first && result.app === ps.app && ps.binaryWanted) showFrame();
       emit("result", result);
     });
   }

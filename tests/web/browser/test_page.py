@@ -168,6 +168,23 @@ def test_overlay_shows_the_located_parts(cell, browser):
     assert browser.severe() == []
 
 
+def test_binarized_image_on_demand(cell, browser):
+    if not cell.has_results:
+        pytest.skip("this vision app has no results stream (--results-bind) yet")
+    select_tab(browser, "live")  # after a LOCATE: the app's binarization is known
+    click(browser, "live-binary")
+    try:
+        wait_until(lambda: browser.js("""const img = document.getElementById('frame');
+                                         return img.src.includes('/binary/') && img.complete && img.naturalWidth > 0;"""),
+                   what="the binarized image")
+        assert browser.js("return document.getElementById('frame').naturalWidth") == cell.camera()["width"]
+        browser.screenshot("live-binarized")
+    finally:
+        click(browser, "live-binary")
+    wait_until(lambda: "/stream/" in browser.js("return document.getElementById('frame').src"), what="the stream again")
+    assert browser.severe() == []
+
+
 def test_overlay_follows_a_cropped_and_resized_camera(cell, browser):
     """Results are in sensor pixels; the page maps them through the camera's
     current ROI and scale."""
@@ -224,6 +241,7 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     assert abs(rect[0] + rect[2] - x1) <= slack and abs(rect[1] + rect[3] - y1) <= slack, rect
     browser.js("""document.getElementById('teach-type').value = '5';
                   document.getElementById('teach-name').value = 'bracket';""")
+    browser.screenshot("teach")
     click(browser, "teach-button")
     reply = wait_until(lambda: browser.js("return document.getElementById('teach-reply').dataset.lastReply"),
                        what="the LEARN reply")
@@ -232,7 +250,7 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     assert reply.startswith("OK 5 bracket"), reply
     wait_until(lambda: browser.js("return document.querySelector('#models-list tr[data-type=\"5\"]')"),
                what="the model in the list")
-    browser.screenshot("teach")
+    browser.screenshot("teach-learned")
     select_tab(browser, "live")
     reply, before = locate_on_page(browser, "5")
     found = poses(reply)
