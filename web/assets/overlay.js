@@ -60,7 +60,10 @@
     const type = num(part.type);
     const label = (type >= 0 ? (part.name || "type" + type) + " #" + type : "region") +
                   (part.score ? " " + num(part.score).toFixed(2) : "") + (part.touching ? " touching" : "");
-    svg(group, "text", { class: "label", x: c[0] + r * 2, y: c[1] - r * 2, "font-size": size * 0.025 }, label);
+    // Labels near the right edge go to the left of the part, inside the frame.
+    const right = c[0] > 0.7 * m.frameW;
+    svg(group, "text", { class: "label", x: c[0] + (right ? -2 * r : 2 * r), y: c[1] - r * 2,
+                         "font-size": size * 0.025, "text-anchor": right ? "end" : "start" }, label);
     const d = ps.frameToDisplay(m, gf[0], gf[1]);
     drawn.parts.push({
       index, type, name: part.name || "", score: num(part.score), offered: !!part.offered,

@@ -293,6 +293,61 @@ def test_roi_drawn_on_the_image_sets_the_camera_roi(cell, browser):
     assert browser.severe() == []
 
 
+def test_grasp_styles_and_fingers_edited_and_drawn(cell, browser):
+    """One part on the table, taught whole (LEARN without a rectangle), a
+    grasp style and two fingers added from the Teach panel: the footprint is
+    drawn on the part, and after a LOCATE the overlay shows the grasp with
+    both fingers free."""
+    cell.set_parts(1)
+    try:
+        wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "1", what="one part on the table")
+        select_tab(browser, "teach")
+        browser.js("""window.picksight.rect.teach = null; window.picksight.drawTool();
+                      document.getElementById('teach-type').value = '7';
+                      document.getElementById('teach-name').value = 'single';
+                      document.getElementById('teach-reply').dataset.lastReply = '';""")
+        click(browser, "teach-button")
+        reply = wait_until(lambda: browser.js("return document.getElementById('teach-reply').dataset.lastReply"),
+                           what="the LEARN reply")
+        assert reply.startswith("OK 7 single"), reply
+        browser.js("""document.getElementById('grasp-type').value = '7';
+                      document.getElementById('style-x').value = '0';
+                      document.getElementById('style-y').value = '0';
+                      document.getElementById('style-rz').value = '0';""")
+        click(browser, "style-clear")
+        wait_until(lambda: "GRASP 7 CLEAR" in browser.driver.find_element(By.ID, "grasp-reply").text, what="CLEAR")
+        click(browser, "style-add")
+        wait_until(lambda: len(browser.driver.find_elements(By.CSS_SELECTOR, "#style-list li")) == 1, what="one style")
+        for y in ("30", "-30"):
+            browser.js("""document.getElementById('finger-x').value = '0';
+                          document.getElementById('finger-y').value = arguments[0];
+                          document.getElementById('finger-w').value = '10';
+                          document.getElementById('finger-h').value = '8';""", y)
+            count = len(browser.driver.find_elements(By.CSS_SELECTOR, "#finger-list li"))
+            click(browser, "finger-add")
+            wait_until(lambda: len(browser.driver.find_elements(By.CSS_SELECTOR, "#finger-list li")) == count + 1,
+                       what="the finger in the list")
+        assert cell.say("GRIPPER 7 LIST").startswith("OK 2 ")
+        select_tab(browser, "live")
+        reply, before = locate_on_page(browser, "7")
+        if cell.has_results:
+            overlay = overlay_after(browser, before)
+            check_overlay_matches(cell, browser, reply, overlay)
+            assert overlay["parts"][0]["fingers"] == [False, False], overlay
+            assert len(browser.driver.find_elements(By.CSS_SELECTOR, "#overlay .finger.free")) == 2
+            browser.screenshot("live-grasp")
+            select_tab(browser, "teach")
+            click(browser, "grasp-load")
+            wait_until(lambda: len(browser.driver.find_elements(By.CSS_SELECTOR, "#tool .footprint path")) == 2,
+                       what="the footprint of both fingers")
+            browser.screenshot("teach-grasp")
+        else:
+            assert len(poses(reply)) == 1, reply
+    finally:
+        cell.set_parts(4)
+    assert browser.severe() == []
+
+
 def test_calibrate_the_simulated_cell(cell, browser):
     select_tab(browser, "calibrate")
     wait_until(lambda: "frame" in browser.driver.find_element(By.ID, "cal-transform").text, what="STATUS")
