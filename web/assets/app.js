@@ -78,6 +78,28 @@
     return w.slice(1);
   };
 
+  // Appends a row of text cells to a table body, with a last cell holding
+  // one button when `button` is given; the row.
+  ps.tableRow = function (tbody, texts, button, onClick) {
+    const row = document.createElement("tr");
+    for (const text of texts) {
+      const td = document.createElement("td");
+      td.textContent = text;
+      row.appendChild(td);
+    }
+    if (button) {
+      const td = document.createElement("td");
+      const b = document.createElement("button");
+      b.type = "button";
+      b.textContent = button;
+      b.addEventListener("click", (e) => { e.stopPropagation(); onClick(); });
+      td.appendChild(b);
+      row.appendChild(td);
+    }
+    tbody.appendChild(row);
+    return row;
+  };
+
   // A camera action; shows the server's message in the camera panel.
   ps.cameraAction = async function (action, body) {
     if (!ps.camera) return { ok: false, body: { error: "no camera" } };

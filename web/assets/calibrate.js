@@ -57,21 +57,11 @@
     const tbody = $("cal-points").querySelector("tbody");
     tbody.textContent = "";
     for (const p of cal.points) {
-      const row = document.createElement("tr");
       const res = cal.residuals[p[0]];
-      for (const text of [p[0], p[1], p[2], p[3], p[4], res ? res.dist.toFixed(3) : "-"]) {
-        const td = document.createElement("td");
-        td.textContent = text;
-        row.appendChild(td);
-      }
-      const td = document.createElement("td");
-      const del = document.createElement("button");
-      del.type = "button";
-      del.textContent = "Delete";
-      del.addEventListener("click", async () => { await say("DELETE " + p[0]); refreshPoints(); });
-      td.appendChild(del);
-      row.appendChild(td);
-      tbody.appendChild(row);
+      ps.tableRow(tbody, [p[0], p[1], p[2], p[3], p[4], res ? res.dist.toFixed(3) : "-"], "Delete", async () => {
+        await say("DELETE " + p[0]);
+        refreshPoints();
+      });
     }
     ps.drawTool();
   }

@@ -32,16 +32,10 @@
     tbody.textContent = "";
     $("feature-names").textContent = "";
     for (const f of features) {
-      const row = document.createElement("tr");
       const range = f.choices && f.choices.length ? f.choices.join(" | ")
         : f.has_range ? (f.min || 0) + " .. " + (f.max || 0) + (f.unit ? " " + f.unit : "") : "";
-      for (const text of [f.name, f.value === undefined ? "" : String(f.value), range]) {
-        const td = document.createElement("td");
-        td.textContent = text;
-        row.appendChild(td);
-      }
+      const row = ps.tableRow(tbody, [f.name, f.value === undefined ? "" : String(f.value), range]);
       row.addEventListener("click", () => { $("feature-name").value = f.name; $("feature-value").value = f.value || ""; });
-      tbody.appendChild(row);
       const o = document.createElement("option");
       o.value = f.name;
       $("feature-names").appendChild(o);

@@ -111,12 +111,6 @@
   }
   ps.drawOverlay = draw;
 
-  function cell(row, text) {
-    const td = document.createElement("td");
-    td.textContent = text;
-    row.appendChild(td);
-  }
-
   function summarize() {
     const result = ps.app ? ps.latest[ps.app] : null;
     const tbody = $("result-parts").querySelector("tbody");
@@ -129,18 +123,14 @@
       (result.frame_sequence || 0) + ", " + num(result.regions_total) + " regions)" +
       (result.why ? "\nwhy: " + result.why : "");
     for (const part of result.parts || []) {
-      const row = document.createElement("tr");
-      if (!part.offered) row.className = "not-offered";
       const [x, y] = pt(part.position);
-      cell(row, num(part.type));
-      cell(row, part.name || "");
-      cell(row, num(part.score).toFixed(3));
-      cell(row, x.toFixed(1));
-      cell(row, y.toFixed(1));
-      cell(row, num(part.angle_deg).toFixed(1));
       const fingers = (part.fingers || []).map((f) => (f.blocked ? "blocked" : "free")).join(" ");
-      cell(row, (part.offered ? "style " + num(part.grasp_style) : "not offered") + (fingers ? " (" + fingers + ")" : ""));
-      tbody.appendChild(row);
+      const row = ps.tableRow(tbody, [
+        num(part.type), part.name || "", num(part.score).toFixed(3), x.toFixed(1), y.toFixed(1),
+        num(part.angle_deg).toFixed(1),
+        (part.offered ? "style " + num(part.grasp_style) : "not offered") + (fingers ? " (" + fingers + ")" : ""),
+      ]);
+      if (!part.offered) row.className = "not-offered";
     }
     for (const rej of result.rejections || []) {
       const li = document.createElement("li");

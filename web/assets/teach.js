@@ -46,26 +46,13 @@
     const tbody = $("models-list").querySelector("tbody");
     tbody.textContent = "";
     for (const m of groups(reply, 5)) {
-      const row = document.createElement("tr");
-      row.dataset.type = m[0];
-      for (const text of m) {
-        const td = document.createElement("td");
-        td.textContent = text;
-        row.appendChild(td);
-      }
-      const td = document.createElement("td");
-      const forget = document.createElement("button");
-      forget.type = "button";
-      forget.textContent = "Forget";
-      forget.addEventListener("click", async () => {
+      const row = ps.tableRow(tbody, m, "Forget", async () => {
         if (!window.confirm("Forget model " + m[0] + " (" + m[1] + ") and its grasps?")) return;
         await say("teach-reply", "FORGET " + m[0]);
         refreshModels();
       });
-      td.appendChild(forget);
-      row.appendChild(td);
-      row.addEventListener("click", (e) => { if (e.target !== forget) { $("grasp-type").value = m[0]; loadGrasp(); } });
-      tbody.appendChild(row);
+      row.dataset.type = m[0];
+      row.addEventListener("click", () => { $("grasp-type").value = m[0]; loadGrasp(); });
     }
   }
 
