@@ -248,6 +248,14 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     if reply.startswith("ERROR 11") and " AT " not in reply:  # its usage has no AT
         pytest.skip(f"this vision app has no LEARN ... AT yet: {reply}")
     assert reply.startswith("OK 5 bracket"), reply
+    try:
+        check_locate_finds_the_taught_part(cell, browser, centroid)
+    finally:
+        cell.say("FORGET 5")  # the later tests teach the same shape as another type
+    assert browser.severe() == []
+
+
+def check_locate_finds_the_taught_part(cell, browser, centroid):
     wait_until(lambda: browser.js("return document.querySelector('#models-list tr[data-type=\"5\"]')"),
                what="the model in the list")
     browser.screenshot("teach-learned")
@@ -260,7 +268,6 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
         check_overlay_matches(cell, browser, reply, overlay)
         assert any(p["name"] == "bracket" for p in overlay["parts"])
         browser.screenshot("live-located")
-    assert browser.severe() == []
 
 
 def test_roi_drawn_on_the_image_sets_the_camera_roi(cell, browser):
