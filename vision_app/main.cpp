@@ -52,14 +52,27 @@ int main(int argc, char** argv) {
     // A bad file costs what it holds, never the start.
     for (const auto& problem : cell.load()) logError(problem);
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
+    // The results stream: subscribers see what each request saw, after
+    // its reply; they never slow a robot.
+    std::unique_ptr<app::ResultsPublisher> results;
+    if (options->results_bind != "none") {
+      app::ResultsOptions results_options;
+      results_options.bind = options->results_bind;
+      results_options.app = options->name.empty() ? options->camera : options->name;
+      results = std::make_unique<app::ResultsPublisher>(results_options);
+      cell.publishResultsTo(results.get());
+    }
     const bool read_only = options->robot_read_only;
-    app::RobotServer robots(options->robot, [&cell, read_only](std::string_view line) {
-      return cell.handle(line, read_only);
-    });
+    app::RobotServer robots(options->robot,
+                            [&cell, read_only](std::string_view line, app::Session& session) {
+                              return cell.handle(line, read_only, &session);
+                            });
     std::unique_ptr<app::RobotServer> setup;
     if (options->setup) {
       setup = std::make_unique<app::RobotServer>(
-          *options->setup, [&cell](std::string_view line) { return cell.handle(line); });
+          *options->setup, [&cell](std::string_view line, app::Session& session) {
+            return cell.handle(line, false, &session);
+          });
     }
     // The PLC port has threads of its own: a PLC never delays a robot.
     std::unique_ptr<app::PlcPort> plc;
@@ -71,12 +84,17 @@ int main(int argc, char** argv) {
     std::cout << "robot " << robots.port() << "\n";
     if (setup) std::cout << "setup " << setup->port() << "\n";
     if (plc) std::cout << "modbus " << plc->port() << "\n";
+    if (results) std::cout << "results " << results->endpoint() << "\n";
     std::cout << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on ",
             options->robot.bind_address, ":", robots.port(), read_only ? " (read-only)" : "",
             ", allowed: ", options->robot.allow.describe());
     if (setup) {
       logInfo("set-up port on ", options->setup->bind_address, ":", setup->port());
+    }
+    if (results) {
+      logInfo("results ", results->endpoint(), " (topic ",
+              options->name.empty() ? options->camera : options->name, ")");
     }
     if (plc) {
       logInfo("PLCs on Modbus port ", plc->port(), " (unit ",
@@ -93,6 +111,7 @@ int main(int argc, char** argv) {
     if (setup) setup->stop();
     robots.stop();
     cell.stop();
+    cell.publishResultsTo(nullptr);
   } catch (const std::exception& e) {
     std::cerr << "picksight-vision: " << e.what() << "\n";
     return 1;

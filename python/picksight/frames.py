@@ -10,10 +10,9 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import zmq
 
 from picksight import picksight_pb2 as pb
-from picksight._socket_owner import SocketOwner
+from picksight._socket_owner import TopicSubscriber
 
 # Bytes per pixel and channels of each wire pixel format.
 _LAYOUT = {pb.MONO8: (1, None), pb.BGR8: (3, 3)}
@@ -65,7 +64,7 @@ def decode_frame(header, pixels):
     return Frame(image=image, header=header)
 
 
-class FrameSubscriber(SocketOwner):
+class FrameSubscriber(TopicSubscriber):
     """Subscribes to the frames of one camera (all cameras with camera="").
 
     `queue_frames` bounds what ZeroMQ keeps for a slow reader: beyond it the
@@ -77,49 +76,8 @@ class FrameSubscriber(SocketOwner):
 
     def __init__(self, endpoint, camera="", queue_frames=4, context=None, curve=None):
         """`curve`: a picksight.CurveKeys for a video server with CURVE."""
-        self._context = context or zmq.Context.instance()
-        self._socket = self._context.socket(zmq.SUB)
-        if curve is not None:
-            curve.apply(self._socket)
         # The high-water mark counts message parts; a frame is three.
-        self._socket.setsockopt(zmq.RCVHWM, queue_frames * 3)
-        self._socket.setsockopt(zmq.LINGER, 0)
-        self._socket.setsockopt(zmq.SUBSCRIBE, camera.encode())
-        self._socket.connect(endpoint)
-        self._camera = camera
-        self._last = {}
-        self.received = 0
-        self.lost = 0
-        self.malformed = 0
-
-    def receive(self, timeout=None):
-        """The next frame, or None when none came within `timeout` seconds
-        (None: wait for ever)."""
-        deadline = None if timeout is None else time.monotonic() + timeout
-        while True:
-            wait_ms = None
-            if deadline is not None:
-                wait_ms = max(0, int((deadline - time.monotonic()) * 1000))
-            if not self._socket.poll(wait_ms, zmq.POLLIN):
-                return None
-            parts = self._socket.recv_multipart(copy=False)
-            # Subscriptions match prefixes: "cam1" also receives "cam10".
-            if self._camera and parts[0].bytes != self._camera.encode():
-                continue
-            frame = self._decode(parts)
-            if frame is None:
-                self.malformed += 1
-                continue
-            frame.received_ns = time.monotonic_ns()
-            self._count(frame)
-            return frame
-
-    def __iter__(self):
-        """Frames for ever (a loop over the subscriber)."""
-        while True:
-            frame = self.receive()
-            if frame is not None:
-                yield frame
+        super().__init__(endpoint, camera, queue_frames * 3, context, curve)
 
     @staticmethod
     def _decode(parts):
@@ -133,9 +91,5 @@ class FrameSubscriber(SocketOwner):
         return decode_frame(header, parts[2].buffer)
 
     def _count(self, frame):
-        self.received += 1
-        seq = frame.header.sequence
-        last = self._last.get(frame.header.camera)
-        if last is not None and seq > last + 1:
-            self.lost += seq - last - 1
-        self._last[frame.header.camera] = seq
+        frame.received_ns = time.monotonic_ns()
+        self._count_sequence(frame.header.camera, frame.header.sequence)

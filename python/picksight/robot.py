@@ -10,6 +10,7 @@ import socket
 from collections import namedtuple
 
 Pose = namedtuple("Pose", "x y rz")
+TypedPose = namedtuple("TypedPose", "type x y rz")
 Finger = namedtuple("Finger", "x y width height")
 Model = namedtuple("Model", "type name area holes symmetry mirror_symmetric")
 FrameInfo = namedtuple("FrameInfo", "camera sequence host_timestamp_ns width height triggered")
@@ -160,6 +161,21 @@ class RobotClient:
     def locate(self, part_type):
         """The grasp poses of the parts of `part_type`, best first."""
         return _groups(self.request(f"LOCATE {int(part_type)}"), 3, Pose, _floats)
+
+    def locate_all(self):
+        """The grasp poses of every trained type in one pass, each with its
+        type (-1: a region, when no model exists), best first."""
+
+        def convert(f):
+            return [int(f[0])] + _floats(f[1:])
+
+        return _groups(self.request("LOCATE ALL"), 4, TypedPose, convert)
+
+    def why(self):
+        """(n, text): why the last LOCATE on this connection left regions
+        out, one "; "-separated sentence per region."""
+        words = self.request("WHY")
+        return int(words[0]), " ".join(words[1:])
 
     def grasp_add(self, part_type, x, y, rz):
         """Adds a grasp style; returns the type's number of styles."""

@@ -14,6 +14,7 @@
 #include "cell_fixture.hpp"
 #include "picksight/common/angles.hpp"
 #include "picksight/common/text.hpp"
+#include "scene_file.hpp"
 
 using namespace picksight;
 using namespace picksight::e2e;
@@ -25,13 +26,7 @@ constexpr int kSuper = 8;  // supersampling: exact edge coverage, unlike LINE_AA
 
 cv::Mat background() { return cv::Mat(480, 640, CV_8UC1, cv::Scalar(200)); }
 
-// A point of the final image (pixel centres at integer coordinates) on the
-// supersampled canvas, in fixed point.
-cv::Point fine(cv::Point2d p) {
-  const double s = kSuper * (1 << kShift);
-  return {static_cast<int>(std::lround((p.x + 0.5) * s - 0.5 * (1 << kShift))),
-          static_cast<int>(std::lround((p.y + 0.5) * s - 0.5 * (1 << kShift)))};
-}
+cv::Point fine(cv::Point2d p) { return supersampledPoint(p, kSuper, kShift); }
 
 // Dark shapes drawn sharp at kSuper times the size, then averaged down.
 struct Canvas {
@@ -56,27 +51,9 @@ struct Canvas {
   }
 };
 
-// The camera's image file, replaced atomically (the file source re-reads
-// it when its inode changes).
-struct Scene {
-  std::string dir;
-  std::string path;
-  Scene() {
-    char d[] = "/tmp/picksight-cell-scene-XXXXXX";
-    REQUIRE(::mkdtemp(d) != nullptr);
-    dir = d;
-    path = dir + "/scene.png";
-    show(background());
-  }
-  ~Scene() {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir, ignored);
-  }
-  void show(const cv::Mat& img) const {
-    const std::string next = dir + "/next.png";
-    REQUIRE(cv::imwrite(next, img));
-    REQUIRE(std::rename(next.c_str(), path.c_str()) == 0);
-  }
+// The camera's image file.
+struct Scene : SceneFile {
+  Scene() : SceneFile(background()) {}
 };
 
 std::string ask(LineClient& robot, const std::string& request) {

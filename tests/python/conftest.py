@@ -75,6 +75,7 @@ class Vision:
                                 "--robot-port", "0", "--bind", "127.0.0.1",
                                 "--data-dir", str(data_dir)])
         self.port = int(self.process.wait_line("robot "))
+        self.results = self.process.wait_line("results ")
         self.process.wait_line("ready")
 
 

@@ -70,7 +70,13 @@ VisionProcess::VisionProcess(const VideoServerProcess& server, const std::string
   if (std::find(extra_args.begin(), extra_args.end(), "--setup-port") != extra_args.end()) {
     setup_port = portLine("setup ");
   }
-  REQUIRE(process->waitForLine("ready", 10s));
+  // Lines up to "ready"; "results <endpoint>" among them unless turned off.
+  for (;;) {
+    auto line = process->readLine(10s);
+    REQUIRE(line);
+    if (line->rfind("results ", 0) == 0) results_endpoint = line->substr(8);
+    if (*line == "ready") break;
+  }
 }
 
 VisionProcess::~VisionProcess() {

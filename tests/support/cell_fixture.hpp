@@ -38,6 +38,7 @@ struct VisionProcess {
   std::unique_ptr<Subprocess> process;
   uint16_t robot_port = 0;
   uint16_t setup_port = 0;
+  std::string results_endpoint;  // empty with --results-bind none
   std::string data_dir;
   bool own_data_dir = true;
   LineClient connect() const;

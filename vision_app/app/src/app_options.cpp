@@ -72,6 +72,16 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
       ->type_name("ENDPOINT")
       ->capture_default_str();
   app.add_option("--camera", o.camera, "camera to watch")->type_name("NAME")->capture_default_str();
+  app.add_option("--name", o.name,
+                 "this vision app's name, the results topic (default: the camera)")
+      ->type_name("NAME")
+      ->check(checkValue([](const std::string& v) {
+        return !v.empty() && v.size() <= 64 ? std::string() : "must be 1 to 64 characters";
+      }));
+  app.add_option("--results-bind", o.results_bind,
+                 "ZeroMQ endpoint the results stream is published on ('none': off)")
+      ->type_name("ENDPOINT")
+      ->capture_default_str();
   app.add_option("--robot-port", raw.robot_port,
                  "TCP port for robot controllers (default 5600, 0 = any free)")
       ->type_name("PORT")
@@ -155,7 +165,8 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
       ->type_name("FILE")
       ->needs(server_key);
   app.footer(
-      "On start it prints 'robot <port>', 'modbus <port>' (with --modbus-port) and 'ready' on "
+      "On start it prints 'robot <port>', 'setup <port>' (with --setup-port), 'modbus <port>' "
+      "(with --modbus-port), 'results <endpoint>' (unless --results-bind none) and 'ready' on "
       "stdout.");
 }
 
@@ -207,6 +218,7 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
     o.setup = o.robot;
     o.setup->port = static_cast<uint16_t>(*parseInt(raw.setup_port));
     o.setup->bind_address = raw.setup_bind;
+    o.setup->label = "setup";
   }
   if (raw.threshold == "adaptive") {
     o.vision.binarize.method = vision::ThresholdMethod::kAdaptive;

@@ -1,10 +1,19 @@
 // Vision cell wiring.
 #include "picksight/vision_app/vision_cell.hpp"
 
+#include <chrono>
+
 #include "picksight/protocol/calibration_commands.hpp"
 #include "picksight/protocol/model_commands.hpp"
 
 namespace picksight::app {
+namespace {
+// Requests that work on a fresh frame and publish it with its regions
+// (LOCATE publishes its own, richer record).
+bool publishesFrame(const std::string& command) {
+  return command == "LEARN" || command == "BLOBS" || command == "STORE" || command == "CALCAM";
+}
+}  // namespace
 
 VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera,
                        VisionOptions options)
@@ -26,6 +35,37 @@ std::vector<std::string> VisionCell::load() {
         "calibration rejected (LOCATE and changes refused until repaired, or CLEARCAL): " +
         ok.error().message);
   return problems;
+}
+
+}  // namespace picksight::app
+
+namespace picksight::app {
+
+std::string VisionCell::handle(std::string_view line, bool read_only, Session* session) const {
+  Session local;
+  Session& s = session ? *session : local;
+  if (!session) s.received = std::chrono::steady_clock::now();
+  const auto frame_before = context_.results ? vision_.lastFramePixels() : nullptr;
+  std::string reply = protocol_.handle(line, read_only, &s);
+  if (!s.after_reply && context_.results) {
+    const auto request = parseRequest(line);
+    if (request && publishesFrame(request->command)) {
+      auto record = std::make_shared<RequestRecord>();
+      record->request = request->command;
+      record->request_line = std::string(line);
+      record->client = s.client;
+      record->options = vision_.options();
+      // A request refused before it took a frame has none of its own.
+      auto frame = vision_.lastFramePixels();
+      if (frame != frame_before) record->frame = std::move(frame);
+      s.after_reply = publishWhenSent(std::move(record), s.received, context_.results);
+    }
+  }
+  if (!session && s.after_reply) {
+    s.after_reply(reply);
+    s.after_reply = nullptr;
+  }
+  return reply;
 }
 
 }  // namespace picksight::app

@@ -17,13 +17,6 @@ namespace {
 // its own grasp.
 constexpr int kFootprintMargin = 3;
 
-const vision::PartModel* modelOf(const LocateScene& scene, int type) {
-  if (!scene.models || type < 0) return nullptr;
-  for (const auto& m : *scene.models)
-    if (m.type == type) return &m;
-  return nullptr;
-}
-
 cv::Point2d apply(const cv::Matx23d& a, cv::Point2d p) {
   return {a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2), a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2)};
 }
@@ -97,6 +90,13 @@ grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
 }
 }  // namespace
 
+const vision::PartModel* modelOf(const LocateScene& scene, int type) {
+  if (!scene.models || type < 0) return nullptr;
+  for (const auto& m : *scene.models)
+    if (m.type == type) return &m;
+  return nullptr;
+}
+
 grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision) {
   const cv::Point2d at = vision.toMm({part.x, part.y});
   // The vision frame flips y: an image rotation turns the other way.
@@ -120,6 +120,7 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
     if (!has_setup || setup->second.gripper.fingers.empty()) {
       pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles.front())));
       pick.parts.push_back(index);
+      pick.styles.push_back(&styles == &kOwnPose ? -1 : 0);
       continue;
     }
     const grasp::Gripper& gripper = setup->second.gripper;
@@ -137,6 +138,7 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
     }
     pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles[*chosen])));
     pick.parts.push_back(index);
+    pick.styles.push_back(&styles == &kOwnPose ? -1 : static_cast<int>(*chosen));
   }
   return pick;
 }

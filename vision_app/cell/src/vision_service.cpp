@@ -59,12 +59,13 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
     }
     return parts;
   }
-  // Every model competes for every region, so that a part is reported as
-  // the type that explains it best, then the requested type is kept.
+  // LOCATE <type> costs the work of that type's models alone; LOCATE ALL
+  // lets every model compete for every region, so that a part is reported
+  // as the type that explains it best.
   std::vector<const vision::PartModel*> list;
-  for (const auto& m : models) list.push_back(&m);
+  for (const auto& m : models)
+    if (type < 0 || m.type == type) list.push_back(&m);
   for (const auto& match : vision::recognize(regions, list)) {
-    if (type >= 0 && match.model->type != type) continue;
     LocatedPart p;
     const cv::Point2d s = mapping.toSensor(match.centroid);
     p.x = s.x;
@@ -76,6 +77,7 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
     p.score = match.score;
     p.symmetry_deg = match.symmetry_deg;
     p.region = static_cast<int>(match.region);
+    p.touching = match.touching;
     parts.push_back(p);
   }
   return parts;
@@ -135,7 +137,10 @@ void VisionService::stop() { camera_->stop(); }
 
 Result<std::shared_ptr<const Frame>> VisionService::freshFrame() {
   auto fresh = camera_->freshFrame();
-  if (fresh) last_frame_ = (*fresh)->info;
+  if (fresh) {
+    last_frame_ = (*fresh)->info;
+    last_pixels_ = *fresh;
+  }
   return fresh;
 }
 
@@ -206,6 +211,11 @@ Result<std::pair<cv::Mat, SensorMapping>> VisionService::greyFrame() {
 std::optional<FrameInfo> VisionService::lastFrame() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return last_frame_;
+}
+
+std::shared_ptr<const Frame> VisionService::lastFramePixels() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_pixels_;
 }
 
 }  // namespace picksight::app

@@ -1,6 +1,8 @@
 // PLC triggers through the cell's one LOCATE path.
 #include "picksight/plc/cell_locator.hpp"
 
+#include <chrono>
+
 #include "picksight/protocol/robot_errors.hpp"
 
 namespace picksight::plc {
@@ -32,9 +34,24 @@ PlcResult plcResult(const app::CellLocate& located) {
 
 PlcDevice::Locator cellLocator(app::CellContext& cell) {
   return [&cell](int type) -> Result<PlcResult> {
+    const auto started = std::chrono::steady_clock::now();
     auto located = app::locateAndPick(cell, type);
-    if (!located) return located.error();
-    return plcResult(*located);
+    Result<PlcResult> result =
+        located ? Result<PlcResult>(plcResult(*located)) : Result<PlcResult>(located.error());
+    if (cell.results) {
+      // Queued only: the publisher builds and sends it on its own thread.
+      const std::string reply =
+          located ? app::locateReply(located->pick) : app::errorReply(located.error());
+      auto record = app::locateRecord(std::move(located), type, cell.vision.options());
+      record->request_line = "PLC TRIGGER " + std::to_string(type);
+      record->client = "plc";
+      record->reply = reply;
+      record->elapsed_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+              .count();
+      cell.results->publish(std::move(record));
+    }
+    return result;
   };
 }
 

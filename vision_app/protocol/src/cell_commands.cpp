@@ -1,4 +1,4 @@
-// LOCATE with grasps, GRASP, GRIPPER, STATUS, EXPOSURE, ROI.
+// LOCATE with grasps, LOCATE ALL, WHY, GRASP, GRIPPER, STATUS, EXPOSURE, ROI.
 #include "picksight/protocol/cell_commands.hpp"
 
 #include <algorithm>
@@ -23,13 +23,30 @@ bool modelExists(const VisionService& vision, int type) {
                      [&](const vision::PartModel& m) { return m.type == type; });
 }
 
+// LOCATE <type> | LOCATE ALL. The record of what it saw goes to the
+// session (for WHY) and, once the reply is sent, to the results stream.
 std::string locate(const Request& r, CellContext& cell) {
-  if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: LOCATE <type>");
-  const auto type = parseType(r.args[0]);
+  if (r.args.size() != 1)
+    return errorReply(ProtocolErrc::kBadArguments, "usage: LOCATE <type> | LOCATE ALL");
+  const bool all = toUpper(r.args[0]) == "ALL";
+  const auto type = all ? std::optional<int>(-1) : parseType(r.args[0]);
   if (!type) return typeError("LOCATE", r.args[0]);
   auto located = locateAndPick(cell, *type);
-  if (!located) return reply(located.error());
-  return locateReply(located->pick);
+  const std::string out = !located ? reply(located.error())
+                          : all    ? locateAllReply(*located)
+                                   : locateReply(located->pick);
+  auto record = locateRecord(std::move(located), *type, cell.vision.options());
+  record->request_line = r.line;
+  record->client = r.session->client;
+  r.session->last_locate = record;
+  r.session->after_reply = publishWhenSent(record, r.session->received, cell.results);
+  return out;
+}
+
+std::string why(const Request& r) {
+  if (!r.args.empty()) return errorReply(ProtocolErrc::kBadArguments, "WHY takes no arguments");
+  if (!r.session->last_locate) return "OK 0 no LOCATE yet";
+  return r.session->last_locate->why();
 }
 
 // GRASP <type> ADD x y rz | CLEAR | LIST, and GRIPPER <type> FINGER x y w h |
@@ -210,11 +227,39 @@ Result<CellLocate> locateAndPick(CellContext& cell, int type) {
   CellLocate located;
   located.pick = pickPoses(*outcome, *grasps, *geometry);
   located.outcome = std::move(*outcome);
+  located.grasps = grasps;
+  located.geometry = *geometry;
   ++cell.locates;
   cell.last_offered = located.pick.poses.size();
   cell.last_skipped = located.pick.skipped;
   cell.skipped_total += located.pick.skipped;
   return located;
+}
+
+std::string locateAllReply(const CellLocate& located) {
+  const CellPick& pick = located.pick;
+  std::string out = "OK " + std::to_string(pick.poses.size());
+  for (size_t i = 0; i < pick.poses.size(); ++i) {
+    const auto& p = pick.poses[i];
+    out += " " + std::to_string(located.outcome.parts[pick.parts[i]].type) + " " +
+           formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
+  }
+  return out;
+}
+
+std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
+                                            const VisionOptions& options) {
+  auto record = std::make_shared<RequestRecord>();
+  record->request = "LOCATE";
+  record->asked_type = type;
+  record->options = options;
+  if (located) {
+    record->locate = std::move(located->outcome);
+    record->pick = std::move(located->pick);
+    record->grasps = std::move(located->grasps);
+    record->geometry = std::move(located->geometry);
+  }
+  return record;
 }
 
 const std::vector<std::string>& exposureFeatureNames() {
@@ -225,8 +270,9 @@ const std::vector<std::string>& exposureFeatureNames() {
 
 void addCellCommands(CommandTable& table, CellContext& cell) {
   table.add(
-      "LOCATE", "LOCATE <type>", [&cell](const Request& r) { return locate(r, cell); },
+      "LOCATE", "LOCATE <type> | LOCATE ALL", [&cell](const Request& r) { return locate(r, cell); },
       neverChanges);
+  table.add("WHY", "WHY", why, neverChanges);
   table.add(
       "GRASP", "GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST",
       [&cell](const Request& r) { return editGrasp(r, cell, false); }, changesUnlessList);

@@ -66,6 +66,7 @@ std::optional<Request> parseRequest(std::string_view line) {
   if (fields.empty()) return std::nullopt;
   Request r;
   r.command = toUpper(fields[0]);
+  r.line = std::string(line);
   for (size_t i = 1; i < fields.size(); ++i) r.args.emplace_back(fields[i]);
   return r;
 }
@@ -79,8 +80,8 @@ void CommandTable::add(const std::string& word, const std::string& usage, Handle
   commands_[toUpper(word)] = Entry{usage, std::move(handler), std::move(changes)};
 }
 
-std::string CommandTable::dispatch(std::string_view line, bool read_only) const {
-  const auto request = parseRequest(line);
+std::string CommandTable::dispatch(std::string_view line, bool read_only, Session* session) const {
+  auto request = parseRequest(line);
   if (!request) return errorReply(ProtocolErrc::kEmptyRequest, "empty request");
   const auto it = commands_.find(request->command);
   if (it == commands_.end()) {
@@ -93,7 +94,12 @@ std::string CommandTable::dispatch(std::string_view line, bool read_only) const 
                           (request->args.empty() ? "" : "with these arguments ") +
                           "changes the cell: refused on this read-only port (use the set-up port)");
   }
-  return it->second.handler(*request);
+  Session local;
+  if (!session) local.received = std::chrono::steady_clock::now();
+  request->session = session ? session : &local;
+  std::string reply = it->second.handler(*request);
+  if (!session && local.after_reply) local.after_reply(reply);
+  return reply;
 }
 
 std::string CommandTable::help() const {

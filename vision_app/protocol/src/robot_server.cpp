@@ -43,6 +43,12 @@ std::string errorLine(ProtocolErrc code, const std::string& text) {
 }  // namespace
 
 RobotServer::RobotServer(RobotServerOptions options, Handler handler)
+    : RobotServer(std::move(options),
+                  [handler = std::move(handler)](std::string_view line, Session&) {
+                    return handler(line);
+                  }) {}
+
+RobotServer::RobotServer(RobotServerOptions options, SessionHandler handler)
     : options_(std::move(options)), handler_(std::move(handler)) {
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (listen_fd_ < 0)
@@ -126,11 +132,17 @@ void RobotServer::acceptLoop() {
     int one = 1;
     ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
     const auto* address = reinterpret_cast<const sockaddr*>(&peer);
-    admit(fd, peerAddress(address), options_.allow.allows(address));
+    uint16_t peer_port = 0;
+    if (peer.ss_family == AF_INET) {
+      peer_port = ntohs(reinterpret_cast<const sockaddr_in*>(&peer)->sin_port);
+    } else if (peer.ss_family == AF_INET6) {
+      peer_port = ntohs(reinterpret_cast<const sockaddr_in6*>(&peer)->sin6_port);
+    }
+    admit(fd, peerAddress(address), peer_port, options_.allow.allows(address));
   }
 }
 
-void RobotServer::admit(int fd, const std::string& peer, bool allowed) {
+void RobotServer::admit(int fd, const std::string& peer, uint16_t peer_port, bool allowed) {
   if (!allowed) {
     sendAll(fd, errorLine(ProtocolErrc::kNotAllowed,
                           "address " + peer + " is not allowed on this port"));
@@ -161,6 +173,7 @@ void RobotServer::admit(int fd, const std::string& peer, bool allowed) {
   Connection& c = connections_.back();
   c.fd = fd;
   c.peer = peer;
+  c.peer_port = peer_port;
   ++active_;
   c.thread = std::thread([this, &c] { serve(c); });
 }
@@ -174,17 +187,33 @@ void RobotServer::serve(Connection& connection) {
   using Clock = std::chrono::steady_clock;
   // Only a complete request (or an over-long one) counts as activity.
   Clock::time_point last_request = Clock::now();
+  Session session;
+  session.client =
+      options_.label + " " + connection.peer + ":" + std::to_string(connection.peer_port);
   const auto on_line = [&](std::string_view line) {
     last_request = Clock::now();
+    session.received = last_request;
+    session.after_reply = nullptr;
     std::string reply;
     try {
-      reply = handler_(line);
+      reply = handler_(line, session);
     } catch (const std::exception& e) {
       // A bug in a command must cost one request, not the server.
       logError("robot request '", printable(line, 80), "': ", e.what());
       reply = "ERROR 99 internal error";
+      session.after_reply = nullptr;
     }
-    return sendAll(fd, reply + "\n");
+    const bool sent = sendAll(fd, reply + "\n");
+    // After the reply: what the request publishes never delays the robot.
+    if (auto after = std::move(session.after_reply)) {
+      session.after_reply = nullptr;
+      try {
+        after(reply);
+      } catch (const std::exception& e) {
+        logError("after robot request '", printable(line, 80), "': ", e.what());
+      }
+    }
+    return sent;
   };
   const auto on_too_long = [&] {
     last_request = Clock::now();

@@ -17,6 +17,10 @@ struct AppOptions {
   std::string frames_endpoint = "tcp://127.0.0.1:5555";
   std::string control_endpoint = "tcp://127.0.0.1:5556";
   std::string camera = "cam0";
+  // The vision app's name: the results stream's topic (empty: the camera's).
+  std::string name;
+  // The results stream's PUB endpoint ("none": no stream).
+  std::string results_bind = "tcp://127.0.0.1:*";
   std::string data_dir = "picksight-data";
   RobotServerOptions robot;
   // The robot port refuses requests that change the cell (docs/SECURITY.md).

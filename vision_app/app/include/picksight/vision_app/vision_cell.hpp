@@ -15,6 +15,7 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"
+#include "picksight/results/results_publisher.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
 
@@ -37,10 +38,16 @@ class VisionCell {
   void stop() { vision_.stop(); }
 
   // One request line in, one reply line out.
-  // On a read-only port requests that change the cell are refused.
-  std::string handle(std::string_view line, bool read_only = false) const {
-    return protocol_.handle(line, read_only);
-  }
+  // On a read-only port requests that change the cell are refused. With a
+  // connection's `session` (RobotServer's), what the request publishes is
+  // left in session->after_reply for after the reply; without, it is
+  // queued before this returns.
+  std::string handle(std::string_view line, bool read_only = false,
+                     Session* session = nullptr) const;
+
+  // Every vision request publishes its result there from now on (null:
+  // none); `results` outlives the cell. Call before serving starts.
+  void publishResultsTo(ResultsPublisher* results) { context_.results = results; }
 
   VisionService& vision() { return vision_; }
   ModelLibrary& models() { return models_; }

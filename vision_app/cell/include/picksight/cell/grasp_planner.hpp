@@ -16,9 +16,13 @@ namespace picksight::app {
 struct CellPick {
   std::vector<grasp::Pose> poses;  // reply frame, in the order of the parts
   std::vector<size_t> parts;       // for each pose, its part in the outcome's parts
+  std::vector<int> styles;         // for each pose, its grasp style (-1: the part's own pose)
   size_t skipped = 0;              // parts with no free grasp, not offered
   CoordinateFrame frame = CoordinateFrame::kVisionPixels;
 };
+
+// The scene's model of `type` (null: none, or a region's type -1).
+const vision::PartModel* modelOf(const LocateScene& scene, int type);
 
 // A located part's own pose in the vision frame: position in vision units,
 // rotation counter-clockwise (a recognized part: from its trained pose, in

@@ -49,6 +49,7 @@ struct LocatedPart {
   double score = 0;           // verified boundary fraction
   double symmetry_deg = 360;  // period of angle_deg (0: any)
   int region = -1;            // index into the scene's regions
+  bool touching = false;      // found inside a blob shared with other parts
 };
 
 // What a location saw beyond the parts: the binary mask and the regions
@@ -100,7 +101,8 @@ LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
                             std::shared_ptr<const ModelList> models, int type);
 
 // Finds parts in a grey image: with `models` non-empty, the recognized parts
-// of type `type` (-1: all types), best first; with none, every region,
+// of type `type` (-1: all types), best first, recognized with that type's
+// models alone (LOCATE ALL: every model competes); with none, every region,
 // largest first.
 // With `scene`, also keeps the mask and regions there.
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
@@ -148,6 +150,9 @@ class VisionService {
   ModelLibrary* models() const { return models_; }
   // The frame the last request worked on.
   std::optional<FrameInfo> lastFrame() const;
+  // That frame itself (null before any), for the results stream's regions
+  // of requests that keep none: kept until the next request.
+  std::shared_ptr<const Frame> lastFramePixels() const;
   const std::string& camera() const { return camera_->camera(); }
   const VisionOptions& options() const { return options_; }
 
@@ -161,6 +166,7 @@ class VisionService {
 
   mutable std::mutex mutex_;  // serializes requests; guards camera_ calls and last_frame_
   std::optional<FrameInfo> last_frame_;
+  std::shared_ptr<const Frame> last_pixels_;
 };
 
 }  // namespace picksight::app

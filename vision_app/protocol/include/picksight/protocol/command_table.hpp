@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "picksight/common/result.hpp"
+#include "picksight/protocol/session.hpp"
 
 namespace picksight::app {
 
@@ -34,6 +35,10 @@ PICKSIGHT_ERROR_DOMAIN(ProtocolErrc, "robot protocol")
 struct Request {
   std::string command;
   std::vector<std::string> args;
+  std::string line;  // as received
+  // The connection's session; dispatch() always sets it (a fresh one when
+  // its caller has none, whose after_reply runs before dispatch returns).
+  Session* session = nullptr;
 };
 
 // Nullopt for an empty or blank line.
@@ -76,9 +81,12 @@ class CommandTable {
   void add(const std::string& word, const std::string& usage, Handler handler,
            ChangesCell changes = alwaysChanges);
   // Parses and runs one request line. On a read-only port a request that
-  // changes the cell gets ProtocolErrc::kReadOnly and does nothing.
+  // changes the cell gets ProtocolErrc::kReadOnly and does nothing. With
+  // `session` (a connection's), its after_reply is left for the caller to
+  // run once the reply is sent; without, it runs before this returns.
   // Thread-safe once set up.
-  std::string dispatch(std::string_view line, bool read_only = false) const;
+  std::string dispatch(std::string_view line, bool read_only = false,
+                       Session* session = nullptr) const;
   // "OK" and every usage, separated by " | ".
   std::string help() const;
 

@@ -17,8 +17,10 @@ class RobotProtocol {
 
   // One request line in, one reply line out; on a read-only port requests
   // that change the cell are refused. Thread-safe.
-  std::string handle(std::string_view line, bool read_only = false) const {
-    return table_.dispatch(line, read_only);
+  // With a connection's `session`, its after_reply is the caller's to run.
+  std::string handle(std::string_view line, bool read_only = false,
+                     Session* session = nullptr) const {
+    return table_.dispatch(line, read_only, session);
   }
   // For features that add commands; only before serving starts.
   CommandTable& table() { return table_; }

@@ -26,6 +26,7 @@
 #include <thread>
 
 #include "picksight/common/allow_list.hpp"
+#include "picksight/protocol/session.hpp"
 
 namespace picksight::app {
 
@@ -42,15 +43,21 @@ struct RobotServerOptions {
   // No complete request for this long: ERROR 16 and closed. 0 = never.
   std::chrono::milliseconds idle_timeout{60000};
   AllowList allow;  // empty: everyone
+  // Names the port in each session's client ("robot 10.0.0.5:41234").
+  std::string label = "robot";
 };
 
 class RobotServer {
  public:
   // Returns the reply line for one request line (without line ending).
   using Handler = std::function<std::string(std::string_view line)>;
+  // The same with the connection's session (see session.hpp); the server
+  // runs session.after_reply once the reply is sent.
+  using SessionHandler = std::function<std::string(std::string_view line, Session& session)>;
 
   // Binds and listens at once; throws std::runtime_error naming the port.
   RobotServer(RobotServerOptions options, Handler handler);
+  RobotServer(RobotServerOptions options, SessionHandler handler);
   ~RobotServer();
   RobotServer(const RobotServer&) = delete;
   RobotServer& operator=(const RobotServer&) = delete;
@@ -64,18 +71,19 @@ class RobotServer {
   struct Connection {
     int fd = -1;
     std::string peer;  // address, for the per-address count
+    uint16_t peer_port = 0;
     std::thread thread;
     std::atomic<bool> done{false};
   };
 
   void acceptLoop();
   // Admits a new connection or answers why not and closes it.
-  void admit(int fd, const std::string& peer, bool allowed);
+  void admit(int fd, const std::string& peer, uint16_t peer_port, bool allowed);
   void serve(Connection& connection);
   void reapFinished();
 
   const RobotServerOptions options_;
-  const Handler handler_;
+  const SessionHandler handler_;
   int listen_fd_ = -1;
   uint16_t port_ = 0;
   std::thread accept_thread_;

@@ -1,0 +1,28 @@
+// One robot connection's state across its requests: who it is, when the
+// current request arrived, the last LOCATE (for WHY), and what to do once
+// the current reply has been written (publish its result).
+//
+// Threading: owned by the connection's thread; requests on one connection
+// are served one after the other, so nothing here needs a lock.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "picksight/results/request_record.hpp"
+
+namespace picksight::app {
+
+struct Session {
+  std::string client;  // "robot 10.0.0.5:41234", "setup 127.0.0.1:5012"; empty: local
+  std::chrono::steady_clock::time_point received{};  // of the current request
+  // Set by a handler; RobotServer runs it (and clears it) once the reply
+  // line has been sent, so that nothing it does delays the robot.
+  std::function<void(const std::string& reply)> after_reply;
+  // The last LOCATE on this connection (null before any), for WHY.
+  std::shared_ptr<const RequestRecord> last_locate;
+};
+
+}  // namespace picksight::app

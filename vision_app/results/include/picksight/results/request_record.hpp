@@ -1,0 +1,84 @@
+// What one vision request saw and answered, as the request thread hands it
+// to the results publisher (and keeps it for the robot's WHY): the LOCATE
+// outcome with its grasps, or the frame other requests worked on, the
+// request and reply lines. The explanation of the regions left out (the
+// rejections) is computed on first use, after the reply, never on the
+// robot's critical path.
+//
+// Threading: filled by one thread, then shared read-only (shared_ptr);
+// rejections() and why() may be called from any thread, computed once.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "picksight/cell/grasp_planner.hpp"
+#include "picksight/cell/vision_service.hpp"
+#include "picksight/common/frame.hpp"
+#include "picksight/store/cell_calibration.hpp"
+#include "picksight/store/model_library.hpp"
+
+namespace picksight::app {
+
+// Why one region was not reported as a part of the asked type (see
+// Rejection in proto/results.proto; sensor pixels).
+struct RegionRejection {
+  int region = -1;
+  int nearest_type = -1;  // -1: no model at all
+  std::string nearest_name;
+  // "area", "holes", "hu", "mirror", "verify", "other type", "no grasp",
+  // "edge", "passes" (passes every test and yet was not reported).
+  std::string test;
+  double measured = 0;
+  double low = 0;
+  double high = 0;
+  std::string text;  // as WHY prints it
+};
+
+// Regions published (and explained) per request, largest first.
+constexpr size_t kMaxResultRegions = 1024;
+// Longest WHY line: the first rejections that fit, then "; ...".
+constexpr size_t kMaxWhyBytes = 1000;
+
+class RequestRecord {
+ public:
+  std::string request;       // "LOCATE", "LEARN", "BLOBS", "STORE", "CALCAM"
+  std::string request_line;  // as received
+  std::string client;        // "robot 10.0.0.5:41234", "plc 10.0.0.9"
+  std::string reply;         // set once the reply is known
+  double elapsed_ms = 0;     // request to reply
+  int asked_type = -1;       // LOCATE: -1 every type
+
+  // LOCATE: its outcome and what the grasps were chosen with (none when
+  // the request failed before a frame).
+  std::optional<LocateOutcome> locate;
+  CellPick pick;
+  std::shared_ptr<const GraspMap> grasps;
+  std::optional<CellGeometry> geometry;
+
+  // Other requests: the frame they worked on (regions are found from it by
+  // the publisher) and the settings to find them with.
+  std::shared_ptr<const Frame> frame;
+  VisionOptions options;
+
+  // The frame the request worked on, if any.
+  std::optional<FrameInfo> frameInfo() const;
+  // Every region of a LOCATE not reported as a part of the asked type, in
+  // region order; empty for other requests.
+  const std::vector<RegionRejection>& rejections() const;
+  // The WHY line: "OK <n> <text>; <text>..." (n rejections), at most
+  // kMaxWhyBytes; empty for requests other than LOCATE.
+  const std::string& why() const;
+
+ private:
+  void explain() const;
+
+  mutable std::once_flag explained_;
+  mutable std::vector<RegionRejection> rejections_;
+  mutable std::string why_;
+};
+
+}  // namespace picksight::app

@@ -1,0 +1,143 @@
+// Rejections and the WHY line of a LOCATE: every region no offered part
+// came from, explained against the asked type's models (or as a part of
+// another type, or one with no free grasp).
+#include "picksight/results/request_record.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "picksight/common/text.hpp"
+#include "picksight/vision/rejection.hpp"
+
+namespace picksight::app {
+namespace {
+
+std::string ofType(int type) { return " of type " + std::to_string(type); }
+
+// The sentence WHY prints for a rejection (values in sensor pixels).
+std::string rejectionText(const RegionRejection& r) {
+  const std::string region = "region " + std::to_string(r.region);
+  if (r.test == "area") {
+    return region + " area " + formatFixed(r.measured, 0) + " outside " + formatFixed(r.low, 0) +
+           ".." + formatFixed(r.high, 0) + ofType(r.nearest_type);
+  }
+  if (r.test == "holes") {
+    return region + " holes " + formatFixed(r.measured, 0) + " not " + formatFixed(r.low, 0) +
+           ofType(r.nearest_type);
+  }
+  if (r.test == "hu") {
+    return region + " shape distance " + formatFixed(r.measured, 3) + " > " +
+           formatFixed(r.high, 3) + ofType(r.nearest_type);
+  }
+  if (r.test == "mirror") return region + " mirror" + ofType(r.nearest_type);
+  if (r.test == "verify") {
+    return region + " boundary " + formatFixed(r.measured, 1) + "% < " + formatFixed(r.high, 1) +
+           "%" + ofType(r.nearest_type);
+  }
+  if (r.test == "other type") {
+    return region + " is type " + std::to_string(r.nearest_type) + " not " +
+           formatFixed(r.measured, 0);
+  }
+  if (r.test == "no grasp") return region + " no free grasp" + ofType(r.nearest_type);
+  if (r.test == "edge") return region + " touches the frame border";
+  if (r.test == "no model") return region + " no model";
+  return region + " passes every test" + ofType(r.nearest_type) + " yet not reported";
+}
+
+std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type) {
+  std::vector<const vision::PartModel*> list;
+  for (const auto& m : models)
+    if (type < 0 || m.type == type) list.push_back(&m);
+  return list;
+}
+
+}  // namespace
+
+std::optional<FrameInfo> RequestRecord::frameInfo() const {
+  if (locate) return locate->frame;
+  if (frame) return frame->info;
+  return std::nullopt;
+}
+
+const std::vector<RegionRejection>& RequestRecord::rejections() const {
+  std::call_once(explained_, [this] { explain(); });
+  return rejections_;
+}
+
+const std::string& RequestRecord::why() const {
+  std::call_once(explained_, [this] { explain(); });
+  return why_;
+}
+
+void RequestRecord::explain() const {
+  if (request != "LOCATE") return;
+  if (!locate) {
+    why_ = "OK 0 LOCATE failed: " + reply;
+    return;
+  }
+  const LocateScene& scene = locate->scene;
+  const ModelList empty;
+  const ModelList& models = scene.models ? *scene.models : empty;
+  std::set<int> offered;
+  for (size_t part : pick.parts) offered.insert(locate->parts[part].region);
+  const auto all = modelsOf(models, -1);
+  const auto asked = modelsOf(models, asked_type);
+  for (size_t i = 0; i < std::min(scene.regions.size(), kMaxResultRegions); ++i) {
+    const int index = static_cast<int>(i);
+    if (offered.count(index)) continue;
+    RegionRejection r;
+    r.region = index;
+    const auto located = std::find_if(locate->parts.begin(), locate->parts.end(),
+                                      [&](const LocatedPart& p) { return p.region == index; });
+    if (located != locate->parts.end()) {
+      r.test = "no grasp";
+      r.nearest_type = located->type;
+    } else if (all.empty()) {
+      r.test = "no model";
+    } else {
+      auto e = vision::explainRegion(scene.regions[i], all);
+      if (asked_type >= 0 && e.test == vision::RegionTest::kPasses &&
+          e.nearest->type != asked_type) {
+        r.test = "other type";
+        r.nearest_type = e.nearest->type;
+        r.nearest_name = e.nearest->name;
+        r.measured = r.low = r.high = asked_type;
+      } else {
+        if (asked_type >= 0) e = vision::explainRegion(scene.regions[i], asked);
+        r.test = vision::regionTestName(e.test);
+        r.nearest_type = e.nearest ? e.nearest->type : -1;
+        r.nearest_name = e.nearest ? e.nearest->name : "";
+        r.measured = e.measured;
+        r.low = e.low;
+        r.high = e.high;
+        if (e.test == vision::RegionTest::kArea) {
+          r.measured = scene.mapping.areaToSensor(r.measured);
+          r.low = scene.mapping.areaToSensor(r.low);
+          r.high = scene.mapping.areaToSensor(r.high);
+        }
+      }
+    }
+    if (r.nearest_name.empty() && r.nearest_type >= 0) {
+      for (const auto& m : models)
+        if (m.type == r.nearest_type) r.nearest_name = m.name;
+    }
+    r.text = rejectionText(r);
+    rejections_.push_back(std::move(r));
+  }
+  why_ = "OK " + std::to_string(rejections_.size());
+  if (rejections_.empty()) {
+    why_ += scene.regions.empty() ? " no region in the frame" : " every region reported";
+    return;
+  }
+  const std::string more = "; ...";
+  for (size_t i = 0; i < rejections_.size(); ++i) {
+    const std::string item = (i == 0 ? " " : "; ") + rejections_[i].text;
+    if (why_.size() + item.size() + more.size() > kMaxWhyBytes) {
+      why_ += more;
+      break;
+    }
+    why_ += item;
+  }
+}
+
+}  // namespace picksight::app
