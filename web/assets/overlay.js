@@ -156,7 +156,15 @@
     for (const id of ["live-overlay", "live-regions"]) $(id).addEventListener("change", draw);
     $("live-binary").addEventListener("change", (e) => { ps.binaryWanted = e.target.checked; ps.showFrame(); });
     $("live-locate").addEventListener("click", () => say("LOCATE " + ($("live-type").value.trim() || "ALL")));
-    $("live-why").addEventListener("click", () => say("WHY"));
+    // WHY answers about the last LOCATE on the same connection: a LOCATE
+    // from elsewhere (a robot) is explained by the latest result's text.
+    $("live-why").addEventListener("click", async () => {
+      const reply = await say("WHY");
+      const result = ps.app ? ps.latest[ps.app] : null;
+      if (reply.includes("no LOCATE yet") && result && result.why) {
+        ps.show("live-reply", "(latest result #" + (result.request_id || 0) + ")", result.why);
+      }
+    });
     $("live-status").addEventListener("click", () => say("STATUS"));
   });
 })();
