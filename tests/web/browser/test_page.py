@@ -348,6 +348,14 @@ def test_grasp_styles_and_fingers_edited_and_drawn(cell, browser):
             wait_until(lambda: len(browser.driver.find_elements(By.CSS_SELECTOR, "#tool .footprint path")) == 2,
                        what="the footprint of both fingers")
             browser.screenshot("teach-grasp")
+            # The whole table again: every part of the type with its grasp
+            # (docs/web-hmi.png is this screenshot).
+            cell.set_parts(4)
+            wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "4", what="four parts on the table")
+            select_tab(browser, "live")
+            reply, before = locate_on_page(browser, "7")
+            check_overlay_matches(cell, browser, reply, overlay_after(browser, before))
+            browser.screenshot("web-hmi")
         else:
             assert len(poses(reply)) == 1, reply
     finally:
