@@ -36,7 +36,7 @@ SOURCE = (f"{CAMERA}=synthetic:width=640,height=480,parts=4,types=l_shape,size=9
           "mm_per_px=0.25,rz=178.7,dx=330.5,dy=-612.25,target_radius=5")
 
 
-def wait_until(condition, timeout=15.0, what="condition", interval=0.05):
+def wait_until(condition, timeout=30.0, what="condition", interval=0.05):
     """Polls `condition` until it returns something truthy; that value."""
     deadline = time.monotonic() + timeout
     last = None
