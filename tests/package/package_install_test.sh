@@ -76,6 +76,7 @@ echo "Depends: $(dpkg-deb -f "$deb" Depends)"
 dpkg-deb -c "$deb" >"$work/contents"
 for path in ./usr/bin/picksight-video-server ./usr/bin/picksight-vision ./usr/bin/picksight-cam \
   ./usr/bin/picksight-calib ./usr/bin/picksight-robot ./usr/bin/picksight-keygen \
+  ./usr/bin/picksight-web ./usr/lib/systemd/system/picksight-web.service ./etc/picksight/web.yaml \
   ./usr/lib/systemd/system/picksight-video-server.service \
   "./usr/lib/systemd/system/picksight-vision@.service" ./usr/lib/sysusers.d/picksight.conf \
   ./usr/lib/tmpfiles.d/picksight.conf ./etc/picksight/video-server.yaml \
@@ -92,8 +93,9 @@ awk '$2 != "root/root" || $1 ~ /^.....w|^........w/' "$work/contents" >"$work/lo
 [ -s "$work/loose" ] && { cat "$work/loose" >&2; fail "files not root's or writable by others"; }
 dpkg-deb -e "$deb" "$work/control"
 diff <(sort "$work/control/conffiles") \
-  <(printf '%s\n' /etc/picksight/video-server.yaml /etc/picksight/vision/cam0.yaml | sort) ||
-  fail "conffiles are not the two example files"
+  <(printf '%s\n' /etc/picksight/video-server.yaml /etc/picksight/vision/cam0.yaml \
+     /etc/picksight/web.yaml | sort) ||
+  fail "conffiles are not the three example files"
 echo "contents: $(grep -c '^-' "$work/contents") files; conffiles: $(tr '\n' ' ' <"$work/control/conffiles")"
 
 # --- install ----------------------------------------------------------------

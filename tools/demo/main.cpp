@@ -3,13 +3,16 @@
 // then does what an integrator and a robot program do over the robot
 // protocol: CALCAM, STORE at several robot points, COMPUTE, LEARN, GRASP,
 // LOCATE, and prints each answer beside the hidden truth (the camera's
-// robot-camera transform and the parts' true places), then stops both.
+// robot-camera transform and the parts' true places), then stops both. With
+// --web PORT it then keeps the cell running (camera in free-run) with
+// picksight-web serving its HMI on that port, until interrupted.
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -18,6 +21,7 @@
 
 #include "picksight/common/angles.hpp"
 #include "picksight/common/command_line.hpp"
+#include "picksight/common/stop_signals.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
@@ -102,6 +106,16 @@ class Cell {
     feature->set_name("Parts");
     feature->set_value(std::to_string(parts));
     return check(control_.call(request), "Parts");
+  }
+
+  // Free-run at `fps`: a live view for the web page.
+  bool setFreerun(double fps) {
+    picksight::proto::ControlRequest request;
+    auto* mode = request.mutable_set_mode();
+    mode->set_camera("cam0");
+    mode->set_mode(picksight::proto::FREERUN);
+    mode->set_fps(fps);
+    return check(control_.call(request), "mode");
   }
 
   // The truth of the frame the last vision request worked on (FRAME).
@@ -226,6 +240,39 @@ void pick(Cell& cell, const cv::Matx33d& robot_to_sensor, int parts, int request
   }
 }
 
+// The start-up lines of a PickSight process ("robot 1234", "results tcp://...")
+// up to its "ready" line, by their first word.
+std::map<std::string, std::string> startLines(picksight::Subprocess& process) {
+  std::map<std::string, std::string> lines;
+  while (auto line = process.readLine(10s)) {
+    if (*line == "ready") break;
+    const size_t space = line->find(' ');
+    if (space != std::string::npos) lines[line->substr(0, space)] = line->substr(space + 1);
+  }
+  return lines;
+}
+
+// Serves the cell's HMI on `port` until SIGINT or SIGTERM.
+int serveWeb(const picksight::StopSignals& stop, Cell& cell, const std::string& dir,
+             const std::string& frames, const std::string& control, const std::string& results,
+             int robot_port, int port) {
+  cell.setFreerun(10);
+  picksight::Subprocess web({dir + "/picksight-web", "--listen",
+                             "127.0.0.1:" + std::to_string(port), "--video-server",
+                             frames + "," + control, "--vision-app",
+                             "cam0," + (results.empty() ? "none" : results) +
+                                 ",127.0.0.1:" + std::to_string(robot_port)});
+  auto url = web.waitForLine("web ", 10s);
+  if (!url) {
+    std::cerr << "demo: picksight-web did not start\n";
+    return 1;
+  }
+  std::cout << "\nThe cell's HMI: " << *url << "  (Ctrl-C stops the cell)" << std::endl;
+  stop.wait();
+  std::cout << "stopping" << std::endl;
+  return WEXITSTATUS(web.terminate());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -235,6 +282,7 @@ int main(int argc, char** argv) {
   int width = 1280;
   int height = 960;
   long long seed = 1;
+  int web_port = -1;
   CLI::App app(
       "Quick-start demo: a whole cell on the synthetic camera and its simulated robot:\n"
       "CALCAM, STORE, COMPUTE, LEARN, GRASP and LOCATE in robot millimetres, beside the truth.",
@@ -264,7 +312,16 @@ int main(int argc, char** argv) {
       ->type_name("S")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--web", web_port,
+                 "after the script, keep the cell running with its web HMI on this port "
+                 "(127.0.0.1; 0: any free port) until interrupted")
+      ->type_name("PORT")
+      ->check(CLI::Range(0, 65535));
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  // Blocked before any thread or child starts: Ctrl-C reaches the demo's
+  // wait (and the children's own), never a ZeroMQ thread.
+  std::optional<picksight::StopSignals> stop_signals;
+  if (web_port >= 0) stop_signals.emplace();
 
   const std::string dir = binDir();
   char data_dir[] = "/tmp/picksight-demo-XXXXXX";
@@ -294,8 +351,8 @@ int main(int argc, char** argv) {
   picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
                                 *control, "--camera", "cam0", "--robot-port", "0", "--bind",
                                 "127.0.0.1", "--data-dir", data_dir});
-  auto port_text = vision.waitForLine("robot ", 10s);
-  auto port = port_text ? picksight::parseInt(*port_text) : std::nullopt;
+  auto started = startLines(vision);
+  auto port = started.count("robot") ? picksight::parseInt(started["robot"]) : std::nullopt;
   if (!port) {
     std::cerr << "demo: the vision app did not start\n";
     return 1;
@@ -328,6 +385,11 @@ int main(int argc, char** argv) {
   pick(cell, h, parts, requests);
   cell.say("STATUS");
 
+  int web_status = 0;
+  if (web_port >= 0) {
+    web_status =
+        serveWeb(*stop_signals, cell, dir, *frames, *control, started["results"], *port, web_port);
+  }
   cell.close();
   const int vision_status = vision.terminate();
   const int server_status = server.terminate();
@@ -335,5 +397,6 @@ int main(int argc, char** argv) {
             << WEXITSTATUS(server_status) << "\n";
   std::error_code ignored;
   std::filesystem::remove_all(data_dir, ignored);
-  return cell.failures() == 0 && vision_status == 0 && server_status == 0 ? 0 : 1;
+  return cell.failures() == 0 && vision_status == 0 && server_status == 0 && web_status == 0 ? 0
+                                                                                             : 1;
 }

@@ -1,0 +1,91 @@
+// One vision app for the web server: its results stream (a SUB socket on the
+// app's results endpoint, decoded to VisionResult, turned into JSON once and
+// sent to every /events client), the counters /metrics shows, and the robot
+// (or setup) connection that commands from the page go through.
+//
+// Threading: the feed's thread owns the SUB socket and its monitor; readers
+// take snapshots under mutex_. command() holds line_mutex_ for one request
+// and reply, on a kept connection (so WHY speaks of the page's last LOCATE).
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <zmq.hpp>
+
+#include "picksight/common/result.hpp"
+#include "picksight/tool_support/line_client.hpp"
+#include "picksight/web/event_hub.hpp"
+#include "picksight/web/web_options.hpp"
+#include "results.pb.h"
+
+namespace picksight::web {
+
+// Upper bounds (seconds) of the request-time histogram's buckets (+Inf after).
+constexpr std::array<double, 11> kRequestBuckets = {0.001, 0.0025, 0.005, 0.01, 0.025, 0.05,
+                                                    0.1,   0.25,   0.5,   1.0,  2.5};
+
+// Counts and time histogram of one request kind (LOCATE, LEARN...).
+struct RequestFigures {
+  uint64_t count = 0;
+  double seconds_sum = 0;
+  std::array<uint64_t, kRequestBuckets.size()> buckets{};  // cumulative at read time
+};
+
+// The longest robot line the page may send (bytes, without the newline).
+constexpr size_t kMaxCommandBytes = 256;
+
+class ResultFeed {
+ public:
+  ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events);
+  ~ResultFeed();
+  ResultFeed(const ResultFeed&) = delete;
+  ResultFeed& operator=(const ResultFeed&) = delete;
+
+  const std::string& name() const { return app_.name; }
+
+  // The /api/apps entry: name, camera, connected, last_result_id.
+  std::string camera() const;
+  bool connected() const { return connected_.load(); }
+  uint64_t lastResultId() const;
+  // The latest result (null before the first) and its JSON.
+  std::shared_ptr<const proto::VisionResult> latest() const;
+  std::string latestJson() const;
+  std::map<std::string, RequestFigures> figures() const;
+
+  // Takes one robot-protocol line to the app and returns its reply line.
+  // Lines over kMaxCommandBytes or with CR/LF are refused (kBadRequest); a
+  // dead app is kUnreachable.
+  Result<std::string> command(const std::string& line);
+
+  // Handles one received result as the thread does (also for tests).
+  void accept(proto::VisionResult result);
+
+  void stop();
+
+ private:
+  void run(zmq::context_t& context);
+
+  const VisionAppEndpoint app_;
+  EventHub& events_;
+
+  mutable std::mutex mutex_;
+  std::shared_ptr<const proto::VisionResult> latest_;  // under mutex_
+  std::string latest_json_;                            // under mutex_
+  std::map<std::string, RequestFigures> figures_;      // under mutex_
+
+  std::mutex line_mutex_;
+  LineClient line_;  // under line_mutex_
+
+  std::atomic<bool> connected_{false};
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace picksight::web

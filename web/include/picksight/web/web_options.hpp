@@ -1,0 +1,55 @@
+// Command-line options and YAML configuration of picksight-web.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "picksight/common/allow_list.hpp"
+#include "picksight/common/result.hpp"
+
+namespace picksight::web {
+
+// One video server: its frames (PUB) and control endpoints.
+struct VideoServerEndpoints {
+  std::string frames;
+  std::string control;
+};
+
+// One vision app: its name, its results stream ("none": not subscribed) and
+// the robot (or setup) port that commands from the page go to.
+struct VisionAppEndpoint {
+  std::string name;
+  std::string results;
+  std::string host;
+  uint16_t port = 0;
+};
+
+struct WebOptions {
+  std::string listen_host = "127.0.0.1";
+  uint16_t listen_port = 8080;  // 0: any free port
+  std::vector<VideoServerEndpoints> video_servers;
+  std::vector<VisionAppEndpoint> vision_apps;
+  std::string assets_dir;  // empty: the build tree's or the installed page
+  AllowList allow;         // checked on every request
+  int jpeg_quality = 80;
+  // Concurrent MJPEG and event streams; beyond it a 503, so that streams
+  // never take every HTTP thread and starve the page.
+  int max_streams = 48;
+};
+
+// Parses argv without the program name; errors name the option. With
+// --config FILE the YAML map in FILE supplies options first (each key is an
+// option without its dashes, a list repeats it) and the command line
+// overrides them.
+Result<WebOptions> parseWebArgs(const std::vector<std::string>& args, bool* help);
+std::string webUsage();
+
+// "HOST:PORT" ("[::1]:80" for IPv6); the error says what is wrong.
+Result<std::pair<std::string, uint16_t>> parseHostPort(const std::string& text);
+
+// The page's directory when --assets is not given: the source tree's
+// web/assets when it exists (a build tree), else the installed one.
+std::string defaultAssetsDir();
+
+}  // namespace picksight::web

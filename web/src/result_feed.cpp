@@ -1,0 +1,164 @@
+// The results subscriber, its counters and the command connection.
+#include "picksight/web/result_feed.hpp"
+
+#include <algorithm>
+
+#include "picksight/common/log.hpp"
+#include "picksight/web/proto_json.hpp"
+#include "picksight/web/web_errors.hpp"
+
+namespace picksight::web {
+namespace {
+using namespace std::chrono_literals;
+
+constexpr auto kConnectTimeout = 2s;
+// A LOCATE in trigger mode waits for its frame; LEARN and COMPUTE take
+// longer than a robot request: the page waits up to this for a reply.
+constexpr auto kReplyTimeout = 10s;
+// A result message is a few hundred kilobytes at most (1024 regions of 512
+// points); anything bigger is not one of ours.
+constexpr int64_t kMaxResultBytes = 16 << 20;
+
+// Follows the SUB socket's connection to the app.
+class ConnectionMonitor : public zmq::monitor_t {
+ public:
+  explicit ConnectionMonitor(std::atomic<bool>& connected) : connected_(connected) {}
+  void on_event_connected(const zmq_event_t&, const char*) override { connected_ = true; }
+  void on_event_disconnected(const zmq_event_t&, const char*) override { connected_ = false; }
+
+ private:
+  std::atomic<bool>& connected_;
+};
+
+}  // namespace
+
+ResultFeed::ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events)
+    : app_(std::move(app)), events_(events) {
+  if (app_.results != "none") thread_ = std::thread([this, &context] { run(context); });
+}
+
+ResultFeed::~ResultFeed() { stop(); }
+
+void ResultFeed::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+void ResultFeed::run(zmq::context_t& context) {
+  try {
+    zmq::socket_t socket(context, zmq::socket_type::sub);
+    socket.set(zmq::sockopt::rcvhwm, 64);
+    socket.set(zmq::sockopt::maxmsgsize, kMaxResultBytes);
+    socket.set(zmq::sockopt::linger, 0);
+    ConnectionMonitor monitor(connected_);
+    // inproc names are per context: the app's name keeps them apart.
+    monitor.init(socket, "inproc://picksight-web-results-" + app_.name,
+                 ZMQ_EVENT_CONNECTED | ZMQ_EVENT_DISCONNECTED);
+    socket.set(zmq::sockopt::subscribe, app_.name);
+    socket.connect(app_.results);
+    zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+    while (!stop_) {
+      monitor.check_event(0);
+      zmq::poll(&item, 1, 200ms);
+      if (!(item.revents & ZMQ_POLLIN)) continue;
+      zmq::message_t topic;
+      zmq::message_t body;
+      if (!socket.recv(topic, zmq::recv_flags::dontwait)) continue;
+      bool two_parts = topic.more() && socket.recv(body, zmq::recv_flags::dontwait);
+      while (socket.get(zmq::sockopt::rcvmore)) {  // drop any extra parts
+        zmq::message_t extra;
+        (void)socket.recv(extra, zmq::recv_flags::dontwait);
+        two_parts = false;
+      }
+      if (!two_parts || topic.to_string_view() != app_.name) continue;
+      proto::VisionResult result;
+      if (!result.ParseFromArray(body.data(), static_cast<int>(body.size()))) {
+        logWarning("vision app ", app_.name, ": malformed result message skipped");
+        continue;
+      }
+      accept(std::move(result));
+    }
+    monitor.abort();
+  } catch (const std::exception& e) {
+    logError("vision app ", app_.name, ": results feed stopped: ", e.what());
+  }
+  connected_ = false;
+}
+
+void ResultFeed::accept(proto::VisionResult result) {
+  if (result.app().empty()) result.set_app(app_.name);
+  std::string json = protoJsonText(result);
+  auto shared = std::make_shared<const proto::VisionResult>(std::move(result));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    RequestFigures& f = figures_[shared->request().empty() ? "unknown" : shared->request()];
+    ++f.count;
+    const double seconds = shared->elapsed_ms() / 1000.0;
+    f.seconds_sum += seconds;
+    for (size_t i = 0; i < kRequestBuckets.size(); ++i)
+      if (seconds <= kRequestBuckets[i]) ++f.buckets[i];
+    latest_ = shared;
+    latest_json_ = json;
+  }
+  events_.publish("result", json);
+}
+
+std::string ResultFeed::camera() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_ ? latest_->camera() : std::string();
+}
+
+uint64_t ResultFeed::lastResultId() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_ ? latest_->request_id() : 0;
+}
+
+std::shared_ptr<const proto::VisionResult> ResultFeed::latest() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_;
+}
+
+std::string ResultFeed::latestJson() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return latest_json_;
+}
+
+std::map<std::string, RequestFigures> ResultFeed::figures() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return figures_;
+}
+
+Result<std::string> ResultFeed::command(const std::string& line) {
+  if (line.empty()) return makeError(WebErrc::kBadRequest, "empty command line");
+  if (line.size() > kMaxCommandBytes)
+    return makeError(WebErrc::kBadRequest,
+                     "command line longer than " + std::to_string(kMaxCommandBytes) + " bytes");
+  if (line.find_first_of("\r\n") != std::string::npos)
+    return makeError(WebErrc::kBadRequest, "command line contains CR or LF");
+  std::lock_guard<std::mutex> lock(line_mutex_);
+  // A kept connection the app has closed meanwhile (restart, idle timeout)
+  // fails at once: then once more on a fresh one. A reply that timed out is
+  // never sent again (the app may have acted on it).
+  Error last;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    const bool reused = line_.isOpen();
+    if (!reused) {
+      auto client = LineClient::connect(app_.host, app_.port, kConnectTimeout);
+      if (!client) {
+        return makeError(WebErrc::kUnreachable, "vision app " + app_.name + " (" + app_.host + ":" +
+                                                    std::to_string(app_.port) +
+                                                    "): " + client.error().message);
+      }
+      line_ = std::move(*client);
+    }
+    const auto start = std::chrono::steady_clock::now();
+    auto reply = line_.request(line, kReplyTimeout);
+    if (reply) return reply;
+    last = reply.error();
+    line_.close();
+    if (!reused || std::chrono::steady_clock::now() - start > 1s) break;
+  }
+  return makeError(WebErrc::kUnreachable, "vision app " + app_.name + ": " + last.message);
+}
+
+}  // namespace picksight::web

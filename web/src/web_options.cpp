@@ -1,0 +1,162 @@
+// picksight-web's options (CLI11) and its YAML file.
+#include "picksight/web/web_options.hpp"
+
+#include <filesystem>
+#include <set>
+
+#include "picksight/common/command_line.hpp"
+#include "picksight/common/config_file.hpp"
+#include "picksight/common/text.hpp"
+#include "picksight/web/web_errors.hpp"
+
+namespace picksight::web {
+namespace {
+
+struct RawOptions {
+  std::string listen = "127.0.0.1:8080";
+  std::vector<std::string> video_servers;
+  std::vector<std::string> vision_apps;
+  std::string allow;
+  std::string config_file;
+};
+
+std::string checkHostPort(const std::string& text) {
+  auto parsed = parseHostPort(text);
+  return parsed ? "" : parsed.error().message;
+}
+
+Result<VideoServerEndpoints> parseVideoServer(const std::string& text) {
+  const auto fields = splitFields(text, ",");
+  if (fields.size() != 2 || fields[0].empty() || fields[1].empty())
+    return makeError(WebErrc::kBadConfig,
+                     "'" + text + "': expected FRAMES_ENDPOINT,CONTROL_ENDPOINT");
+  return VideoServerEndpoints{std::string(fields[0]), std::string(fields[1])};
+}
+
+Result<VisionAppEndpoint> parseVisionApp(const std::string& text) {
+  const auto fields = splitFields(text, ",");
+  if (fields.size() != 3 || fields[0].empty() || fields[1].empty())
+    return makeError(WebErrc::kBadConfig,
+                     "'" + text + "': expected NAME,RESULTS_ENDPOINT,HOST:PORT");
+  auto host_port = parseHostPort(std::string(fields[2]));
+  if (!host_port) return host_port.error();
+  return VisionAppEndpoint{std::string(fields[0]), std::string(fields[1]), host_port->first,
+                           host_port->second};
+}
+
+template <typename F>
+CLI::Validator checkEach(F parse) {
+  return checkValue([parse](const std::string& value) {
+    auto parsed = parse(value);
+    return parsed ? std::string() : parsed.error().message;
+  });
+}
+
+void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
+  app.set_help_flag("-h,--help", "print this help");
+  app.add_option("--listen", raw.listen,
+                 "HOST:PORT to serve HTTP on (port 0: any free port; prints 'web http://...')")
+      ->check(checkValue(checkHostPort))
+      ->capture_default_str();
+  app.add_option("--video-server", raw.video_servers,
+                 "FRAMES_ENDPOINT,CONTROL_ENDPOINT of a video server (repeatable)")
+      ->check(checkEach(parseVideoServer))
+      ->take_all();
+  app.add_option("--vision-app", raw.vision_apps,
+                 "NAME,RESULTS_ENDPOINT,HOST:PORT of a vision app: its results stream "
+                 "('none': no results) and its robot or setup port (repeatable)")
+      ->check(checkEach(parseVisionApp))
+      ->take_all();
+  app.add_option("--assets", o.assets_dir, "directory of the page's files (index.html, ...)")
+      ->capture_default_str();
+  app.add_option("--allow", raw.allow,
+                 "peers allowed to connect: addresses or CIDR networks (default: everyone "
+                 "that reaches the listen address)")
+      ->check(checkValue([](const std::string& v) {
+        auto list = AllowList::parse(v);
+        return list ? std::string() : list.error().message;
+      }));
+  app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of the streams")
+      ->check(CLI::Range(10, 100))
+      ->capture_default_str();
+  app.add_option("--max-streams", o.max_streams, "concurrent MJPEG and event streams")
+      ->check(CLI::Range(1, 200))
+      ->capture_default_str();
+  app.add_option("--config", raw.config_file,
+                 "YAML file of options, each named as its flag without dashes "
+                 "(lists for the repeatable ones); the command line overrides it");
+}
+
+CLI::App webApp() {
+  return CLI::App(
+      "Web HMI of a PickSight cell: live cameras, vision results, camera settings, "
+      "teaching and calibration from a browser.",
+      "picksight-web");
+}
+
+Result<WebOptions> parseWords(const std::vector<std::string>& args, bool* help,
+                              ConfigParseExtras* extras) {
+  CLI::App app = webApp();
+  WebOptions o;
+  RawOptions raw;
+  defineOptions(app, o, raw);
+  if (auto ok = parseArgs(app, args, help); !ok) return ok.error();
+  if (extras) {
+    extras->config_file = raw.config_file;
+    extras->given = givenOptions(app);
+  }
+  // The validators accepted these: the conversions cannot fail.
+  auto listen = parseHostPort(raw.listen);
+  o.listen_host = listen->first;
+  o.listen_port = listen->second;
+  for (const auto& v : raw.video_servers) o.video_servers.push_back(*parseVideoServer(v));
+  std::set<std::string> names;
+  for (const auto& v : raw.vision_apps) {
+    o.vision_apps.push_back(*parseVisionApp(v));
+    if (!names.insert(o.vision_apps.back().name).second)
+      return makeError(WebErrc::kBadConfig,
+                       "--vision-app: name '" + o.vision_apps.back().name + "' given twice");
+  }
+  if (!raw.allow.empty()) o.allow = *AllowList::parse(raw.allow);
+  return o;
+}
+
+}  // namespace
+
+Result<std::pair<std::string, uint16_t>> parseHostPort(const std::string& text) {
+  const size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0)
+    return makeError(WebErrc::kBadConfig, "'" + text + "': expected HOST:PORT");
+  std::string host = text.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
+    host = host.substr(1, host.size() - 2);
+  const auto port = parseInt(std::string_view(text).substr(colon + 1));
+  if (!port || *port < 0 || *port > 65535)
+    return makeError(WebErrc::kBadConfig, "'" + text + "': the port must be 0..65535");
+  return std::make_pair(host, static_cast<uint16_t>(*port));
+}
+
+std::string defaultAssetsDir() {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(PICKSIGHT_WEB_SOURCE_ASSETS "/index.html", ec))
+    return PICKSIGHT_WEB_SOURCE_ASSETS;
+  return PICKSIGHT_WEB_INSTALLED_ASSETS;
+}
+
+std::string webUsage() {
+  CLI::App app = webApp();
+  WebOptions o;
+  RawOptions raw;
+  defineOptions(app, o, raw);
+  return app.help();
+}
+
+Result<WebOptions> parseWebArgs(const std::vector<std::string>& args, bool* help) {
+  CLI::App app = webApp();
+  WebOptions unused;
+  RawOptions raw;
+  defineOptions(app, unused, raw);
+  return parseWithConfigFile<WebOptions>(args, help, app, parseWords);
+}
+
+}  // namespace picksight::web

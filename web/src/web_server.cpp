@@ -1,0 +1,462 @@
+// The HTTP routes of picksight-web over cpp-httplib.
+#include "picksight/web/web_server.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
+#include <atomic>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include <httplib.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <zmq.hpp>
+
+#include "picksight/common/log.hpp"
+#include "picksight/common/text.hpp"
+#include "picksight/transport/control_client.hpp"
+#include "picksight/vision/binarize.hpp"
+#include "picksight/web/camera_actions.hpp"
+#include "picksight/web/camera_monitor.hpp"
+#include "picksight/web/event_hub.hpp"
+#include "picksight/web/metrics_text.hpp"
+#include "picksight/web/proto_json.hpp"
+#include "picksight/web/result_feed.hpp"
+#include "picksight/web/web_errors.hpp"
+
+namespace picksight::web {
+namespace {
+using namespace std::chrono_literals;
+
+constexpr size_t kMaxBodyBytes = 64 * 1024;
+constexpr auto kKeepalive = 15s;
+constexpr const char* kBoundary = "picksightframe";
+
+// The one table from errors to HTTP statuses.
+int httpStatus(const Error& error) {
+  const auto& code = error.code;
+  if (code == WebErrc::kBadRequest) return 400;
+  if (code == WebErrc::kNotFound) return 404;
+  if (code == WebErrc::kUnreachable) return 502;
+  if (code == ControlErrc::kBadRequest || code == ControlErrc::kOutOfRange ||
+      code == ControlErrc::kUnknownFeature || code == ControlErrc::kNotSupported)
+    return 400;
+  if (code == ControlErrc::kUnknownCamera) return 404;
+  if (code == ControlErrc::kCameraUnavailable || code == ControlErrc::kBusy) return 503;
+  if (code == ControlErrc::kTimeout) return 504;
+  if (code == ControlErrc::kNoReply) return 502;
+  return 500;
+}
+
+void sendJson(httplib::Response& res, const nlohmann::json& body, int status = 200) {
+  res.status = status;
+  res.set_header("Cache-Control", "no-store");
+  res.set_content(body.dump(), "application/json");
+}
+
+void sendError(httplib::Response& res, const Error& error) {
+  sendJson(res, {{"error", error.message}}, httpStatus(error));
+}
+
+void sendError(httplib::Response& res, WebErrc code, const std::string& message) {
+  sendError(res, makeError(code, message));
+}
+
+std::string contentType(const std::string& path) {
+  static const std::map<std::string, std::string> types = {
+      {"html", "text/html; charset=utf-8"},
+      {"js", "text/javascript; charset=utf-8"},
+      {"mjs", "text/javascript; charset=utf-8"},
+      {"css", "text/css; charset=utf-8"},
+      {"json", "application/json"},
+      {"svg", "image/svg+xml"},
+      {"png", "image/png"},
+      {"jpg", "image/jpeg"},
+      {"ico", "image/x-icon"},
+      {"txt", "text/plain; charset=utf-8"},
+      {"woff2", "font/woff2"}};
+  const size_t dot = path.rfind('.');
+  auto it = dot == std::string::npos ? types.end() : types.find(path.substr(dot + 1));
+  return it == types.end() ? "application/octet-stream" : it->second;
+}
+
+// Whether the HTTP peer may talk to us (its address as httplib reports it).
+bool peerAllowed(const AllowList& allow, const std::string& address) {
+  if (allow.allowsEveryone()) return true;
+  sockaddr_in v4{};
+  if (inet_pton(AF_INET, address.c_str(), &v4.sin_addr) == 1) {
+    v4.sin_family = AF_INET;
+    return allow.allows(reinterpret_cast<const sockaddr*>(&v4));
+  }
+  sockaddr_in6 v6{};
+  if (inet_pton(AF_INET6, address.c_str(), &v6.sin6_addr) == 1) {
+    v6.sin6_family = AF_INET6;
+    return allow.allows(reinterpret_cast<const sockaddr*>(&v6));
+  }
+  return false;
+}
+
+void setFrameHeaders(httplib::Response& res, uint64_t sequence, uint64_t timestamp_ns) {
+  res.set_header("X-Frame-Sequence", std::to_string(sequence));
+  res.set_header("X-Frame-Timestamp-Ns", std::to_string(timestamp_ns));
+  res.set_header("Cache-Control", "no-store");
+}
+
+}  // namespace
+
+class WebServer::Impl {
+ public:
+  explicit Impl(WebOptions options) : options_(std::move(options)) {
+    if (options_.assets_dir.empty()) options_.assets_dir = defaultAssetsDir();
+  }
+  ~Impl() { stop(); }
+
+  Result<void> start();
+  void stop();
+
+  WebOptions options_;
+  zmq::context_t context_;
+  EventHub events_;
+  std::unique_ptr<CameraMonitor> cameras_;
+  std::map<std::string, std::unique_ptr<ResultFeed>> apps_;
+  httplib::Server http_;
+  std::thread thread_;
+  int port_ = 0;
+  std::atomic<bool> stopping_{false};
+  std::atomic<int> streams_{0};
+
+ private:
+  void routes();
+  void serveFile(const std::string& relative, httplib::Response& res);
+  std::shared_ptr<CameraFeed> feedOr404(const std::string& camera, httplib::Response& res);
+  ResultFeed* appOr404(const std::string& name, httplib::Response& res);
+  void snapshot(const std::string& camera, httplib::Response& res);
+  void frameJpeg(const std::string& camera, httplib::Response& res);
+  void stream(const std::string& camera, httplib::Response& res);
+  void binary(const std::string& app, httplib::Response& res);
+  void events(httplib::Response& res);
+  void apps(httplib::Response& res);
+  std::string metrics();
+  // Claims one of max_streams slots; false (and a 503) when all are taken.
+  bool claimStream(httplib::Response& res);
+};
+
+Result<void> WebServer::Impl::start() {
+  cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
+                                             options_.jpeg_quality);
+  for (const auto& app : options_.vision_apps)
+    apps_[app.name] = std::make_unique<ResultFeed>(context_, app, events_);
+  // Every stream holds a thread; the rest serve the page and the API.
+  const size_t threads = static_cast<size_t>(options_.max_streams) + 16;
+  http_.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  http_.set_payload_max_length(kMaxBodyBytes);
+  // A viewer whose socket takes no bytes for this long is dropped: it held
+  // one HTTP thread, never a camera or another viewer.
+  http_.set_write_timeout(5s);
+  http_.set_read_timeout(10s);
+  http_.set_keep_alive_timeout(5);
+  http_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (peerAllowed(options_.allow, req.remote_addr))
+      return httplib::Server::HandlerResponse::Unhandled;
+    logWarning("refused HTTP request from ", req.remote_addr, " (not in --allow)");
+    sendError(res, makeError(WebErrc::kBadRequest,
+                             "forbidden: " + req.remote_addr + " is not in the allow-list"));
+    res.status = 403;
+    return httplib::Server::HandlerResponse::Handled;
+  });
+  routes();
+  port_ =
+      options_.listen_port == 0
+          ? http_.bind_to_any_port(options_.listen_host)
+          : (http_.bind_to_port(options_.listen_host, options_.listen_port) ? options_.listen_port
+                                                                            : -1);
+  if (port_ <= 0) {
+    return makeError(WebErrc::kBadConfig, "cannot listen on " + options_.listen_host + ":" +
+                                              std::to_string(options_.listen_port));
+  }
+  thread_ = std::thread([this] { http_.listen_after_bind(); });
+  return {};
+}
+
+void WebServer::Impl::stop() {
+  if (stopping_.exchange(true)) return;
+  events_.closeAll();
+  http_.stop();
+  if (cameras_) cameras_->stop();  // wakes the streams waiting on frames
+  if (thread_.joinable()) thread_.join();
+  for (auto& [name, app] : apps_) app->stop();
+}
+
+void WebServer::Impl::serveFile(const std::string& relative, httplib::Response& res) {
+  if (relative.empty() || relative.find("..") != std::string::npos || relative[0] == '/') {
+    sendError(res, WebErrc::kNotFound, "no file '" + relative + "'");
+    return;
+  }
+  std::ifstream in(options_.assets_dir + "/" + relative, std::ios::binary);
+  if (!in) {
+    sendError(res, WebErrc::kNotFound, "no file '" + relative + "' in " + options_.assets_dir);
+    return;
+  }
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  res.set_header("Cache-Control", "no-cache");
+  res.set_content(bytes.str(), contentType(relative).c_str());
+}
+
+std::shared_ptr<CameraFeed> WebServer::Impl::feedOr404(const std::string& camera,
+                                                       httplib::Response& res) {
+  auto feed = cameras_->feed(camera);
+  if (!feed) sendError(res, WebErrc::kNotFound, "no camera '" + camera + "'");
+  return feed;
+}
+
+ResultFeed* WebServer::Impl::appOr404(const std::string& name, httplib::Response& res) {
+  auto it = apps_.find(name);
+  if (it != apps_.end()) return it->second.get();
+  sendError(res, WebErrc::kNotFound, "no vision app '" + name + "'");
+  return nullptr;
+}
+
+void WebServer::Impl::snapshot(const std::string& camera, httplib::Response& res) {
+  auto feed = feedOr404(camera, res);
+  if (!feed) return;
+  auto frame = feed->latest();
+  if (!frame) return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
+  std::vector<unsigned char> png;
+  // Fast compression: lossless all the same, and a 1920x1080 frame takes
+  // tens of milliseconds instead of hundreds.
+  if (!cv::imencode(".png", frame->image, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
+    return sendError(res, WebErrc::kEncode, "PNG encoding failed");
+  setFrameHeaders(res, frame->info.sequence, frame->info.host_timestamp_ns);
+  res.set_content(std::string(png.begin(), png.end()), "image/png");
+}
+
+void WebServer::Impl::frameJpeg(const std::string& camera, httplib::Response& res) {
+  auto feed = feedOr404(camera, res);
+  if (!feed) return;
+  auto jpeg = feed->jpeg();
+  if (!jpeg) return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
+  setFrameHeaders(res, jpeg->sequence, jpeg->host_timestamp_ns);
+  res.set_content(jpeg->bytes, "image/jpeg");
+}
+
+bool WebServer::Impl::claimStream(httplib::Response& res) {
+  if (++streams_ <= options_.max_streams) return true;
+  --streams_;
+  sendJson(res,
+           {{"error",
+             "too many streams open (--max-streams " + std::to_string(options_.max_streams) + ")"}},
+           503);
+  return false;
+}
+
+void WebServer::Impl::stream(const std::string& camera, httplib::Response& res) {
+  auto feed = feedOr404(camera, res);
+  if (!feed || !claimStream(res)) return;
+  struct Viewer {
+    Viewer(std::shared_ptr<CameraFeed> f, std::atomic<int>& s)
+        : feed(std::move(f)), count(*feed), streams(s) {}
+    ~Viewer() { --streams; }
+    std::shared_ptr<CameraFeed> feed;
+    ViewerCount count;
+    std::atomic<int>& streams;
+    uint64_t seen = 0;
+  };
+  auto viewer = std::make_shared<Viewer>(feed, streams_);
+  res.set_header("Cache-Control", "no-store");
+  res.set_chunked_content_provider(
+      std::string("multipart/x-mixed-replace; boundary=") + kBoundary,
+      [this, viewer](size_t, httplib::DataSink& sink) {
+        // Always the newest frame: what this viewer could not take in time
+        // is skipped for it alone.
+        const uint64_t now = viewer->feed->waitNewer(viewer->seen, 1s);
+        if (stopping_) return false;
+        if (now == viewer->seen) return true;  // no new frame: asked again
+        viewer->seen = now;
+        auto jpeg = viewer->feed->jpeg();
+        if (!jpeg) return true;
+        const std::string head =
+            std::string("--") + kBoundary + "\r\nContent-Type: image/jpeg\r\nContent-Length: " +
+            std::to_string(jpeg->bytes.size()) +
+            "\r\nX-Frame-Sequence: " + std::to_string(jpeg->sequence) +
+            "\r\nX-Frame-Timestamp-Ns: " + std::to_string(jpeg->host_timestamp_ns) + "\r\n\r\n";
+        return sink.write(head.data(), head.size()) &&
+               sink.write(jpeg->bytes.data(), jpeg->bytes.size()) && sink.write("\r\n", 2);
+      },
+      [viewer](bool) {});
+}
+
+void WebServer::Impl::binary(const std::string& name, httplib::Response& res) {
+  ResultFeed* app = appOr404(name, res);
+  if (!app) return;
+  auto result = app->latest();
+  // The app's camera: from its latest result, else the camera of its name.
+  const std::string camera = result && !result->camera().empty() ? result->camera() : name;
+  auto feed = feedOr404(camera, res);
+  if (!feed) return;
+  auto frame = feed->latest();
+  if (!frame) return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
+  vision::BinarizeOptions options;
+  if (result && result->has_binarize()) {
+    const auto& b = result->binarize();
+    options.method = b.method() == "otsu"    ? vision::ThresholdMethod::kOtsu
+                     : b.method() == "fixed" ? vision::ThresholdMethod::kFixed
+                                             : vision::ThresholdMethod::kAdaptive;
+    options.fixed_threshold = static_cast<int>(b.threshold());
+    options.polarity =
+        b.dark_parts() ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
+    options.adaptive_window = static_cast<int>(b.window());
+  }
+  cv::Mat grey = frame->image;
+  if (grey.channels() == 3) cv::cvtColor(frame->image, grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat mask = vision::binarize(grey, options);
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
+    return sendError(res, WebErrc::kEncode, "PNG encoding failed");
+  setFrameHeaders(res, frame->info.sequence, frame->info.host_timestamp_ns);
+  res.set_content(std::string(png.begin(), png.end()), "image/png");
+}
+
+void WebServer::Impl::events(httplib::Response& res) {
+  if (!claimStream(res)) return;
+  struct Client {
+    Client(std::shared_ptr<EventQueue> q, std::atomic<int>& s) : queue(std::move(q)), streams(s) {}
+    ~Client() { --streams; }
+    std::shared_ptr<EventQueue> queue;
+    std::atomic<int>& streams;
+    bool greeted = false;
+  };
+  auto client = std::make_shared<Client>(events_.subscribe(), streams_);
+  res.set_header("Cache-Control", "no-store");
+  res.set_header("X-Accel-Buffering", "no");
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [this, client](size_t, httplib::DataSink& sink) {
+        if (!client->greeted) {
+          // The camera list at once, so the page need not wait a second.
+          client->greeted = true;
+          const std::string first =
+              "retry: 2000\nevent: cameras\ndata: " + cameras_->cameras().dump() + "\n\n";
+          return sink.write(first.data(), first.size());
+        }
+        auto event = client->queue->pop(kKeepalive);
+        if (stopping_ || client->queue->closed()) return false;
+        if (!event) return sink.write(": keepalive\n\n", 13);
+        return sink.write(event->data(), event->size());
+      },
+      [client](bool) {});
+}
+
+void WebServer::Impl::apps(httplib::Response& res) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [name, app] : apps_) {
+    std::string camera = app->camera();
+    if (camera.empty() && cameras_->feed(name)) camera = name;  // default: app named as its camera
+    list.push_back({{"name", name},
+                    {"camera", camera},
+                    {"connected", app->connected()},
+                    {"last_result_id", app->lastResultId()}});
+  }
+  sendJson(res, list);
+}
+
+std::string WebServer::Impl::metrics() {
+  std::vector<AppFigures> apps;
+  for (const auto& [name, app] : apps_) apps.push_back({name, app->figures()});
+  return metricsText(cameras_->figures(), apps);
+}
+
+void WebServer::Impl::routes() {
+  http_.Get("/", [this](const httplib::Request&, httplib::Response& res) {
+    serveFile("index.html", res);
+  });
+  http_.Get(R"(/static/(.+))", [this](const httplib::Request& req, httplib::Response& res) {
+    serveFile(req.matches[1], res);
+  });
+  http_.Get("/api/cameras", [this](const httplib::Request&, httplib::Response& res) {
+    sendJson(res, cameras_->cameras());
+  });
+  http_.Get("/api/apps", [this](const httplib::Request&, httplib::Response& res) { apps(res); });
+  http_.Get(R"(/snapshot/([^/]+)\.png)",
+            [this](const httplib::Request& req, httplib::Response& res) {
+              snapshot(req.matches[1], res);
+            });
+  http_.Get(R"(/frame/([^/]+)\.jpg)", [this](const httplib::Request& req, httplib::Response& res) {
+    frameJpeg(req.matches[1], res);
+  });
+  http_.Get(
+      R"(/stream/([^/]+)\.mjpg)",
+      [this](const httplib::Request& req, httplib::Response& res) { stream(req.matches[1], res); });
+  http_.Get(R"(/binary/([^/]+)\.png)", [this](const httplib::Request& req, httplib::Response& res) {
+    binary(req.matches[1], res);
+  });
+  http_.Get("/events", [this](const httplib::Request&, httplib::Response& res) { events(res); });
+  http_.Get(R"(/api/results/([^/]+)/latest)", [this](const httplib::Request& req,
+                                                     httplib::Response& res) {
+    ResultFeed* app = appOr404(req.matches[1], res);
+    if (!app) return;
+    const std::string json = app->latestJson();
+    if (json.empty())
+      return sendError(res, WebErrc::kNotFound, "no result from '" + app->name() + "' yet");
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(json, "application/json");
+  });
+  http_.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_content(metrics(), "text/plain; version=0.0.4; charset=utf-8");
+  });
+  http_.Post(R"(/api/apps/([^/]+)/command)",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               ResultFeed* app = appOr404(req.matches[1], res);
+               if (!app) return;
+               auto body = parseJsonBody(req.body);
+               if (!body) return sendError(res, body.error());
+               auto line = body->find("line");
+               if (line == body->end() || !line->is_string())
+                 return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
+               auto reply = app->command(line->get<std::string>());
+               if (!reply) return sendError(res, reply.error());
+               sendJson(res, {{"reply", *reply}});
+             });
+  http_.Get(R"(/api/cameras/([^/]+)/features)",
+            [this](const httplib::Request& req, httplib::Response& res) {
+              proto::ControlRequest request;
+              request.mutable_list_features()->set_camera(req.matches[1]);
+              auto reply = cameras_->control(req.matches[1], request);
+              if (!reply) return sendError(res, reply.error());
+              nlohmann::json list = nlohmann::json::array();
+              for (const auto& f : reply->list_features().features())
+                list.push_back(protoJson(f, true));
+              sendJson(res, list);
+            });
+  http_.Post(R"(/api/cameras/([^/]+)/([a-z]+))",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               const std::string camera = req.matches[1];
+               if (!cameras_->feed(camera))
+                 return sendError(res, WebErrc::kNotFound, "no camera '" + camera + "'");
+               auto body = parseJsonBody(req.body);
+               if (!body) return sendError(res, body.error());
+               auto request = cameraAction(camera, req.matches[2], *body);
+               if (!request) return sendError(res, request.error());
+               auto reply = cameras_->control(camera, *request);
+               if (!reply) return sendError(res, reply.error());
+               sendJson(res, actionReplyJson(*reply));
+             });
+}
+
+WebServer::WebServer(WebOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+WebServer::~WebServer() = default;
+Result<void> WebServer::start() { return impl_->start(); }
+void WebServer::stop() { impl_->stop(); }
+uint16_t WebServer::port() const { return static_cast<uint16_t>(impl_->port_); }
+
+std::string WebServer::url() const {
+  const std::string& host = impl_->options_.listen_host;
+  const bool v6 = host.find(':') != std::string::npos;
+  return "http://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(impl_->port_);
+}
+
+}  // namespace picksight::web
