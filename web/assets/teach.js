@@ -38,7 +38,11 @@
     if (r) line += " AT " + r.x + " " + r.y + " " + r.width + " " + r.height;
     const reply = await say("teach-reply", line);
     $("teach-reply").dataset.lastReply = reply;
-    if (reply.startsWith("OK")) refreshModels();
+    if (reply.startsWith("OK")) {
+      refreshModels();
+      $("grasp-type").value = type;  // its grasps next
+      loadGrasp();
+    }
   }
 
   async function refreshModels() {
