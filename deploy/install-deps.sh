@@ -41,6 +41,8 @@ PACKAGES=(
   python3-serial-asyncio
   # calibration: Fisher's F distribution for COMPUTE BEST's model test (header-only Boost.Math)
   libboost-math-dev
+  # the web HMI page's tests in a real browser: headless Chromium driven by Selenium
+  chromium chromium-driver python3-selenium
 )
 
 missing=()

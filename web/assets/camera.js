@@ -1,0 +1,100 @@
+// The Camera panel: open/close, mode, trigger, exposure and gain, the ROI
+// drawn on the image (sensor pixels), output size, and any feature by name,
+// all through picksight-web's camera endpoints (the video server's control
+// socket).
+"use strict";
+
+(function () {
+  const ps = window.picksight;
+  const $ = ps.$;
+  let features = [];
+
+  // The first feature the camera has of a list of usual names (GenICam,
+  // V4L2), else the first name, which the server then refuses with a message.
+  function featureName(candidates) {
+    for (const name of candidates) if (features.some((f) => f.name === name)) return name;
+    return candidates[0];
+  }
+  const exposureName = () => featureName(["ExposureTime", "ExposureTimeAbs", "exposure_time_absolute"]);
+  const gainName = () => featureName(["Gain", "GainRaw", "gain"]);
+
+  function featureValue(name) {
+    const f = features.find((x) => x.name === name);
+    return f ? f.value : "";
+  }
+
+  async function refreshFeatures() {
+    if (!ps.camera) return;
+    const r = await ps.get("/api/cameras/" + encodeURIComponent(ps.camera) + "/features");
+    if (!r.ok) { ps.show("camera-reply", "features", "ERROR " + r.body.error); return; }
+    features = Array.isArray(r.body) ? r.body : r.body.features || [];
+    const tbody = $("feature-list").querySelector("tbody");
+    tbody.textContent = "";
+    $("feature-names").textContent = "";
+    for (const f of features) {
+      const range = f.choices && f.choices.length ? f.choices.join(" | ")
+        : f.has_range ? (f.min || 0) + " .. " + (f.max || 0) + (f.unit ? " " + f.unit : "") : "";
+      const row = ps.tableRow(tbody, [f.name, f.value === undefined ? "" : String(f.value), range]);
+      row.addEventListener("click", () => { $("feature-name").value = f.name; $("feature-value").value = f.value || ""; });
+      const o = document.createElement("option");
+      o.value = f.name;
+      $("feature-names").appendChild(o);
+    }
+    $("cam-exposure").value = featureValue(exposureName());
+    $("cam-gain").value = featureValue(gainName());
+  }
+
+  async function setFeature(name, value) {
+    if (!name) return;
+    await ps.cameraAction("feature", { name, value: String(value) });
+    refreshFeatures();
+  }
+
+  function showRoi(rect) {
+    const c = ps.cameraInfo() || {};
+    const r = rect || c.roi || {};
+    $("roi-x").value = r.x || 0;
+    $("roi-y").value = r.y || 0;
+    $("roi-w").value = r.width || 0;
+    $("roi-h").value = r.height || 0;
+  }
+
+  function showCamera() {
+    const c = ps.cameraInfo();
+    if (!c) return;
+    for (const radio of document.querySelectorAll("input[name=cam-mode]")) radio.checked = radio.value === c.mode;
+    if (!ps.rect.roi) showRoi();
+    if (document.activeElement !== $("size-w")) $("size-w").value = c.width || 0;
+    if (document.activeElement !== $("size-h")) $("size-h").value = c.height || 0;
+  }
+
+  const intOf = (id) => Math.max(0, Math.round(Number($(id).value) || 0));
+
+  document.addEventListener("DOMContentLoaded", () => {
+    ps.on("camera", () => { ps.rect.roi = null; showCamera(); refreshFeatures(); });
+    ps.on("cameras", showCamera);
+    ps.on("tab", (tab) => { if (tab === "camera") refreshFeatures(); });
+    ps.on("rect", (e) => { if (e.mode === "roi") showRoi(e.rect); });
+    $("cam-open").addEventListener("click", () => ps.cameraAction("open"));
+    $("cam-close").addEventListener("click", () => ps.cameraAction("close"));
+    $("cam-trigger").addEventListener("click", () => ps.cameraAction("trigger"));
+    for (const radio of document.querySelectorAll("input[name=cam-mode]")) {
+      radio.addEventListener("change", () => ps.cameraAction("mode", { mode: radio.value }));
+    }
+    $("cam-exposure-set").addEventListener("click", () => setFeature(exposureName(), $("cam-exposure").value));
+    $("cam-gain-set").addEventListener("click", () => setFeature(gainName(), $("cam-gain").value));
+    $("roi-apply").addEventListener("click", async () => {
+      const body = { x: intOf("roi-x"), y: intOf("roi-y"), width: intOf("roi-w"), height: intOf("roi-h") };
+      const r = await ps.cameraAction("roi", body);
+      if (r.ok) { ps.rect.roi = null; ps.drawTool(); }
+    });
+    $("roi-full").addEventListener("click", async () => {
+      const r = await ps.cameraAction("roi", { x: 0, y: 0, width: 0, height: 0 });
+      if (r.ok) { ps.rect.roi = null; ps.drawTool(); }
+    });
+    $("size-apply").addEventListener("click", () => ps.cameraAction("size", { width: intOf("size-w"), height: intOf("size-h") }));
+    $("scale-apply").addEventListener("click", () => ps.cameraAction("size", { scale: Number($("size-scale").value) || 1 }));
+    $("feature-set").addEventListener("click", () => setFeature($("feature-name").value.trim(), $("feature-value").value));
+    $("feature-refresh").addEventListener("click", refreshFeatures);
+  });
+})();
