@@ -3,8 +3,8 @@
 // camera, which names its exposure ExposureTimeAbs (older GenICam).
 #include <catch2/catch.hpp>
 
-#include "fake_gv_camera.hpp"
 #include "cell_fixture.hpp"
+#include "fake_gv_camera.hpp"
 
 using namespace picksight;
 using namespace picksight::e2e;

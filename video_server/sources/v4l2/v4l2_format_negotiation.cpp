@@ -112,8 +112,8 @@ Result<void> V4l2Source::chooseFormat() {
   const V4l2PixelFormat* info = findPixelFormat(fmt.fmt.pix.pixelformat);
   if (!info) {
     return makeError(SourceErrc::kBadConfig, "v4l2:" + options_.path + ": driver set format " +
-                                           fourccName(fmt.fmt.pix.pixelformat) +
-                                           ", which is not supported");
+                                                 fourccName(fmt.fmt.pix.pixelformat) +
+                                                 ", which is not supported");
   }
   format_ = fmt.fmt.pix;
   layout_ = info->layout;

@@ -5,8 +5,8 @@
 #include <opencv2/core.hpp>
 
 #include "picksight/common/result.hpp"
-#include "picksight/video_server/frame_pipeline.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/video_server/frame_pipeline.hpp"
 
 namespace picksight::video {
 

@@ -2,9 +2,9 @@
 // DELETE, LIST, COMPUTE and RESIDUALS (robot-camera), docs/PROTOCOL.md.
 #pragma once
 
-#include "picksight/store/cell_calibration.hpp"
-#include "picksight/protocol/command_table.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/command_table.hpp"
+#include "picksight/store/cell_calibration.hpp"
 
 namespace picksight::app {
 
