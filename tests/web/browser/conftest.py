@@ -76,12 +76,10 @@ class Cell:
         vision = [bin_path("picksight-vision"), "--frames", self.frames, "--control", self.control,
                   "--camera", CAMERA, "--robot-port", "0", "--bind", "127.0.0.1",
                   "--data-dir", str(data_dir)]
-        self.has_results = "--results-bind" in self._help(vision[0])
-        if self.has_results:
-            vision += ["--name", APP, "--results-bind", "tcp://127.0.0.1:*"]
+        vision += ["--name", APP, "--results-bind", "tcp://127.0.0.1:*"]
         lines = stdout_lines(self._start(vision))
         self.robot_port = int(lines["robot"])
-        self.results = lines.get("results", "none")
+        self.results = lines["results"]
         web = self._start([bin_path("picksight-web"), "--listen", "127.0.0.1:0", "--assets", ASSETS,
                            "--video-server", f"{self.frames},{self.control}",
                            "--vision-app", f"{APP},{self.results},127.0.0.1:{self.robot_port}"])
@@ -91,11 +89,6 @@ class Cell:
         p = Process(argv)
         self.processes.append(p)
         return p
-
-    @staticmethod
-    def _help(binary):
-        import subprocess
-        return subprocess.run([binary, "--help"], capture_output=True, text=True, timeout=10).stdout
 
     def stop(self):
         for p in reversed(self.processes):

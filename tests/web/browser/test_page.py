@@ -3,7 +3,6 @@ without console errors, shows frames that change, draws a LOCATE's parts
 where the reply puts them, teaches a part from a rectangle drawn with the
 mouse, and sets the camera's ROI from a rectangle drawn on the image."""
 
-import pytest
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
@@ -157,8 +156,6 @@ def locate_on_page(browser, type_text):
 
 
 def test_overlay_shows_the_located_parts(cell, browser):
-    if not cell.has_results:
-        pytest.skip("this vision app has no results stream (--results-bind) yet")
     select_tab(browser, "live")
     reply, before = locate_on_page(browser, "1")  # no model yet: every region
     assert reply.startswith("OK "), reply
@@ -169,8 +166,6 @@ def test_overlay_shows_the_located_parts(cell, browser):
 
 
 def test_binarized_image_on_demand(cell, browser):
-    if not cell.has_results:
-        pytest.skip("this vision app has no results stream (--results-bind) yet")
     select_tab(browser, "live")  # after a LOCATE: the app's binarization is known
     click(browser, "live-binary")
     try:
@@ -188,8 +183,6 @@ def test_binarized_image_on_demand(cell, browser):
 def test_overlay_follows_a_cropped_and_resized_camera(cell, browser):
     """Results are in sensor pixels; the page maps them through the camera's
     current ROI and scale."""
-    if not cell.has_results:
-        pytest.skip("this vision app has no results stream (--results-bind) yet")
     select_tab(browser, "live")
     for action, body in (("roi", {"x": 64, "y": 32, "width": 512, "height": 416}), ("size", {"scale": 0.5})):
         status, reply = cell.http("POST", f"/api/cameras/{CAMERA}/{action}", body)
@@ -229,7 +222,11 @@ def isolated_region(cell):
 def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     select_tab(browser, "teach")
     (x0, y0, x1, y1), centroid = isolated_region(cell)
-    camera, box = cell.camera(), frame_box(browser)
+    camera = cell.camera()
+    # An earlier test resized the camera: measure the image once the page
+    # shows frames of the current size, or the drag lands beside the part.
+    wait_until(lambda: frame_box(browser)["natural_width"] == camera["width"], what="a frame of the current size")
+    box = frame_box(browser)
     drag(browser, box, sensor_to_display(camera, box, x0, y0), sensor_to_display(camera, box, x1, y1))
     rect = wait_until(lambda: browser.js("""
         const r = document.getElementById('teach-rect');
@@ -245,8 +242,6 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     click(browser, "teach-button")
     reply = wait_until(lambda: browser.js("return document.getElementById('teach-reply').dataset.lastReply"),
                        what="the LEARN reply")
-    if reply.startswith("ERROR 11") and " AT " not in reply:  # its usage has no AT
-        pytest.skip(f"this vision app has no LEARN ... AT yet: {reply}")
     assert reply.startswith("OK 5 bracket"), reply
     try:
         check_locate_finds_the_taught_part(cell, browser, centroid)
@@ -263,11 +258,10 @@ def check_locate_finds_the_taught_part(cell, browser, centroid):
     reply, before = locate_on_page(browser, "5")
     found = poses(reply)
     assert any(abs(x - centroid[0]) <= 2 and abs(-y - centroid[1]) <= 2 for x, y, _ in found), (reply, centroid)
-    if cell.has_results:
-        overlay = overlay_after(browser, before)
-        check_overlay_matches(cell, browser, reply, overlay)
-        assert any(p["name"] == "bracket" for p in overlay["parts"])
-        browser.screenshot("live-located")
+    overlay = overlay_after(browser, before)
+    check_overlay_matches(cell, browser, reply, overlay)
+    assert any(p["name"] == "bracket" for p in overlay["parts"])
+    browser.screenshot("live-located")
 
 
 def test_roi_drawn_on_the_image_sets_the_camera_roi(cell, browser):
@@ -337,27 +331,24 @@ def test_grasp_styles_and_fingers_edited_and_drawn(cell, browser):
         assert cell.say("GRIPPER 7 LIST").startswith("OK 2 ")
         select_tab(browser, "live")
         reply, before = locate_on_page(browser, "7")
-        if cell.has_results:
-            overlay = overlay_after(browser, before)
-            check_overlay_matches(cell, browser, reply, overlay)
-            assert overlay["parts"][0]["fingers"] == [False, False], overlay
-            assert len(browser.driver.find_elements(By.CSS_SELECTOR, "#overlay .finger.free")) == 2
-            browser.screenshot("live-grasp")
-            select_tab(browser, "teach")
-            click(browser, "grasp-load")
-            wait_until(lambda: len(browser.driver.find_elements(By.CSS_SELECTOR, "#tool .footprint path")) == 2,
-                       what="the footprint of both fingers")
-            browser.screenshot("teach-grasp")
-            # The whole table again: every part of the type with its grasp
-            # (docs/web-hmi.png is this screenshot).
-            cell.set_parts(4)
-            wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "4", what="four parts on the table")
-            select_tab(browser, "live")
-            reply, before = locate_on_page(browser, "7")
-            check_overlay_matches(cell, browser, reply, overlay_after(browser, before))
-            browser.screenshot("web-hmi")
-        else:
-            assert len(poses(reply)) == 1, reply
+        overlay = overlay_after(browser, before)
+        check_overlay_matches(cell, browser, reply, overlay)
+        assert overlay["parts"][0]["fingers"] == [False, False], overlay
+        assert len(browser.driver.find_elements(By.CSS_SELECTOR, "#overlay .finger.free")) == 2
+        browser.screenshot("live-grasp")
+        select_tab(browser, "teach")
+        click(browser, "grasp-load")
+        wait_until(lambda: len(browser.driver.find_elements(By.CSS_SELECTOR, "#tool .footprint path")) == 2,
+                   what="the footprint of both fingers")
+        browser.screenshot("teach-grasp")
+        # The whole table again: every part of the type with its grasp
+        # (docs/web-hmi.png is this screenshot).
+        cell.set_parts(4)
+        wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "4", what="four parts on the table")
+        select_tab(browser, "live")
+        reply, before = locate_on_page(browser, "7")
+        check_overlay_matches(cell, browser, reply, overlay_after(browser, before))
+        browser.screenshot("web-hmi")
     finally:
         cell.set_parts(4)
     assert browser.severe() == []
