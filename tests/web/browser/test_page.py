@@ -223,9 +223,18 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     select_tab(browser, "teach")
     (x0, y0, x1, y1), centroid = isolated_region(cell)
     camera = cell.camera()
-    # An earlier test resized the camera: measure the image once the page
-    # shows frames of the current size, or the drag lands beside the part.
-    wait_until(lambda: frame_box(browser)["natural_width"] == camera["width"], what="a frame of the current size")
+    # An earlier test cropped and resized the camera: drag once the page
+    # shows frames of the current size and knows the current ROI and scale
+    # (from its once-a-second camera events), or the rectangle is mapped
+    # through the old ones.
+    roi = camera.get("roi", {})
+
+    def page_knows_the_camera():
+        m = browser.js("return window.picksight.mapping()")
+        return (m["frameW"] == camera["width"] and m["roiX"] == roi.get("x", 0) and
+                m["roiY"] == roi.get("y", 0) and m["scaleX"] == (camera.get("scale_x") or 1.0))
+
+    wait_until(page_knows_the_camera, what="the page's mapping of the current camera")
     box = frame_box(browser)
     drag(browser, box, sensor_to_display(camera, box, x0, y0), sensor_to_display(camera, box, x1, y1))
     rect = wait_until(lambda: browser.js("""
