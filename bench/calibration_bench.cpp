@@ -73,6 +73,7 @@ void runScenario(const Scenario& s) {
     std::vector<double> origin, rotation, scale, placement;
     int fails = 0;
     int chose[4] = {0, 0, 0, 0};
+    int dropped = 0;
     for (int c = 0; c < kCells; ++c) {
       const auto cell = test::makeCalibrationCell(randomSpec(s, c));
       auto r = calibration::calibrate(cell.points, m);
@@ -81,6 +82,7 @@ void runScenario(const Scenario& s) {
         continue;
       }
       ++chose[static_cast<int>(r->transform.model)];
+      if (m == Method::kBest && r->inliers < s.points - s.outliers) ++dropped;
       const auto truth = *calibration::PlaneTransform::homography(cell.vision_to_robot);
       origin.push_back(cv::norm(r->transform.apply({0, 0}) - truth.apply({0, 0})));
       rotation.push_back(angleDiffDeg(r->transform.rz_deg, truth.rz_deg));
@@ -97,7 +99,7 @@ void runScenario(const Scenario& s) {
                 rms(scale), place, quantile(placement, 0.5), p95(placement),
                 quantile(placement, 1.0), fails, goal);
     if (m == Method::kBest)
-      std::printf("  (chose rigid %d, similarity %d, tilt %d, homography %d)", chose[0], chose[1],
+      std::printf("  (dropped good points in %d; chose rigid %d, similarity %d, tilt %d, homography %d)", dropped, chose[0], chose[1],
                   chose[3], chose[2]);
     std::printf("\n");
   }
