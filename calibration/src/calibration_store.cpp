@@ -114,6 +114,11 @@ std::string CalibrationStore::serialize() const {
     out << YAML::Key << "mm_per_px_x" << YAML::Value << scale_->mm_per_px_x;
     out << YAML::Key << "mm_per_px_y" << YAML::Value << scale_->mm_per_px_y;
     out << YAML::Key << "skew_deg" << YAML::Value << scale_->skew_deg;
+    if (scale_->rectify) {
+      out << YAML::Key << "rectify" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+      for (int i = 0; i < 9; ++i) out << scale_->rectify->val[i];
+      out << YAML::EndSeq;
+    }
     out << YAML::EndMap;
   }
   if (lens_) {
@@ -170,6 +175,19 @@ Result<void> CalibrationStore::load() {
                        s["skew_deg"] ? number(s, "skew_deg", "scale.") : 0};
       if (!(scale.mm_per_px_x > 0) || !(scale.mm_per_px_y > 0))
         throw std::runtime_error("scale must be positive");
+      if (const auto r = s["rectify"]) {
+        const auto v = r.as<std::vector<double>>();
+        if (v.size() != 9) throw std::runtime_error("scale.rectify must have 9 values");
+        cv::Matx33d h;
+        for (int i = 0; i < 9; ++i) {
+          if (!std::isfinite(v[static_cast<size_t>(i)]))
+            throw std::runtime_error("scale.rectify is not all finite");
+          h.val[i] = v[static_cast<size_t>(i)];
+        }
+        if (!(std::abs(cv::determinant(h)) > 1e-12))
+          throw std::runtime_error("scale.rectify is singular");
+        scale.rectify = h;
+      }
       loaded.scale_ = scale;
     }
     if (const auto l = root["lens"]) {

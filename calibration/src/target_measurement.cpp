@@ -368,12 +368,14 @@ Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) 
   cv::Mat bx(static_cast<int>(centres.size()), 1, CV_64F), by = bx.clone();
   int min_i = 0, max_i = 0, min_j = 0, max_j = 0;
   std::vector<std::pair<int, int>> seen;
+  std::vector<cv::Point2i> indices;
   for (size_t k = 0; k < centres.size(); ++k) {
     const cv::Vec2d f = to_index * cv::Vec2d(centres[k].x - p0.x, centres[k].y - p0.y);
     const int i = static_cast<int>(std::lround(f[0])), j = static_cast<int>(std::lround(f[1]));
     if (std::abs(f[0] - i) > 0.25 || std::abs(f[1] - j) > 0.25)
       return makeError(CalibrationErrc::kBadTarget, "the dots are not on a regular grid");
     seen.emplace_back(i, j);
+    indices.emplace_back(i, j);
     min_i = std::min(min_i, i);
     max_i = std::max(max_i, i);
     min_j = std::min(min_j, j);
@@ -417,6 +419,7 @@ Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) 
   g.grid_rms_px = std::sqrt(ss / static_cast<double>(centres.size()));
   g.rotation_deg = std::atan2(step_u.y, step_u.x) * kDegPerRad;
   g.centres = std::move(centres);
+  g.indices = std::move(indices);
   return g;
 }
 

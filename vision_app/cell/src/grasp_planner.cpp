@@ -99,9 +99,10 @@ const vision::PartModel* modelOf(const LocateScene& scene, int type) {
 
 grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision) {
   const cv::Point2d at = vision.toMm({part.x, part.y});
-  // The vision frame flips y: an image rotation turns the other way.
-  const double rz = part.type >= 0 ? wrapDeg(-part.angle_deg, part.symmetry_deg)
-                                   : calibration::VisionFrame::angleToVision(part.angle_deg);
+  // The vision frame flips y, so an image rotation turns the other way; a
+  // tilted camera's rectification turns directions a little more, locally.
+  const double direction = vision.directionToVision(part.angle_deg, {part.x, part.y});
+  const double rz = part.type >= 0 ? wrapDeg(direction, part.symmetry_deg) : direction;
   return {at.x, at.y, rz};
 }
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "picksight/calibration/dot_grid_model.hpp"
 #include "picksight/calibration/target_measurement.hpp"
 #include "picksight/common/text.hpp"
 
@@ -37,7 +38,9 @@ Result<calibration::DiscMeasurement> measuredDisc(const TargetOutcome& t) {
   return disc;
 }
 
-// CALCAM GRID <pitch_mm>: the scale on X and on Y from a grid of dots.
+// CALCAM GRID <pitch_mm>: the scale from a grid of dots, and with 9 dots
+// or more (3 x 3) the camera's tilt; with the whole sensor in view and no
+// chessboard lens model, the lens's radial distortion as well.
 std::string calcamGrid(const Request& r, VisionService& vision, CellCalibration& calibration) {
   const std::vector<std::string> rest(r.args.begin() + 1, r.args.end());
   const auto pitch = parseNumbers(rest);
@@ -48,12 +51,25 @@ std::string calcamGrid(const Request& r, VisionService& vision, CellCalibration&
   if (!frame) return reply(frame.error());
   auto grid = calibration::measureDotGrid(frame->first, (*pitch)[0]);
   if (!grid) return errorReply(VisionErrc::kNotADisc, grid.error().message);
-  // Measured in frame pixels; a frame pixel is 1/scale sensor pixels.
-  calibration::PixelScale scale = grid->scale;
-  scale.mm_per_px_x *= frame->second.scale_x;
-  scale.mm_per_px_y *= frame->second.scale_y;
-  if (auto ok = calibration.setScale(scale); !ok) return reply(ok.error());
-  return "OK " + formatFixed(scale.mm_per_px_x, 6) + " " + formatFixed(scale.mm_per_px_y, 6);
+  // Fitted in sensor pixels, where the vision frame starts.
+  const SensorMapping& mapping = frame->second;
+  std::vector<cv::Point2d> sensor;
+  for (const auto& c : grid->centres) sensor.push_back(mapping.toSensor(c));
+  // A lens model from chessboard views is trusted; one fitted to an
+  // earlier grid is fitted again. The centre of distortion is the sensor's
+  // middle, known only when the frame is the whole sensor, unresized.
+  std::optional<calibration::LensModel> lens = calibration.lens();
+  if (lens && lens->views <= 1) lens.reset();
+  const bool whole_sensor =
+      mapping.roi_x == 0 && mapping.roi_y == 0 && mapping.scale_x == 1 && mapping.scale_y == 1;
+  const auto model = calibration::fitDotGrid(
+      sensor, grid->indices, (*pitch)[0], lens,
+      whole_sensor ? std::optional<cv::Size>(frame->first.size()) : std::nullopt);
+  if (!model) return errorReply(VisionErrc::kNotADisc, model.error().message);
+  if (auto ok = calibration.setGridCalibration(model->scale, model->lens); !ok)
+    return reply(ok.error());
+  return "OK " + formatFixed(model->scale.mm_per_px_x, 6) + " " +
+         formatFixed(model->scale.mm_per_px_y, 6);
 }
 
 std::string calcam(const Request& r, VisionService& vision, CellCalibration& calibration) {

@@ -175,7 +175,7 @@ void addParts(proto::VisionResult& out, const RequestRecord& record) {
       chosen = setup->styles.front();  // the first style tried
     const grasp::Pose gripper = grasp::gripperPose(part_pose, chosen);
     setPoint(p->mutable_grasp_position(), vision.toPixels({gripper.x, gripper.y}));
-    p->set_grasp_angle_deg(calibration::VisionFrame::angleToImage(gripper.rz_deg));
+    p->set_grasp_angle_deg(vision.directionToImage(gripper.rz_deg, {gripper.x, gripper.y}));
     if (!setup || setup->gripper.fingers.empty()) continue;
     for (const auto& polygon : grasp::fingerPolygons(gripper, setup->gripper, vision)) {
       auto* finger = p->add_fingers();

@@ -203,6 +203,24 @@ Result<void> CellCalibration::setLens(const calibration::LensModel& lens) {
   return {};
 }
 
+Result<void> CellCalibration::setGridCalibration(
+    const calibration::PixelScale& scale, const std::optional<calibration::LensModel>& lens) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!damaged_.empty()) return blocked();
+  if (lens) {
+    if (auto ok = store_.setLens(*lens); !ok) return storageError(ok.error());
+  }
+  auto ok = store_.setScale(scale);
+  if (!ok) return storageError(ok.error());
+  ++revision_;
+  return {};
+}
+
+std::optional<calibration::LensModel> CellCalibration::lens() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return store_.lens();
+}
+
 Result<int> CellCalibration::addPoint(const calibration::PointPair& pair,
                                       std::optional<cv::Point2d> pixel) {
   std::lock_guard<std::mutex> lock(mutex_);

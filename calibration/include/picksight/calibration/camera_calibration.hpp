@@ -4,6 +4,7 @@
 // located points.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,12 @@ struct PixelScale {
   // How far the imaged circle's axes are from the image axes (degrees): a
   // large value means a tilted camera or a distorted lens, not a scale.
   double skew_deg = 0;
+  // From a dot grid (CALCAM GRID): the homography that takes ideal
+  // (undistorted) sensor pixels to the pixels of a camera looking straight
+  // down, the perspective of a tilted camera taken out. It fixes the middle
+  // of the dots and their local direction, so it departs from the identity
+  // only by the tilt; the scale above then holds everywhere on the plane.
+  std::optional<cv::Matx33d> rectify = std::nullopt;
 };
 
 // From the moments of the imaged target (a disc of `radius_mm`, seen as an

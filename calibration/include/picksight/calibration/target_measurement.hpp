@@ -56,6 +56,7 @@ struct DotGridMeasurement {
   double grid_rms_px = 0;   // dot centres about the fitted grid
   double rotation_deg = 0;  // the grid's first direction, image axes
   std::vector<cv::Point2d> centres;
+  std::vector<cv::Point2i> indices;  // each centre's place in the grid (steps)
 };
 
 // Measures a regular grid of dots `pitch_mm` apart (at least 2 x 2):

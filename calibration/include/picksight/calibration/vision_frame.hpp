@@ -30,6 +30,12 @@ class VisionFrame {
   // An angle measured in image axes to the vision frame, and back; both in [0, 360).
   static double angleToVision(double image_deg);
   static double angleToImage(double vision_deg);
+  // The same for a direction at a place (sensor pixel `at`; vision mm
+  // `at_mm`): through the local scale on X and Y, lens and rectification,
+  // which turn directions unevenly over the image of a tilted camera
+  // (about 0.5 degree at the edge of a 1920 px image tilted 2 degrees).
+  double directionToVision(double image_deg, cv::Point2d at) const;
+  double directionToImage(double vision_deg, cv::Point2d at_mm) const;
 
   const PixelScale& scale() const { return scale_; }
   bool calibrated() const { return calibrated_; }

@@ -98,6 +98,11 @@ class CellCalibration {
   // Each change is written before it takes effect (CellCalibrationErrc::kCalibrationStorage).
   Result<void> setScale(const calibration::PixelScale& scale);
   Result<void> setLens(const calibration::LensModel& lens);
+  // A dot grid's scale (with its rectification) and, when fitted, its lens
+  // model, under one lock so no request sees one without the other.
+  Result<void> setGridCalibration(const calibration::PixelScale& scale,
+                                  const std::optional<calibration::LensModel>& lens);
+  std::optional<calibration::LensModel> lens() const;
   // Refuses non-finite coordinates, and a point past kMaxPoints. `pixel`:
   // the sensor pixel `pair.vision` was measured at (STORE), so that a later
   // CALCAM or lens model places the point again.
