@@ -1,7 +1,7 @@
 // The cell's recognition pass: each model judges holes with the minimum
 // hole area it was trained with, whatever the cell's setting, and
 // `LOCATE <type>` does not report a part clearly closer to another type's
-// model. Drawn scenes, the vision app's own locate path.
+// model, and WHY says so. Drawn scenes, the vision app's own locate path.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -13,6 +13,7 @@
 #include "../vision/drawn_parts.hpp"
 #include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/results/request_record.hpp"
 
 using namespace picksight;
 using namespace picksight::app;
@@ -160,6 +161,18 @@ TEST_CASE("LOCATE of one type does not report a part clearly closer to another t
   CHECK(notches.parts.size() == 2);
   CHECK(near(notches.parts, 650, 200));
   CHECK(near(notches.parts, 1050, 450));
+  // WHY names them as the other type.
+  RequestRecord record;
+  record.request = "LOCATE";
+  record.asked_type = 1;
+  record.locate = bars;
+  for (size_t i = 0; i < bars.parts.size(); ++i) record.pick.parts.push_back(i);
+  INFO("WHY: " << record.why());
+  size_t named = 0;
+  for (const auto& r : record.rejections()) named += r.test == "other type" && r.nearest_type == 2;
+  CHECK(named == 2);
+  CHECK(record.why().find(" is type 2 not 1") != std::string::npos);
+
   // LOCATE ALL labels each as its own type.
   const auto all = locateInFrame(frame, {}, both, -1);
   REQUIRE(all.parts.size() == 4);
