@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "locate_args.hpp"
 #include "picksight/tool_support/line_client.hpp"
@@ -55,15 +56,23 @@ struct VisionRun {
   LineClient robot;
 };
 
-// Starts a vision app on `server`'s camera with `data_dir` and connects a
-// robot to it; nullopt when either failed.
+// Starts a vision app on `server`'s camera with `data_dir` (and `extra`
+// options) and connects a robot to it; nullopt when either failed.
 inline std::optional<VisionRun> startVision(const VideoServerRun& server,
-                                            const std::string& data_dir) {
+                                            const std::string& data_dir,
+                                            const std::vector<std::string>& extra = {}) {
   using namespace std::chrono_literals;
   VisionRun run;
-  run.process = std::make_unique<Subprocess>(std::vector<std::string>{
-      binDir() + "/picksight-vision", "--frames", server.frames, "--control", server.control,
-      "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
+  std::vector<std::string> command{binDir() + "/picksight-vision",
+                                   "--frames",
+                                   server.frames,
+                                   "--control",
+                                   server.control,
+                                   "--data-dir",
+                                   data_dir};
+  for (const char* option : {"--robot-port", "0", "--bind", "127.0.0.1"}) command.push_back(option);
+  command.insert(command.end(), extra.begin(), extra.end());
+  run.process = std::make_unique<Subprocess>(command);
   const auto port = run.process->waitForLine("robot ", 10s);
   if (!port || !run.process->waitForLine("ready", 10s)) return std::nullopt;
   auto robot = LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);

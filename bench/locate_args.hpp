@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <functional>
 #include <string>
 
 #include "picksight/common/command_line.hpp"
@@ -19,10 +20,13 @@ struct LocateArgs {
 };
 
 // --requests N --width N --height N --parts N (positive integers), over the
-// given defaults. --help, or a bad option, prints the help and exits: the
-// callers are benchmark mains with nothing to clean up yet.
-inline LocateArgs parseLocateArgs(int argc, char** argv, LocateArgs a) {
+// given defaults, and whatever `more` adds to the command line. --help, or a
+// bad option, prints the help and exits: the callers are benchmark mains
+// with nothing to clean up yet.
+inline LocateArgs parseLocateArgs(int argc, char** argv, LocateArgs a,
+                                  const std::function<void(CLI::App&)>& more = {}) {
   CLI::App app("LOCATE benchmark against the real processes.", argc > 0 ? argv[0] : "bench");
+  if (more) more(app);
   app.set_help_flag("-h,--help", "print this help");
   app.add_option("--requests", a.requests, "LOCATE requests to time")
       ->check(CLI::PositiveNumber)

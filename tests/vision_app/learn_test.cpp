@@ -13,6 +13,7 @@
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
+#include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/model_file.hpp"
@@ -322,4 +323,75 @@ TEST_CASE(
   const auto outcome = locateInFrame(crop, {}, models, 1);
   REQUIRE(outcome.parts.size() == 1);
   CHECK(std::hypot(outcome.parts[0].x - kParts[0].x, outcome.parts[0].y - kParts[0].y) < 0.1);
+}
+
+TEST_CASE(
+    "the models scaled for a resized frame are built once per scale and again after the library "
+    "changes",
+    "[learn][resized][scaled_cache]") {
+  char d[] = "/tmp/picksight-scaled-cache-test-XXXXXX";
+  REQUIRE(::mkdtemp(d) != nullptr);
+  const std::string dir = d;
+  ModelLibrary library(dir + "/models");
+  const auto learned = learnInImage(fullFrame(), {}, {}, std::make_shared<const ModelList>(), 1,
+                                    "bar", boxAround(kParts[0], 4));
+  REQUIRE(learned);
+  REQUIRE(library.store(learned->model));
+
+  const auto resized = [](double scale) {
+    Frame frame;
+    cv::resize(fullFrame(), frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
+    frame.mapping.scale_x = frame.mapping.scale_y = scale;
+    return frame;
+  };
+  const Frame half = resized(0.5);
+  const Frame three_quarters = resized(0.75);
+  // Every LOCATE of a resized camera finds both bars, from one scaled list.
+  const auto findsBars = [&](const Frame& frame, ScaledModelCache& cache,
+                             std::shared_ptr<const ModelList> models) {
+    const auto outcome = locateInFrame(frame, {}, std::move(models), 1, &cache);
+    CHECK(outcome.parts.size() == 2);
+    for (size_t k : {size_t{0}, size_t{2}}) {
+      const LocatedPart& p = nearest(outcome.parts, kParts[k].x, kParts[k].y);
+      CHECK(std::hypot(p.x - kParts[k].x, p.y - kParts[k].y) < 0.3);
+    }
+    return outcome.scene.models;
+  };
+  ScaledModelCache cache;
+  const auto first = findsBars(half, cache, library.snapshot());
+  for (int i = 0; i < 3; ++i) CHECK(findsBars(half, cache, library.snapshot()) == first);
+  CHECK(cache.builds() == 1);
+  // Another scale is built once and the first is still kept.
+  const auto other = findsBars(three_quarters, cache, library.snapshot());
+  CHECK(other != first);
+  CHECK(findsBars(half, cache, library.snapshot()) == first);
+  CHECK(cache.builds() == 2);
+  // The full size needs no scaled list.
+  CHECK(cache.forFrame(library.snapshot(), {}) == library.snapshot());
+  CHECK(cache.builds() == 2);
+
+  // LEARN (a new model) and DELETE publish new lists: each is scaled anew.
+  auto disc =
+      learnInImage(fullFrame(), {}, {}, library.snapshot(), 2, "disc", boxAround(kParts[1], 4));
+  REQUIRE(disc);
+  REQUIRE(library.store(disc->model));
+  const auto with_disc = findsBars(half, cache, library.snapshot());
+  CHECK(with_disc != first);
+  CHECK(with_disc->size() == 2);
+  CHECK(cache.builds() == 3);
+  CHECK(findsBars(half, cache, library.snapshot()) == with_disc);
+  const auto discs = locateInFrame(half, {}, library.snapshot(), 2, &cache);
+  REQUIRE(discs.parts.size() == 1);
+  CHECK(std::hypot(discs.parts[0].x - kParts[1].x, discs.parts[0].y - kParts[1].y) < 0.3);
+  REQUIRE(library.remove(2));
+  const auto without_disc = findsBars(half, cache, library.snapshot());
+  CHECK(without_disc->size() == 1);
+  CHECK(cache.builds() == 4);
+  // A reload from disk is a new generation too.
+  REQUIRE(library.load().empty());
+  findsBars(half, cache, library.snapshot());
+  CHECK(cache.builds() == 5);
+
+  std::error_code ignored;
+  std::filesystem::remove_all(dir, ignored);
 }

@@ -109,8 +109,20 @@ TEST_CASE("a part learned at full size is found after the camera is resized or c
   const cv::Rect2d sensor(0, 0, 1280, 960);
   checkFound(ask(robot, "LOCATE 1"), truth, sensor, 0.1);
 
-  // Half the pixels each way: positions to a few tenths of a sensor pixel.
+  // Half the pixels each way: positions to a few tenths of a sensor pixel,
+  // on every LOCATE (the scaled models are kept from one to the next).
   camera(server, {"size", "cam0", "--scale", "0.5"});
+  for (int i = 0; i < 3; ++i) checkFound(ask(robot, "LOCATE 1"), truth, sensor, 0.3);
+  // A LEARN while resized and a FORGET change the models: every type still
+  // finds every part.
+  const std::string second = "LEARN 2 again AT " + std::to_string(x) + " " + std::to_string(y) +
+                             " " + std::to_string(side) + " " + std::to_string(side);
+  const std::string relearned = ask(robot, second);
+  INFO(second << " -> " << relearned);
+  REQUIRE(relearned.rfind("OK 2 again ", 0) == 0);
+  checkFound(ask(robot, "LOCATE 2"), truth, sensor, 0.3);
+  checkFound(ask(robot, "LOCATE 1"), truth, sensor, 0.3);
+  REQUIRE(ask(robot, "FORGET 2").rfind("OK", 0) == 0);
   checkFound(ask(robot, "LOCATE 1"), truth, sensor, 0.3);
 
   // Back to full size, then cropped to the left half of the sensor.

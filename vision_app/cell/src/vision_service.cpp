@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "picksight/cell/recognition_pass.hpp"
+#include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision/recognizer.hpp"
 
@@ -47,7 +49,7 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
   LocateScene local;
   LocateScene& s = scene ? *scene : local;
   s.mask = vision::binarize(grey, options.binarize);
-  s.regions = vision::findRegions(s.mask, options.regions, grey);
+  s.regions = vision::findRegions(s.mask, regionOptionsFor(options.regions, models), grey);
   s.mapping = mapping;
   const auto& regions = s.regions;
   std::vector<LocatedPart> parts;
@@ -67,13 +69,13 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
     }
     return parts;
   }
-  // LOCATE <type> costs the work of that type's models alone; LOCATE ALL
-  // lets every model compete for every region, so that a part is reported
-  // as the type that explains it best.
-  std::vector<const vision::PartModel*> list;
-  for (const auto& m : models)
-    if (type < 0 || m.type == type) list.push_back(&m);
-  for (const auto& match : vision::recognize(regions, list)) {
+  // LOCATE <type> costs the work of that type's models alone (and a cheap
+  // screen across the others); LOCATE ALL lets every model compete for
+  // every region, so that a part is reported as the type that explains it best.
+  const RecognitionPass pass = recognizeParts(regions, models, type);
+  for (const auto& out : pass.screened_out)
+    s.screened_out.push_back({static_cast<int>(out.region), out.closer->type});
+  for (const auto& match : pass.matches) {
     LocatedPart p;
     const cv::Point2d s = mapping.toSensor(match.centroid);
     p.x = s.x;
@@ -91,21 +93,21 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
   return parts;
 }
 
-namespace {
-// Frame pixels per sensor pixel along no particular axis.
 double frameScale(const SensorMapping& mapping) {
   return std::sqrt(mapping.scale_x * mapping.scale_y);
 }
 
-// Below this relative change a resize is none: the models are used as they are.
-constexpr double kSameScale = 1e-9;
-}  // namespace
+bool isResized(const SensorMapping& mapping) {
+  // Below this relative change a resize is none: the models are used as they are.
+  constexpr double kSameScale = 1e-9;
+  return std::abs(frameScale(mapping) - 1.0) >= kSameScale;
+}
 
 std::shared_ptr<const ModelList> modelsForFrame(std::shared_ptr<const ModelList> models,
                                                 const SensorMapping& mapping) {
   if (!models) return std::make_shared<const ModelList>();
   const double scale = frameScale(mapping);
-  if (std::abs(scale - 1.0) < kSameScale || models->empty()) return models;
+  if (!isResized(mapping) || models->empty()) return models;
   auto scaled = std::make_shared<ModelList>();
   scaled->reserve(models->size());
   for (const auto& m : *models) scaled->push_back(vision::scaledModel(m, scale));
@@ -134,10 +136,12 @@ VisionOptions frameOptions(const VisionOptions& options, const SensorMapping& ma
 }
 
 LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
-                            std::shared_ptr<const ModelList> models, int type) {
+                            std::shared_ptr<const ModelList> models, int type,
+                            ScaledModelCache* cache) {
   LocateOutcome outcome;
   outcome.frame = frame.info;
-  outcome.scene.models = modelsForFrame(std::move(models), frame.mapping);
+  outcome.scene.models = cache ? cache->forFrame(std::move(models), frame.mapping)
+                               : modelsForFrame(std::move(models), frame.mapping);
   const cv::Mat grey = greyImage(frame);
   outcome.parts = locateInImage(
       grey, frame.mapping, frameOptions(options, frame.mapping, grey.size(), *outcome.scene.models),
@@ -182,7 +186,12 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& ma
 
 VisionService::VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
                              ModelLibrary* models)
-    : camera_(std::move(camera)), options_(std::move(options)), models_(models) {}
+    : camera_(std::move(camera)),
+      options_(std::move(options)),
+      models_(models),
+      scaled_models_(std::make_unique<ScaledModelCache>()) {}
+
+VisionService::~VisionService() = default;
 
 void VisionService::start() { camera_->start(); }
 void VisionService::stop() { camera_->stop(); }
@@ -208,7 +217,7 @@ Result<LocateOutcome> VisionService::locate(int type) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  return locateInFrame(**frame, options_, models, type);
+  return locateInFrame(**frame, options_, models, type, scaled_models_.get());
 }
 
 Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
@@ -218,7 +227,7 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
   auto frame = freshFrame();
   if (!frame) return frame.error();
   auto learned = learnInImage(greyImage(**frame), (*frame)->mapping, options_, models_->snapshot(),
-                              type, name, at);
+                              type, name, at, scaled_models_.get());
   if (!learned) return learned.error();
   auto stored = models_->store(learned->model);
   if (!stored)
@@ -300,7 +309,8 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const SensorMapp
 Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                   const VisionOptions& options,
                                   std::shared_ptr<const ModelList> models, int type,
-                                  const std::string& name, const std::optional<cv::Rect>& at) {
+                                  const std::string& name, const std::optional<cv::Rect>& at,
+                                  ScaledModelCache* cache) {
   const cv::Rect rect = at ? frameRect(*at, mapping, grey.size()) : cv::Rect({0, 0}, grey.size());
   if (rect.empty()) {
     return makeError(VisionErrc::kOutsideFrame,
@@ -308,7 +318,8 @@ Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapp
                          ": the rectangle holds no pixel of the frame (sensor " +
                          sensorRectText(mapping.boxToSensor(cv::Rect({0, 0}, grey.size()))) + ")");
   }
-  const auto frame_models = modelsForFrame(std::move(models), mapping);
+  const auto frame_models = cache ? cache->forFrame(std::move(models), mapping)
+                                  : modelsForFrame(std::move(models), mapping);
   VisionOptions o = frameOptions(options, mapping, grey.size(), *frame_models);
   o.regions.keep_border_regions = true;
   for (int pass = 0;; ++pass) {
@@ -345,9 +356,8 @@ Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapp
     auto trained = vision::trainModelFromRegion(grey, r, type, name, train);
     if (!trained) return trained.error();
     LearnOutcome out;
-    const double scale = frameScale(mapping);
-    out.model = std::abs(scale - 1.0) < kSameScale ? std::move(*trained)
-                                                   : vision::scaledModel(*trained, 1.0 / scale);
+    out.model = !isResized(mapping) ? std::move(*trained)
+                                    : vision::scaledModel(*trained, 1.0 / frameScale(mapping));
     out.model.trained_centroid = mapping.toSensor(r.centroid);
     out.model.trained_angle_deg = mapping.directionToSensor(r.angle_deg);
     out.model.min_region_area = options.regions.min_area;

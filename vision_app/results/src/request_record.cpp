@@ -89,9 +89,17 @@ void RequestRecord::explain() const {
     r.region = index;
     const auto located = std::find_if(locate->parts.begin(), locate->parts.end(),
                                       [&](const LocatedPart& p) { return p.region == index; });
+    const auto screened = std::find_if(scene.screened_out.begin(), scene.screened_out.end(),
+                                       [&](const ScreenedRegion& s) { return s.region == index; });
     if (located != locate->parts.end()) {
       r.test = "no grasp";
       r.nearest_type = located->type;
+    } else if (screened != scene.screened_out.end()) {
+      // Passed the asked type's tests, but the screen across types found
+      // it clearly closer to another type.
+      r.test = "other type";
+      r.nearest_type = screened->closer_type;
+      r.measured = r.low = r.high = asked_type;
     } else if (all.empty()) {
       r.test = "no model";
     } else {

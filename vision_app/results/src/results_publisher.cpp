@@ -1,11 +1,13 @@
 // Results publisher: a bounded queue of request records, one thread that
-// turns each into a VisionResult and sends it without blocking.
+// turns each into a VisionResult and sends it without blocking, when
+// someone subscribes.
 #include "picksight/results/results_publisher.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <stdexcept>
 #include <thread>
 #include <zmq.hpp>
@@ -16,7 +18,9 @@
 namespace picksight::app {
 
 struct ResultsPublisher::Impl {
-  explicit Impl(ResultsOptions o) : options(std::move(o)), socket(context, zmq::socket_type::pub) {
+  // XPUB: a PUB socket that also hands over its subscriptions, so that no
+  // result is built while nobody listens.
+  explicit Impl(ResultsOptions o) : options(std::move(o)), socket(context, zmq::socket_type::xpub) {
     // HWM counts message parts: two per result.
     socket.set(zmq::sockopt::sndhwm, 2 * std::max(options.send_hwm, 1));
     socket.set(zmq::sockopt::linger, 0);
@@ -52,6 +56,13 @@ struct ResultsPublisher::Impl {
         id = queue.front().second;
         queue.pop_front();
       }
+      readSubscriptions();
+      if (!watched()) {
+        // Nobody would receive it: building the message (regions, outlines,
+        // rejections) would only take CPU from the next request.
+        ++unwatched;
+        continue;
+      }
       try {
         buildVisionResult(*record, options.app, id, message);
         message.SerializeToString(&bytes);
@@ -74,6 +85,28 @@ struct ResultsPublisher::Impl {
     }
   }
 
+  // The subscriptions the socket received since last time (a message each:
+  // 1 subscribe or 0 unsubscribe, then the topic prefix), never waiting.
+  // XPUB passes on the first subscription to a prefix and the last
+  // unsubscription (a subscriber's disconnection included).
+  void readSubscriptions() {
+    zmq::message_t m;
+    while (socket.recv(m, zmq::recv_flags::dontwait)) {
+      if (m.size() == 0) continue;
+      const auto* bytes = static_cast<const char*>(m.data());
+      const std::string prefix(bytes + 1, m.size() - 1);
+      // Only prefixes of this stream's topic matter, which also bounds the map.
+      if (options.app.compare(0, prefix.size(), prefix) != 0) continue;
+      if (bytes[0] == 1) {
+        ++subscriptions[prefix];
+      } else if (bytes[0] == 0) {
+        const auto it = subscriptions.find(prefix);
+        if (it != subscriptions.end() && --it->second <= 0) subscriptions.erase(it);
+      }
+    }
+  }
+  bool watched() const { return !subscriptions.empty(); }
+
   const ResultsOptions options;
   zmq::context_t context{1};
   zmq::socket_t socket;
@@ -85,7 +118,9 @@ struct ResultsPublisher::Impl {
   bool stop = false;
   std::atomic<uint64_t> sent{0};
   std::atomic<uint64_t> dropped{0};
-  std::thread thread;  // last: started once everything else is ready
+  std::atomic<uint64_t> unwatched{0};
+  std::map<std::string, int> subscriptions;  // publisher thread: prefixes of the topic
+  std::thread thread;                        // last: started once everything else is ready
 };
 
 ResultsPublisher::ResultsPublisher(ResultsOptions options)
@@ -110,6 +145,7 @@ void ResultsPublisher::publish(std::shared_ptr<const RequestRecord> record) {
 
 uint64_t ResultsPublisher::sent() const { return impl_->sent; }
 uint64_t ResultsPublisher::dropped() const { return impl_->dropped; }
+uint64_t ResultsPublisher::unwatched() const { return impl_->unwatched; }
 
 std::function<void(const std::string& reply)> publishWhenSent(
     std::shared_ptr<RequestRecord> record, std::chrono::steady_clock::time_point received,

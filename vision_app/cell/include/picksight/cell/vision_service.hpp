@@ -25,6 +25,8 @@
 
 namespace picksight::app {
 
+class ScaledModelCache;
+
 // Why a vision request failed (besides the camera link's CameraErrc and
 // training's vision::PartModelErrc).
 enum class VisionErrc {
@@ -55,6 +57,13 @@ struct LocatedPart {
   bool touching = false;      // found inside a blob shared with other parts
 };
 
+// A region that passed every test of the asked type's model, left out of
+// `LOCATE <type>` because it is clearly closer to another type's model.
+struct ScreenedRegion {
+  int region = -1;  // index into the scene's regions
+  int closer_type = -1;
+};
+
 // What a location saw beyond the parts: the binary mask and the regions
 // (frame pixels), for grasp clearance.
 struct LocateScene {
@@ -62,6 +71,7 @@ struct LocateScene {
   std::vector<vision::Region> regions;
   SensorMapping mapping;
   std::shared_ptr<const ModelList> models;  // the models the parts refer to
+  std::vector<ScreenedRegion> screened_out;
 };
 
 struct LocateOutcome {
@@ -96,8 +106,14 @@ struct VisionOptions {
 // The frame's image as 8-bit grey: the image itself, or a converted copy.
 cv::Mat greyImage(const Frame& frame);
 
+// Frame pixels per sensor pixel along no particular axis (the geometric
+// mean of the two scales), and whether that is a resize at all.
+double frameScale(const SensorMapping& mapping);
+bool isResized(const SensorMapping& mapping);
+
 // Models are in sensor pixels; a resized frame sees them scaled. The same
-// list when the frame is not resized, else a scaled copy (frame pixels).
+// list when the frame is not resized, else a scaled copy (frame pixels),
+// built anew on each call (ScaledModelCache keeps them).
 std::shared_ptr<const ModelList> modelsForFrame(std::shared_ptr<const ModelList> models,
                                                 const SensorMapping& mapping);
 
@@ -119,23 +135,29 @@ struct LearnOutcome {
 // LEARN on one grey frame: binarizes the whole frame as LOCATE would (with
 // `models`, sensor pixels, widening the window), then trains from the one
 // part inside `at` (sensor pixels; none: the whole frame). Parts touching
-// the frame border are taken only when there is no other.
+// the frame border are taken only when there is no other. `cache` (may be
+// null) keeps the models scaled for a resized frame.
 Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                   const VisionOptions& options,
                                   std::shared_ptr<const ModelList> models, int type,
-                                  const std::string& name, const std::optional<cv::Rect>& at);
+                                  const std::string& name, const std::optional<cv::Rect>& at,
+                                  ScaledModelCache* cache = nullptr);
 
 // LOCATE on one frame, as the robot server, the offline tool and the
 // benchmarks run it: the parts of `type` (-1: all types) recognized with
 // `models` (every region when there are none), with the scene kept for
-// grasp selection. The outcome's frame info is the frame's.
+// grasp selection. The outcome's frame info is the frame's. `cache` (may be
+// null: the models are scaled anew) keeps the models scaled for a resized
+// frame from one call to the next.
 LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
-                            std::shared_ptr<const ModelList> models, int type);
+                            std::shared_ptr<const ModelList> models, int type,
+                            ScaledModelCache* cache = nullptr);
 
 // Finds parts in a grey image: with `models` non-empty, the recognized parts
 // of type `type` (-1: all types), best first, recognized with that type's
-// models alone (LOCATE ALL: every model competes); with none, every region,
-// largest first.
+// models alone and screened against the others (LOCATE ALL: every model
+// competes; see recognizeParts), each model counting holes with its own
+// minimum hole area; with none, every region, largest first.
 // With `scene`, also keeps the mask and regions there.
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
@@ -153,6 +175,7 @@ class VisionService {
   // `models` (borrowed, may be null: no recognition) outlives the service.
   VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
                 ModelLibrary* models = nullptr);
+  ~VisionService();
 
   void start();
   void stop();
@@ -201,6 +224,8 @@ class VisionService {
   mutable std::mutex mutex_;  // serializes requests; guards camera_ calls and last_frame_
   std::optional<FrameInfo> last_frame_;
   std::shared_ptr<const Frame> last_pixels_;
+  // The models scaled for the camera's current size (a resized camera).
+  std::unique_ptr<ScaledModelCache> scaled_models_;
 };
 
 }  // namespace picksight::app

@@ -6,7 +6,9 @@
 // full queue drops the oldest record and counts it); a publisher thread
 // builds the message (regions, outlines, rejections) and sends it without
 // blocking (a small send high-water mark: a slow subscriber loses
-// messages, never delays the cell).
+// messages, never delays the cell). While nobody subscribes to the topic
+// (the socket is an XPUB and sees the subscriptions), no message is built:
+// the next request gets the CPU.
 //
 // Threading: publish() from any thread; the socket belongs to the
 // publisher thread. ZeroMQ and Protobuf stay inside this library.
@@ -45,6 +47,8 @@ class ResultsPublisher {
 
   uint64_t sent() const;     // messages handed to ZeroMQ
   uint64_t dropped() const;  // records dropped by a full queue or a full socket
+  // Records not built because nobody subscribed to the topic.
+  uint64_t unwatched() const;
 
  private:
   struct Impl;

@@ -1,0 +1,48 @@
+// Recognition of one frame's regions as the cell runs it: each model judges
+// the regions with its own minimum hole area (the one it was trained with),
+// and `LOCATE <type>` recognizes with that type's models alone but drops a
+// part that a cheap screen across every type (area, hole count, Hu
+// distance; no pose search) finds clearly closer to another type's model.
+//
+// Threading: pure functions; the models and regions are only read.
+#pragma once
+
+#include <vector>
+
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/recognizer.hpp"
+#include "picksight/vision/regions.hpp"
+
+namespace picksight::app {
+
+// The region settings that let every model of `models` see what it was
+// trained to see: the smallest minimum hole and region areas among the
+// cell's (`cell`) and the models' own (frame pixels, all of them).
+vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
+                                       const std::vector<vision::PartModel>& models);
+
+// The holes of `region` at least `min_hole_area` large (pixels, inside
+// their boundary trace, as findRegions measures them).
+int holesAtLeast(const vision::Region& region, double min_hole_area);
+
+// Why a region left out of `LOCATE <type>` by the screen is not the asked type.
+struct ScreenedOut {
+  size_t region = 0;
+  const vision::PartModel* asked = nullptr;   // the asked type's model it passed
+  const vision::PartModel* closer = nullptr;  // the other type's model it is closer to
+  double asked_distance = 0;                  // Hu distance over the asked model's Hu tolerance
+  double closer_distance = 0;                 // the same for the closer model
+};
+
+struct RecognitionPass {
+  std::vector<vision::Match> matches;  // best score first
+  std::vector<ScreenedOut> screened_out;
+};
+
+// The parts among `regions` (found with regionOptionsFor(..., models)) of
+// type `type` (-1: every type competes for every region), each model
+// judging hole counts with its own minimum hole area.
+RecognitionPass recognizeParts(const std::vector<vision::Region>& regions,
+                               const std::vector<vision::PartModel>& models, int type);
+
+}  // namespace picksight::app
