@@ -13,7 +13,8 @@ from picksight import picksight_pb2 as pb
 from picksight._socket_owner import SocketOwner
 from picksight.frames import decode_frame
 
-_MODES = {"freerun": pb.FREERUN, "trigger": pb.TRIGGER}
+_MODES = {"freerun": pb.FREERUN, "trigger": pb.TRIGGER, "hardware": pb.HARDWARE_TRIGGER}
+_ACTIVATIONS = ("", "RisingEdge", "FallingEdge", "AnyEdge", "LevelHigh", "LevelLow")
 _FORMATS = {"mono8": pb.MONO8, "bgr8": pb.BGR8}
 
 
@@ -102,13 +103,44 @@ class CameraControl(SocketOwner):
         r.set_size.width, r.set_size.height, r.set_size.scale = width, height, scale
         self.call(r)
 
-    def set_mode(self, camera, mode, fps=0.0):
-        """mode "freerun" or "trigger"; fps 0 leaves the rate unchanged."""
+    def set_mode(self, camera, mode, fps=0.0, line="", activation="", trigger_timeout=0.0):
+        """mode "freerun", "trigger" (software) or "hardware" (one frame per
+        pulse on the camera's input `line`, e.g. "Line1"; `activation` one of
+        RisingEdge, FallingEdge, AnyEdge, LevelHigh, LevelLow, "" = as the
+        camera is set; `trigger_timeout` in s: how long a snap or a robot's
+        LOCATE waits for a pulse, 0 = the server's default, 10 s). fps 0
+        leaves the rate unchanged. A camera without a trigger input (V4L2,
+        synthetic, files) refuses "hardware" with NOT_SUPPORTED."""
+        if mode not in _MODES:
+            raise ValueError(f"mode must be one of {sorted(_MODES)}, got {mode!r}")
+        if activation not in _ACTIVATIONS:
+            raise ValueError(f"activation must be one of {_ACTIVATIONS[1:]} or empty")
         r = pb.ControlRequest()
         r.set_mode.camera = camera
         r.set_mode.mode = _MODES[mode]
         r.set_mode.fps = fps
+        if mode == "hardware":
+            r.set_mode.trigger_line = line
+            r.set_mode.trigger_activation = activation
+            r.set_mode.trigger_timeout_ms = int(round(trigger_timeout * 1000))
         self.call(r)
+
+    def set_hardware_trigger(self, camera, line="Line1", activation="", timeout=10.0):
+        """Hardware-trigger mode on `line` (see set_mode)."""
+        self.set_mode(camera, "hardware", line=line, activation=activation, trigger_timeout=timeout)
+
+    def hardware_trigger(self, camera):
+        """The camera's hardware trigger settings as a dict: mode ("freerun",
+        "trigger" or "hardware"), line, activation, timeout (s); the line
+        settings are kept in every mode."""
+        d = self.describe(camera)
+        names = {v: k for k, v in _MODES.items()}
+        return {
+            "mode": names.get(d.summary.mode, "freerun"),
+            "line": d.trigger_line,
+            "activation": d.trigger_activation,
+            "timeout": d.trigger_timeout_ms / 1000.0,
+        }
 
     def set_format(self, camera, pixel_format):
         """pixel_format "mono8" or "bgr8"."""
@@ -119,11 +151,20 @@ class CameraControl(SocketOwner):
 
     def trigger(self, camera):
         """A software trigger; returns (sequence, triggered): waiting for that
-        sequence number gives a frame taken after the request."""
+        sequence number gives a frame taken after the request. In hardware
+        mode nothing is triggered: the sequence is that of the next pulse's
+        frame (trigger_ticket gives the line and the timeout too)."""
         r = pb.ControlRequest()
         r.trigger.camera = camera
         t = self.call(r).trigger
         return t.sequence, t.triggered
+
+    def trigger_ticket(self, camera):
+        """The whole TriggerReply: sequence, triggered, mode and, in hardware
+        mode, trigger_line and trigger_timeout_ms."""
+        r = pb.ControlRequest()
+        r.trigger.camera = camera
+        return self.call(r).trigger
 
     def statistics(self, camera=""):
         """StatisticsReply: per-camera counters and the subscriber count."""
@@ -142,8 +183,10 @@ class CameraControl(SocketOwner):
         self.call(r)
 
     def snap(self, camera, timeout=5.0):
-        """The camera's next frame (triggered in trigger mode) as a Frame; the
-        server itself waits up to 3 s for it, hence the longer timeout."""
+        """The camera's next frame (triggered in trigger mode, the next
+        pulse's in hardware mode) as a Frame. The server itself waits up to
+        3 s for it, or the camera's trigger timeout in hardware mode: pass a
+        `timeout` longer than that one."""
         r = pb.ControlRequest()
         r.snap.camera = camera
         s = self.call(r, timeout=max(timeout, self.timeout)).snap

@@ -19,6 +19,9 @@ Transform = namedtuple("Transform", "dx dy rz rms")
 Residual = namedtuple("Residual", "id dx dy distance")
 Exposure = namedtuple("Exposure", "feature value")
 Roi = namedtuple("Roi", "x y width height")
+# mode "FREE" (fps), "SOFTWARE" or "HARDWARE" (line, timeout in s); None where
+# the mode has no such setting.
+CameraMode = namedtuple("CameraMode", "mode fps line timeout")
 Blob = namedtuple(
     "Blob",
     "x y angle area perimeter roundness holes eccentricity bx by bw bh "
@@ -272,6 +275,33 @@ class RobotClient:
             self.request(f"ROI {int(x)} {int(y)} {int(width)} {int(height)}")
             return None
         return Roi(*(int(v) for v in self.request("ROI")))
+
+    def camera_mode(self, mode=None, fps=None, line=None, timeout=None):
+        """Reads, or sets and reads back, the camera's acquisition mode
+        (CAMMODE): "free" (at `fps`, None: as it is), "software", or
+        "hardware" (one frame per pulse on `line`, None: Line1; a request
+        waits up to `timeout` seconds for it, None: 10 s, and fails with
+        RobotError code 23 when none came). Returns a CameraMode."""
+        if mode is None:
+            words = self.request("CAMMODE")
+        else:
+            kind = str(mode).upper()
+            request = f"CAMMODE {kind}"
+            if kind == "FREE" and fps is not None:
+                request += f" {_number(fps)}"
+            elif kind == "HARDWARE":
+                if timeout is not None and line is None:
+                    line = "Line1"
+                if line is not None:
+                    request += f" {line}"
+                if timeout is not None:
+                    request += f" {int(round(timeout * 1000))}"
+            words = self.request(request)
+        if words[0] == "FREE":
+            return CameraMode("FREE", float(words[1]), None, None)
+        if words[0] == "HARDWARE":
+            return CameraMode("HARDWARE", None, words[1], int(words[2]) / 1000.0)
+        return CameraMode(words[0], None, None, None)
 
     def roi_full(self):
         self.request("ROI FULL")

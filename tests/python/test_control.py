@@ -94,3 +94,18 @@ def test_no_reply_is_a_timeout_and_the_client_recovers(cell_factory):
     assert e.value.code is None
     silent.close()
     control.close()
+
+
+def test_hardware_trigger_mode_is_refused_by_a_camera_without_an_input(cell_factory):
+    server, _ = cell_factory("--source", "cam0=synthetic:width=320,height=240,parts=1",
+                             "--mode", "trigger", vision=False)
+    with CameraControl(server.control) as control:
+        with pytest.raises(ControlError) as e:
+            control.set_hardware_trigger("cam0", line="Line1", timeout=2.0)
+        assert e.value.code == pb.Error.NOT_SUPPORTED
+        assert "hardware trigger" in e.value.text
+        with pytest.raises(ValueError):
+            control.set_mode("cam0", "hardware", activation="Sideways")
+        assert control.hardware_trigger("cam0")["mode"] == "trigger"  # left as it was
+        ticket = control.trigger_ticket("cam0")
+        assert ticket.triggered and ticket.mode == pb.TRIGGER

@@ -77,6 +77,12 @@ def test_camera_settings(synthetic_cell):
         assert e.value.code == 22
         with pytest.raises(ValueError):
             robot.roi(1, 2)
+        # Trigger mode; the synthetic camera has no trigger input.
+        assert robot.camera_mode() == ("SOFTWARE", None, None, None)
+        with pytest.raises(RobotError) as e:
+            robot.camera_mode("hardware", line="Line1", timeout=2)
+        assert e.value.code == 22
+        assert robot.camera_mode("free", fps=5) == ("FREE", 5.0, None, None)
 
 
 def test_a_whole_set_up_calibrate_teach_grip_pick(cell_factory, tmp_path):

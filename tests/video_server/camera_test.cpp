@@ -1,7 +1,8 @@
 // Pins a camera's acquisition: one frame per trigger with the ticket's
 // sequence, none without, increasing sequences in free-run, tickets after
-// every published frame, output settings applied from the next frame, and
-// retries of a source that is not there yet.
+// every published frame, output settings applied from the next frame,
+// retries of a source that is not there yet, and frames that keep coming
+// while a long feature listing runs.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -11,8 +12,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -107,9 +110,22 @@ bool waitForState(const Camera& camera, const std::string& state) {
 
 using picksight::test::TempDir;
 
+// A streaming camera of 8 x 8 pixels; what it delivers is the subclass's.
+class TinyStreamingSource : public picksight::video::Source {
+ public:
+  void close() override {}
+  picksight::video::SourceInfo info() const override {
+    picksight::video::SourceInfo i;
+    i.sensor_width = 8;
+    i.sensor_height = 8;
+    return i;
+  }
+  bool streams() const override { return true; }
+};
+
 // A streaming camera that delivers `good` frames after each open, then only
 // bad frames (`bad`) or nothing: a stream that stops reaching the host.
-class StallingSource : public picksight::video::Source {
+class StallingSource : public TinyStreamingSource {
  public:
   struct Counters {
     std::atomic<int> opens{0};
@@ -136,14 +152,6 @@ class StallingSource : public picksight::video::Source {
     delivered_ = 0;
     return {};
   }
-  void close() override {}
-  picksight::video::SourceInfo info() const override {
-    picksight::video::SourceInfo i;
-    i.sensor_width = 8;
-    i.sensor_height = 8;
-    return i;
-  }
-  bool streams() const override { return true; }
   picksight::Result<picksight::video::SourceFrame> grab(
       std::chrono::milliseconds timeout) override {
     using picksight::video::SourceErrc;
@@ -526,4 +534,71 @@ TEST_CASE("Camera without a trigger input refuses the hardware trigger mode", "[
   CHECK(refused.error().message.find("no hardware trigger input") != std::string::npos);
   CHECK(camera->status().mode == AcquisitionMode::kFreeRun);
   camera->stop();
+}
+
+namespace {
+// A streaming camera at 20 fps whose feature reads are slow (5 ms each, a
+// register round trip over a busy link), with 200 features of which every
+// fourth is not available (left out of the list).
+class SlowFeaturesSource : public TinyStreamingSource {
+ public:
+  static constexpr int kFeatures = 200;
+  picksight::Result<void> open() override { return {}; }
+  picksight::Result<picksight::video::SourceFrame> grab(
+      std::chrono::milliseconds timeout) override {
+    // The device's own pace: a frame every 50 ms.
+    const auto now = std::chrono::steady_clock::now();
+    if (due_ == std::chrono::steady_clock::time_point{}) due_ = now;
+    if (due_ > now + timeout) {
+      std::this_thread::sleep_for(timeout);
+      return picksight::makeError(picksight::video::SourceErrc::kTimeout, "no frame");
+    }
+    std::this_thread::sleep_until(due_);
+    due_ = std::max(due_ + 50ms, std::chrono::steady_clock::now());
+    picksight::video::SourceFrame f;
+    f.image = cv::Mat(8, 8, CV_8UC1, cv::Scalar(1));
+    return f;
+  }
+  std::vector<std::string> featureNames() override {
+    std::vector<std::string> names;
+    for (int i = 0; i < kFeatures; ++i) names.push_back("F" + std::to_string(i));
+    return names;
+  }
+  std::optional<picksight::video::Feature> listedFeature(const std::string& name) override {
+    std::this_thread::sleep_for(5ms);
+    if (std::stoi(name.substr(1)) % 4 == 3) return std::nullopt;
+    picksight::video::Feature f;
+    f.name = name;
+    return f;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point due_{};
+};
+}  // namespace
+
+TEST_CASE("Camera keeps delivering frames while a long feature listing runs", "[video_server]") {
+  CollectingSink sink;
+  Camera camera(config(AcquisitionMode::kFreeRun, 20, "slow features"),
+                std::make_unique<SlowFeaturesSource>(), sink);
+  camera.start();
+  REQUIRE(sink.waitForCount(1));
+  const size_t before = sink.count();
+  std::atomic<bool> listed{false};
+  auto listing = std::async(std::launch::async, [&] {
+    auto features = camera.features();
+    listed = true;
+    return features;
+  });
+  // The list takes dozens of slices of at most half a frame period, with a
+  // grab after each: ten frames come long before it is complete. Read in one
+  // pass, it would hold the acquisition thread and no frame would come.
+  CHECK(sink.waitForCount(before + 10));
+  CHECK_FALSE(listed.load());
+  auto features = listing.get();
+  REQUIRE(features);
+  CHECK(features->size() == SlowFeaturesSource::kFeatures / 4 * 3);
+  CHECK(features->front().name == "F0");
+  CHECK(features->back().name == "F198");
+  camera.stop();
 }

@@ -27,6 +27,18 @@ const char* errorName(SourceErrc e) {
   return "unknown";
 }
 
+std::vector<std::string> Source::featureNames() {
+  std::vector<std::string> names;
+  for (const Feature& f : features()) names.push_back(f.name);
+  return names;
+}
+
+std::optional<Feature> Source::listedFeature(const std::string& name) {
+  auto f = feature(name);
+  if (!f) return std::nullopt;
+  return *f;
+}
+
 Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
   const size_t colon = uri.find(':');
   if (colon == std::string::npos) {
@@ -57,11 +69,9 @@ Result<std::unique_ptr<Source>> makeSource(const std::string& uri) {
     return std::unique_ptr<Source>(std::make_unique<V4l2Source>(std::move(*options)));
   }
   if (scheme == "stream") {
-    if (rest.empty()) {
-      return makeError(SourceErrc::kBadConfig,
-                       "stream: needs a URL, as in stream:rtsp://host/path");
-    }
-    return std::unique_ptr<Source>(std::make_unique<StreamSource>(rest));
+    auto options = parseStreamOptions(rest);
+    if (!options) return options.error();
+    return std::unique_ptr<Source>(std::make_unique<StreamSource>(std::move(*options)));
   }
   if (scheme == "dir") {
     if (rest.empty()) {

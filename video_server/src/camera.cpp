@@ -10,7 +10,6 @@
 #include "picksight/video_server/video_errors.hpp"
 
 #include <algorithm>
-#include <future>
 #include <set>
 
 #include "picksight/common/clock.hpp"
@@ -24,10 +23,12 @@ constexpr std::chrono::milliseconds kMaxBackoff{5000};
 // Streaming sources are polled in short slices so feature commands and stop
 // requests are served promptly even when no frame comes.
 constexpr std::chrono::milliseconds kGrabSlice{200};
-constexpr std::chrono::milliseconds kCommandTimeout{5000};
 constexpr std::chrono::milliseconds kTriggerPatience{2000};
 // Bad frames come at the frame rate: one warning per this interval at most.
 constexpr std::chrono::seconds kBadFrameLogInterval{10};
+// Requests remembered for a late source; beyond, the oldest are forgotten
+// (their clients have long timed out).
+constexpr size_t kMaxRequests = 256;
 }  // namespace
 
 bool isTriggerActivation(const std::string& name) {
@@ -39,6 +40,7 @@ bool isTriggerActivation(const std::string& name) {
 Camera::Camera(CameraConfig config, std::unique_ptr<Source> source, FrameSink& sink)
     : config_(std::move(config)),
       source_(std::move(source)),
+      source_reports_age_(source_->reportsAge()),
       sink_(sink),
       output_(config_.output),
       mode_(config_.mode),
@@ -131,6 +133,7 @@ Result<void> Camera::setMode(AcquisitionMode mode, double fps,
       fps_asked_ = true;
     }
     if (mode != AcquisitionMode::kTrigger) pending_triggers_ = 0;
+    requests_.clear();
     reconfigure_ = true;
   }
   wake_.notify_all();
@@ -141,7 +144,10 @@ void Camera::setOpen(bool open) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     open_requested_ = open;
-    if (!open) pending_triggers_ = 0;
+    if (!open) {
+      pending_triggers_ = 0;
+      requests_.clear();
+    }
   }
   wake_.notify_all();
 }
@@ -160,18 +166,31 @@ Result<TriggerTicket> Camera::trigger() {
       return makeError(SourceErrc::kUnavailable,
                        "camera '" + config_.name + "' is not streaming: " + status_.last_error);
     }
+    ticket.mode = mode_;
+    ticket.hardware = hardware_;
     if (mode_ == AcquisitionMode::kTrigger) {
       ticket.sequence = next_sequence_ + pending_triggers_;
       ticket.triggered = true;
       ++pending_triggers_;
-    } else if (mode_ == AcquisitionMode::kHardwareTrigger && grab_sequence_) {
+    } else if (mode_ == AcquisitionMode::kHardwareTrigger && grab_sequence_ && grab_waits_pulse_ &&
+               !reconfigure_) {
       // The grab under way waits for the next pulse: the first frame
-      // delivered after this request carries its number.
+      // delivered after this request carries its number. (A grab begun
+      // before the switch to this mode may bring a free-run frame: the next
+      // one is the first that waits for a pulse.)
       ticket.sequence = *grab_sequence_;
     } else {
       // Sequence numbers are taken when a grab starts, so next_sequence_ is
       // a frame whose acquisition begins after this request.
       ticket.sequence = next_sequence_;
+    }
+    if (source_reports_age_) {
+      // One frame per request: each frame is held to the request it serves,
+      // and a later request never raises the bar for an earlier one.
+      if (!requests_.empty())
+        ticket.sequence = std::max(ticket.sequence, requests_.back().first + 1);
+      requests_.emplace_back(ticket.sequence, monotonicNs());
+      if (requests_.size() > kMaxRequests) requests_.pop_front();
     }
   }
   wake_.notify_all();
@@ -184,74 +203,6 @@ std::optional<Frame> Camera::waitForFrame(uint64_t sequence, std::chrono::millis
   frame_published_.wait_for(lock, timeout, ready);
   if (!ready()) return std::nullopt;
   return last_frame_;
-}
-
-template <typename T>
-Result<T> Camera::onAcquisitionThread(std::function<Result<T>(Source&, bool open)> fn) {
-  auto promise = std::make_shared<std::promise<Result<T>>>();
-  auto future = promise->get_future();
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    // open_ is read on the acquisition thread when the command runs.
-    commands_.push_back([this, fn, promise] { promise->set_value(fn(*source_, open_)); });
-    if (!thread_.joinable()) {
-      // No acquisition thread: nobody else touches the source.
-      Command command = std::move(commands_.back());
-      commands_.pop_back();
-      command();
-      return future.get();
-    }
-  }
-  wake_.notify_all();
-  if (future.wait_for(kCommandTimeout) != std::future_status::ready) {
-    return makeError(SourceErrc::kTimeout,
-                     "camera " + config_.name + " is busy: no answer within 5 s");
-  }
-  return future.get();
-}
-
-Result<std::vector<Feature>> Camera::features() {
-  return onAcquisitionThread<std::vector<Feature>>(
-      [](Source& s, bool open) -> Result<std::vector<Feature>> {
-        if (!open) return makeError(SourceErrc::kUnavailable, "camera is not connected");
-        return s.features();
-      });
-}
-
-Result<Feature> Camera::feature(const std::string& name) {
-  return onAcquisitionThread<Feature>([name](Source& s, bool open) -> Result<Feature> {
-    if (!open) return makeError(SourceErrc::kUnavailable, "camera is not connected");
-    return s.feature(name);
-  });
-}
-
-Result<Feature> Camera::setFeature(const std::string& name, const std::string& value) {
-  return onAcquisitionThread<Feature>([name, value](Source& s, bool open) -> Result<Feature> {
-    if (!open) return makeError(SourceErrc::kUnavailable, "camera is not connected");
-    if (auto ok = s.setFeature(name, value); !ok) return ok.error();
-    return s.feature(name);
-  });
-}
-
-Result<SimulatedRobot> Camera::moveTarget(std::optional<cv::Point2d> at_mm) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!robot_) return makeError(SourceErrc::kNotSupported, "this camera has no simulated robot");
-  }
-  // A closed synthetic source keeps the position for when it opens again.
-  auto robot = onAcquisitionThread<SimulatedRobot>(
-      [at_mm](Source& s, bool /*open*/) { return s.moveTarget(at_mm); });
-  if (robot) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    robot_ = *robot;
-  }
-  return robot;
-}
-
-Result<SimulatedRobot> Camera::simulatedRobot() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!robot_) return makeError(SourceErrc::kNotSupported, "this camera has no simulated robot");
-  return *robot_;
 }
 
 void Camera::runCommands(std::unique_lock<std::mutex>& lock) {
@@ -296,6 +247,7 @@ bool Camera::ensureOpen(std::unique_lock<std::mutex>& lock) {
   if (!opened) {
     status_.state = "reconnecting";
     pending_triggers_ = 0;  // their clients get no frame; new ones are refused
+    requests_.clear();
     if (status_.last_error != opened.error().message) {
       logWarning("camera ", config_.name, ": ", opened.error().message, " (retrying)");
     }
@@ -342,6 +294,7 @@ void Camera::run() {
     const OutputSettings output = output_;
     if (!waiting_since_) waiting_since_ = Clock::now();
     grab_sequence_ = sequence;
+    grab_waits_pulse_ = mode_ == AcquisitionMode::kHardwareTrigger;
     lock.unlock();
     Grab grab = grabAndConvert(*triggered, streams, output);
     lock.lock();
@@ -349,6 +302,10 @@ void Camera::run() {
     status_.driver = grab.counters;
     if (!grab.out) {
       handleGrabFailure(lock, sequence, *triggered, grab.out.error());
+      continue;
+    }
+    if (exposedTooEarly(sequence, grab)) {
+      leaveOut(sequence, *triggered);
       continue;
     }
     publish(lock, sequence, *triggered, std::move(grab));
@@ -418,6 +375,11 @@ Camera::Grab Camera::grabAndConvert(bool triggered, bool streams, const OutputSe
   grab.grabbed = asked ? source_->grab(streams ? kGrabSlice : std::chrono::milliseconds(1000))
                        : Result<SourceFrame>(asked.error());
   grab.host_ns = realtimeNs();
+  grab.exposed_ns = monotonicNs();
+  if (grab.grabbed) {
+    grab.age = std::max(std::chrono::nanoseconds(0), grab.grabbed->age);
+    grab.exposed_ns -= std::min<uint64_t>(grab.exposed_ns, grab.age.count());
+  }
   grab.counters = source_->driverCounters();
   // Standardize, then ROI and resize, in the pipeline's one step.
   grab.out = grab.grabbed ? applyOutputSettings(*grab.grabbed, output)
@@ -469,10 +431,29 @@ void Camera::handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequ
   startOutage(lock);
 }
 
+bool Camera::exposedTooEarly(uint64_t sequence, const Grab& grab) const {
+  if (!source_reports_age_) return false;
+  // The latest request this frame would serve.
+  uint64_t asked_ns = 0;
+  for (const auto& [ticket, at_ns] : requests_) {
+    if (ticket > sequence) break;
+    asked_ns = std::max(asked_ns, at_ns);
+  }
+  return grab.exposed_ns < asked_ns;
+}
+
+void Camera::leaveOut(uint64_t sequence, bool triggered) {
+  // As for a failed grab: no gap in the numbers, the trigger still owed.
+  if (next_sequence_ == sequence + 1) next_sequence_ = sequence;
+  if (triggered) ++pending_triggers_;
+  ++status_.frames_before_request;
+}
+
 void Camera::startOutage(std::unique_lock<std::mutex>& lock) {
   closeSource(lock);
   status_.state = "reconnecting";
   waiting_since_.reset();
+  requests_.clear();
   // Owed frames are not delivered after the outage; their clients time
   // out, and new triggers are refused until the camera is back.
   pending_triggers_ = 0;
@@ -511,7 +492,9 @@ void Camera::publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool
   frame.info.camera = config_.name;
   frame.info.sequence = sequence;
   frame.info.device_timestamp_ns = grab.grabbed->device_timestamp_ns;
-  frame.info.host_timestamp_ns = grab.host_ns;
+  // A late source's frame is stamped with its estimated exposure.
+  frame.info.host_timestamp_ns =
+      grab.host_ns - std::min<uint64_t>(grab.host_ns, static_cast<uint64_t>(grab.age.count()));
   frame.info.width = static_cast<uint32_t>(frame.image.cols);
   frame.info.height = static_cast<uint32_t>(frame.image.rows);
   frame.info.triggered = triggered;
@@ -523,6 +506,7 @@ void Camera::publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool
   last_frame_ = frame;
   ++status_.frames_acquired;
   status_.last_sequence = sequence;
+  while (!requests_.empty() && requests_.front().first <= sequence) requests_.pop_front();
   if (last_frame_ns_ != 0) {
     // Exponential average of the instantaneous rate: smooth, and follows a
     // rate change within a few frames.

@@ -24,9 +24,8 @@ proto::AcquisitionMode toProto(AcquisitionMode m) {
 }
 
 // The snap of a camera waiting for a pulse waits as long as its trigger
-// timeout says; the others, for a frame they were sent or stream anyway.
-std::chrono::milliseconds snapTimeout(const CameraStatus& s);
-
+// timeout says; the others this long, for a frame they were sent or stream
+// anyway.
 constexpr std::chrono::milliseconds kSnapTimeout{3000};
 
 void fillFeature(const Feature& f, proto::Feature* out) {
@@ -174,6 +173,12 @@ proto::ControlReply trigger(Camera& camera) {
   proto::ControlReply reply = okReply();
   reply.mutable_trigger()->set_sequence(t->sequence);
   reply.mutable_trigger()->set_triggered(t->triggered);
+  reply.mutable_trigger()->set_mode(toProto(t->mode));
+  if (t->mode == AcquisitionMode::kHardwareTrigger) {
+    reply.mutable_trigger()->set_trigger_line(t->hardware.input.line);
+    reply.mutable_trigger()->set_trigger_timeout_ms(
+        static_cast<uint32_t>(t->hardware.timeout.count()));
+  }
   return reply;
 }
 
@@ -206,15 +211,16 @@ proto::ControlReply snap(Camera& camera) {
   }
   const auto t = camera.trigger();
   if (!t) return errorReply(t.error());
-  const CameraStatus status = camera.status();
-  const std::chrono::milliseconds timeout = snapTimeout(status);
+  // The ticket's own mode: a mode change after it does not change its wait.
+  const bool hardware = t->mode == AcquisitionMode::kHardwareTrigger;
+  const std::chrono::milliseconds timeout = hardware ? t->hardware.timeout : kSnapTimeout;
   auto frame = camera.waitForFrame(t->sequence, timeout);
   if (!frame) {
     const std::string waited = " within " + std::to_string(timeout.count()) + " ms";
-    if (status.mode == AcquisitionMode::kHardwareTrigger) {
+    if (hardware) {
       return errorReply(makeError(VideoErrc::kNoFrame, "no hardware trigger on " +
-                                                           status.hardware.input.line +
-                                                           " of camera '" + name + "'" + waited));
+                                                           t->hardware.input.line + " of camera '" +
+                                                           name + "'" + waited));
     }
     return errorReply(
         makeError(VideoErrc::kNoFrame, "no frame from camera '" + name + "'" + waited));
@@ -261,10 +267,6 @@ proto::ControlReply setTarget(Camera& camera, const proto::SetTargetRequest& req
   proto::ControlReply reply = okReply();
   fillSimulatedRobot(*robot, reply.mutable_simulated_robot());
   return reply;
-}
-
-std::chrono::milliseconds snapTimeout(const CameraStatus& s) {
-  return s.mode == AcquisitionMode::kHardwareTrigger ? s.hardware.timeout : kSnapTimeout;
 }
 
 proto::ControlReply notSupported() {
@@ -372,6 +374,7 @@ proto::ControlReply VideoServer::statistics(const proto::StatisticsRequest& requ
     cs->set_driver_underruns(s.driver.underruns);
     cs->set_driver_sequence_gaps(s.driver.sequence_gaps);
     cs->set_frames_skipped_stale(s.driver.skipped_stale);
+    cs->set_frames_before_request(s.frames_before_request);
   }
   return reply;
 }

@@ -1,7 +1,8 @@
 // Pins the stream driver: MJPEG over HTTP (as smartphone IP-camera apps
 // serve it) from a server the test runs on loopback, frames with the right
-// content, unavailable when the server stops, resuming when it restarts; and
-// a video file, which loops.
+// content, unavailable when the server stops, resuming when it restarts; a
+// video file, which loops; the pipeline delay and "a frame after the
+// request" judged by the frame's estimated exposure.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -22,8 +23,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "picksight/common/clock.hpp"
 #include "picksight/sources/source.hpp"
+#include "picksight/video_server/camera.hpp"
 #include "picksight/video_server/pixel_format.hpp"
+#include "stream/stream_source.hpp"
 
 using namespace std::chrono_literals;
 using namespace picksight::video;
@@ -242,4 +246,89 @@ TEST_CASE("stream: a video file plays every frame in order and loops", "[video_s
   REQUIRE_FALSE(opened);
   CHECK(opened.error().code == SourceErrc::kUnavailable);
   CHECK_THAT(opened.error().message, Catch::Contains("/nonexistent/clip.avi"));
+}
+
+TEST_CASE("stream: source options name what is wrong", "[video_server][stream]") {
+  auto parsed = parseStreamOptions("rtsp://cam/stream1|latency_ms=250");
+  REQUIRE(parsed);
+  CHECK(parsed->url == "rtsp://cam/stream1");
+  CHECK(parsed->latency == 250ms);
+  CHECK(parseStreamOptions("http://phone:8080/video")->latency == 0ms);
+  for (const char* bad :
+       {"rtsp://cam|latency_ms=-1", "rtsp://cam|latency_ms=10001", "rtsp://cam|latency_ms=abc",
+        "rtsp://cam|transport=udp", "|latency_ms=1"}) {
+    INFO(bad);
+    auto refused = makeSource(std::string("stream:") + bad);
+    REQUIRE_FALSE(refused);
+    CHECK(refused.error().code == SourceErrc::kBadConfig);
+  }
+}
+
+TEST_CASE("stream: buffering is measured against the stream's clock only when it is one",
+          "[video_server][stream]") {
+  constexpr uint64_t kMs = 1000000;
+  constexpr uint64_t kDecode = 3 * kMs;
+  StreamDelay delay;
+  // Presentation times that follow arrival (40 ms apart): one frame held
+  // 50 ms longer than the others on its way shows that much delay.
+  for (int i = 0; i < 20; ++i) {
+    const uint64_t in = (1000 + 40 * static_cast<uint64_t>(i)) * kMs;
+    CHECK(delay.add(in, in + kDecode, 40.0 * i) == std::chrono::nanoseconds(kDecode));
+  }
+  const uint64_t late = (1000 + 40 * 20 + 50) * kMs;
+  CHECK(delay.add(late, late + kDecode, 40.0 * 20) == std::chrono::nanoseconds(kDecode + 50 * kMs));
+  // A nominal 25 fps count while frames come every 100 ms (an MJPEG-over-HTTP
+  // server): not a clock, only the decode time is known.
+  StreamDelay nominal;
+  for (int i = 0; i < 30; ++i) {
+    const uint64_t in = (5000 + 100 * static_cast<uint64_t>(i)) * kMs;
+    CHECK(nominal.add(in, in + kDecode, 40.0 * i) == std::chrono::nanoseconds(kDecode));
+  }
+  // No presentation time at all.
+  StreamDelay none;
+  CHECK(none.add(10 * kMs, 10 * kMs + kDecode, -1) == std::chrono::nanoseconds(kDecode));
+}
+
+namespace {
+class NoSink : public FrameSink {
+ public:
+  void publish(picksight::Frame) override {}
+};
+}  // namespace
+
+TEST_CASE("stream: a snap or a trigger never gets a frame exposed before the request",
+          "[video_server][stream]") {
+  MjpegHttpServer server;
+  const uint16_t port = server.start();
+  // A phone's 2 s of latency: frames arriving within 2 s of a request were
+  // exposed before it, by estimate, whatever the machine's load.
+  const std::string uri =
+      "stream:http://127.0.0.1:" + std::to_string(port) + "/video|latency_ms=2000";
+  auto made = makeSource(uri);
+  REQUIRE(made);
+  CHECK((*made)->reportsAge());
+  CameraConfig config;
+  config.name = "phone";
+  config.uri = uri;
+  NoSink sink;
+  Camera camera(config, std::move(*made), sink);
+  camera.start();
+  REQUIRE(camera.waitForFrame(1, 30s));
+
+  const auto served = [&camera] {
+    const uint64_t requested = picksight::realtimeNs();
+    auto ticket = camera.trigger();
+    REQUIRE(ticket);
+    auto frame = camera.waitForFrame(ticket->sequence, 60s);
+    REQUIRE(frame);
+    // host_timestamp_ns is the estimated exposure (arrival minus the delay).
+    CHECK(frame->info.host_timestamp_ns >= requested);
+  };
+  for (int i = 0; i < 2; ++i) served();
+  REQUIRE(camera.setMode(AcquisitionMode::kTrigger, 0));
+  served();
+  // The frames left out were counted (the first frame after each request
+  // arrived well within the 2 s).
+  CHECK(camera.status().frames_before_request > 0);
+  camera.stop();
 }

@@ -531,6 +531,16 @@ std::vector<Feature> AravisSource::features() {
   return GenicamFeatures(arv_camera_get_device(camera_.get())).list();
 }
 
+std::vector<std::string> AravisSource::featureNames() {
+  if (!camera_) return {};
+  return GenicamFeatures(arv_camera_get_device(camera_.get())).names();
+}
+
+std::optional<Feature> AravisSource::listedFeature(const std::string& name) {
+  if (!camera_ || control_lost_->load()) return std::nullopt;
+  return GenicamFeatures(arv_camera_get_device(camera_.get())).listed(name);
+}
+
 Result<Feature> AravisSource::feature(const std::string& name) {
   if (!camera_) return lost("not open");
   if (control_lost_->load()) return lost("control lost");

@@ -51,6 +51,8 @@ class AravisSource : public Source {
   DriverCounters driverCounters() const override;
 
   std::vector<Feature> features() override;
+  std::vector<std::string> featureNames() override;
+  std::optional<Feature> listedFeature(const std::string& name) override;
   Result<Feature> feature(const std::string& name) override;
   Result<void> setFeature(const std::string& name, const std::string& value) override;
 

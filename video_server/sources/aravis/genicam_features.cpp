@@ -109,7 +109,8 @@ Feature GenicamFeatures::describe(ArvGcFeatureNode* node) const {
   return f;
 }
 
-void GenicamFeatures::collect(ArvGcNode* category, std::vector<Feature>& out, int depth) const {
+template <typename Visit>
+void GenicamFeatures::walk(ArvGcNode* category, const Visit& visit, int depth) const {
   if (depth > kMaxCategoryDepth || category == nullptr || !ARV_IS_GC_CATEGORY(category)) return;
   ArvGc* genicam = arv_device_get_genicam(device_);
   for (const GSList* it = arv_gc_category_get_features(ARV_GC_CATEGORY(category)); it != nullptr;
@@ -117,23 +118,46 @@ void GenicamFeatures::collect(ArvGcNode* category, std::vector<Feature>& out, in
     ArvGcNode* child = arv_gc_get_node(genicam, static_cast<const char*>(it->data));
     if (child == nullptr || !ARV_IS_GC_FEATURE_NODE(child)) continue;
     if (ARV_IS_GC_CATEGORY(child)) {
-      collect(child, out, depth + 1);
+      walk(child, visit, depth + 1);
       continue;
     }
-    auto* feature = ARV_GC_FEATURE_NODE(child);
-    GErrorSlot error;
-    if (!arv_gc_feature_node_is_implemented(feature, error.out()) ||
-        !arv_gc_feature_node_is_available(feature, error.out())) {
-      continue;
-    }
-    out.push_back(describe(feature));
+    visit(ARV_GC_FEATURE_NODE(child));
   }
+}
+
+bool GenicamFeatures::listable(ArvGcFeatureNode* feature) {
+  // Both may read registers: part of reading the feature, not of naming it.
+  GErrorSlot error;
+  return arv_gc_feature_node_is_implemented(feature, error.out()) &&
+         arv_gc_feature_node_is_available(feature, error.out());
 }
 
 std::vector<Feature> GenicamFeatures::list() const {
   std::vector<Feature> out;
-  collect(arv_gc_get_node(arv_device_get_genicam(device_), "Root"), out, 0);
+  walk(
+      arv_gc_get_node(arv_device_get_genicam(device_), "Root"),
+      [&](ArvGcFeatureNode* feature) {
+        if (listable(feature)) out.push_back(describe(feature));
+      },
+      0);
   return out;
+}
+
+std::vector<std::string> GenicamFeatures::names() const {
+  std::vector<std::string> out;
+  walk(
+      arv_gc_get_node(arv_device_get_genicam(device_), "Root"),
+      [&](ArvGcFeatureNode* feature) {
+        out.emplace_back(orEmpty(arv_gc_feature_node_get_name(feature)));
+      },
+      0);
+  return out;
+}
+
+std::optional<Feature> GenicamFeatures::listed(const std::string& name) const {
+  auto n = node(name);
+  if (!n || !listable(*n)) return std::nullopt;
+  return describe(*n);
 }
 
 Result<Feature> GenicamFeatures::get(const std::string& name) const {

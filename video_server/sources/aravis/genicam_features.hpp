@@ -5,6 +5,7 @@
 
 #include <arv.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,11 @@ class GenicamFeatures {
 
   // Every implemented, available feature under the "Root" category.
   std::vector<Feature> list() const;
+  // The names of every feature under "Root", from the XML alone (no device
+  // access); listed() describes one as list() would, or nullopt when list()
+  // leaves it out (not implemented, not available).
+  std::vector<std::string> names() const;
+  std::optional<Feature> listed(const std::string& name) const;
   Result<Feature> get(const std::string& name) const;
   // Commands execute; the value is ignored for them.
   Result<void> set(const std::string& name, const std::string& value) const;
@@ -27,7 +33,10 @@ class GenicamFeatures {
  private:
   Result<ArvGcFeatureNode*> node(const std::string& name) const;
   Feature describe(ArvGcFeatureNode* node) const;
-  void collect(ArvGcNode* category, std::vector<Feature>& out, int depth) const;
+  // Calls `visit` for every feature node under `category`, in order.
+  template <typename Visit>
+  void walk(ArvGcNode* category, const Visit& visit, int depth) const;
+  static bool listable(ArvGcFeatureNode* feature);
 
   ArvDevice* device_;
 };

@@ -13,8 +13,17 @@ const char* errorName(CameraErrc e) {
       return "camera refused";
     case CameraErrc::kUnknownFeature:
       return "unknown feature";
+    case CameraErrc::kNoTriggerPulse:
+      return "no trigger pulse";
   }
   return "unknown";
+}
+
+Result<CameraModeSettings> CameraLink::mode() {
+  return makeError(CameraErrc::kCameraRefused, "camera " + camera() + " has no acquisition modes");
+}
+Result<void> CameraLink::setMode(const CameraModeSettings&) {
+  return makeError(CameraErrc::kCameraRefused, "camera " + camera() + " has no acquisition modes");
 }
 
 // The still image is copied once here, so the caller may reuse its own.

@@ -45,11 +45,80 @@ Result<std::shared_ptr<const Frame>> VideoServerCamera::freshFrame() {
     // A camera in an outage refuses at once (camera refused, with its reason).
     auto reply = call(request);
     if (!reply) return reply.error();
-    const auto wait = std::min<std::chrono::milliseconds>(
-        kRetrigger, std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now));
+    if (reply->trigger().mode() == proto::HARDWARE_TRIGGER) {
+      return hardwareFrame(reply->trigger(), requested_ns);
+    }
+    // Nothing to lose in free-run: any later frame serves, and asking again
+    // would only set a later bar (a stream's frames are held to the request).
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now);
+    const auto wait = reply->trigger().triggered() ? std::min(kRetrigger, left) : left;
     auto frame = feed_.waitFor(reply->trigger().sequence(), requested_ns, wait);
     if (frame) return frame;
   }
+}
+
+Result<std::shared_ptr<const Frame>> VideoServerCamera::hardwareFrame(
+    const proto::TriggerReply& ticket, uint64_t requested_ns) {
+  // The frame comes when the line is pulsed (by the robot, after sending its
+  // request): asking again would change nothing, so one wait, bounded by the
+  // camera's trigger timeout, not by this link's own frame timeout.
+  const std::chrono::milliseconds timeout(
+      ticket.trigger_timeout_ms() > 0 ? ticket.trigger_timeout_ms() : frame_timeout_.count());
+  const auto elapsed = std::chrono::nanoseconds(monotonicNs() - requested_ns);
+  const auto left =
+      std::max(std::chrono::milliseconds(0),
+               timeout - std::chrono::duration_cast<std::chrono::milliseconds>(elapsed));
+  if (auto frame = feed_.waitFor(ticket.sequence(), requested_ns, left)) return frame;
+  return makeError(CameraErrc::kNoTriggerPulse, "camera " + camera_ +
+                                                    " is in hardware trigger mode: no pulse on " +
+                                                    ticket.trigger_line() + " within " +
+                                                    std::to_string(timeout.count()) + " ms");
+}
+
+Result<CameraModeSettings> VideoServerCamera::mode() {
+  proto::ControlRequest request;
+  request.mutable_describe_camera()->set_camera(camera_);
+  auto reply = call(request);
+  if (!reply) return reply.error();
+  const auto& d = reply->describe_camera();
+  CameraModeSettings settings;
+  switch (d.summary().mode()) {
+    case proto::TRIGGER:
+      settings.mode = CameraMode::kSoftwareTrigger;
+      break;
+    case proto::HARDWARE_TRIGGER:
+      settings.mode = CameraMode::kHardwareTrigger;
+      break;
+    default:
+      settings.mode = CameraMode::kFreeRun;
+  }
+  settings.fps = d.fps();
+  settings.line = d.trigger_line();
+  settings.timeout = std::chrono::milliseconds(d.trigger_timeout_ms());
+  return settings;
+}
+
+Result<void> VideoServerCamera::setMode(const CameraModeSettings& settings) {
+  proto::ControlRequest request;
+  auto* set = request.mutable_set_mode();
+  set->set_camera(camera_);
+  switch (settings.mode) {
+    case CameraMode::kFreeRun:
+      set->set_mode(proto::FREERUN);
+      set->set_fps(settings.fps);
+      break;
+    case CameraMode::kSoftwareTrigger:
+      set->set_mode(proto::TRIGGER);
+      break;
+    case CameraMode::kHardwareTrigger:
+      set->set_mode(proto::HARDWARE_TRIGGER);
+      set->set_trigger_line(settings.line);
+      set->set_trigger_timeout_ms(static_cast<uint32_t>(settings.timeout.count()));
+      break;
+  }
+  auto reply = call(request);
+  if (!reply) return reply.error();
+  return {};
 }
 
 Result<std::string> VideoServerCamera::feature(const std::string& name) {

@@ -1,7 +1,9 @@
-// LOCATE with grasps, LOCATE ALL, WHY, GRASP, GRIPPER, STATUS, EXPOSURE, ROI.
+// LOCATE with grasps, LOCATE ALL, WHY, GRASP, GRIPPER, STATUS, EXPOSURE, ROI,
+// CAMMODE.
 #include "picksight/protocol/cell_commands.hpp"
 
 #include <algorithm>
+#include <cctype>
 
 #include "picksight/cell/grasp_planner.hpp"
 #include "picksight/common/text.hpp"
@@ -211,6 +213,80 @@ std::string roi(const Request& r, CellContext& cell) {
   }
   return std::string("OK");
 }
+
+std::string cameraModeReply(const CameraModeSettings& m) {
+  switch (m.mode) {
+    case CameraMode::kSoftwareTrigger:
+      return "OK SOFTWARE";
+    case CameraMode::kHardwareTrigger:
+      return "OK HARDWARE " + printable(m.line, 32) + " " + std::to_string(m.timeout.count());
+    case CameraMode::kFreeRun:
+      break;
+  }
+  return "OK FREE " + formatFixed(m.fps, 3);
+}
+
+// CAMMODE [FREE [<fps>] | SOFTWARE | HARDWARE [<line> [<timeout_ms>]]]: the
+// reply is the mode read back from the camera.
+std::string cameraMode(const Request& r, CellContext& cell) {
+  const std::string usage =
+      "usage: CAMMODE [FREE [<fps>] | SOFTWARE | HARDWARE [<line> [<timeout_ms>]]]";
+  std::optional<CameraModeSettings> wanted;
+  if (!r.args.empty()) {
+    CameraModeSettings m;
+    const std::string kind = toUpper(r.args[0]);
+    if (kind == "FREE" && r.args.size() <= 2) {
+      m.mode = CameraMode::kFreeRun;
+      if (r.args.size() == 2) {
+        const auto fps = parseDouble(r.args[1]);
+        if (!fps || !(*fps > 0 && *fps <= 1000))
+          return errorReply(
+              ProtocolErrc::kBadArguments,
+              "CAMMODE FREE: fps must be in (0, 1000], got '" + printable(r.args[1]) + "'");
+        m.fps = *fps;
+      }
+    } else if (kind == "SOFTWARE" && r.args.size() == 1) {
+      m.mode = CameraMode::kSoftwareTrigger;
+    } else if (kind == "HARDWARE" && r.args.size() <= 3) {
+      m.mode = CameraMode::kHardwareTrigger;
+      if (r.args.size() >= 2) {
+        const std::string& line = r.args[1];
+        const bool name_ok = line.size() <= 32 && std::all_of(line.begin(), line.end(), [](char c) {
+                               return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+                             });
+        if (!name_ok)
+          return errorReply(ProtocolErrc::kBadArguments,
+                            "CAMMODE HARDWARE: line must be 1 to 32 of A-Z a-z 0-9 _, got '" +
+                                printable(line) + "'");
+        m.line = line;
+      }
+      if (r.args.size() == 3) {
+        const auto ms = parseInt(r.args[2]);
+        if (!ms || *ms < 1 || *ms > 3600000)
+          return errorReply(ProtocolErrc::kBadArguments,
+                            "CAMMODE HARDWARE: timeout_ms must be in [1, 3600000], got '" +
+                                printable(r.args[2]) + "'");
+        m.timeout = std::chrono::milliseconds(*ms);
+      }
+    } else {
+      return errorReply(ProtocolErrc::kBadArguments, usage);
+    }
+    wanted = m;
+  }
+  auto answer = cell.vision.withCamera([&](CameraLink& camera) -> Result<CameraModeSettings> {
+    if (wanted) {
+      if (auto set = camera.setMode(*wanted); !set) return set.error();
+    }
+    return camera.mode();
+  });
+  if (!answer) {
+    const CameraErrc code = answer.error().code == CameraErrc::kNoVideoServer
+                                ? CameraErrc::kNoVideoServer
+                                : CameraErrc::kCameraRefused;
+    return errorReply(code, "CAMMODE: " + printable(answer.error().message, 160));
+  }
+  return cameraModeReply(*answer);
+}
 }  // namespace
 
 Result<CellLocate> locateAndPick(CellContext& cell, int type) {
@@ -290,6 +366,9 @@ void addCellCommands(CommandTable& table, CellContext& cell) {
   table.add(
       "ROI", "ROI [<x> <y> <w> <h> | FULL]", [&cell](const Request& r) { return roi(r, cell); },
       changesWithArguments);
+  table.add(
+      "CAMMODE", "CAMMODE [FREE [<fps>] | SOFTWARE | HARDWARE [<line> [<timeout_ms>]]]",
+      [&cell](const Request& r) { return cameraMode(r, cell); }, changesWithArguments);
 }
 
 }  // namespace picksight::app

@@ -36,6 +36,7 @@ const std::pair<std::error_code, int> kTable[] = {
     {ControlErrc::kNoReply, 21},
     {CameraErrc::kCameraRefused, 22},
     {CameraErrc::kUnknownFeature, 22},
+    {CameraErrc::kNoTriggerPulse, 23},
     {vision::PartModelErrc::kNoPart, 30},
     {vision::PartModelErrc::kSeveralParts, 31},
     {VisionErrc::kUnknownType, 32},

@@ -72,6 +72,10 @@ class FrameSink {
 struct TriggerTicket {
   uint64_t sequence = 0;   // the frame to wait for (or any later one)
   bool triggered = false;  // false in free-run: no frame was forced
+  // The mode the ticket was taken in, and in kHardwareTrigger the settings a
+  // client needs to wait for the pulse (taken together, under one lock).
+  AcquisitionMode mode = AcquisitionMode::kFreeRun;
+  HardwareTrigger hardware;
 };
 
 struct CameraStatus {
@@ -95,6 +99,9 @@ struct CameraStatus {
   uint64_t acquisition_errors = 0;
   uint64_t reconnects = 0;
   uint64_t last_sequence = 0;
+  // Frames of a source that reports their age (streams) left out because
+  // they were exposed before the request they would have served.
+  uint64_t frames_before_request = 0;
   DriverCounters driver;  // as of the last grab
 };
 
@@ -124,7 +131,10 @@ class Camera {
   // In trigger mode queues one frame and returns its sequence number. In
   // free-run returns the first sequence number acquired after this call; in
   // hardware trigger mode, that of the first frame delivered after it (the
-  // next pulse's, unless one was in flight).
+  // next pulse's, unless one was in flight). With a source that reports its
+  // frames' age (a stream), the frame that carries the number was exposed
+  // after this call by estimate (older ones are left out and their number
+  // reused), and concurrent requests get numbers of their own.
   // A closed camera (kCameraClosed) or one in an outage (SourceErrc::
   // kUnavailable, state "reconnecting") refuses at once; triggers still owed
   // when an outage starts are dropped, never served in a burst afterwards.
@@ -139,7 +149,9 @@ class Camera {
   std::optional<Frame> waitForFrame(uint64_t sequence, std::chrono::milliseconds timeout);
 
   // Feature access runs on the acquisition thread, between grabs, so the
-  // source is only ever called from one thread.
+  // source is only ever called from one thread. The list is read in slices
+  // of at most half a frame period (10 to 100 ms) with a grab between them:
+  // listing hundreds of features does not stop the frames.
   Result<std::vector<Feature>> features();
   Result<Feature> feature(const std::string& name);
   Result<Feature> setFeature(const std::string& name, const std::string& value);
@@ -159,7 +171,9 @@ class Camera {
   struct Grab {
     Result<SourceFrame> grabbed = Error{};
     Result<OutputFrame> out = Error{};
-    uint64_t host_ns = 0;
+    uint64_t host_ns = 0;     // CLOCK_REALTIME when grabbed
+    uint64_t exposed_ns = 0;  // CLOCK_MONOTONIC of the exposure (estimated: host_ns - age)
+    std::chrono::nanoseconds age{0};
     DriverCounters counters;  // the source's, right after the grab
   };
 
@@ -176,6 +190,10 @@ class Camera {
   void handleGrabFailure(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool triggered,
                          const Error& error);
   void publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool triggered, Grab grab);
+  // A frame exposed before a request it would serve (sources that report
+  // their frames' age): left out, its number and its trigger given back.
+  bool exposedTooEarly(uint64_t sequence, const Grab& grab) const;
+  void leaveOut(uint64_t sequence, bool triggered);
   bool ensureOpen(std::unique_lock<std::mutex>& lock);
   void closeSource(std::unique_lock<std::mutex>& lock);
   void waitBackoff(std::unique_lock<std::mutex>& lock);
@@ -184,12 +202,15 @@ class Camera {
   // A frame that could not be used: counted, logged at a bounded rate.
   void logBadFrame(const Error& error);
   void runCommands(std::unique_lock<std::mutex>& lock);
+  // How long one slice of a feature listing may hold the acquisition thread.
+  std::chrono::milliseconds featureSlice() const;
   // Runs `fn` on the acquisition thread and waits for it.
   template <typename T>
   Result<T> onAcquisitionThread(std::function<Result<T>(Source&, bool open)> fn);
 
   const CameraConfig config_;
   const std::unique_ptr<Source> source_;  // acquisition thread only
+  const bool source_reports_age_;         // a constant of the driver
   FrameSink& sink_;
   std::thread thread_;
   // When the pending software trigger was sent (acquisition thread only).
@@ -225,7 +246,11 @@ class Camera {
   bool fps_asked_;
   uint64_t next_sequence_ = 1;
   std::optional<uint64_t> grab_sequence_;  // the number of the grab under way, if one is
+  bool grab_waits_pulse_ = false;          // that grab was begun in hardware trigger mode
   uint64_t pending_triggers_ = 0;
+  // Requests waiting for a frame of a source that reports its frames' age:
+  // (ticket sequence, CLOCK_MONOTONIC of the request), sequences ascending.
+  std::deque<std::pair<uint64_t, uint64_t>> requests_;
   CameraStatus status_;
   std::optional<SimulatedRobot> robot_;  // the source's simulated robot, if it has one
 };

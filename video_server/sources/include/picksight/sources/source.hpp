@@ -132,6 +132,12 @@ struct SourceFrame {
   // released): consumers may then keep the image, and the camera publishes
   // it without copying.
   bool keepable = false;
+  // How long before grab() returned it the frame was (by estimate) exposed,
+  // from sources whose frames reach the host a pipeline delay late and carry
+  // no clock the host can read (streams: the time since it arrived plus the
+  // measured decode and buffering delay plus the configured latency). 0: the
+  // frame counts as taken when grabbed.
+  std::chrono::nanoseconds age{0};
 };
 
 struct SourceInfo {
@@ -196,6 +202,10 @@ class Source {
   // True when the device delivers frames at its own pace once configured
   // (a camera); the Camera then does not pace free-run itself.
   virtual bool streams() const { return false; }
+  // True when grab() reports each frame's age (SourceFrame::age): the camera
+  // then serves a request only with a frame estimated to be exposed after
+  // it. A property of the driver, constant.
+  virtual bool reportsAge() const { return false; }
   // Called after open() and whenever the mode or rate changes. A streaming
   // source sets its trigger mode (software) and frame rate here, as asked.
   virtual Result<void> configureAcquisition(const AcquisitionRequest& /*request*/) { return {}; }
@@ -210,6 +220,13 @@ class Source {
   // --- Features by name. Values travel as text and are checked by type and
   // range; errors name the feature and, for a range, the range.
   virtual std::vector<Feature> features() { return {}; }
+  // The same list in pieces, so that a camera with hundreds of features
+  // can grab frames between them: the names features() would list, read
+  // without touching the device where the driver can, then each one as
+  // features() would list it (nullopt: features() would leave it out). The
+  // defaults go through features(), for drivers whose list is cheap.
+  virtual std::vector<std::string> featureNames();
+  virtual std::optional<Feature> listedFeature(const std::string& name);
   virtual Result<Feature> feature(const std::string& name) {
     return makeError(SourceErrc::kUnknownFeature, "unknown feature '" + name + "'");
   }

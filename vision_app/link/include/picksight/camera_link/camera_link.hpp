@@ -10,6 +10,7 @@
 // settings; framesReceived() may be called from any thread.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -30,6 +31,20 @@ enum class CameraErrc {
   // The camera has no setting of that name (kept apart so that a caller can
   // try another name; reported to robots as CameraErrc::kCameraRefused).
   kUnknownFeature,
+  // The camera is in hardware-trigger mode and no pulse came on its line
+  // within its trigger timeout (no software trigger is ever sent then).
+  kNoTriggerPulse,
+};
+
+// How the camera acquires: free-run at fps, one frame per software trigger,
+// or one per pulse on its trigger input `line` (the robot's digital output),
+// a frame request waiting up to `timeout` for it.
+enum class CameraMode { kFreeRun, kSoftwareTrigger, kHardwareTrigger };
+struct CameraModeSettings {
+  CameraMode mode = CameraMode::kFreeRun;
+  double fps = 0;                        // kFreeRun; 0 = leave (as read: the setting)
+  std::string line;                      // kHardwareTrigger; empty = the camera's default
+  std::chrono::milliseconds timeout{0};  // kHardwareTrigger; 0 = the camera's default
 };
 const char* errorName(CameraErrc e);
 PICKSIGHT_ERROR_DOMAIN(CameraErrc, "camera link")
@@ -51,6 +66,9 @@ class CameraLink {
   // empty rectangle selects the full sensor.
   virtual Result<cv::Rect> roi() = 0;
   virtual Result<void> setRoi(const cv::Rect& roi) = 0;
+  // The acquisition mode; links without modes refuse (kCameraRefused).
+  virtual Result<CameraModeSettings> mode();
+  virtual Result<void> setMode(const CameraModeSettings& mode);
 
   virtual uint64_t framesReceived() const = 0;
   virtual const std::string& camera() const = 0;

@@ -1,5 +1,6 @@
 // The camera link to a video server: a software trigger (or the next
-// free-run frame) on the control socket, the frame from a subscriber thread;
+// free-run frame, or the next hardware-triggered one: the camera's line is
+// pulsed by the robot) on the control socket, the frame from a subscriber thread;
 // camera settings as control requests. The only part of the vision app that
 // speaks the video server's protocol.
 //
@@ -33,12 +34,17 @@ class VideoServerCamera : public CameraLink {
   Result<std::string> setFeature(const std::string& name, const std::string& value) override;
   Result<cv::Rect> roi() override;
   Result<void> setRoi(const cv::Rect& roi) override;
+  Result<CameraModeSettings> mode() override;
+  Result<void> setMode(const CameraModeSettings& mode) override;
   uint64_t framesReceived() const override { return feed_.framesReceived(); }
   const std::string& camera() const override { return camera_; }
 
  private:
   // One request to the video server, its errors as CameraErrc values.
   Result<proto::ControlReply> call(const proto::ControlRequest& request);
+  // The frame of the next pulse on a hardware-triggered camera's line.
+  Result<std::shared_ptr<const Frame>> hardwareFrame(const proto::TriggerReply& ticket,
+                                                     uint64_t requested_ns);
 
   const std::string camera_;
   const std::chrono::milliseconds frame_timeout_;
