@@ -106,6 +106,8 @@ struct ArcAnchor {
   cv::Point2d centre;
   double radius = 0;
   double length = 0;
+  double mid_deg = 0;    // direction of the arc's middle from its centre
+  double sweep_deg = 0;  // signed, in the loop's walking direction
 };
 
 void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
@@ -146,7 +148,8 @@ void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>
     for (const auto& p : prims) {
       if (p.kind == PrimitiveKind::kArc && std::abs(p.sweep_deg) >= kMinArcSweepDeg &&
           p.radius >= kMinArcRadiusPx) {
-        arcs->push_back({p.centre, p.radius, p.length()});
+        arcs->push_back(
+            {p.centre, p.radius, p.length(), angleOf(p.pointAt(0.5) - p.centre), p.sweep_deg});
       }
     }
   }
@@ -335,58 +338,124 @@ void keepTelling(std::vector<CornerAnchor>* corners, std::vector<ArcAnchor>* arc
   }
 }
 
+}  // namespace
+
+struct BlobSearchModel {
+  std::vector<CornerAnchor> corners;   // the most telling (keepTelling)
+  std::vector<ArcAnchor> arcs;         // likewise
+  std::vector<BoundarySample> sparse;  // hypotheses are screened on these
+  std::vector<BoundarySample> glance;  // after a first look at these
+  std::vector<EdgeSample> edges;       // poses are refined on these, 1 px apart
+};
+
+std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& model) {
+  auto b = std::make_shared<BlobSearchModel>();
+  anchorsOf(model.loops, &b->corners, &b->arcs);
+  keepTelling(&b->corners, &b->arcs);
+  b->sparse = sparseSamples(model.samples, kSparseSamples);
+  b->glance = sparseSamples(model.samples, kGlanceSamples);
+  b->edges = edgeSamples(model, 1.0);
+  return b;
+}
+
+namespace {
+// The model's side of the search: derived by prepareModel, or here for a
+// model put together without it.
+std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m) {
+  return m.blob_search ? m.blob_search : makeBlobSearchModel(m);
+}
+
+// A blob's arc is a piece of the model's arc it matches, or the model's arc
+// a piece of it (the contact cuts arcs, the fit breaks a curved outline
+// where it likes): the turn that lines up their middles is off by at most
+// half the difference of their sweeps, and this for where the breaks fell.
+constexpr double kArcSlideDeg = 30;
+constexpr double kCircleDeg = 359;
+// A corner's first look counts boundary samples within this many edge
+// tolerances; the search of its turn then starts at this step, each step
+// halved down to the finest.
+constexpr double kLooseScreenFactor = 2.0;
+constexpr double kCornerTurnStepDeg = 2.0;
+constexpr double kCornerTurnFinestDeg = 0.5;
+
 // Screens the poses proposed for one model (direct or mirrored) in a blob.
-void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnchor>& image_corners,
+void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored,
+             const std::vector<CornerAnchor>& image_corners,
              const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
              std::vector<Candidate>* out) {
-  std::vector<CornerAnchor> corners;
-  std::vector<ArcAnchor> arcs;
-  anchorsOf(model.loops, &corners, &arcs);
-  keepTelling(&corners, &arcs);
-  const auto sparse = sparseSamples(model.samples, kSparseSamples);
-  const auto glance = sparseSamples(model.samples, kGlanceSamples);
+  const auto& sparse = search.sparse;
+  const auto& glance = search.glance;
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double f = mirrored ? -1.0 : 1.0;
   // The pose putting model point `model_point` on `image_point` turned by
   // `angle`, scored on `samples`.
-  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
-                          const std::vector<BoundarySample>& samples) {
+  const auto screenAt = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
+                            const std::vector<BoundarySample>& samples, double tolerance) {
     const double c = std::cos(angle * kRadPerDeg);
     const double s = std::sin(angle * kRadPerDeg);
     const cv::Point2d centre = image_point - rotate({model_point.x, f * model_point.y}, c, s);
-    const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, mirrored);
+    const double score = verifyScore(samples, centre, angle, edges, tolerance, mirrored);
     return Candidate{&model, ImagePose{centre, normalizeDeg(angle), mirrored}, score, 0};
   };
-  for (const auto& mc : corners) {
+  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
+                          const std::vector<BoundarySample>& samples) {
+    return screenAt(model_point, image_point, angle, samples, model.edge_tolerance);
+  };
+  // A corner's direction is a few degrees off (its edges are short): the
+  // first look forgives that with a wider tolerance, and the turn about the
+  // corner is then searched coarse to fine on the screening samples.
+  const double loose = kLooseScreenFactor * model.edge_tolerance;
+  for (const auto& mc : search.corners) {
     for (const auto& ic : image_corners) {
       if (mc.convex != ic.convex) continue;
       if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
       const double angle = ic.bisector_deg - f * mc.bisector_deg;
-      if (screen(mc.at, ic.at, angle, glance).score < threshold - kGlanceSlack) continue;
-      const Candidate c = screen(mc.at, ic.at, angle, sparse);
+      if (screenAt(mc.at, ic.at, angle, glance, loose).score < threshold - kGlanceSlack) continue;
+      Candidate c = screen(mc.at, ic.at, angle, sparse);
+      for (double step = kCornerTurnStepDeg; step >= kCornerTurnFinestDeg; step /= 2) {
+        const double at = c.pose.angle_deg;
+        for (int k = -2; k <= 2; ++k) {
+          if (k == 0 || (step < kCornerTurnStepDeg && std::abs(k) > 1)) continue;
+          const Candidate n = screen(mc.at, ic.at, at + k * step, sparse);
+          if (n.score > c.score) c = n;
+        }
+      }
       if (c.score >= threshold) out->push_back(c);
     }
   }
-  // An arc fixes where its centre goes; the rotation about it is scanned
-  // coarsely at a glance, and around each promising step finely.
+  // An arc fixes where its centre goes; the turn about it lines up the two
+  // arcs (kArcSlideDeg), scanned coarsely at a glance, and around each
+  // promising step finely. The placed hand walks the model's arc the way
+  // the blob's arc goes: a mirror reverses it.
   const double fine = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
-  const int steps = static_cast<int>(std::ceil(360.0 / coarse));
-  std::vector<double> scan(static_cast<size_t>(steps));
-  for (const auto& ma : arcs) {
+  std::vector<double> scan;
+  for (const auto& ma : search.arcs) {
     for (const auto& ia : image_arcs) {
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
+      if ((ia.sweep_deg > 0) != (f * ma.sweep_deg > 0)) continue;
+      const double middle = ia.mid_deg - f * ma.mid_deg;
+      // A whole circle's ends are wherever its loop started: any turn.
+      const bool circle = std::max(std::abs(ma.sweep_deg), std::abs(ia.sweep_deg)) >= kCircleDeg;
+      const double half =
+          circle ? 180.0
+                 : std::min(180.0, 0.5 * std::abs(std::abs(ma.sweep_deg) - std::abs(ia.sweep_deg)) +
+                                       kArcSlideDeg);
+      const int steps = static_cast<int>(std::ceil(2 * half / coarse)) + 1;
+      const double step = 2 * half / (steps - 1);
+      scan.resize(static_cast<size_t>(steps));
       for (int k = 0; k < steps; ++k)
-        scan[k] = screen(ma.centre, ia.centre, k * 360.0 / steps, glance).score;
+        scan[k] = screen(ma.centre, ia.centre, middle - half + k * step, glance).score;
       for (int k = 0; k < steps; ++k) {
         const double s = scan[k];
-        if (s < threshold - kGlanceSlack || s < scan[(k + steps - 1) % steps] ||
-            s <= scan[(k + 1) % steps]) {
+        if (s < threshold - kGlanceSlack || (k > 0 && s < scan[k - 1]) ||
+            (k + 1 < steps && s <= scan[k + 1])) {
           continue;
         }
         Candidate best;
         best.score = -1;
-        for (double a = k * 360.0 / steps - coarse; a <= k * 360.0 / steps + coarse; a += fine) {
+        const double at = middle - half + k * step;
+        for (double a = at - step; a <= at + step; a += fine) {
           const Candidate c = screen(ma.centre, ia.centre, a, sparse);
           if (c.score > best.score) best = c;
         }
@@ -399,7 +468,8 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
 
 EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
                           double search_px, int iterations) {
-  const auto samples = edgeSamples(model, 1.0);
+  const auto search = searchOf(model);
+  const auto& samples = search->edges;
   const Coverage cov(region);
   const double flip = start.mirrored ? -1.0 : 1.0;
   EdgeFit fit;
@@ -530,13 +600,14 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
 
   std::vector<std::vector<cv::Point>> contours{region.outer};
   contours.insert(contours.end(), region.hole_boundaries.begin(), region.hole_boundaries.end());
-  const int margin = static_cast<int>(std::ceil(tolerance)) + 2;
-  // Only verifyScore reads it, at no more than the largest tolerance.
+  const double screen_reach = kLooseScreenFactor * tolerance;
+  const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
+  // Only verifyScore reads it, at no more than the loose screening tolerance.
   const EdgeDistance edges(
       contours,
       cv::Rect(region.bbox.x - margin, region.bbox.y - margin, region.bbox.width + 2 * margin,
                region.bbox.height + 2 * margin),
-      tolerance);
+      screen_reach);
   std::vector<std::vector<cv::Point2d>> loops2d;
   for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
   std::vector<CornerAnchor> image_corners;
@@ -551,7 +622,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     for (const bool mirrored : {false, true}) {
       if (mirrored && m->body.mirror_symmetric) continue;
       std::vector<Candidate> proposed;
-      propose(*m, mirrored, image_corners, image_arcs, edges, &proposed);
+      propose(*m, *searchOf(*m), mirrored, image_corners, image_arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
       std::vector<ImagePose> kept;
