@@ -51,6 +51,9 @@ constexpr int kMaxRefinedPerBlob = 48;
 // Edge-fit iterations before the last two read every third edge sample:
 // the pose is still settling there.
 constexpr int kSparseFitStride = 3;
+// A sparse iteration that moves the boundary by less than this (pixels, at
+// the rim) has settled: the remaining sparse ones are skipped.
+constexpr double kSettledPx = 0.01;
 // A mirror-image candidate that verifies within this of the direct one
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
@@ -346,6 +349,7 @@ struct BlobSearchModel {
   std::vector<BoundarySample> sparse;  // hypotheses are screened on these
   std::vector<BoundarySample> glance;  // after a first look at these
   std::vector<EdgeSample> edges;       // poses are refined on these, 1 px apart
+  double glance_weight = 0;            // the glance samples' total
 };
 
 std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& model) {
@@ -354,6 +358,7 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   keepTelling(&b->corners, &b->arcs);
   b->sparse = sparseSamples(model.samples, kSparseSamples);
   b->glance = sparseSamples(model.samples, kGlanceSamples);
+  for (const auto& g : b->glance) b->glance_weight += g.weight;
   b->edges = edgeSamples(model, 1.0);
   return b;
 }
@@ -378,6 +383,30 @@ constexpr double kLooseScreenFactor = 2.0;
 constexpr double kCornerTurnStepDeg = 2.0;
 constexpr double kCornerTurnFinestDeg = 0.5;
 
+// Whether at least `needed` (a fraction) of the samples' weight lies within
+// `tolerance` of an edge at the pose (centre, turn with cosine c and sine s,
+// mirrored when flip is -1), as verifyScore would say; stops as soon as the
+// rest cannot decide otherwise, which most wrong hypotheses show within a
+// few samples.
+bool verifiesAtLeast(const std::vector<BoundarySample>& samples, double total, cv::Point2d centre,
+                     double c, double s, double flip, const EdgeDistance& edges, double tolerance,
+                     double needed) {
+  const double goal = needed * total;
+  double on = 0;
+  double left = total;
+  for (const auto& sample : samples) {
+    const double x = sample.point.x;
+    const double y = flip * sample.point.y;
+    if (edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}) <= tolerance) {
+      on += sample.weight;
+      if (on >= goal) return true;
+    }
+    left -= sample.weight;
+    if (on + left < goal) return false;
+  }
+  return on >= goal;
+}
+
 // Screens the poses proposed for one model (direct or mirrored) in a blob.
 void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored,
              const std::vector<CornerAnchor>& image_corners,
@@ -389,17 +418,13 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
   const double f = mirrored ? -1.0 : 1.0;
   // The pose putting model point `model_point` on `image_point` turned by
   // `angle`, scored on `samples`.
-  const auto screenAt = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
-                            const std::vector<BoundarySample>& samples, double tolerance) {
+  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
+                          const std::vector<BoundarySample>& samples) {
     const double c = std::cos(angle * kRadPerDeg);
     const double s = std::sin(angle * kRadPerDeg);
     const cv::Point2d centre = image_point - rotate({model_point.x, f * model_point.y}, c, s);
-    const double score = verifyScore(samples, centre, angle, edges, tolerance, mirrored);
+    const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, mirrored);
     return Candidate{&model, ImagePose{centre, normalizeDeg(angle), mirrored}, score, 0};
-  };
-  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
-                          const std::vector<BoundarySample>& samples) {
-    return screenAt(model_point, image_point, angle, samples, model.edge_tolerance);
   };
   // A corner's direction is a few degrees off (its edges are short): the
   // first look forgives that with a wider tolerance, and the turn about the
@@ -410,7 +435,13 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       if (mc.convex != ic.convex) continue;
       if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
       const double angle = ic.bisector_deg - f * mc.bisector_deg;
-      if (screenAt(mc.at, ic.at, angle, glance, loose).score < threshold - kGlanceSlack) continue;
+      const double cosine = std::cos(angle * kRadPerDeg);
+      const double sine = std::sin(angle * kRadPerDeg);
+      const cv::Point2d centre = ic.at - rotate({mc.at.x, f * mc.at.y}, cosine, sine);
+      if (!verifiesAtLeast(glance, search.glance_weight, centre, cosine, sine, f, edges, loose,
+                           threshold - kGlanceSlack)) {
+        continue;
+      }
       Candidate c = screen(mc.at, ic.at, angle, sparse);
       for (double step = kCornerTurnStepDeg; step >= kCornerTurnFinestDeg; step /= 2) {
         const double at = c.pose.angle_deg;
@@ -521,6 +552,9 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     // edges near a contact) fall outside the gate.
     window = std::max(1.5, std::min(window, 3.0 * rms + 1.0));
     gate = std::max(0.5, std::min(gate, 3.0 * rms + 0.3));
+    // Settled on the sparse samples: straight on to the dense passes.
+    const double moved = std::hypot(x[0], x[1]) + std::abs(x[2]) * model.radius;
+    if (moved < kSettledPx && it < iterations - 3) it = iterations - 3;
   }
   fit.ok = true;
   return fit;
