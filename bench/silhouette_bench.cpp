@@ -5,10 +5,12 @@
 // per shape family the LOCATE-equivalent time (binarize, regions, recognize
 // with every model) beside a plain OpenCV pass on the same frames,
 // precision, recall and the position and angle errors. Never fails on them.
+// --types trains any other drawings instead (shapes never tuned on).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <map>
 #include <string>
 #include <vector>
@@ -167,8 +169,8 @@ void printRow(const std::string& name, const Stats& s) {
               s.angles ? std::sqrt(s.ang2 / s.angles) : 0.0, s.worst_ang);
 }
 
-void print(ps::Arrangement arrangement, const Tally& t, bool per_type) {
-  const auto& specs = typeSpecs();
+void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
+           const std::vector<TypeSpec>& specs) {
   std::printf("\n%s: %d frames, %.1f parts per frame, %.1f of them distractors\n",
               ps::arrangementName(arrangement), t.frames,
               t.frames ? static_cast<double>(t.parts) / t.frames : 0.0,
@@ -227,6 +229,11 @@ int main(int argc, char** argv) {
   app.add_option("--arrangements", which, "separated, touching, overlapping")
       ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
   app.add_flag("!--no-per-type", per_type, "families only");
+  std::vector<std::string> custom;
+  app.add_option("--types", custom,
+                 "train these drawings instead of the default 15 (family \"other\"): "
+                 "FILE[:SIZE_PX] under the data directory, e.g. "
+                 "shapes/tari1000/obj3_1.png:220 (size default 220)");
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
   if (threads >= 0) cv::setNumThreads(threads);
 
@@ -237,7 +244,30 @@ int main(int argc, char** argv) {
   pv::TrainOptions train;
   train.binarize = binarize;
 
-  const auto& specs = typeSpecs();
+  std::vector<TypeSpec> specs = typeSpecs();
+  if (!custom.empty()) {
+    specs.clear();
+    for (const auto& item : custom) {
+      const auto colon = item.rfind(':');
+      const std::string file = colon == std::string::npos ? item : item.substr(0, colon);
+      double size = 220;
+      if (colon != std::string::npos) {
+        try {
+          size = std::stod(item.substr(colon + 1));
+        } catch (const std::exception&) {
+          size = 0;
+        }
+      }
+      if (!(size >= 20 && size <= 600)) {
+        std::fprintf(stderr, "--types %s: size must be 20..600 px\n", item.c_str());
+        return 1;
+      }
+      const auto slash = file.rfind('/');
+      std::string name = slash == std::string::npos ? file : file.substr(slash + 1);
+      name = name.substr(0, name.rfind('.'));
+      specs.push_back({name, file, "other", size});
+    }
+  }
   std::vector<ps::SilhouetteType> types;
   for (const auto& spec : specs) {
     if (spec.file.empty()) {
@@ -313,7 +343,7 @@ int main(int argc, char** argv) {
         if (sink == 0) std::printf("!");
       }
     }
-    print(arrangement, tally, per_type);
+    print(arrangement, tally, per_type, specs);
     std::fflush(stdout);
   }
   return 0;

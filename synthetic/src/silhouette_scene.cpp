@@ -33,7 +33,13 @@ struct Posed {
 
 Posed pose(const cv::Mat& type_mask, double deg, bool mirrored, double scale) {
   cv::Mat src = type_mask;
-  if (mirrored) cv::flip(type_mask, src, 1);
+  if (mirrored) {
+    // Into a new buffer: src shares the type's pixels, and flipping it in
+    // place would mirror the type itself for every later part (and scene).
+    cv::Mat flipped;
+    cv::flip(type_mask, flipped, 1);
+    src = flipped;
+  }
   const int side = static_cast<int>(std::ceil(std::hypot(src.cols, src.rows) * scale)) + 8;
   cv::Mat m = cv::getRotationMatrix2D(cv::Point2f(0.5f * src.cols, 0.5f * src.rows), -deg, scale);
   m.at<double>(0, 2) += 0.5 * side - 0.5 * src.cols;

@@ -186,6 +186,7 @@ void prepareModel(PartModel& model) {
   // (handednessWeight).
   model.boundary_map =
       std::make_shared<const BoundaryDistanceMap>(model.loops, 2 * model.edge_tolerance + 1.0);
+  model.blob_search = makeBlobSearchModel(model);
 }
 
 const char* errorName(PartModelErrc e) {

@@ -35,7 +35,8 @@ std::vector<double> candidates(double region_phase_deg, double model_phase_deg, 
 
 struct Best {
   double score = -1;
-  double angle_deg = 0;
+  double angle_deg = 0;  // reported
+  double fit_deg = 0;    // where the boundary fits best: the score's, and the hand test's
 };
 
 // The moments' phase is as good as the part's direction is marked: on a
@@ -47,13 +48,15 @@ constexpr double kRefineFinestDeg = 0.05;
 // Candidates this far below the verify fraction are not worth refining.
 constexpr double kRefineSlack = 0.3;
 constexpr double kKeepMomentsDeg = 1.0;
+// ... and verified within this fraction of the refined pose's score.
+constexpr double kKeepMomentsSlack = 0.02;
 
 Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
             const EdgeDistance& edges, bool mirrored) {
   Best best;
   for (double t : turns) {
     const double s = verifyScore(model.samples, centre, t, edges, model.edge_tolerance, mirrored);
-    if (s > best.score) best = {s, t};
+    if (s > best.score) best = {s, t, t};
   }
   if (best.score * 100 < model.verify_percent - 100 * kRefineSlack) return best;
   const double clip = 2 * model.edge_tolerance;
@@ -77,13 +80,19 @@ Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2
     }
   }
   // The verification is of the best pose; but where the moments were
-  // close, their angle is the finer estimate (every pixel of the part,
-  // against a distance map on the pixel grid, biased by tenths of a
-  // degree) and is the one reported.
+  // close and verified about as well, their angle is the finer estimate
+  // (every pixel of the part, against a distance map on the pixel grid,
+  // biased by tenths of a degree) and is the one reported. A high order's
+  // phase (a spoon's 6th) can be off by most of a degree: the pose that
+  // fits is then the one reported, and the hands are always compared at
+  // their fitted poses.
   const double s = verifyScore(model.samples, centre, at, edges, model.edge_tolerance, mirrored);
   if (s <= best.score) return best;
+  const bool keep_moments =
+      std::abs(at - best.angle_deg) < kKeepMomentsDeg && s - best.score <= kKeepMomentsSlack;
   best.score = s;
-  if (std::abs(at - best.angle_deg) >= kKeepMomentsDeg) best.angle_deg = normalizeDeg(at);
+  best.fit_deg = normalizeDeg(at);
+  if (!keep_moments) best.angle_deg = best.fit_deg;
   return best;
 }
 
@@ -198,8 +207,8 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
       // pose: where the two hands differ decides which one the region is.
       const Best mirror = bestOf(candidates(phase, -model->orientation_phase_deg, k), *model,
                                  r.centroid, edges, true);
-      if (showsMirrorImage(*model, {r.centroid, direct.angle_deg, false},
-                           {r.centroid, mirror.angle_deg, true}, edges)) {
+      if (showsMirrorImage(*model, {r.centroid, direct.fit_deg, false},
+                           {r.centroid, mirror.fit_deg, true}, edges)) {
         whole_part = true;
         continue;
       }

@@ -51,6 +51,9 @@ constexpr int kMaxRefinedPerBlob = 48;
 // Edge-fit iterations before the last two read every third edge sample:
 // the pose is still settling there.
 constexpr int kSparseFitStride = 3;
+// A sparse iteration that moves the boundary by less than this (pixels, at
+// the rim) has settled: the remaining sparse ones are skipped.
+constexpr double kSettledPx = 0.01;
 // A mirror-image candidate that verifies within this of the direct one
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
@@ -106,6 +109,8 @@ struct ArcAnchor {
   cv::Point2d centre;
   double radius = 0;
   double length = 0;
+  double mid_deg = 0;    // direction of the arc's middle from its centre
+  double sweep_deg = 0;  // signed, in the loop's walking direction
 };
 
 void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
@@ -146,7 +151,8 @@ void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>
     for (const auto& p : prims) {
       if (p.kind == PrimitiveKind::kArc && std::abs(p.sweep_deg) >= kMinArcSweepDeg &&
           p.radius >= kMinArcRadiusPx) {
-        arcs->push_back({p.centre, p.radius, p.length()});
+        arcs->push_back(
+            {p.centre, p.radius, p.length(), angleOf(p.pointAt(0.5) - p.centre), p.sweep_deg});
       }
     }
   }
@@ -335,16 +341,79 @@ void keepTelling(std::vector<CornerAnchor>* corners, std::vector<ArcAnchor>* arc
   }
 }
 
+}  // namespace
+
+struct BlobSearchModel {
+  std::vector<CornerAnchor> corners;   // the most telling (keepTelling)
+  std::vector<ArcAnchor> arcs;         // likewise
+  std::vector<BoundarySample> sparse;  // hypotheses are screened on these
+  std::vector<BoundarySample> glance;  // after a first look at these
+  std::vector<EdgeSample> edges;       // poses are refined on these, 1 px apart
+  double glance_weight = 0;            // the glance samples' total
+};
+
+std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& model) {
+  auto b = std::make_shared<BlobSearchModel>();
+  anchorsOf(model.loops, &b->corners, &b->arcs);
+  keepTelling(&b->corners, &b->arcs);
+  b->sparse = sparseSamples(model.samples, kSparseSamples);
+  b->glance = sparseSamples(model.samples, kGlanceSamples);
+  for (const auto& g : b->glance) b->glance_weight += g.weight;
+  b->edges = edgeSamples(model, 1.0);
+  return b;
+}
+
+namespace {
+// The model's side of the search: derived by prepareModel, or here for a
+// model put together without it.
+std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m) {
+  return m.blob_search ? m.blob_search : makeBlobSearchModel(m);
+}
+
+// A blob's arc is a piece of the model's arc it matches, or the model's arc
+// a piece of it (the contact cuts arcs, the fit breaks a curved outline
+// where it likes): the turn that lines up their middles is off by at most
+// half the difference of their sweeps, and this for where the breaks fell.
+constexpr double kArcSlideDeg = 30;
+constexpr double kCircleDeg = 359;
+// A corner's first look counts boundary samples within this many edge
+// tolerances; the search of its turn then starts at this step, each step
+// halved down to the finest.
+constexpr double kLooseScreenFactor = 2.0;
+constexpr double kCornerTurnStepDeg = 2.0;
+constexpr double kCornerTurnFinestDeg = 0.5;
+
+// Whether at least `needed` (a fraction) of the samples' weight lies within
+// `tolerance` of an edge at the pose (centre, turn with cosine c and sine s,
+// mirrored when flip is -1), as verifyScore would say; stops as soon as the
+// rest cannot decide otherwise, which most wrong hypotheses show within a
+// few samples.
+bool verifiesAtLeast(const std::vector<BoundarySample>& samples, double total, cv::Point2d centre,
+                     double c, double s, double flip, const EdgeDistance& edges, double tolerance,
+                     double needed) {
+  const double goal = needed * total;
+  double on = 0;
+  double left = total;
+  for (const auto& sample : samples) {
+    const double x = sample.point.x;
+    const double y = flip * sample.point.y;
+    if (edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}) <= tolerance) {
+      on += sample.weight;
+      if (on >= goal) return true;
+    }
+    left -= sample.weight;
+    if (on + left < goal) return false;
+  }
+  return on >= goal;
+}
+
 // Screens the poses proposed for one model (direct or mirrored) in a blob.
-void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnchor>& image_corners,
+void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored,
+             const std::vector<CornerAnchor>& image_corners,
              const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
              std::vector<Candidate>* out) {
-  std::vector<CornerAnchor> corners;
-  std::vector<ArcAnchor> arcs;
-  anchorsOf(model.loops, &corners, &arcs);
-  keepTelling(&corners, &arcs);
-  const auto sparse = sparseSamples(model.samples, kSparseSamples);
-  const auto glance = sparseSamples(model.samples, kGlanceSamples);
+  const auto& sparse = search.sparse;
+  const auto& glance = search.glance;
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double f = mirrored ? -1.0 : 1.0;
   // The pose putting model point `model_point` on `image_point` turned by
@@ -357,36 +426,67 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
     const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, mirrored);
     return Candidate{&model, ImagePose{centre, normalizeDeg(angle), mirrored}, score, 0};
   };
-  for (const auto& mc : corners) {
+  // A corner's direction is a few degrees off (its edges are short): the
+  // first look forgives that with a wider tolerance, and the turn about the
+  // corner is then searched coarse to fine on the screening samples.
+  const double loose = kLooseScreenFactor * model.edge_tolerance;
+  for (const auto& mc : search.corners) {
     for (const auto& ic : image_corners) {
       if (mc.convex != ic.convex) continue;
       if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
       const double angle = ic.bisector_deg - f * mc.bisector_deg;
-      if (screen(mc.at, ic.at, angle, glance).score < threshold - kGlanceSlack) continue;
-      const Candidate c = screen(mc.at, ic.at, angle, sparse);
+      const double cosine = std::cos(angle * kRadPerDeg);
+      const double sine = std::sin(angle * kRadPerDeg);
+      const cv::Point2d centre = ic.at - rotate({mc.at.x, f * mc.at.y}, cosine, sine);
+      if (!verifiesAtLeast(glance, search.glance_weight, centre, cosine, sine, f, edges, loose,
+                           threshold - kGlanceSlack)) {
+        continue;
+      }
+      Candidate c = screen(mc.at, ic.at, angle, sparse);
+      for (double step = kCornerTurnStepDeg; step >= kCornerTurnFinestDeg; step /= 2) {
+        const double at = c.pose.angle_deg;
+        for (int k = -2; k <= 2; ++k) {
+          if (k == 0 || (step < kCornerTurnStepDeg && std::abs(k) > 1)) continue;
+          const Candidate n = screen(mc.at, ic.at, at + k * step, sparse);
+          if (n.score > c.score) c = n;
+        }
+      }
       if (c.score >= threshold) out->push_back(c);
     }
   }
-  // An arc fixes where its centre goes; the rotation about it is scanned
-  // coarsely at a glance, and around each promising step finely.
+  // An arc fixes where its centre goes; the turn about it lines up the two
+  // arcs (kArcSlideDeg), scanned coarsely at a glance, and around each
+  // promising step finely. The placed hand walks the model's arc the way
+  // the blob's arc goes: a mirror reverses it.
   const double fine = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
-  const int steps = static_cast<int>(std::ceil(360.0 / coarse));
-  std::vector<double> scan(static_cast<size_t>(steps));
-  for (const auto& ma : arcs) {
+  std::vector<double> scan;
+  for (const auto& ma : search.arcs) {
     for (const auto& ia : image_arcs) {
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
+      if ((ia.sweep_deg > 0) != (f * ma.sweep_deg > 0)) continue;
+      const double middle = ia.mid_deg - f * ma.mid_deg;
+      // A whole circle's ends are wherever its loop started: any turn.
+      const bool circle = std::max(std::abs(ma.sweep_deg), std::abs(ia.sweep_deg)) >= kCircleDeg;
+      const double half =
+          circle ? 180.0
+                 : std::min(180.0, 0.5 * std::abs(std::abs(ma.sweep_deg) - std::abs(ia.sweep_deg)) +
+                                       kArcSlideDeg);
+      const int steps = static_cast<int>(std::ceil(2 * half / coarse)) + 1;
+      const double step = 2 * half / (steps - 1);
+      scan.resize(static_cast<size_t>(steps));
       for (int k = 0; k < steps; ++k)
-        scan[k] = screen(ma.centre, ia.centre, k * 360.0 / steps, glance).score;
+        scan[k] = screen(ma.centre, ia.centre, middle - half + k * step, glance).score;
       for (int k = 0; k < steps; ++k) {
         const double s = scan[k];
-        if (s < threshold - kGlanceSlack || s < scan[(k + steps - 1) % steps] ||
-            s <= scan[(k + 1) % steps]) {
+        if (s < threshold - kGlanceSlack || (k > 0 && s < scan[k - 1]) ||
+            (k + 1 < steps && s <= scan[k + 1])) {
           continue;
         }
         Candidate best;
         best.score = -1;
-        for (double a = k * 360.0 / steps - coarse; a <= k * 360.0 / steps + coarse; a += fine) {
+        const double at = middle - half + k * step;
+        for (double a = at - step; a <= at + step; a += fine) {
           const Candidate c = screen(ma.centre, ia.centre, a, sparse);
           if (c.score > best.score) best = c;
         }
@@ -399,7 +499,8 @@ void propose(const PartModel& model, bool mirrored, const std::vector<CornerAnch
 
 EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
                           double search_px, int iterations) {
-  const auto samples = edgeSamples(model, 1.0);
+  const auto search = searchOf(model);
+  const auto& samples = search->edges;
   const Coverage cov(region);
   const double flip = start.mirrored ? -1.0 : 1.0;
   EdgeFit fit;
@@ -451,6 +552,9 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     // edges near a contact) fall outside the gate.
     window = std::max(1.5, std::min(window, 3.0 * rms + 1.0));
     gate = std::max(0.5, std::min(gate, 3.0 * rms + 0.3));
+    // Settled on the sparse samples: straight on to the dense passes.
+    const double moved = std::hypot(x[0], x[1]) + std::abs(x[2]) * model.radius;
+    if (moved < kSettledPx && it < iterations - 3) it = iterations - 3;
   }
   fit.ok = true;
   return fit;
@@ -530,13 +634,14 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
 
   std::vector<std::vector<cv::Point>> contours{region.outer};
   contours.insert(contours.end(), region.hole_boundaries.begin(), region.hole_boundaries.end());
-  const int margin = static_cast<int>(std::ceil(tolerance)) + 2;
-  // Only verifyScore reads it, at no more than the largest tolerance.
+  const double screen_reach = kLooseScreenFactor * tolerance;
+  const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
+  // Only verifyScore reads it, at no more than the loose screening tolerance.
   const EdgeDistance edges(
       contours,
       cv::Rect(region.bbox.x - margin, region.bbox.y - margin, region.bbox.width + 2 * margin,
                region.bbox.height + 2 * margin),
-      tolerance);
+      screen_reach);
   std::vector<std::vector<cv::Point2d>> loops2d;
   for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
   std::vector<CornerAnchor> image_corners;
@@ -551,7 +656,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     for (const bool mirrored : {false, true}) {
       if (mirrored && m->body.mirror_symmetric) continue;
       std::vector<Candidate> proposed;
-      propose(*m, mirrored, image_corners, image_arcs, edges, &proposed);
+      propose(*m, *searchOf(*m), mirrored, image_corners, image_arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
       std::vector<ImagePose> kept;

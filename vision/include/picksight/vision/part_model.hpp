@@ -18,6 +18,9 @@
 
 namespace picksight::vision {
 
+// What the search for touching parts reads of a model (touching_parts.cpp).
+struct BlobSearchModel;
+
 struct BodyModel {
   double area = 0;              // pixels
   double area_tolerance = 0.1;  // relative: a match is within area * (1 +- this)
@@ -74,6 +77,9 @@ struct PartModel {
   // cost of a lookup however many primitives the boundary has. Shared
   // between copies of the model; read-only.
   std::shared_ptr<const BoundaryDistanceMap> boundary_map;
+  // Its most telling corners and arcs, screening and edge samples, derived
+  // once instead of at every blob searched. Shared, read-only.
+  std::shared_ptr<const BlobSearchModel> blob_search;
 
   // Period of the reported rotation: 360 / symmetry order, 0 for any.
   double symmetryDeg() const { return symmetry_order == 0 ? 0.0 : 360.0 / symmetry_order; }

@@ -3,6 +3,7 @@
 // sub-pixel refinement on the grey-level edges, best-first acceptance.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -12,6 +13,11 @@
 #include "picksight/vision/regions.hpp"
 
 namespace picksight::vision {
+
+// The model's side of the search for touching parts, derived by
+// prepareModel (see PartModel::blob_search): built once per model, then
+// read by any number of threads.
+std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& model);
 
 struct EdgeFit {
   bool ok = false;
