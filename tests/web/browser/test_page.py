@@ -431,3 +431,28 @@ def test_calibrate_the_simulated_cell(cell, browser):
     assert abs(dx - 330.5) < 0.5 and abs(dy + 612.25) < 0.5 and abs(rz - 178.7) < 0.1, status
     browser.screenshot("calibrate")
     assert browser.severe() == []
+
+
+def test_hardware_trigger_from_the_camera_panel(cell, browser):
+    """The hardware trigger mode chosen in the Camera panel with its input,
+    edge and timeout: the synthetic camera has no trigger input, and its
+    refusal is shown; the camera keeps running free."""
+    select_tab(browser, "camera")
+    browser.js("""document.getElementById('cam-hw-line').value = 'Line2';
+                  document.getElementById('cam-hw-activation').value = 'FallingEdge';
+                  document.getElementById('cam-hw-timeout').value = '2500';""")
+    click(browser, "cam-hw-apply")
+    reply = wait_until(lambda: (lambda t: t if "mode" in t else None)(
+        browser.driver.find_element(By.ID, "camera-reply").text), what="the mode reply")
+    first = reply.split("\n")[:2]
+    assert first[0].startswith("> mode ") and '"mode":"hardware"' in first[0], first
+    for sent in ('"line":"Line2"', '"activation":"FallingEdge"', '"timeout_ms":2500'):
+        assert sent in first[0], first
+    assert first[1].startswith("< ERROR ") and "has no hardware trigger input" in first[1], first
+    browser.screenshot("camera-hardware")
+    assert cell.camera()["mode"] == "freerun"
+    # The refusal is an HTTP 400, which Chromium logs; nothing else may be.
+    refused = [e for e in browser.severe() if "/api/cameras/cam0/mode" in e.get("message", "")]
+    assert refused and all(" 400 " in e["message"] for e in refused), refused
+    browser.console = [e for e in browser.console if e not in refused]
+    assert browser.severe() == []
