@@ -360,6 +360,37 @@ TEST_CASE("a camera ROI posted to the web reaches the camera", "[web]") {
   CHECK(res->status == 404);
 }
 
+TEST_CASE("the hardware mode reaches the video server and its refusal reaches the client",
+          "[web]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
+  WebProcess web(videoServerArgs(server));
+  REQUIRE(pollUntil([&] { return listsCamera(web, "cam0"); }));
+  const auto error = [](const httplib::Result& res) {
+    return json::parse(res->body)["error"].get<std::string>();
+  };
+  // The synthetic camera has no trigger input: the camera's own message.
+  auto res = postJson(web, "/api/cameras/cam0/mode",
+                      R"({"mode":"hardware","line":"Line2","activation":"RisingEdge",)"
+                      R"("timeout_ms":2000})");
+  REQUIRE(res);
+  CHECK(res->status == 400);
+  CHECK_THAT(error(res), Catch::Contains("has no hardware trigger input"));
+  CHECK_THAT(error(res), Catch::Contains("cam0"));
+  // The settings travel as given: the video server judges the edge's name.
+  res = postJson(web, "/api/cameras/cam0/mode", R"({"mode":"hardware","activation":"Sideways"})");
+  REQUIRE(res);
+  CHECK(res->status == 400);
+  CHECK_THAT(error(res), Catch::Contains("trigger_activation must be one of"));
+  CHECK_THAT(error(res), Catch::Contains("'Sideways'"));
+  // Refused here, before anything is sent, naming the field.
+  res = postJson(web, "/api/cameras/cam0/mode", R"({"mode":"trigger","line":"Line1"})");
+  REQUIRE(res);
+  CHECK(res->status == 400);
+  CHECK_THAT(error(res), Catch::Contains("\"line\""));
+  // Nothing changed: the camera still runs free.
+  CHECK(getJson(web, "/api/cameras")[0]["mode"] == "freerun");
+}
+
 TEST_CASE("bad JSON is refused with a 400 that names the problem", "[web]") {
   VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
   WebProcess web(videoServerArgs(server));

@@ -1,4 +1,5 @@
-// The Camera panel: open/close, mode, trigger, exposure and gain, the ROI
+// The Camera panel: open/close, mode (free-run, software or hardware
+// trigger with its input, edge and timeout), trigger, exposure and gain, the ROI
 // drawn on the image (sensor pixels), output size, and any feature by name,
 // all through picksight-web's camera endpoints (the video server's control
 // socket).
@@ -63,12 +64,28 @@
     const c = ps.cameraInfo();
     if (!c) return;
     for (const radio of document.querySelectorAll("input[name=cam-mode]")) radio.checked = radio.value === c.mode;
+    const keep = (id) => document.activeElement === $(id);
+    if (c.trigger_line && !keep("cam-hw-line")) $("cam-hw-line").value = c.trigger_line;
+    if (c.trigger_activation !== undefined && !keep("cam-hw-activation")) $("cam-hw-activation").value = c.trigger_activation;
+    if (c.trigger_timeout_ms && !keep("cam-hw-timeout")) $("cam-hw-timeout").value = c.trigger_timeout_ms;
     if (!ps.rect.roi) showRoi();
     if (document.activeElement !== $("size-w")) $("size-w").value = c.width || 0;
     if (document.activeElement !== $("size-h")) $("size-h").value = c.height || 0;
   }
 
   const intOf = (id) => Math.max(0, Math.round(Number($(id).value) || 0));
+
+  // The hardware mode with the input, edge and timeout of the fields (empty
+  // ones left to the video server's defaults).
+  function hardwareMode() {
+    const body = { mode: "hardware" };
+    const line = $("cam-hw-line").value.trim();
+    if (line) body.line = line;
+    if ($("cam-hw-activation").value) body.activation = $("cam-hw-activation").value;
+    const ms = intOf("cam-hw-timeout");
+    if (ms > 0) body.timeout_ms = ms;
+    return ps.cameraAction("mode", body);
+  }
 
   document.addEventListener("DOMContentLoaded", () => {
     ps.on("camera", () => { ps.rect.roi = null; showCamera(); refreshFeatures(); });
@@ -79,8 +96,10 @@
     $("cam-close").addEventListener("click", () => ps.cameraAction("close"));
     $("cam-trigger").addEventListener("click", () => ps.cameraAction("trigger"));
     for (const radio of document.querySelectorAll("input[name=cam-mode]")) {
-      radio.addEventListener("change", () => ps.cameraAction("mode", { mode: radio.value }));
+      radio.addEventListener("change", () =>
+        radio.value === "hardware" ? hardwareMode() : ps.cameraAction("mode", { mode: radio.value }));
     }
+    $("cam-hw-apply").addEventListener("click", hardwareMode);
     $("cam-exposure-set").addEventListener("click", () => setFeature(exposureName(), $("cam-exposure").value));
     $("cam-gain-set").addEventListener("click", () => setFeature(gainName(), $("cam-gain").value));
     $("roi-apply").addEventListener("click", async () => {

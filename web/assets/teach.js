@@ -1,6 +1,6 @@
 // The Teach panel: LEARN the part inside a rectangle drawn on the image
 // (LEARN <type> <name> AT x y w h, sensor pixels), the model list (MODELS,
-// FORGET), and a type's grasp styles and gripper fingers (GRASP, GRIPPER)
+// FORGET), each model's tolerances (TOLERANCE), and a type's grasp styles and gripper fingers (GRASP, GRIPPER)
 // with their footprint drawn live on the latest located part of that type.
 "use strict";
 
@@ -58,6 +58,97 @@
       row.dataset.type = m[0];
       row.addEventListener("click", () => { $("grasp-type").value = m[0]; loadGrasp(); });
     }
+    await refreshTolerances(groups(reply, 5).map((m) => m[0]));
+  }
+
+  // The tolerances TOLERANCE reports, in its order: [key, input step];
+  // mirror_symmetric is a check box.
+  const toleranceKeys = [["area_tolerance", "0.01"], ["hu_tolerance", "0.1"], ["verify_percent", "1"],
+                         ["edge_tolerance_px", "0.1"], ["mirror_symmetric", null]];
+
+  // {type, name, values: {key: text}} from "OK <type> <name> key=value ...".
+  function parseTolerances(reply) {
+    const f = ps.okFields(reply);
+    if (!f || f.length < 2) return null;
+    const values = {};
+    for (const word of f.slice(2)) {
+      const eq = word.indexOf("=");
+      if (eq > 0) values[word.slice(0, eq)] = word.slice(eq + 1);
+    }
+    return { type: f[0], name: f[1], values };
+  }
+
+  // "0.100000" as "0.1": the fields are narrow.
+  const shownValue = (t, key) => (t.values[key] === undefined ? "" : String(Number(t.values[key])));
+
+  function toleranceRow(tbody, t) {
+    const row = document.createElement("tr");
+    row.dataset.type = t.type;
+    row.dataset.shown = JSON.stringify(t);
+    const cell = (child) => {
+      const td = document.createElement("td");
+      if (typeof child === "string") td.textContent = child; else td.appendChild(child);
+      row.appendChild(td);
+    };
+    cell(t.type);
+    cell(t.name);
+    for (const [key, step] of toleranceKeys) {
+      const input = document.createElement("input");
+      input.dataset.key = key;
+      input.className = "tolerance-input";
+      if (step) {
+        input.type = "number";
+        input.step = step;
+        input.value = shownValue(t, key);
+      } else {
+        input.type = "checkbox";
+        input.checked = t.values[key] === "1";
+      }
+      cell(input);
+    }
+    const save = document.createElement("button");
+    save.type = "button";
+    save.className = "tolerance-save";
+    save.textContent = "Save";
+    save.addEventListener("click", () => saveTolerances(row, t));
+    cell(save);
+    tbody.appendChild(row);
+    return row;
+  }
+
+  // Sends the changed fields of a row in one TOLERANCE line (the vision app
+  // checks them all before it changes any), then shows what is in force.
+  async function saveTolerances(row, t) {
+    let line = "TOLERANCE " + t.type;
+    for (const input of row.querySelectorAll("input[data-key]")) {
+      const key = input.dataset.key;
+      const value = input.type === "checkbox" ? (input.checked ? "1" : "0") : input.value.trim();
+      if (value !== (input.type === "checkbox" ? t.values[key] : shownValue(t, key))) line += " " + key + " " + (value === "" ? "none" : value);
+    }
+    if (line === "TOLERANCE " + t.type) { ps.show("tolerance-reply", line, "nothing changed"); return; }
+    const reply = await say("tolerance-reply", line);
+    const now = parseTolerances(reply);
+    if (now && row.parentNode) row.parentNode.replaceChild(toleranceRow(row.parentNode, now), row);
+  }
+
+  // A row whose model still has the values it shows is kept as it is, so a
+  // refresh (a tab switch, another LEARN) never drops an edit not yet saved.
+  async function refreshTolerances(types) {
+    const tbody = $("tolerance-list").querySelector("tbody");
+    const wanted = [];
+    for (const type of types) {
+      const t = parseTolerances(await ps.command("TOLERANCE " + type));
+      if (t) wanted.push(t);
+    }
+    const shown = new Map();
+    for (const row of Array.from(tbody.rows)) shown.set(row.dataset.shown, row);
+    for (const t of wanted) {
+      const key = JSON.stringify(t);
+      let row = shown.get(key);
+      if (row) shown.delete(key); else row = toleranceRow(tbody, t);
+      tbody.appendChild(row);  // in the models' order
+    }
+    for (const row of shown.values()) row.remove();
   }
 
   function list(ol, items, format) {

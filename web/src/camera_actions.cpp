@@ -11,6 +11,11 @@
 namespace picksight::web {
 namespace {
 
+// Bounds of the hardware trigger's settings: GenICam names are short, and
+// a pulse an hour late is a broken wire rather than a slow machine.
+constexpr size_t kMaxTriggerName = 64;
+constexpr uint32_t kMaxTriggerTimeoutMs = 3600000;
+
 Error fieldError(const std::string& field, const std::string& what) {
   return makeError(WebErrc::kBadRequest, "\"" + field + "\": " + what);
 }
@@ -102,8 +107,37 @@ Result<proto::ControlRequest> cameraAction(const std::string& camera, const std:
       mode->set_mode(proto::FREERUN);
     } else if (*name == "trigger") {
       mode->set_mode(proto::TRIGGER);
+    } else if (*name == "hardware") {
+      mode->set_mode(proto::HARDWARE_TRIGGER);
     } else {
-      return fieldError("mode", "must be \"freerun\" or \"trigger\"");
+      return fieldError("mode", "must be \"freerun\", \"trigger\" or \"hardware\"");
+    }
+    // The trigger input's settings go with the hardware mode only, as with
+    // picksight-cam; their names and values are the video server's to judge
+    // (it names the camera's choices when it refuses one).
+    for (const char* field : {"line", "activation", "timeout_ms"}) {
+      if (mode->mode() != proto::HARDWARE_TRIGGER && body.contains(field) &&
+          !body.at(field).is_null())
+        return fieldError(field, "goes with the \"hardware\" mode only");
+    }
+    for (const char* field : {"line", "activation"}) {
+      auto value = text(body, field, false);
+      if (!value) return value.error();
+      if (value->size() > kMaxTriggerName) {
+        return fieldError(field, "longer than " + std::to_string(kMaxTriggerName) + " bytes");
+      }
+      if (field[0] == 'l') mode->set_trigger_line(*value);
+      if (field[0] == 'a') mode->set_trigger_activation(*value);
+    }
+    auto timeout = number(body, "timeout_ms");
+    if (!timeout) return timeout.error();
+    if (*timeout) {
+      const double ms = **timeout;
+      if (ms < 1 || ms > kMaxTriggerTimeoutMs || ms != std::floor(ms)) {
+        return fieldError("timeout_ms", "must be a whole number of milliseconds, 1.." +
+                                            std::to_string(kMaxTriggerTimeoutMs));
+      }
+      mode->set_trigger_timeout_ms(static_cast<uint32_t>(ms));
     }
     auto fps = number(body, "fps");
     if (!fps) return fps.error();

@@ -11,9 +11,11 @@ namespace picksight::web {
 namespace {
 using namespace std::chrono_literals;
 
-// "freerun" or "trigger": the wire enum's own name, in the API's lower case.
+// "freerun", "trigger" or "hardware": the wire enum's own name in the API's
+// lower case, the hardware trigger's as POST .../mode takes it.
 std::string modeName(proto::AcquisitionMode mode) {
   if (mode == proto::ACQUISITION_MODE_UNSPECIFIED) return "unknown";
+  if (mode == proto::HARDWARE_TRIGGER) return "hardware";
   std::string name = proto::AcquisitionMode_Name(mode);
   std::transform(name.begin(), name.end(), name.begin(),
                  [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
@@ -157,7 +159,10 @@ nlohmann::json CameraMonitor::cameraJson(const CameraState& s) const {
           {"reconnects", st.reconnects()},
           {"last_error", st.last_error()},
           {"sequence", st.last_sequence()},
-          {"simulated_robot", d.has_simulated_robot()}};
+          {"simulated_robot", d.has_simulated_robot()},
+          {"trigger_line", d.trigger_line()},
+          {"trigger_activation", d.trigger_activation()},
+          {"trigger_timeout_ms", d.trigger_timeout_ms()}};
 }
 
 nlohmann::json CameraMonitor::cameras() const {

@@ -363,6 +363,52 @@ def test_grasp_styles_and_fingers_edited_and_drawn(cell, browser):
     assert browser.severe() == []
 
 
+def test_tolerances_edited_in_the_page(cell, browser):
+    """A model's tolerances shown in the Teach panel, two of them changed and
+    saved there: the vision app has them (read back through the robot
+    protocol); an out-of-range value is refused naming the key and changes
+    nothing."""
+    cell.set_parts(1)
+    try:
+        wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "1", what="one part on the table")
+        assert cell.say("LEARN 8 tol").startswith("OK 8 tol"), "LEARN"
+        before = cell.say("TOLERANCE 8")
+        assert " area_tolerance=0.100000 " in before and before.endswith(" mirror_symmetric=0"), before
+        select_tab(browser, "teach")
+        click(browser, "models-refresh")
+        row_css = '#tolerance-list tr[data-type="8"]'
+        field = lambda key: browser.driver.find_element(By.CSS_SELECTOR, f'{row_css} input[data-key="{key}"]')
+        wait_until(lambda: field("area_tolerance").get_attribute("value") == "0.1",
+                   what="the model's tolerances in the page")
+        assert field("verify_percent").get_attribute("value") == "80"
+        area = field("area_tolerance")
+        area.clear()
+        area.send_keys("0.3")
+        field("mirror_symmetric").click()
+        browser.screenshot("teach-tolerances")
+        browser.driver.find_element(By.CSS_SELECTOR, f"{row_css} .tolerance-save").click()
+        wait_until(lambda: "< OK 8 tol" in browser.driver.find_element(By.ID, "tolerance-reply").text,
+                   what="the TOLERANCE reply")
+        after = cell.say("TOLERANCE 8")
+        assert " area_tolerance=0.300000 " in after and after.endswith(" mirror_symmetric=1"), after
+        # The row shows what is in force.
+        wait_until(lambda: field("area_tolerance").get_attribute("value") == "0.3", what="the saved value")
+        assert field("mirror_symmetric").is_selected()
+
+        verify = field("verify_percent")
+        verify.clear()
+        verify.send_keys("150")
+        browser.driver.find_element(By.CSS_SELECTOR, f"{row_css} .tolerance-save").click()
+        wait_until(lambda: "ERROR 11" in browser.driver.find_element(By.ID, "tolerance-reply").text,
+                   what="the refusal")
+        assert "verify_percent must be" in browser.driver.find_element(By.ID, "tolerance-reply").text
+        assert cell.say("TOLERANCE 8") == after
+    finally:
+        cell.say("FORGET 8")
+        cell.set_parts(4)
+    assert browser.severe() == []
+
+
 def test_calibrate_the_simulated_cell(cell, browser):
     select_tab(browser, "calibrate")
     wait_until(lambda: "frame" in browser.driver.find_element(By.ID, "cal-transform").text, what="STATUS")
@@ -384,4 +430,29 @@ def test_calibrate_the_simulated_cell(cell, browser):
     dx, dy, rz = (float(v) for v in status.split("transform=")[1].split()[0].split(","))
     assert abs(dx - 330.5) < 0.5 and abs(dy + 612.25) < 0.5 and abs(rz - 178.7) < 0.1, status
     browser.screenshot("calibrate")
+    assert browser.severe() == []
+
+
+def test_hardware_trigger_from_the_camera_panel(cell, browser):
+    """The hardware trigger mode chosen in the Camera panel with its input,
+    edge and timeout: the synthetic camera has no trigger input, and its
+    refusal is shown; the camera keeps running free."""
+    select_tab(browser, "camera")
+    browser.js("""document.getElementById('cam-hw-line').value = 'Line2';
+                  document.getElementById('cam-hw-activation').value = 'FallingEdge';
+                  document.getElementById('cam-hw-timeout').value = '2500';""")
+    click(browser, "cam-hw-apply")
+    reply = wait_until(lambda: (lambda t: t if "mode" in t else None)(
+        browser.driver.find_element(By.ID, "camera-reply").text), what="the mode reply")
+    first = reply.split("\n")[:2]
+    assert first[0].startswith("> mode ") and '"mode":"hardware"' in first[0], first
+    for sent in ('"line":"Line2"', '"activation":"FallingEdge"', '"timeout_ms":2500'):
+        assert sent in first[0], first
+    assert first[1].startswith("< ERROR ") and "has no hardware trigger input" in first[1], first
+    browser.screenshot("camera-hardware")
+    assert cell.camera()["mode"] == "freerun"
+    # The refusal is an HTTP 400, which Chromium logs; nothing else may be.
+    refused = [e for e in browser.severe() if "/api/cameras/cam0/mode" in e.get("message", "")]
+    assert refused and all(" 400 " in e["message"] for e in refused), refused
+    browser.console = [e for e in browser.console if e not in refused]
     assert browser.severe() == []

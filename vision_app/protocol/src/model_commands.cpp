@@ -1,8 +1,9 @@
-// LEARN, MODELS, FORGET and BLOBS.
+// LEARN, MODELS, TOLERANCE, FORGET and BLOBS.
 #include "picksight/protocol/model_commands.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -58,6 +59,145 @@ std::optional<cv::Rect> parseRect(const std::vector<std::string>& args, size_t f
   }
   return cv::Rect(v[0], v[1], v[2], v[3]);
 }
+
+// A tolerance TOLERANCE reads and sets: its name in the model file
+// (docs/PROTOCOL.md, "Part models"), its bounds and where it lives. Each
+// bound is one validateModel accepts, or tighter: past it a value is a typo.
+// The hole count is left out: it is a measured feature, not a tolerance,
+// and the touching-parts search does not test it, so a changed count would
+// not keep a part from being found.
+struct ToleranceKey {
+  const char* name;
+  double low;
+  double high;
+  bool low_open;   // low itself refused
+  bool high_open;  // high itself refused
+  bool whole;      // an integer (a yes/no)
+  int decimals;    // in replies
+  double (*get)(const vision::PartModel&);
+  void (*set)(vision::PartModel&, double);
+};
+
+const ToleranceKey kToleranceKeys[] = {
+    {"area_tolerance", 0, 1, true, true, false, 6,
+     [](const vision::PartModel& m) { return m.body.area_tolerance; },
+     [](vision::PartModel& m, double v) { m.body.area_tolerance = v; }},
+    {"hu_tolerance", 0, 100, true, false, false, 6,
+     [](const vision::PartModel& m) { return m.body.hu_tolerance; },
+     [](vision::PartModel& m, double v) { m.body.hu_tolerance = v; }},
+    {"verify_percent", 0, 100, true, false, false, 3,
+     [](const vision::PartModel& m) { return m.verify_percent; },
+     [](vision::PartModel& m, double v) { m.verify_percent = v; }},
+    {"edge_tolerance_px", 0, 50, true, false, false, 3,
+     [](const vision::PartModel& m) { return m.edge_tolerance; },
+     [](vision::PartModel& m, double v) { m.edge_tolerance = v; }},
+    {"mirror_symmetric", 0, 1, false, false, true, 0,
+     [](const vision::PartModel& m) { return m.body.mirror_symmetric ? 1.0 : 0.0; },
+     [](vision::PartModel& m, double v) { m.body.mirror_symmetric = v != 0; }},
+};
+
+// Any case: robot programs often send upper case only.
+const ToleranceKey* findToleranceKey(std::string_view name) {
+  for (const auto& key : kToleranceKeys) {
+    if (toUpper(name) == toUpper(key.name)) return &key;
+  }
+  return nullptr;
+}
+
+std::string toleranceNames() {
+  std::string names;
+  for (const auto& key : kToleranceKeys)
+    names += (names.empty() ? "" : ", ") + std::string(key.name);
+  return names;
+}
+
+// "<name> must be ... in (low, high]": the key and its bounds, for errors.
+std::string toleranceBounds(const ToleranceKey& key) {
+  return std::string(key.name) + " must be " + (key.whole ? "an integer" : "a number") + " in " +
+         (key.low_open ? "(" : "[") + formatFixed(key.low, 0) + ", " + formatFixed(key.high, 0) +
+         (key.high_open ? ")" : "]");
+}
+
+// The value for `key` from `text`, or the error reply naming the key.
+Result<double> toleranceValue(const ToleranceKey& key, const std::string& text) {
+  const auto bad = [&] {
+    return makeError(ProtocolErrc::kBadArguments,
+                     "TOLERANCE: " + toleranceBounds(key) + ", got '" + printable(text) + "'");
+  };
+  std::optional<double> value;
+  if (key.whole) {
+    if (const auto n = parseInt(text)) value = static_cast<double>(*n);
+  } else {
+    value = parseDouble(text);
+  }
+  if (!value || !std::isfinite(*value)) return bad();
+  const double v = *value;
+  if (v < key.low || v > key.high || (key.low_open && v == key.low) ||
+      (key.high_open && v == key.high))
+    return bad();
+  return v;
+}
+}  // namespace
+
+std::string toleranceReply(const vision::PartModel& m) {
+  std::string reply = "OK " + std::to_string(m.type) + " " + m.name;
+  for (const auto& key : kToleranceKeys)
+    reply += " " + std::string(key.name) + "=" + formatFixed(key.get(m), key.decimals);
+  return reply;
+}
+
+namespace {
+std::string tolerance(VisionService& vision, const Request& r) {
+  constexpr const char* kUsage = "usage: TOLERANCE <type> [<key> <value>]...";
+  if (r.args.empty() || r.args.size() % 2 == 0)
+    return errorReply(ProtocolErrc::kBadArguments, kUsage);
+  const auto type = parseType(r.args[0]);
+  if (!type) {
+    return errorReply(
+        ProtocolErrc::kBadArguments,
+        "TOLERANCE: type must be an integer in [0, 9999], got '" + printable(r.args[0]) + "'");
+  }
+  // Every pair is checked before the model is touched: a bad one changes
+  // nothing.
+  std::vector<std::pair<const ToleranceKey*, double>> changes;
+  for (size_t i = 1; i < r.args.size(); i += 2) {
+    const ToleranceKey* key = findToleranceKey(r.args[i]);
+    if (!key) {
+      return errorReply(ProtocolErrc::kBadArguments, "TOLERANCE: no key '" + printable(r.args[i]) +
+                                                         "' (keys: " + toleranceNames() + ")");
+    }
+    for (const auto& [seen, unused] : changes) {
+      if (seen == key)
+        return errorReply(ProtocolErrc::kBadArguments,
+                          "TOLERANCE: " + std::string(key->name) + " given twice");
+    }
+    auto value = toleranceValue(*key, r.args[i + 1]);
+    if (!value) return errorReply(value.error());
+    changes.emplace_back(key, *value);
+  }
+  const auto no_model = [&] {
+    return errorReply(VisionErrc::kUnknownType, "no model for type " + std::to_string(*type));
+  };
+  if (!vision.models()) return no_model();
+  if (changes.empty()) {
+    const auto models = vision.models()->snapshot();
+    for (const auto& m : *models) {
+      if (m.type == *type) return toleranceReply(m);
+    }
+    return no_model();
+  }
+  auto updated = vision.models()->update(*type, [&](vision::PartModel& m) {
+    for (const auto& [key, value] : changes) key->set(m, value);
+  });
+  if (!updated) {
+    // The bounds above are validateModel's or tighter: an invalid model
+    // here would be a bug, reported as such rather than as a bad request.
+    if (updated.error().code == ModelErrc::kInvalidModel)
+      return errorReply(ProtocolErrc::kInternalError, "TOLERANCE: " + updated.error().message);
+    return errorReply(updated.error());
+  }
+  return toleranceReply(*updated);
+}
 }  // namespace
 
 void addModelCommands(CommandTable& table, VisionService& vision) {
@@ -109,6 +249,10 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         return reply;
       },
       neverChanges);
+  table.add(
+      "TOLERANCE", "TOLERANCE <type> [<key> <value>]...",
+      [&vision](const Request& r) { return tolerance(vision, r); },
+      [](const Request& r) { return r.args.size() > 1; });
   table.add("FORGET", "FORGET <type>", [&vision](const Request& r) {
     if (r.args.size() != 1) return errorReply(ProtocolErrc::kBadArguments, "usage: FORGET <type>");
     const auto type = parseType(r.args[0]);

@@ -146,6 +146,31 @@ Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp) {
   return {};
 }
 
+Result<vision::PartModel> ModelLibrary::update(
+    int type, const std::function<void(vision::PartModel&)>& change) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto found = std::find_if(models_->begin(), models_->end(),
+                                  [&](const vision::PartModel& m) { return m.type == type; });
+  if (found == models_->end())
+    return makeError(ModelErrc::kUnknownType, "no model for type " + std::to_string(type));
+  vision::PartModel changed = *found;
+  change(changed);
+  changed.type = type;  // the file name and the list order depend on it
+  if (auto valid = vision::validateModel(changed); !valid)
+    return makeError(ModelErrc::kInvalidModel, valid.error().message);
+  vision::prepareModel(changed);
+  const auto kept = grasps_->find(type);
+  auto written = writeFileAtomically(
+      pathOf(type), modelToYaml(changed, kept == grasps_->end() ? GraspSetup{} : kept->second));
+  if (!written) return makeError(ModelErrc::kStorage, written.error().message);
+  auto models = std::make_shared<ModelList>(*models_);
+  for (auto& m : *models) {
+    if (m.type == type) m = changed;
+  }
+  models_ = std::move(models);
+  return changed;
+}
+
 std::shared_ptr<const ModelList> ModelLibrary::snapshot() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return models_;

@@ -1,5 +1,5 @@
 // Robot protocol commands for part models and blob analysis: LEARN, MODELS,
-// FORGET, BLOBS (docs/PROTOCOL.md).
+// TOLERANCE, FORGET, BLOBS (docs/PROTOCOL.md).
 #pragma once
 
 #include "picksight/cell/vision_service.hpp"
@@ -15,6 +15,10 @@ std::string modelSummary(const vision::PartModel& model);
 // LEARN's reply: "OK <type> <name> <area> <holes> <symmetry> <mirror 0/1>",
 // then " ; warning: <text>" for each warning.
 std::string learnReply(const LearnOutcome& learned);
+// TOLERANCE's reply: "OK <type> <name>" then " <key>=<value>" for each
+// tolerance a model file stores (area_tolerance, hu_tolerance,
+// verify_percent, edge_tolerance_px, mirror_symmetric).
+std::string toleranceReply(const vision::PartModel& model);
 // The reply fields of one region's features (see BLOBS).
 std::string blobSummary(const vision::BlobFeatures& blob);
 

@@ -5,6 +5,7 @@
 // (shared_ptr), so a recognition in progress never sees a half-changed list.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -42,6 +43,15 @@ class ModelLibrary {
   // Replaces the grasp styles and gripper of `type`, written with its model;
   // ModelErrc::kUnknownType if there is no model of `type`.
   Result<void> setGrasp(int type, const GraspSetup& grasp);
+  // Changes the model of `type` in place: `change` edits a copy (under the
+  // library's lock, so a LEARN of the same type at the same moment is never
+  // overwritten by the older model), which is validated, prepared again
+  // (derived members depend on the tolerances) and written with its grasps,
+  // the file first, then memory. Returns the stored model.
+  // ModelErrc::kUnknownType if there is no model of `type`, kInvalidModel
+  // (nothing written) if the changed model is not valid, kStorage if the file
+  // cannot be written.
+  Result<vision::PartModel> update(int type, const std::function<void(vision::PartModel&)>& change);
 
   std::shared_ptr<const ModelList> snapshot() const;
   std::shared_ptr<const GraspMap> grasps() const;

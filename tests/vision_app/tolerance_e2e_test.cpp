@@ -1,0 +1,148 @@
+// TOLERANCE against a real video server and vision app: a model's
+// tolerances read back, changed, in force at the next LOCATE, kept across a
+// restart, and bad requests refused naming the key without changing anything.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../vision/drawn_parts.hpp"
+#include "cell_fixture.hpp"
+#include "scene_file.hpp"
+
+using namespace picksight;
+using namespace picksight::e2e;
+using namespace std::chrono_literals;
+
+namespace {
+// A plate 200 x 120 px with one round hole, and the same plate 3 % larger:
+// its area (6 % more) is within the learned tolerance, its shape the same,
+// but its sides lie 1.8 px (long) and 3 px (short) from the model's, so it
+// verifies within an edge tolerance of 6 px and not within 1 px.
+const synthetic::Shape kPlate{{test::rectLoop(200, 120), test::circleLoop(25, {45, 0})}};
+const synthetic::Shape kLargerPlate = test::scaled(kPlate, 1.03);
+
+cv::Mat scene(const synthetic::Shape& shape, double angle_deg) {
+  return test::drawParts(640, 480, {{shape, 320, 240, angle_deg}}, 11);
+}
+
+std::string askRobot(LineClient& robot, const std::string& request) {
+  auto reply = robot.request(request, 20s);
+  REQUIRE(reply);
+  return *reply;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A file camera in trigger mode showing one plate, a vision app on it whose
+// data directory outlives it (restart), the plate learned as type 1.
+struct PlateCell {
+  SceneFile scene{::scene(kPlate, 0)};
+  std::string data_dir = scene.dir + "/data";
+  VideoServerProcess server{{"--source", "cam0=file:" + scene.path, "--mode", "trigger"}};
+  std::unique_ptr<VisionProcess> vision;
+  std::unique_ptr<LineClient> robot;
+
+  PlateCell() {
+    std::filesystem::create_directories(data_dir);
+    restart();
+    REQUIRE(askRobot(*robot, "LEARN 1 plate").rfind("OK 1 plate ", 0) == 0);
+  }
+  void restart() {
+    robot.reset();
+    vision.reset();
+    vision = std::make_unique<VisionProcess>(server, "cam0", data_dir);
+    robot = std::make_unique<LineClient>(vision->connect());
+  }
+  std::string ask(const std::string& request) { return askRobot(*robot, request); }
+  std::string modelFile() const { return readFile(data_dir + "/models/type_1.yaml"); }
+};
+}  // namespace
+
+TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next LOCATE",
+          "[vision_app][tolerance][e2e]") {
+  PlateCell cell;
+  const std::string learned = cell.ask("TOLERANCE 1");
+  CHECK_THAT(learned, Catch::StartsWith("OK 1 plate area_tolerance=0.100000 hu_tolerance="));
+  CHECK_THAT(learned, Catch::EndsWith(" verify_percent=80.000 edge_tolerance_px=2.000 "
+                                      "mirror_symmetric=1"));
+  cell.scene.show(scene(kPlate, 30));
+  CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+
+  // The larger plate with a tight edge tolerance: the next LOCATE leaves it
+  // out, and WHY says the boundary failed.
+  cell.scene.show(scene(kLargerPlate, 30));
+  CHECK_THAT(cell.ask("TOLERANCE 1 edge_tolerance_px 1"),
+             Catch::EndsWith(" verify_percent=80.000 edge_tolerance_px=1.000 mirror_symmetric=1"));
+  CHECK(cell.ask("LOCATE 1") == "OK 0");
+  CHECK_THAT(cell.ask("WHY"), Catch::Contains("region 0 boundary "));
+  CHECK_THAT(cell.modelFile(), Catch::Contains("edge_tolerance_px: 1"));
+
+  // Stored: a restarted vision app has it. Then several keys at once, in
+  // any case, let the larger plate through.
+  cell.restart();
+  CHECK_THAT(cell.ask("TOLERANCE 1"), Catch::Contains(" edge_tolerance_px=1.000 "));
+  CHECK(cell.ask("LOCATE 1") == "OK 0");
+  const std::string relaxed = cell.ask(
+      "TOLERANCE 1 EDGE_TOLERANCE_PX 6 area_tolerance 0.25 "
+      "hu_tolerance 1.5 verify_percent 75.5 mirror_symmetric 0");
+  CHECK_THAT(relaxed, Catch::StartsWith("OK 1 plate area_tolerance=0.250000 hu_tolerance=1.500000 "
+                                        "verify_percent=75.500 edge_tolerance_px=6.000 "
+                                        "mirror_symmetric=0"));
+  CHECK_THAT(cell.modelFile(), Catch::Contains("mirror_symmetric: false"));
+  CHECK(cell.ask("TOLERANCE 1 mirror_symmetric 1") == relaxed.substr(0, relaxed.size() - 1) + "1");
+  CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+  CHECK_THAT(cell.ask("MODELS"), Catch::StartsWith("OK 1 1 plate "));
+}
+
+TEST_CASE("TOLERANCE refuses a bad request naming the key and changes nothing",
+          "[vision_app][tolerance][e2e]") {
+  PlateCell cell;
+  const std::string before = cell.ask("TOLERANCE 1");
+  const std::string file = cell.modelFile();
+  struct Bad {
+    const char* request;
+    const char* says;
+  };
+  const Bad bad[] = {
+      {"TOLERANCE 1 area_tolerance 1", "area_tolerance must be a number in (0, 1), got '1'"},
+      {"TOLERANCE 1 area_tolerance 0", "area_tolerance must be a number in (0, 1)"},
+      {"TOLERANCE 1 area_tolerance -0.1", "area_tolerance must be a number in (0, 1)"},
+      {"TOLERANCE 1 area_tolerance nan", "area_tolerance must be a number in (0, 1)"},
+      {"TOLERANCE 1 area_tolerance inf", "area_tolerance must be a number in (0, 1)"},
+      {"TOLERANCE 1 hu_tolerance 1e400", "hu_tolerance must be a number in (0, 100]"},
+      {"TOLERANCE 1 hu_tolerance abc", "hu_tolerance must be a number in (0, 100]"},
+      {"TOLERANCE 1 verify_percent 100.5", "verify_percent must be a number in (0, 100]"},
+      {"TOLERANCE 1 edge_tolerance_px 51", "edge_tolerance_px must be a number in (0, 50]"},
+      {"TOLERANCE 1 mirror_symmetric 0.5", "mirror_symmetric must be an integer in [0, 1]"},
+      {"TOLERANCE 1 mirror_symmetric -1", "mirror_symmetric must be an integer in [0, 1]"},
+      {"TOLERANCE 1 mirror_symmetric 2", "mirror_symmetric must be an integer in [0, 1]"},
+      {"TOLERANCE 1 speed 3", "no key 'speed' (keys: area_tolerance, hu_tolerance,"},
+      {"TOLERANCE 1 verify_percent 90 VERIFY_PERCENT 95", "verify_percent given twice"},
+      // One good pair and one bad: neither is applied.
+      {"TOLERANCE 1 area_tolerance 0.3 verify_percent 200", "verify_percent must be"},
+      {"TOLERANCE 1 hu_tolerance", "usage: TOLERANCE <type>"},
+      {"TOLERANCE", "usage: TOLERANCE <type>"},
+      {"TOLERANCE x hu_tolerance 1", "type must be an integer in [0, 9999]"},
+  };
+  for (const auto& b : bad) {
+    INFO(b.request);
+    const std::string reply = cell.ask(b.request);
+    CHECK_THAT(reply, Catch::StartsWith("ERROR 11 "));
+    CHECK_THAT(reply, Catch::Contains(b.says));
+  }
+  CHECK_THAT(cell.ask("TOLERANCE 2"), Catch::StartsWith("ERROR 32 "));
+  CHECK_THAT(cell.ask("TOLERANCE 2 verify_percent 90"), Catch::StartsWith("ERROR 32 "));
+  CHECK(cell.ask("TOLERANCE 1") == before);
+  CHECK(cell.modelFile() == file);
+  CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+}
