@@ -169,6 +169,14 @@ TEST_CASE("a camera tilted 2 degrees, calibrated on a dot grid, places parts wit
     CHECK(scale[0] == Approx(kMmPerPx).epsilon(0.02));
     CHECK(scale[0] == scale[1]);  // square on the plane once rectified
     CHECK(ask(robot, "STATUS").find(" lens=1 ") != std::string::npos);
+    // Again through a resized camera: the lens cannot be fitted there, so
+    // the first grid's is kept, and the dots are undistorted by it.
+    REQUIRE(run({binPath("picksight-cam"), "--control", server.control, "size", "cam0", "--scale",
+                 "0.75"})
+                .exit_code == 0);
+    const auto again = replyNumbers(ask(robot, "CALCAM GRID 25"), 2);
+    CHECK(again[0] == Approx(scale[0]).epsilon(0.001));
+    CHECK(ask(robot, "STATUS").find(" lens=1 ") != std::string::npos);
   }
   VideoServerProcess server({"--source", cell + ",target_radius=5", "--mode", "trigger"});
   VisionProcess vision(server, "cam0", data.path().string());

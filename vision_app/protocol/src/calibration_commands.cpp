@@ -55,16 +55,20 @@ std::string calcamGrid(const Request& r, VisionService& vision, CellCalibration&
   const SensorMapping& mapping = frame->second;
   std::vector<cv::Point2d> sensor;
   for (const auto& c : grid->centres) sensor.push_back(mapping.toSensor(c));
-  // A lens model from chessboard views is trusted; one fitted to an
-  // earlier grid is fitted again. The centre of distortion is the sensor's
-  // middle, known only when the frame is the whole sensor, unresized.
-  std::optional<calibration::LensModel> lens = calibration.lens();
-  if (lens && lens->views <= 1) lens.reset();
+  // A lens model from chessboard views is trusted. One fitted to an
+  // earlier grid is fitted again when this grid can (the whole sensor in
+  // view: its middle is the centre of distortion, and dots far enough out),
+  // else trusted too, so that the stored lens and the rectification always
+  // agree on which pixels they were fitted to.
+  const std::optional<calibration::LensModel> stored = calibration.lens();
   const bool whole_sensor =
       mapping.roi_x == 0 && mapping.roi_y == 0 && mapping.scale_x == 1 && mapping.scale_y == 1;
-  const auto model = calibration::fitDotGrid(
-      sensor, grid->indices, (*pitch)[0], lens,
-      whole_sensor ? std::optional<cv::Size>(frame->first.size()) : std::nullopt);
+  const bool refit_lens = whole_sensor && !(stored && stored->views > 1);
+  auto model = calibration::fitDotGrid(
+      sensor, grid->indices, (*pitch)[0], refit_lens ? std::nullopt : stored,
+      refit_lens ? std::optional<cv::Size>(frame->first.size()) : std::nullopt);
+  if (model && refit_lens && !model->lens && stored)
+    model = calibration::fitDotGrid(sensor, grid->indices, (*pitch)[0], stored, std::nullopt);
   if (!model) return errorReply(VisionErrc::kNotADisc, model.error().message);
   if (auto ok = calibration.setGridCalibration(model->scale, model->lens); !ok)
     return reply(ok.error());
