@@ -228,6 +228,14 @@ Result<DotGridModel> fitDotGrid(const std::vector<cv::Point2d>& centres,
   rectify *= 1 / rectify(2, 2);
 
   model.scale.mm_per_px_x = model.scale.mm_per_px_y = mm_per_px;
+  if (!projective) {
+    // Too few dots for a tilt: the scale on X and on Y separately, from the
+    // pixels per millimetre B = j^-1 (B B^T = diag(1/sx^2, 1/sy^2) whatever
+    // the grid's rotation), as for a camera with pixels that are not square.
+    const cv::Matx22d b = j.inv();
+    model.scale.mm_per_px_x = 1 / std::hypot(b(0, 0), b(0, 1));
+    model.scale.mm_per_px_y = 1 / std::hypot(b(1, 0), b(1, 1));
+  }
   if (projective) {
     model.scale.rectify = rectify;
     for (const auto& q : img)

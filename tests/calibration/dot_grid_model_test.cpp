@@ -151,6 +151,17 @@ TEST_CASE("fewer than 3 x 3 dots give a scale without rectification, bad input a
   CHECK_FALSE(model->scale.rectify);
   CHECK_FALSE(model->lens);
   CHECK(model->scale.mm_per_px_x == Approx(0.25).epsilon(0.01));
+  // Pixels 2 % taller than wide, the grid turned 30 degrees: X and Y apart.
+  std::vector<cv::Point2d> tall;
+  for (const auto& ij : g.indices) {
+    const double a = 30 * M_PI / 180, x = ij.x * 25 / 0.25, y = ij.y * 25 / 0.25;
+    tall.emplace_back(100 + std::cos(a) * x - std::sin(a) * y,
+                      100 + (std::sin(a) * x + std::cos(a) * y) / 1.02);
+  }
+  auto anisotropic = fitDotGrid(tall, g.indices, 25, std::nullopt, std::nullopt);
+  REQUIRE(anisotropic);
+  CHECK(anisotropic->scale.mm_per_px_x == Approx(0.25).epsilon(1e-9));
+  CHECK(anisotropic->scale.mm_per_px_y == Approx(0.255).epsilon(1e-9));
   CHECK_FALSE(fitDotGrid(g.centres, g.indices, 0, std::nullopt, std::nullopt));
   CHECK_FALSE(fitDotGrid({g.centres[0]}, {g.indices[0]}, 25, std::nullopt, std::nullopt));
 }
