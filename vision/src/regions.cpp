@@ -79,6 +79,34 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, cons
   return true;
 }
 
+// Raw moments up to the third order, gathered row by row: a row's sums of
+// w, w x, w x^2 and w x^3 give all ten.
+struct Moments10 {
+  double m00 = 0, m10 = 0, m01 = 0, m20 = 0, m11 = 0, m02 = 0, m30 = 0, m21 = 0, m12 = 0, m03 = 0;
+
+  void addRow(double y, double s0, double s1, double s2, double s3) {
+    m00 += s0;
+    m10 += s1;
+    m01 += y * s0;
+    m20 += s2;
+    m11 += y * s1;
+    m02 += y * y * s0;
+    m30 += s3;
+    m21 += y * s2;
+    m12 += y * y * s1;
+    m03 += y * y * y * s0;
+  }
+
+  // Pixels a..b-1 of row y, each of weight 1: the power sums in closed form
+  // (exact in doubles for any image width).
+  void addRun(int a, int b, int y) {
+    const auto p1 = [](double n) { return n * (n - 1) / 2; };
+    const auto p2 = [](double n) { return (n - 1) * n * (2 * n - 1) / 6; };
+    const auto p3 = [&](double n) { return p1(n) * p1(n); };
+    addRow(y, b - a, p1(b) - p1(a), p2(b) - p2(a), p3(b) - p3(a));
+  }
+};
+
 // Grey-level coverage moments of one region (see findRegions). Returns
 // false, leaving the moments alone, when the grey levels cannot be trusted.
 //
@@ -93,8 +121,9 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, cons
 // `own` is the region's mask over `box` (the bounding box with a margin for
 // the edge blur and the background ring), `set` the mask of all regions
 // there. Two passes over the box and no full-box temporaries besides the
-// coverage itself: the contrast over the interior, then coverage and
-// moments together (moments from per-row sums of w x^p, as cv::moments does).
+// coverage itself: the interior (its runs, for the contrast and its
+// moments), then the band's coverage and moments (per-row sums of w x^p, as
+// cv::moments does).
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set,
                  const cv::Rect& box, cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights,
                  cv::Point* origin) {
@@ -123,58 +152,70 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
   // A black background carries no light to divide by: parts are lit on
   // their own, and levels are read against the background additively.
   const bool lit = min_background >= kMinLitBackground;
-  const auto level = [&](uint8_t g, float b) {
-    return lit ? static_cast<float>(g) / b : static_cast<float>(g) - b;
-  };
 
-  // First pass: the level of every pixel that counts (the region and its
-  // blurred edge, never a neighbour's pixels), kept in the coverage buffer
-  // so that each is divided once; the interior's mean level on the way.
-  cv::Mat coverage(box.size(), CV_32F);
-  // Row by row, the pixels that count as one mask (1 = counts).
-  cv::Mat counted(box.size(), CV_8UC1);
+  // Pixels 3 or more inside the binary boundary are the part's: their
+  // coverage is 1. The band is then 2 pixels each side of the boundary, as
+  // wide as `near` reaches out (a band 1 or 3 pixels deep placed the
+  // benchmark's parts 3 and 1.3 times worse). Reading the interior from grey
+  // levels too would only add its noise, and let a highlight or a printed mark on the part pull its
+  // centroid. Only the band around the boundary, where the edge blur is,
+  // carries the sub-pixel information. The interior's moments are summed
+  // run by run in closed form, so the cost follows the boundary's length,
+  // not the part's area.
+  cv::Mat coverage(box.size(), CV_32F, cv::Scalar(0));
+  Moments10 sums;
+  double interior_count = 0;
+  double interior_grey = 0;
   for (int y = 0; y < h; ++y) {
-    const uint8_t* nr = near.ptr<uint8_t>(y);
-    const uint8_t* st = set.ptr<uint8_t>(y);
-    const uint8_t* o = own.ptr<uint8_t>(y);
-    uint8_t* k = counted.ptr<uint8_t>(y);
-    for (int x = 0; x < w; ++x) k[x] = nr[x] && (!st[x] || o[x]);
-  }
-  double level_sum = 0;
-  int interior_count = 0;
-  for (int y = 0; y < h; ++y) {
-    const uint8_t* g = grey_box.ptr<uint8_t>(y);
     const uint8_t* in = interior.ptr<uint8_t>(y);
-    const uint8_t* k = counted.ptr<uint8_t>(y);
+    const uint8_t* g = grey_box.ptr<uint8_t>(y);
     float* c = coverage.ptr<float>(y);
-    const double row_background = plane[0] + plane[2] * y;
-    for (int x = 0; x < w; ++x) {
-      if (!k[x]) continue;
-      c[x] = level(g[x], static_cast<float>(row_background + plane[1] * x));
-      if (!in[x]) continue;
-      level_sum += c[x];
-      ++interior_count;
+    for (int x = 0; x < w;) {
+      if (!in[x]) {
+        ++x;
+        continue;
+      }
+      const int a = x;
+      int grey_sum = 0;
+      for (; x < w && in[x]; ++x) {
+        grey_sum += g[x];
+        c[x] = 1.0f;
+      }
+      sums.addRun(a, x, y);
+      interior_count += x - a;
+      interior_grey += grey_sum;
     }
   }
   if (interior_count < 8) return false;
-  const double mean_level = level_sum / interior_count;
+  // The interior's mean level: its mean grey against the background at its
+  // centroid (the plane is linear, so that is the background's mean there).
+  const double interior_background =
+      plane[0] + plane[1] * sums.m10 / sums.m00 + plane[2] * sums.m01 / sums.m00;
+  const double mean_grey = interior_grey / interior_count;
+  if (lit && interior_background <= 0) return false;
+  const double mean_level = lit ? mean_grey / interior_background : mean_grey - interior_background;
   const double contrast = lit ? 1.0 - mean_level : mean_level;
   if (std::abs(contrast) < (lit ? kMinContrast : kMinContrast * 255)) return false;
   // Coverage = scale * level + offset: (1 - R) / contrast, or offset / contrast.
   const float scale = static_cast<float>(lit ? -1.0 / contrast : 1.0 / contrast);
   const float offset = static_cast<float>(lit ? 1.0 / contrast : 0.0);
 
-  double m00 = 0, m10 = 0, m01 = 0, m20 = 0, m11 = 0, m02 = 0, m30 = 0, m21 = 0, m12 = 0, m03 = 0;
+  // The band: pixels near the region, not deep inside it, never a
+  // neighbour's.
   for (int y = 0; y < h; ++y) {
-    const uint8_t* k = counted.ptr<uint8_t>(y);
+    const uint8_t* g = grey_box.ptr<uint8_t>(y);
+    const uint8_t* nr = near.ptr<uint8_t>(y);
+    const uint8_t* st = set.ptr<uint8_t>(y);
+    const uint8_t* o = own.ptr<uint8_t>(y);
+    const uint8_t* in = interior.ptr<uint8_t>(y);
     float* c = coverage.ptr<float>(y);
+    const double row_background = plane[0] + plane[2] * y;
     double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     for (int x = 0; x < w; ++x) {
-      if (!k[x]) {
-        c[x] = 0;
-        continue;
-      }
-      const float v = std::min(std::max(scale * c[x] + offset, 0.0f), 1.0f);
+      if (!nr[x] || in[x] || (st[x] && !o[x])) continue;
+      const auto b = static_cast<float>(row_background + plane[1] * x);
+      const float level = lit ? static_cast<float>(g[x]) / b : static_cast<float>(g[x]) - b;
+      const float v = std::min(std::max(scale * level + offset, 0.0f), 1.0f);
       c[x] = v;
       const double xv = static_cast<double>(x) * v;
       const double xxv = xv * x;
@@ -183,18 +224,10 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
       s2 += xxv;
       s3 += xxv * x;
     }
-    const double yd = y;
-    m00 += s0;
-    m10 += s1;
-    m01 += yd * s0;
-    m20 += s2;
-    m11 += yd * s1;
-    m02 += yd * yd * s0;
-    m30 += s3;
-    m21 += yd * s2;
-    m12 += yd * yd * s1;
-    m03 += yd * yd * yd * s0;
+    sums.addRow(y, s0, s1, s2, s3);
   }
+  const double m00 = sums.m00, m10 = sums.m10, m01 = sums.m01, m20 = sums.m20, m11 = sums.m11,
+               m02 = sums.m02, m30 = sums.m30, m21 = sums.m21, m12 = sums.m12, m03 = sums.m03;
   if (m00 <= 0) return false;
   *moments = cv::Moments(m00, m10, m01, m20, m11, m02, m30, m21, m12, m03);
   *centroid = cv::Point2d(box.x + m10 / m00, box.y + m01 / m00);
