@@ -150,6 +150,11 @@ namespace {
 // the row: k + 1 products and sums a pixel instead of a complex power. The
 // order K a constant where it can be (the sums then stay in registers);
 // K = -1: the order `k` known only at run time.
+//
+// x^p depends on the column only: the powers of every column and their
+// running sums along the row are computed once, so a pixel of the band
+// costs k + 1 products, and a run of fully covered pixels (most of a part)
+// k + 1 differences whatever its length.
 template <int K>
 std::complex<double> rowPowerSums(const Region& region, int k, double scale) {
   using Sums =
@@ -161,21 +166,42 @@ std::complex<double> rowPowerSums(const Region& region, int k, double scale) {
   binomial[0] = 1;
   for (int p = 1; p < n; ++p) binomial[p] = binomial[p - 1] * (order - p + 1) / p;
   const cv::Mat& w = region.coverage;
+  const auto cols = static_cast<size_t>(w.cols);
+  const auto un = static_cast<size_t>(n);
+  // power[x n + p] = dx^p; before[x n + p] = the sum of dx^p over columns < x.
+  std::vector<double> power(cols * un);
+  std::vector<double> before((cols + 1) * un, 0.0);
+  for (size_t x = 0; x < cols; ++x) {
+    const double dx =
+        (region.coverage_origin.x + static_cast<double>(x) - region.centroid.x) * scale;
+    double term = 1;
+    for (size_t p = 0; p < un; ++p) {
+      power[x * un + p] = term;
+      before[(x + 1) * un + p] = before[x * un + p] + term;
+      term *= dx;
+    }
+  }
   std::complex<double> sum(0, 0);
   for (int y = 0; y < w.rows; ++y) {
     const float* row = w.ptr<float>(y);
     Sums sums{};
-    if constexpr (K < 0) sums.resize(static_cast<size_t>(n));
+    if constexpr (K < 0) sums.resize(un);
     bool any = false;
-    for (int x = 0; x < w.cols; ++x) {
-      if (row[x] <= 0) continue;
-      any = true;
-      const double dx = (region.coverage_origin.x + x - region.centroid.x) * scale;
-      double term = row[x];
-      for (int p = 0; p < n; ++p) {
-        sums[p] += term;
-        term *= dx;
+    for (size_t x = 0; x < cols;) {
+      const float v = row[x];
+      if (v <= 0) {
+        ++x;
+        continue;
       }
+      any = true;
+      if (v < 1.0f) {
+        for (size_t p = 0; p < un; ++p) sums[p] += v * power[x * un + p];
+        ++x;
+        continue;
+      }
+      const size_t a = x;
+      while (x < cols && row[x] >= 1.0f) ++x;
+      for (size_t p = 0; p < un; ++p) sums[p] += before[x * un + p] - before[a * un + p];
     }
     if (!any) continue;
     const std::complex<double> iy(0, (region.coverage_origin.y + y - region.centroid.y) * scale);
