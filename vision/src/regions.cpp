@@ -154,14 +154,14 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
   const bool lit = min_background >= kMinLitBackground;
 
   // Pixels 3 or more inside the binary boundary are the part's: their
-  // coverage is 1. The band is then 2 pixels each side of the boundary, as
-  // wide as `near` reaches out (a band 1 or 3 pixels deep placed the
-  // benchmark's parts 3 and 1.3 times worse). Reading the interior from grey
-  // levels too would only add its noise, and let a highlight or a printed mark on the part pull its
-  // centroid. Only the band around the boundary, where the edge blur is,
-  // carries the sub-pixel information. The interior's moments are summed
-  // run by run in closed form, so the cost follows the boundary's length,
-  // not the part's area.
+  // coverage is 1. Only the band around the boundary, where the edge blur
+  // is, carries sub-pixel information; reading the interior from grey levels
+  // too would only add its noise, and let a highlight or a printed mark on
+  // the part pull its centroid. The band is 2 pixels each side of the
+  // boundary, as far as `near` reaches out (1 or 3 pixels deep placed the
+  // benchmark's parts 3 and 1.3 times worse). The interior's moments are
+  // summed run by run in closed form, so the cost follows the boundary's
+  // length, not the part's area.
   cv::Mat coverage(box.size(), CV_32F, cv::Scalar(0));
   Moments10 sums;
   double interior_count = 0;
