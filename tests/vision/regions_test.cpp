@@ -302,3 +302,28 @@ TEST_CASE("the area of a defocused part is read from beyond its edge blur", "[vi
   INFO("area off by up to " << 100 * worst << " %");
   CHECK(worst < 0.02);
 }
+
+TEST_CASE("a highlight inside a part does not move its centroid", "[vision][regions]") {
+  // A shiny spot on the long leg, 6 px round, lighter than the part but not
+  // enough to be cut out of it: the part's pixels all the same. Read from
+  // its grey levels as partly uncovered, it would pull the centroid about a
+  // third of a pixel away; the interior is the part's whole.
+  for (const double deg : {0.0, 37.0, 141.0}) {
+    INFO("turned " << deg);
+    Drawn d = drawL(deg, false);
+    const double a = deg * M_PI / 180.0;
+    // The long leg's middle, 40 px along it from the L's own origin.
+    const cv::Point2d local(100 - 45, 15 - 25);
+    const cv::Point2d spot(200 + local.x * std::cos(a) - local.y * std::sin(a),
+                           200 + local.x * std::sin(a) + local.y * std::cos(a));
+    cv::circle(d.grey,
+               cv::Point(static_cast<int>(std::lround(spot.x * 16)),
+                         static_cast<int>(std::lround(spot.y * 16))),
+               6 * 16, cv::Scalar(110), cv::FILLED, cv::LINE_AA, 4);
+    const auto regions = regionsOf(d, true);
+    REQUIRE(regions.size() == 1);
+    CHECK(regions[0].holes == 0);
+    CHECK(cv::norm(regions[0].centroid - d.centroid) < 0.02);
+    CHECK(regions[0].area == Approx(4800).epsilon(0.005));
+  }
+}

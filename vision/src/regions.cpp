@@ -3,6 +3,7 @@
 #include "picksight/vision/regions.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
@@ -77,6 +78,21 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, cons
   if (!cv::solve(normal, rhs, solution, cv::DECOMP_CHOLESKY)) return false;
   *plane = solution;
   return true;
+}
+
+// The median of the values counted in `histogram` (`count` of them), each
+// bin taken as spread evenly over its unit width: a part of one grey level
+// gives exactly that level.
+double interpolatedMedian(const std::array<int, 256>& histogram, double count) {
+  const double half = count / 2;
+  double below = 0;
+  for (size_t v = 0; v < histogram.size(); ++v) {
+    const double here = histogram[v];
+    if (below + here >= half && here > 0)
+      return static_cast<double>(v) - 0.5 + (half - below) / here;
+    below += here;
+  }
+  return 255;
 }
 
 // Raw moments up to the third order, gathered row by row: a row's sums of
@@ -165,7 +181,8 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
   cv::Mat coverage(box.size(), CV_32F, cv::Scalar(0));
   Moments10 sums;
   double interior_count = 0;
-  double interior_grey = 0;
+  // The interior's grey levels, for their median.
+  std::array<int, 256> histogram{};
   for (int y = 0; y < h; ++y) {
     const uint8_t* in = interior.ptr<uint8_t>(y);
     const uint8_t* g = grey_box.ptr<uint8_t>(y);
@@ -176,25 +193,25 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
         continue;
       }
       const int a = x;
-      int grey_sum = 0;
       for (; x < w && in[x]; ++x) {
-        grey_sum += g[x];
+        ++histogram[g[x]];
         c[x] = 1.0f;
       }
       sums.addRun(a, x, y);
       interior_count += x - a;
-      interior_grey += grey_sum;
     }
   }
   if (interior_count < 8) return false;
-  // The interior's mean level: its mean grey against the background at its
+  // The interior's level: its median grey against the background at its
   // centroid (the plane is linear, so that is the background's mean there).
+  // The median, so that a highlight or a mark on the part does not change
+  // the contrast every edge pixel is read with.
   const double interior_background =
       plane[0] + plane[1] * sums.m10 / sums.m00 + plane[2] * sums.m01 / sums.m00;
-  const double mean_grey = interior_grey / interior_count;
+  const double part_grey = interpolatedMedian(histogram, interior_count);
   if (lit && interior_background <= 0) return false;
-  const double mean_level = lit ? mean_grey / interior_background : mean_grey - interior_background;
-  const double contrast = lit ? 1.0 - mean_level : mean_level;
+  const double part_level = lit ? part_grey / interior_background : part_grey - interior_background;
+  const double contrast = lit ? 1.0 - part_level : part_level;
   if (std::abs(contrast) < (lit ? kMinContrast : kMinContrast * 255)) return false;
   // Coverage = scale * level + offset: (1 - R) / contrast, or offset / contrast.
   const float scale = static_cast<float>(lit ? -1.0 / contrast : 1.0 / contrast);
