@@ -250,6 +250,21 @@ int main(int argc, char** argv) {
   app.add_option("--arrangements", which, "separated, touching, overlapping")
       ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
   app.add_flag("!--no-per-type", per_type, "families only");
+  // The camera's look, for conditions the defaults do not show: a defocused
+  // lens, a noisier sensor, less contrast, light parts on a dark table.
+  ps::SilhouetteSceneOptions look;
+  app.add_option("--blur", look.blur_sigma, "edge blur, sigma in pixels")
+      ->check(CLI::Range(0.0, 5.0))
+      ->capture_default_str();
+  app.add_option("--noise", look.noise_sigma, "sensor noise, sigma in grey levels")
+      ->check(CLI::Range(0.0, 40.0))
+      ->capture_default_str();
+  app.add_option("--part-level", look.part_level, "grey level of the parts")
+      ->check(CLI::Range(0.0, 255.0))
+      ->capture_default_str();
+  app.add_option("--background-level", look.background_level, "grey level of the background")
+      ->check(CLI::Range(0.0, 255.0))
+      ->capture_default_str();
   std::vector<std::string> custom;
   app.add_option("--types", custom,
                  "train these drawings instead of the default 15 (family \"other\"): "
@@ -262,6 +277,7 @@ int main(int argc, char** argv) {
   // setting a user picks for parts up to 350 px.
   pv::BinarizeOptions binarize;
   binarize.adaptive_window = 400;
+  if (look.part_level > look.background_level) binarize.polarity = pv::Polarity::kLightOnDark;
   pv::TrainOptions train;
   train.binarize = binarize;
 
@@ -304,7 +320,6 @@ int main(int argc, char** argv) {
   }
 
   // One model per type, trained on the part alone at rotation 0.
-  const ps::SilhouetteSceneOptions look;
   std::vector<pv::PartModel> models;
   std::vector<bool> chiral;
   std::vector<cv::Point2d> reference;  // per type: trained centroid - drawn centroid
