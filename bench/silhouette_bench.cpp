@@ -26,45 +26,15 @@
 #include "picksight/vision/part_model.hpp"
 #include "picksight/vision/recognizer.hpp"
 #include "picksight/vision/regions.hpp"
+#include "silhouette_types.hpp"
 
 namespace {
 namespace ps = picksight::synthetic;
 namespace pv = picksight::vision;
+using picksight::bench::TypeSpec;
 
 // A result this close to a drawn part's centroid is about that part.
 constexpr double kMatchRadiusPx = 12;
-
-// A benchmark type: where its drawing comes from and which family it shows.
-struct TypeSpec {
-  std::string name;
-  std::string file;  // under the data directory; empty: partShape(name)
-  std::string family;
-  double size_px;  // longest side in the image
-};
-
-// Chosen for what breaks recognition: thin stems and tines, long slender
-// parts, organic curved outlines, near-symmetric parts, and the repository's
-// own shapes as the reference.
-const std::vector<TypeSpec>& typeSpecs() {
-  static const std::vector<TypeSpec> specs = {
-      {"tulip", "shapes/tari1000/obj16_1.png", "thin", 260},
-      {"spoon", "shapes/tari1000/obj29_1.png", "thin", 240},
-      {"twig", "shapes/tari1000/obj43_1.png", "thin", 280},
-      {"palm", "shapes/tari1000/obj10_1.png", "thin", 250},
-      {"bottle", "shapes/tari1000/obj32_1.png", "slender", 230},
-      {"stick", "shapes/tari1000/obj50_1.png", "slender", 260},
-      {"bone", "shapes/kimia99/trainimage9_1.png", "slender", 240},
-      {"turtle", "shapes/tari1000/obj4_1.png", "curved", 200},
-      {"frog", "shapes/tari1000/obj20_1.png", "curved", 220},
-      {"blob", "shapes/tari1000/obj7_1.png", "curved", 180},
-      {"star", "shapes/tari1000/obj2_1.png", "near-symmetric", 200},
-      {"bell", "shapes/tari1000/obj41_1.png", "near-symmetric", 190},
-      {"gear", "", "own", 170},
-      {"l_shape", "", "own", 180},
-      {"slot", "", "own", 170},
-  };
-  return specs;
-}
 
 struct Stats {
   int truths = 0;
@@ -281,7 +251,7 @@ int main(int argc, char** argv) {
   pv::TrainOptions train;
   train.binarize = binarize;
 
-  std::vector<TypeSpec> specs = typeSpecs();
+  std::vector<TypeSpec> specs = picksight::bench::silhouetteTypeSpecs();
   if (!custom.empty()) {
     specs.clear();
     for (const auto& item : custom) {
@@ -306,18 +276,7 @@ int main(int argc, char** argv) {
     }
   }
   std::vector<ps::SilhouetteType> types;
-  for (const auto& spec : specs) {
-    if (spec.file.empty()) {
-      types.push_back(ps::silhouetteFromPartType(spec.name, spec.size_px));
-      continue;
-    }
-    const cv::Mat drawing = cv::imread(data_dir + "/" + spec.file, cv::IMREAD_GRAYSCALE);
-    if (drawing.empty()) {
-      std::fprintf(stderr, "cannot read %s/%s (--data DIR)\n", data_dir.c_str(), spec.file.c_str());
-      return 1;
-    }
-    types.push_back(ps::silhouetteFromDrawing(spec.name, drawing, spec.size_px));
-  }
+  if (!picksight::bench::loadSilhouetteTypes(specs, data_dir, &types)) return 1;
 
   // One model per type, trained on the part alone at rotation 0.
   std::vector<pv::PartModel> models;

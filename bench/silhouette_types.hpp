@@ -1,0 +1,66 @@
+// The everyday-object silhouette types the recognition benchmarks train, and
+// their drawings read from the test data. Header-only: bench code.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "picksight/synthetic/silhouette_scene.hpp"
+
+namespace picksight::bench {
+
+// A benchmark type: where its drawing comes from and which family it shows.
+struct TypeSpec {
+  std::string name;
+  std::string file;  // under the data directory; empty: partShape(name)
+  std::string family;
+  double size_px;  // longest side in the image
+};
+
+// Chosen for what breaks recognition: thin stems and tines, long slender
+// parts, organic curved outlines, near-symmetric parts, and the repository's
+// own shapes as the reference.
+inline const std::vector<TypeSpec>& silhouetteTypeSpecs() {
+  static const std::vector<TypeSpec> specs = {
+      {"tulip", "shapes/tari1000/obj16_1.png", "thin", 260},
+      {"spoon", "shapes/tari1000/obj29_1.png", "thin", 240},
+      {"twig", "shapes/tari1000/obj43_1.png", "thin", 280},
+      {"palm", "shapes/tari1000/obj10_1.png", "thin", 250},
+      {"bottle", "shapes/tari1000/obj32_1.png", "slender", 230},
+      {"stick", "shapes/tari1000/obj50_1.png", "slender", 260},
+      {"bone", "shapes/kimia99/trainimage9_1.png", "slender", 240},
+      {"turtle", "shapes/tari1000/obj4_1.png", "curved", 200},
+      {"frog", "shapes/tari1000/obj20_1.png", "curved", 220},
+      {"blob", "shapes/tari1000/obj7_1.png", "curved", 180},
+      {"star", "shapes/tari1000/obj2_1.png", "near-symmetric", 200},
+      {"bell", "shapes/tari1000/obj41_1.png", "near-symmetric", 190},
+      {"gear", "", "own", 170},
+      {"l_shape", "", "own", 180},
+      {"slot", "", "own", 170},
+  };
+  return specs;
+}
+
+// The types of `specs`, drawings read under `data_dir`. False, with a
+// message, when a drawing cannot be read.
+inline bool loadSilhouetteTypes(const std::vector<TypeSpec>& specs, const std::string& data_dir,
+                                std::vector<synthetic::SilhouetteType>* types) {
+  for (const auto& spec : specs) {
+    if (spec.file.empty()) {
+      types->push_back(synthetic::silhouetteFromPartType(spec.name, spec.size_px));
+      continue;
+    }
+    const cv::Mat drawing = cv::imread(data_dir + "/" + spec.file, cv::IMREAD_GRAYSCALE);
+    if (drawing.empty()) {
+      std::fprintf(stderr, "cannot read %s/%s (--data DIR)\n", data_dir.c_str(), spec.file.c_str());
+      return false;
+    }
+    types->push_back(synthetic::silhouetteFromDrawing(spec.name, drawing, spec.size_px));
+  }
+  return true;
+}
+
+}  // namespace picksight::bench
