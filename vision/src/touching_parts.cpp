@@ -20,6 +20,10 @@ using picksight::angleDiffDeg;
 using picksight::wrapDeg;
 
 constexpr int kMaxRefinedPerModel = 8;
+// The mirror image of a model is searched for among the blob's corners and
+// arcs this far beyond the model's reach from where the model itself may
+// lie (pixels).
+constexpr double kMirrorSearchMarginPx = 10;
 // Poses refined per blob, for each part the blob can hold: the best
 // screened hypotheses of all models, so that a blob costs about the same
 // whatever the number of trained types.
@@ -132,10 +136,33 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   double smallest = region.area;
   for (const PartModel* m : fitting) {
     smallest = std::min(smallest, m->body.area);
+    std::vector<ImagePose> direct_poses;
     for (const bool mirrored : {false, true}) {
       if (mirrored && m->body.mirror_symmetric) continue;
+      // The mirror image is looked for only where the model itself may lie:
+      // it is there to tell a part from its mirror image (a part shown
+      // mirrored is never reported), and the corners and arcs elsewhere in
+      // the blob cannot place it there.
+      if (mirrored && direct_poses.empty()) continue;
+      const double reach = m->radius + kMirrorSearchMarginPx;
+      const auto nearDirect = [&](cv::Point2d p) {
+        return std::any_of(direct_poses.begin(), direct_poses.end(), [&](const ImagePose& q) {
+          return std::hypot(p.x - q.centre.x, p.y - q.centre.y) <= reach;
+        });
+      };
+      std::vector<CornerAnchor> mirror_corners;
+      std::vector<ArcAnchor> mirror_arcs;
+      if (mirrored) {
+        for (const auto& c : image_corners) {
+          if (nearDirect(c.at)) mirror_corners.push_back(c);
+        }
+        for (const auto& a : image_arcs) {
+          if (nearDirect(a.centre)) mirror_arcs.push_back(a);
+        }
+      }
       std::vector<Candidate> proposed;
-      propose(*m, *searchOf(*m), mirrored, image_corners, image_arcs, edges, &proposed);
+      propose(*m, *searchOf(*m), mirrored, mirrored ? mirror_corners : image_corners,
+              mirrored ? mirror_arcs : image_arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
       std::vector<ImagePose> kept;
@@ -146,6 +173,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
         kept.push_back(p.pose);
         screened.push_back(p);
       }
+      if (!mirrored) direct_poses = kept;
     }
   }
   std::stable_sort(screened.begin(), screened.end(),

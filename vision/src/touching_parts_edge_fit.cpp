@@ -31,6 +31,8 @@ double loopOrientation(const BoundaryLoop& loop) {
 }
 
 namespace {
+// Step of the coverage readings along an edge sample's normal.
+constexpr double kFitStepPx = 0.5;
 // Edge-fit iterations before the last two read every third edge sample:
 // the pose is still settling there.
 constexpr int kSparseFitStride = 3;
@@ -77,21 +79,36 @@ void alongPrimitive(const Primitive& p, bool whole_loop, double weight, double s
 // Where, along p + s n (n pointing away from the body), the coverage falls
 // through 0.5 from a clean inside to a clean outside, nearest to `expected`;
 // none where the part touches another (no outside) or the edge is a mess.
+// Read every `step` pixels; `halve`: the chosen crossing is then placed
+// between readings half a step apart (one more reading), as precisely as
+// a scan at half the step would place it.
 std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point2d n, double window,
-                                   double expected, double step) {
+                                   double expected, double step, bool halve = false) {
   std::optional<double> best;
+  double best_from = 0;  // the reading before the chosen crossing, its value, the next
+  double best_before = 0;
+  double best_after = 0;
   double previous = cov.at(p - n * window);
   for (double s = -window + step; s <= window + 1e-9; s += step) {
     const double v = cov.at(p + n * s);
     if (previous >= 0.5 && v < 0.5) {
       const double at = s - step + step * (previous - 0.5) / (previous - v);
       if (!best || std::abs(at - expected) < std::abs(*best - expected)) {
-        if (cov.at(p + n * (at - 1.5)) >= 0.7 && cov.at(p + n * (at + 1.5)) <= 0.3) best = at;
+        if (cov.at(p + n * (at - 1.5)) >= 0.7 && cov.at(p + n * (at + 1.5)) <= 0.3) {
+          best = at;
+          best_from = s - step;
+          best_before = previous;
+          best_after = v;
+        }
       }
     }
     previous = v;
   }
-  return best;
+  if (!best || !halve) return best;
+  const double half = 0.5 * step;
+  const double middle = cov.at(p + n * (best_from + half));
+  if (middle >= 0.5) return best_from + half + half * (middle - 0.5) / (middle - best_after);
+  return best_from + half * (best_before - 0.5) / (best_before - middle);
 }
 }  // namespace
 
@@ -126,38 +143,39 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
   double total = 0;
   for (const auto& e : samples) total += e.weight;
   if (total <= 0) return fit;
-  // The last pass only measures: residuals and inliers at the final pose.
-  for (int it = 0; it <= iterations; ++it) {
-    const bool measure_only = it == iterations;
+  for (int it = 0; it < iterations; ++it) {
     const double c = std::cos(fit.pose.angle_deg * kRadPerDeg);
     const double s = std::sin(fit.pose.angle_deg * kRadPerDeg);
-    const double step = window > 2.0 ? 0.5 : 0.25;
+    // Coarse readings place the crossing well enough while the pose
+    // settles; the two dense passes halve them.
+    const bool dense = it >= iterations - 2;
     cv::Matx44d a = cv::Matx44d::zeros();
     cv::Vec4d b(0, 0, 0, 0);
     double found = 0;
     double sum2 = 0;
     int used = 0;
-    const size_t stride = it < iterations - 2 ? kSparseFitStride : 1;
+    const size_t stride = it == iterations - 1 ? 1 : dense ? 2 : kSparseFitStride;
     for (size_t i = 0; i < samples.size(); i += stride) {
       const EdgeSample& e = samples[i];
       const cv::Point2d r = rotate({e.point.x, flip * e.point.y}, c, s);
       const cv::Point2d n = rotate({e.normal.x, flip * e.normal.y}, c, s);
-      const auto crossing = edgeCrossing(cov, fit.pose.centre + r, n, window, offset, step);
+      const auto crossing =
+          edgeCrossing(cov, fit.pose.centre + r, n, window, offset, kFitStepPx, dense);
       if (!crossing || std::abs(*crossing - offset) > gate) continue;
       const double residual = *crossing - offset;
       found += e.weight;
       sum2 += residual * residual;
       ++used;
-      if (measure_only) continue;
       const cv::Vec4d j(n.x, n.y, n.x * -r.y + n.y * r.x, 1.0);
       a += e.weight * (j * j.t());
       b += e.weight * *crossing * j;
     }
     if (used < 8) return fit;
+    // Measured before the last update: it moves the pose by hundredths of a
+    // pixel, not worth another pass over every sample.
     const double rms = std::sqrt(sum2 / used);
     fit.rms_px = rms;
     fit.inlier_fraction = found * static_cast<double>(stride) / total;
-    if (measure_only) break;
     cv::Vec4d x;
     if (!cv::solve(a, b, x, cv::DECOMP_CHOLESKY)) return fit;
     fit.pose.centre += cv::Point2d(x[0], x[1]);

@@ -138,8 +138,8 @@ void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>
         const double det = in.x * out.y - in.y * out.x;
         const double along = (gap.x * out.y - gap.y * out.x) / det;
         const bool loop_convex = (turn > 0) == left_interior;
-        corners->push_back({a.end + in * along, angleOf(u), 180.0 - std::abs(turn),
-                            loop.hole ? !loop_convex : loop_convex});
+        corners->push_back({a.end + in * along, angleOf(u), u / std::hypot(u.x, u.y),
+                            180.0 - std::abs(turn), loop.hole ? !loop_convex : loop_convex});
       }
     }
     for (const auto& p : prims) {
@@ -184,8 +184,9 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       if (mc.convex != ic.convex) continue;
       if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
       const double angle = ic.bisector_deg - f * mc.bisector_deg;
-      const double cosine = std::cos(angle * kRadPerDeg);
-      const double sine = std::sin(angle * kRadPerDeg);
+      // cos and sin of the difference of the two bisectors' directions.
+      const double cosine = ic.bisector.x * mc.bisector.x + f * ic.bisector.y * mc.bisector.y;
+      const double sine = ic.bisector.y * mc.bisector.x - f * ic.bisector.x * mc.bisector.y;
       const cv::Point2d centre = ic.at - rotate({mc.at.x, f * mc.at.y}, cosine, sine);
       if (!verifiesAtLeast(glance, search.glance_weight, centre, cosine, sine, f, edges, loose,
                            threshold - kGlanceSlack)) {
@@ -224,8 +225,18 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       const int steps = static_cast<int>(std::ceil(2 * half / coarse)) + 1;
       const double step = 2 * half / (steps - 1);
       scan.resize(static_cast<size_t>(steps));
-      for (int k = 0; k < steps; ++k)
-        scan[k] = screen(ma.centre, ia.centre, middle - half + k * step, glance).score;
+      // A step whose glance cannot reach the threshold is neither kept nor
+      // a better neighbour of one that is: -1 stands for its score.
+      for (int k = 0; k < steps; ++k) {
+        const double angle = middle - half + k * step;
+        const double c = std::cos(angle * kRadPerDeg);
+        const double s = std::sin(angle * kRadPerDeg);
+        const cv::Point2d centre = ia.centre - rotate({ma.centre.x, f * ma.centre.y}, c, s);
+        scan[k] = verifiesAtLeast(glance, search.glance_weight, centre, c, s, f, edges,
+                                  model.edge_tolerance, threshold - kGlanceSlack)
+                      ? screen(ma.centre, ia.centre, angle, glance).score
+                      : -1.0;
+      }
       for (int k = 0; k < steps; ++k) {
         const double s = scan[k];
         if (s < threshold - kGlanceSlack || (k > 0 && s < scan[k - 1]) ||

@@ -35,6 +35,7 @@ double loopOrientation(const BoundaryLoop& loop);
 struct CornerAnchor {
   cv::Point2d at;
   double bisector_deg = 0;
+  cv::Point2d bisector;  // the unit vector: turns between corners without a sine
   double opening_deg = 0;
   bool convex = true;
 };
