@@ -81,6 +81,12 @@ constexpr double kCircleDeg = 359;
 // to the finest.
 constexpr double kCornerTurnStepDeg = 2.0;
 constexpr double kCornerTurnFinestDeg = 0.5;
+// A settled pose explains a corner or arc of the blob when it puts the
+// model's within this many pixels of it, turned within this many degrees
+// (a corner's bisector is a few degrees off; an arc's middle is wherever
+// the contact cut it: any turn within kArcSlideDeg).
+constexpr double kExplainedPx = 3.0;
+constexpr double kExplainedDeg = kCornerAngleSlackDeg;
 
 // Whether at least `needed` (a fraction) of the samples' weight lies within
 // `tolerance` of an edge at the pose (centre, turn with cosine c and sine s,
@@ -179,11 +185,34 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
   // first look forgives that with a wider tolerance, and the turn about the
   // corner is then searched coarse to fine on the screening samples.
   const double loose = kLooseScreenFactor * model.edge_tolerance;
+  // Poses screened as well as a part verifies: a corner or an arc of the
+  // blob that one of them already puts its model's corner or arc on has
+  // nothing new to propose (every corner of a part that shows leads to the
+  // same pose, which would be screened again and again).
+  struct Settled {
+    ImagePose pose;
+    double c;
+    double s;
+  };
+  std::vector<Settled> settled;
+  const auto settle = [&](const Candidate& c) {
+    if (c.score * 100 < model.verify_percent) return;
+    settled.push_back(
+        {c.pose, std::cos(c.pose.angle_deg * kRadPerDeg), std::sin(c.pose.angle_deg * kRadPerDeg)});
+  };
+  const auto explained = [&](cv::Point2d model_point, cv::Point2d image_point, double angle) {
+    return std::any_of(settled.begin(), settled.end(), [&](const Settled& q) {
+      if (std::abs(signedDeg(q.pose.angle_deg - angle)) > kExplainedDeg) return false;
+      const cv::Point2d at = q.pose.centre + rotate({model_point.x, f * model_point.y}, q.c, q.s);
+      return std::hypot(at.x - image_point.x, at.y - image_point.y) <= kExplainedPx;
+    });
+  };
   for (const auto& mc : search.corners) {
     for (const auto& ic : image_corners) {
       if (mc.convex != ic.convex) continue;
       if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
       const double angle = ic.bisector_deg - f * mc.bisector_deg;
+      if (explained(mc.at, ic.at, angle)) continue;
       // cos and sin of the difference of the two bisectors' directions.
       const double cosine = ic.bisector.x * mc.bisector.x + f * ic.bisector.y * mc.bisector.y;
       const double sine = ic.bisector.y * mc.bisector.x - f * ic.bisector.x * mc.bisector.y;
@@ -202,6 +231,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
         }
       }
       if (c.score >= threshold) out->push_back(c);
+      settle(c);
     }
   }
   // An arc fixes where its centre goes; the turn about it lines up the two
@@ -216,6 +246,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
       if ((ia.sweep_deg > 0) != (f * ma.sweep_deg > 0)) continue;
       const double middle = ia.mid_deg - f * ma.mid_deg;
+      if (explained(ma.centre, ia.centre, middle)) continue;
       // A whole circle's ends are wherever its loop started: any turn.
       const bool circle = std::max(std::abs(ma.sweep_deg), std::abs(ia.sweep_deg)) >= kCircleDeg;
       const double half =
@@ -251,6 +282,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
           if (c.score > best.score) best = c;
         }
         if (best.score >= threshold) out->push_back(best);
+        settle(best);
       }
     }
   }
