@@ -27,7 +27,7 @@ constexpr double kMinArcRadiusPx = 4;
 // Hypotheses are screened on this many boundary samples before a full check,
 // after a first look at a quarter of them.
 constexpr size_t kSparseSamples = 64;
-constexpr size_t kGlanceSamples = 16;
+constexpr size_t kGlanceSamples = 12;
 // The first look's score may fall this far below the screening threshold
 // (16 samples judge a pose more roughly).
 constexpr double kGlanceSlack = 0.1;
