@@ -5,7 +5,8 @@
 // per shape family the LOCATE-equivalent time (binarize, regions, recognize
 // with every model) beside a plain OpenCV pass on the same frames,
 // precision, recall and the position and angle errors. Never fails on them.
-// --types trains any other drawings instead (shapes never tuned on).
+// --types trains any other drawings instead (shapes never tuned on);
+// --from-edges locates every part the way touching parts are.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,6 +27,7 @@
 #include "picksight/vision/part_model.hpp"
 #include "picksight/vision/recognizer.hpp"
 #include "picksight/vision/regions.hpp"
+#include "picksight/vision/touching_parts.hpp"
 #include "silhouette_types.hpp"
 
 namespace {
@@ -235,6 +237,10 @@ int main(int argc, char** argv) {
   app.add_option("--background-level", look.background_level, "grey level of the background")
       ->check(CLI::Range(0.0, 255.0))
       ->capture_default_str();
+  bool from_edges = false;
+  app.add_flag("--from-edges", from_edges,
+               "locate every blob's parts the way touching parts are (hypotheses and the edge "
+               "fit), to measure that path on separated parts");
   std::vector<std::string> custom;
   app.add_option("--types", custom,
                  "train these drawings instead of the default 15 (family \"other\"): "
@@ -339,7 +345,15 @@ int main(int argc, char** argv) {
             turn++,
             {[&] {
                const auto regions = pv::findRegions(pv::binarize(grey, binarize), {}, grey);
-               matches = pv::recognize(regions, list);
+               if (from_edges) {
+                 matches.clear();
+                 for (size_t i = 0; i < regions.size(); ++i) {
+                   const auto in_blob = pv::locateInBlob(regions, i, list);
+                   matches.insert(matches.end(), in_blob.begin(), in_blob.end());
+                 }
+               } else {
+                 matches = pv::recognize(regions, list);
+               }
              },
              [&] { sink += picksight::bench::competentOpenCvPass(grey); }},
             {&tally.ours_ms, &tally.plain_ms});

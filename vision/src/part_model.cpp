@@ -131,6 +131,38 @@ HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const Image
   return e;
 }
 
+// A boundary fitted to the edges puts the part's centroid a few tenths of a
+// pixel off where the snap to the edges could not move a primitive (short
+// edges, thin stems): every pose found from the edges (parts that touch)
+// would inherit it. The boundary is moved, once, so that the fit to the
+// training edges puts the model's origin on the trained centroid.
+constexpr double kMaxCentringPx = 1.0;
+constexpr double kMaxCentringDeg = 1.0;
+
+void centreOnEdges(PartModel& m, const Region& r) {
+  const EdgeFit fit = refinePoseOnEdges(m, r, {r.centroid, 0.0, false});
+  if (!fit.ok) return;
+  // Model point p lies on the edges at centroid + delta + R(e) p: in the
+  // model frame, at delta + R(e) p.
+  const cv::Point2d delta = fit.pose.centre - r.centroid;
+  const double e = signedDeg(fit.pose.angle_deg);
+  if (std::hypot(delta.x, delta.y) > kMaxCentringPx || std::abs(e) > kMaxCentringDeg) return;
+  const double c = std::cos(e * kRadPerDeg);
+  const double s = std::sin(e * kRadPerDeg);
+  const auto move = [&](cv::Point2d p) {
+    return cv::Point2d(c * p.x - s * p.y, s * p.x + c * p.y) + delta;
+  };
+  for (auto& loop : m.loops) {
+    for (auto& p : loop.primitives) {
+      p.start = move(p.start);
+      p.end = move(p.end);
+      p.centre = move(p.centre);
+    }
+  }
+  m.corners = findCorners(m.loops, m.conformity);
+  prepareModel(m);
+}
+
 std::vector<std::vector<cv::Point>> contoursOf(const Region& r) {
   std::vector<std::vector<cv::Point>> all{r.outer};
   all.insert(all.end(), r.hole_boundaries.begin(), r.hole_boundaries.end());
@@ -250,6 +282,7 @@ Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int
   snapToEdges(m.loops, r, r.centroid);
   m.corners = findCorners(m.loops, m.conformity);
   prepareModel(m);
+  centreOnEdges(m, r);
 
   // Orientation order: the lowest whose complex moment has a direction.
   std::vector<double> strength;

@@ -1,0 +1,123 @@
+// What the touching-parts files share: boundary anchors (corners, arcs), the
+// model's search data, screened candidates and the coverage reader. Not
+// installed: only touching_parts*.cpp include it.
+#pragma once
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/common/angles.hpp"
+#include "picksight/vision/boundary_model.hpp"
+#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/regions.hpp"
+
+namespace picksight::vision {
+namespace touching {
+
+using picksight::kRadPerDeg;
+
+inline double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kRadPerDeg; }
+
+inline cv::Point2d rotate(cv::Point2d p, double c, double s) {
+  return {c * p.x - s * p.y, s * p.x + c * p.y};
+}
+
+// Twice the signed area of a loop: > 0 when its interior lies on the side of
+// the left normal (-t.y, t.x) of the walking direction t.
+double loopOrientation(const BoundaryLoop& loop);
+
+// A corner as an unordered pair of edges leaving a point, so that it reads
+// the same on a mirrored model: the bisector of the two edges, the opening
+// angle between them, and whether the body fills the opening.
+struct CornerAnchor {
+  cv::Point2d at;
+  double bisector_deg = 0;
+  cv::Point2d bisector;  // the unit vector: turns between corners without a sine
+  double opening_deg = 0;
+  bool convex = true;
+};
+
+struct ArcAnchor {
+  cv::Point2d centre;
+  double radius = 0;
+  double length = 0;
+  double mid_deg = 0;    // direction of the arc's middle from its centre
+  double sweep_deg = 0;  // signed, in the loop's walking direction
+};
+
+// The corners and arcs of fitted loops (model frame or image).
+void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
+               std::vector<ArcAnchor>* arcs);
+
+// A boundary point of the model with its normal pointing away from the body.
+struct EdgeSample {
+  cv::Point2d point;
+  cv::Point2d normal;
+  double weight = 0;
+};
+
+// The model's edge samples every `step` pixels, away from primitive ends.
+std::vector<EdgeSample> edgeSamples(const PartModel& model, double step);
+
+// Bilinear reading of a region's coverage (0 outside its box).
+class Coverage {
+ public:
+  explicit Coverage(const Region& r) : c_(r.coverage), origin_(r.coverage_origin) {}
+  float at(cv::Point2d p) const {
+    const double x = p.x - origin_.x;
+    const double y = p.y - origin_.y;
+    const int x0 = static_cast<int>(std::floor(x));
+    const int y0 = static_cast<int>(std::floor(y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= c_.cols || y0 + 1 >= c_.rows) return 0.f;
+    const float fx = static_cast<float>(x - x0);
+    const float fy = static_cast<float>(y - y0);
+    const float* r0 = c_.ptr<float>(y0) + x0;
+    const float* r1 = c_.ptr<float>(y0 + 1) + x0;
+    return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+  }
+
+ private:
+  const cv::Mat& c_;
+  cv::Point origin_;
+};
+
+struct Candidate {
+  const PartModel* model = nullptr;
+  ImagePose pose;
+  double score = 0;
+  double rms = 0;
+};
+
+// A corner's first look counts boundary samples within this many edge
+// tolerances: the blob's distance map must reach that far.
+constexpr double kLooseScreenFactor = 2.0;
+
+}  // namespace touching
+
+struct BlobSearchModel {
+  std::vector<touching::CornerAnchor> corners;  // the most telling (keepTelling)
+  std::vector<touching::ArcAnchor> arcs;        // likewise
+  std::vector<BoundarySample> sparse;           // hypotheses are screened on these
+  std::vector<BoundarySample> glance;           // after a first look at these
+  std::vector<touching::EdgeSample> edges;      // poses are refined on these, 1 px apart
+  double glance_weight = 0;                     // the glance samples' total
+};
+
+namespace touching {
+
+// The model's side of the search: derived by prepareModel, or built here
+// for a model put together without it.
+std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m);
+
+// Screens the poses proposed for one model (direct or mirrored) in a blob:
+// appends those that verify well enough on `edges` to `out`.
+void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored,
+             const std::vector<CornerAnchor>& image_corners,
+             const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
+             std::vector<Candidate>* out);
+
+}  // namespace touching
+}  // namespace picksight::vision
