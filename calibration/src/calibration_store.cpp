@@ -221,48 +221,51 @@ Result<void> CalibrationStore::load() {
   return {};
 }
 
-Result<int> CalibrationStore::addPoint(const PointPair& pair, std::optional<cv::Point2d> pixel) {
+Result<void> CalibrationStore::change(const std::function<void(CalibrationStore&)>& edit) {
   CalibrationStore next = *this;
-  const int id = next.next_id_++;
-  next.points_[id] = pair;
-  if (pixel) next.pixels_[id] = *pixel;
-  if (auto ok = next.save(); !ok) return ok.error();
+  edit(next);
+  if (auto ok = next.save(); !ok) return ok;
   *this = std::move(next);
+  return {};
+}
+
+Result<int> CalibrationStore::addPoint(const PointPair& pair, std::optional<cv::Point2d> pixel) {
+  const int id = next_id_;
+  auto ok = change([&](CalibrationStore& next) {
+    ++next.next_id_;
+    next.points_[id] = pair;
+    if (pixel) next.pixels_[id] = *pixel;
+  });
+  if (!ok) return ok.error();
   return id;
 }
 
 Result<void> CalibrationStore::deletePoint(int id) {
   if (!points_.count(id)) return systemError(ENOENT, "no point with id " + std::to_string(id));
-  CalibrationStore next = *this;
-  next.points_.erase(id);
-  next.pixels_.erase(id);
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) {
+    next.points_.erase(id);
+    next.pixels_.erase(id);
+  });
 }
 
 Result<void> CalibrationStore::setTransform(const CalibrationResult& result) {
-  CalibrationStore next = *this;
-  next.transform_ = result;
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) { next.transform_ = result; });
 }
 
 Result<void> CalibrationStore::setScale(const PixelScale& scale) {
-  CalibrationStore next = *this;
-  next.scale_ = scale;
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) { next.scale_ = scale; });
 }
 
 Result<void> CalibrationStore::setLens(const LensModel& lens) {
-  CalibrationStore next = *this;
-  next.lens_ = lens;
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) { next.lens_ = lens; });
+}
+
+Result<void> CalibrationStore::setScaleAndLens(const PixelScale& scale,
+                                               const std::optional<LensModel>& lens) {
+  return change([&](CalibrationStore& next) {
+    next.scale_ = scale;
+    if (lens) next.lens_ = *lens;
+  });
 }
 
 }  // namespace picksight::calibration
