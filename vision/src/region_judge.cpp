@@ -136,13 +136,20 @@ constexpr double kKeepMomentsDeg = 1.0;
 // ... and verified within this fraction of the refined pose's score.
 constexpr double kKeepMomentsSlack = 0.02;
 
-Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
-            const EdgeDistance& edges, bool mirrored) {
+// The best verified of the rotation candidates, unrefined.
+Best bestCandidate(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
+                   const EdgeDistance& edges, bool mirrored) {
   Best best;
   for (double t : turns) {
     const double s = verifyScore(model.samples, centre, t, edges, model.edge_tolerance, mirrored);
     if (s > best.score) best = {s, t, t};
   }
+  return best;
+}
+
+Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
+            const EdgeDistance& edges, bool mirrored) {
+  Best best = bestCandidate(turns, model, centre, edges, mirrored);
   if (best.score * 100 < model.verify_percent - 100 * kRefineSlack) return best;
   const double clip = 2 * model.edge_tolerance;
   const auto cost = [&](double t) {
@@ -257,13 +264,15 @@ Verdict judgeRegion(RegionCache& cache, const PartModel& model, bool check_scale
   // The mirror image of the model, turned its own way, at its best pose:
   // where the two hands differ decides which one the region is. A region
   // the model does not verify on is its mirror image when that verifies
-  // (an L's, whose legs swap sides): a whole part, not a blob to search.
-  const Best mirror =
-      bestOf(candidates(phase, -model.orientation_phase_deg, k), model, r.centroid, edges, true);
-  const bool mirror_verified = mirror.score * 100 >= model.verify_percent;
+  // at one of its candidates (an L's, whose legs swap sides): a whole
+  // part, not a blob to search. Unrefined: a region of another type that
+  // passes this one's body tests costs a few lookups more, not a search.
+  const std::vector<double> mirror_turns = candidates(phase, -model.orientation_phase_deg, k);
+  const Best mirror = verified ? bestOf(mirror_turns, model, r.centroid, edges, true)
+                               : bestCandidate(mirror_turns, model, r.centroid, edges, true);
   if (verified ? showsMirrorImage(model, {r.centroid, direct.fit_deg, false},
                                   {r.centroid, mirror.fit_deg, true}, edges)
-               : mirror_verified) {
+               : mirror.score * 100 >= model.verify_percent) {
     v.test = RegionTest::kMirror;
     v.measured = std::max(0.0, mirror.score) * 100;
     v.low = v.high = std::max(0.0, direct.score) * 100;
