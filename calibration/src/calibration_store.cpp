@@ -10,6 +10,8 @@
 #include <sys/stat.h>
 #include <cerrno>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "picksight/common/atomic_file.hpp"
 
@@ -33,6 +35,24 @@ double number(const YAML::Node& node, const char* key, const std::string& where)
   return v;
 }
 
+// A 3x3 matrix under `key`, row by row: nine finite numbers.
+cv::Matx33d matrix(const YAML::Node& node, const char* key, const std::string& where) {
+  if (!node[key]) throw std::runtime_error("missing " + where + key);
+  std::vector<double> v;
+  try {
+    v = node[key].as<std::vector<double>>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(where + key + " is not a list of numbers");
+  }
+  if (v.size() != 9) throw std::runtime_error(where + key + " must have 9 values");
+  cv::Matx33d m;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) throw std::runtime_error(where + key + " is not all finite numbers");
+    m.val[i] = v[i];
+  }
+  return m;
+}
+
 PlaneTransform transformFromYaml(const YAML::Node& t) {
   const std::string model = t["model"] ? t["model"].as<std::string>() : "rigid";
   const RigidTransform rigid{number(t, "dx", "transform."), number(t, "dy", "transform."),
@@ -45,15 +65,7 @@ PlaneTransform transformFromYaml(const YAML::Node& t) {
     return PlaneTransform::similarity(rigid, scale);
   }
   if (model == "homography" || model == "tilt") {
-    const auto m = t["matrix"] ? t["matrix"].as<std::vector<double>>() : std::vector<double>{};
-    if (m.size() != 9) throw std::runtime_error("transform.matrix must have 9 values");
-    cv::Matx33d h;
-    for (int i = 0; i < 9; ++i) {
-      if (!std::isfinite(m[static_cast<size_t>(i)]))
-        throw std::runtime_error("transform.matrix is not all finite numbers");
-      h.val[i] = m[static_cast<size_t>(i)];
-    }
-    auto p = PlaneTransform::homography(h);
+    auto p = PlaneTransform::homography(matrix(t, "matrix", "transform."));
     if (!p) throw std::runtime_error("transform.matrix: " + p.error().message);
     if (model == "tilt") p->model = TransformModel::kTilt;
     return *p;
@@ -175,15 +187,8 @@ Result<void> CalibrationStore::load() {
                        s["skew_deg"] ? number(s, "skew_deg", "scale.") : 0};
       if (!(scale.mm_per_px_x > 0) || !(scale.mm_per_px_y > 0))
         throw std::runtime_error("scale must be positive");
-      if (const auto r = s["rectify"]) {
-        const auto v = r.as<std::vector<double>>();
-        if (v.size() != 9) throw std::runtime_error("scale.rectify must have 9 values");
-        cv::Matx33d h;
-        for (int i = 0; i < 9; ++i) {
-          if (!std::isfinite(v[static_cast<size_t>(i)]))
-            throw std::runtime_error("scale.rectify is not all finite");
-          h.val[i] = v[static_cast<size_t>(i)];
-        }
+      if (s["rectify"]) {
+        const cv::Matx33d h = matrix(s, "rectify", "scale.");
         if (!(std::abs(cv::determinant(h)) > 1e-12))
           throw std::runtime_error("scale.rectify is singular");
         scale.rectify = h;
@@ -216,48 +221,51 @@ Result<void> CalibrationStore::load() {
   return {};
 }
 
-Result<int> CalibrationStore::addPoint(const PointPair& pair, std::optional<cv::Point2d> pixel) {
+Result<void> CalibrationStore::change(const std::function<void(CalibrationStore&)>& edit) {
   CalibrationStore next = *this;
-  const int id = next.next_id_++;
-  next.points_[id] = pair;
-  if (pixel) next.pixels_[id] = *pixel;
-  if (auto ok = next.save(); !ok) return ok.error();
+  edit(next);
+  if (auto ok = next.save(); !ok) return ok;
   *this = std::move(next);
+  return {};
+}
+
+Result<int> CalibrationStore::addPoint(const PointPair& pair, std::optional<cv::Point2d> pixel) {
+  const int id = next_id_;
+  auto ok = change([&](CalibrationStore& next) {
+    ++next.next_id_;
+    next.points_[id] = pair;
+    if (pixel) next.pixels_[id] = *pixel;
+  });
+  if (!ok) return ok.error();
   return id;
 }
 
 Result<void> CalibrationStore::deletePoint(int id) {
   if (!points_.count(id)) return systemError(ENOENT, "no point with id " + std::to_string(id));
-  CalibrationStore next = *this;
-  next.points_.erase(id);
-  next.pixels_.erase(id);
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) {
+    next.points_.erase(id);
+    next.pixels_.erase(id);
+  });
 }
 
 Result<void> CalibrationStore::setTransform(const CalibrationResult& result) {
-  CalibrationStore next = *this;
-  next.transform_ = result;
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) { next.transform_ = result; });
 }
 
 Result<void> CalibrationStore::setScale(const PixelScale& scale) {
-  CalibrationStore next = *this;
-  next.scale_ = scale;
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) { next.scale_ = scale; });
 }
 
 Result<void> CalibrationStore::setLens(const LensModel& lens) {
-  CalibrationStore next = *this;
-  next.lens_ = lens;
-  if (auto ok = next.save(); !ok) return ok;
-  *this = std::move(next);
-  return {};
+  return change([&](CalibrationStore& next) { next.lens_ = lens; });
+}
+
+Result<void> CalibrationStore::setScaleAndLens(const PixelScale& scale,
+                                               const std::optional<LensModel>& lens) {
+  return change([&](CalibrationStore& next) {
+    next.scale_ = scale;
+    if (lens) next.lens_ = *lens;
+  });
 }
 
 }  // namespace picksight::calibration

@@ -223,20 +223,20 @@ TEST_CASE("WHY and the rejections name the test a region failed", "[e2e][results
   INFO("WHY: " << why);
   CHECK(why == r.why());
   CHECK(why.rfind("OK 3 region ", 0) == 0);
-  bool area = false, mirror = false, other = false;
+  bool scale = false, mirror = false, other = false;
   for (const auto& rejection : r.rejections()) {
     const auto& region = r.regions(rejection.region());
     INFO(rejection.text());
     CHECK(why.find(rejection.text()) != std::string::npos);
     if (region.centroid().x() > 400 && region.centroid().y() < 240) {
-      // The small L: 0.64 of the area, outside the model's tolerance.
-      area = rejection.test() == "area";
+      // The small L: the L at 0.8x, outside the sizes the model's area
+      // tolerance allows.
+      scale = rejection.test() == "scale";
       CHECK(rejection.nearest_type() == 1);
-      CHECK(rejection.measured() == Approx(region.area()).epsilon(0.001));
+      CHECK(rejection.measured() == Approx(0.8).margin(0.01));
       CHECK(rejection.measured() < rejection.low());
       CHECK(rejection.low() < rejection.high());
-      CHECK(rejection.text().find(" area ") != std::string::npos);
-      CHECK(rejection.text().find(" outside ") != std::string::npos);
+      CHECK(rejection.text().find(" scaled 0.80x outside ") != std::string::npos);
     } else if (region.centroid().x() < 320) {
       mirror = rejection.test() == "mirror";
       CHECK(rejection.nearest_type() == 1);
@@ -247,7 +247,7 @@ TEST_CASE("WHY and the rejections name the test a region failed", "[e2e][results
       CHECK(rejection.nearest_name() == "disc");
     }
   }
-  CHECK(area);
+  CHECK(scale);
   CHECK(mirror);
   CHECK(other);
   // WHY is per connection: another robot has not located yet.

@@ -2,14 +2,13 @@
 // `LOCATE <type>` across every type.
 #include "picksight/cell/recognition_pass.hpp"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
 
 #include "picksight/vision/blob_features.hpp"
+#include "picksight/vision/region_judge.hpp"
 
 namespace picksight::app {
 namespace {
@@ -19,29 +18,6 @@ namespace {
 // taught twice, tie, and a tie keeps the asked type.
 constexpr double kCloserFactor = 2.0 / 3;
 constexpr double kCloserMargin = 0.1;
-
-bool hasHoleBelow(const std::vector<vision::Region>& regions, double min_hole_area) {
-  for (const auto& r : regions)
-    if (holesAtLeast(r, min_hole_area) != r.holes) return true;
-  return false;
-}
-
-// The regions as a model with `min_hole_area` sees them: same order (the
-// matches' indices hold), smaller holes left out.
-std::vector<vision::Region> withHolesAtLeast(const std::vector<vision::Region>& regions,
-                                             double min_hole_area) {
-  std::vector<vision::Region> out = regions;
-  for (auto& r : out) {
-    auto& holes = r.hole_boundaries;
-    holes.erase(std::remove_if(holes.begin(), holes.end(),
-                               [&](const std::vector<cv::Point>& h) {
-                                 return cv::contourArea(h) < min_hole_area;
-                               }),
-                holes.end());
-    r.holes = static_cast<int>(holes.size());
-  }
-  return out;
-}
 
 // Where models of several hole settings found parts in one region, the
 // setting whose best part there scores highest keeps the region: as when
@@ -74,7 +50,7 @@ std::optional<ScreenedOut> screen(const vision::Match& match, const vision::Regi
   out.asked_distance = normalizedHu(*match.model, log_hu);
   for (const vision::PartModel* m : others) {
     const vision::BodyModel& body = m->body;
-    if (holesAtLeast(region, m->min_hole_area) != body.holes) continue;
+    if (vision::holesAtLeast(region, m->min_hole_area) != body.holes) continue;
     if (std::abs(region.area - body.area) > body.area_tolerance * body.area) continue;
     const double d = normalizedHu(*m, log_hu);
     if (d > 1 || d >= kCloserFactor * out.asked_distance ||
@@ -101,13 +77,6 @@ vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
   return o;
 }
 
-int holesAtLeast(const vision::Region& region, double min_hole_area) {
-  if (min_hole_area <= 0) return region.holes;
-  int n = 0;
-  for (const auto& h : region.hole_boundaries) n += cv::contourArea(h) >= min_hole_area ? 1 : 0;
-  return n;
-}
-
 RecognitionPass recognizeParts(const std::vector<vision::Region>& regions,
                                const std::vector<vision::PartModel>& models, int type) {
   // The asked models by their minimum hole area: one recognize() per
@@ -124,15 +93,15 @@ RecognitionPass recognizeParts(const std::vector<vision::Region>& regions,
   RecognitionPass pass;
   if (settings.size() == 1) {
     const auto& [min_hole_area, list] = *settings.begin();
-    pass.matches = hasHoleBelow(regions, min_hole_area)
-                       ? vision::recognize(withHolesAtLeast(regions, min_hole_area), list)
+    pass.matches = vision::hasHoleBelow(regions, min_hole_area)
+                       ? vision::recognize(vision::withHolesAtLeast(regions, min_hole_area), list)
                        : vision::recognize(regions, list);
   } else {
     std::vector<std::pair<size_t, vision::Match>> all;
     size_t setting = 0;
     for (const auto& [min_hole_area, list] : settings) {
-      auto found = hasHoleBelow(regions, min_hole_area)
-                       ? vision::recognize(withHolesAtLeast(regions, min_hole_area), list)
+      auto found = vision::hasHoleBelow(regions, min_hole_area)
+                       ? vision::recognize(vision::withHolesAtLeast(regions, min_hole_area), list)
                        : vision::recognize(regions, list);
       for (auto& m : found) all.emplace_back(setting, std::move(m));
       ++setting;

@@ -29,6 +29,11 @@ std::string rejectionText(const RegionRejection& r) {
     return region + " shape distance " + formatFixed(r.measured, 3) + " > " +
            formatFixed(r.high, 3) + ofType(r.nearest_type);
   }
+  if (r.test == "scale") {
+    // A copy of the part at another size: its size against the trained one.
+    return region + " scaled " + formatFixed(r.measured, 2) + "x outside " + formatFixed(r.low, 2) +
+           ".." + formatFixed(r.high, 2) + ofType(r.nearest_type);
+  }
   if (r.test == "mirror") return region + " mirror" + ofType(r.nearest_type);
   if (r.test == "verify") {
     return region + " boundary " + formatFixed(r.measured, 1) + "% < " + formatFixed(r.high, 1) +

@@ -207,10 +207,9 @@ Result<void> CellCalibration::setGridCalibration(
     const calibration::PixelScale& scale, const std::optional<calibration::LensModel>& lens) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!damaged_.empty()) return blocked();
-  if (lens) {
-    if (auto ok = store_.setLens(*lens); !ok) return storageError(ok.error());
-  }
-  auto ok = store_.setScale(scale);
+  // One write: a failure leaves the file, and the calibration in use, as
+  // they were, never a new lens with the old scale.
+  auto ok = store_.setScaleAndLens(scale, lens);
   if (!ok) return storageError(ok.error());
   ++revision_;
   return {};

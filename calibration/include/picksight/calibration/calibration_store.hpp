@@ -6,6 +6,7 @@
 // Threading: not thread-safe; its owner serializes access.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -48,9 +49,15 @@ class CalibrationStore {
   Result<void> setLens(const LensModel& lens);
   const std::optional<LensModel>& lens() const { return lens_; }
 
+  // The scale and, when given, the lens model in one write: the file holds
+  // both or, when the write fails, neither (the lens kept when not given).
+  Result<void> setScaleAndLens(const PixelScale& scale, const std::optional<LensModel>& lens);
+
   const std::string& path() const { return path_; }
 
  private:
+  // Applies `edit` to a copy, writes the copy, and only then keeps it.
+  Result<void> change(const std::function<void(CalibrationStore&)>& edit);
   Result<void> save();
   std::string serialize() const;
 

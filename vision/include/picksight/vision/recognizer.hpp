@@ -26,15 +26,16 @@ struct Match {
 };
 
 // Every part of the given models among the regions, best score first. A
-// region that matches a model as a whole holds one part, the model that
-// verifies best; a region that matches none is searched for parts that
-// touch (one merged blob) with the boundary models (see locateInBlob).
+// region that passes every test of a model (judgeRegion) holds one part,
+// of the model that verifies best; a region that is the whole of a part
+// drawn other than trained (judgeRegion's kScale or kMirror for some model)
+// holds none; any other is searched for parts that touch (one merged blob)
+// with the boundary models (see locateInBlob). Holes are counted as the
+// regions hold them: give the regions as the models see them
+// (withHolesAtLeast with their min_hole_area).
 // Regions are searched on OpenCV's worker threads (cv::setNumThreads); the
 // result does not depend on their number.
 std::vector<Match> recognize(const std::vector<Region>& regions,
                              const std::vector<const PartModel*>& models);
-
-// The rotation candidates of a region for a model (before verification).
-std::vector<double> rotationCandidates(const Region& region, const PartModel& model);
 
 }  // namespace picksight::vision

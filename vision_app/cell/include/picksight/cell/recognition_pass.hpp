@@ -21,10 +21,6 @@ namespace picksight::app {
 vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
                                        const std::vector<vision::PartModel>& models);
 
-// The holes of `region` at least `min_hole_area` large (pixels, inside
-// their boundary trace, as findRegions measures them).
-int holesAtLeast(const vision::Region& region, double min_hole_area);
-
 // Why a region left out of `LOCATE <type>` by the screen is not the asked type.
 struct ScreenedOut {
   size_t region = 0;

@@ -29,8 +29,9 @@ struct RegionRejection {
   int region = -1;
   int nearest_type = -1;  // -1: no model at all
   std::string nearest_name;
-  // "area", "holes", "hu", "mirror", "verify", "other type", "no grasp",
-  // "edge", "passes" (passes every test and yet was not reported).
+  // "area", "holes", "hu", "verify", "scale", "mirror", "other type",
+  // "no grasp", "edge", "no model", "passes" (passes every test and yet
+  // was not reported).
   std::string test;
   double measured = 0;
   double low = 0;

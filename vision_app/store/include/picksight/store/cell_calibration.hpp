@@ -99,7 +99,9 @@ class CellCalibration {
   Result<void> setScale(const calibration::PixelScale& scale);
   Result<void> setLens(const calibration::LensModel& lens);
   // A dot grid's scale (with its rectification) and, when fitted, its lens
-  // model, under one lock so no request sees one without the other.
+  // model (else the stored lens is kept), under one lock and in one write:
+  // no request sees one without the other, and a failed write changes
+  // neither.
   Result<void> setGridCalibration(const calibration::PixelScale& scale,
                                   const std::optional<calibration::LensModel>& lens);
   std::optional<calibration::LensModel> lens() const;
