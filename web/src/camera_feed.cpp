@@ -5,6 +5,7 @@
 #include <sched.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "picksight/common/log.hpp"
@@ -36,7 +37,8 @@ CameraFeed::CameraFeed(zmq::context_t& context, std::string frames_endpoint, std
                        int jpeg_quality)
     : frames_endpoint_(std::move(frames_endpoint)),
       camera_(std::move(camera)),
-      encoder_(jpeg_quality) {
+      encoder_(jpeg_quality),
+      starved_encoder_(jpeg_quality) {
   thread_ = std::thread([this, &context] { run(context); });
   encode_thread_ = std::thread([this] { encodeLoop(); });
 }
@@ -105,7 +107,22 @@ std::shared_ptr<const EncodedJpeg> CameraFeed::jpeg(uint64_t generation,
     wanted_ = generation;
     encode_wake_.notify_one();
   }
-  encoded_.wait_for(lock, timeout, [&] { return attempted_ >= generation || encode_stopping_; });
+  const auto done = [&] { return attempted_ >= generation || encode_stopping_; };
+  if (!encoded_.wait_for(lock, std::min(timeout, kEncoderStarved), done) &&
+      timeout > kEncoderStarved) {
+    // The cores have been busy all along: encode at this thread's priority.
+    lock.unlock();
+    {
+      std::lock_guard<std::mutex> starved(starved_mutex_);
+      bool needed = false;
+      {
+        std::lock_guard<std::mutex> check(encode_mutex_);
+        needed = !done();  // another starved caller may have done it meanwhile
+      }
+      if (needed) encodeNewest(starved_encoder_);
+    }
+    lock.lock();
+  }
   return jpeg_ && jpeg_->generation >= generation ? jpeg_ : nullptr;
 }
 
@@ -115,33 +132,41 @@ void CameraFeed::encodeLoop() {
   while (true) {
     encode_wake_.wait(lock, [&] { return wanted_ > attempted_ || encode_stopping_; });
     if (encode_stopping_) return;
-    std::shared_ptr<const Frame> frame;
-    uint64_t generation = 0;
-    {
-      std::lock_guard<std::mutex> frames(mutex_);
-      frame = latest_;
-      generation = generation_;
-    }
     lock.unlock();
-    const uint64_t start = threadCpuNs();
-    auto bytes = encoder_.encode(frame->image);
-    encode_ns_ += threadCpuNs() - start;
-    std::shared_ptr<EncodedJpeg> jpeg;
-    if (bytes) {
-      ++encoded_frames_;
-      jpeg = std::make_shared<EncodedJpeg>();
-      jpeg->generation = generation;
-      jpeg->sequence = frame->info.sequence;
-      jpeg->host_timestamp_ns = frame->info.host_timestamp_ns;
-      jpeg->bytes = std::move(*bytes);
-    } else {
-      logWarning("camera ", camera_, ": ", bytes.error().message);
-    }
+    encodeNewest(encoder_);
     lock.lock();
-    if (jpeg) jpeg_ = std::move(jpeg);
-    attempted_ = generation;
-    encoded_.notify_all();
   }
+}
+
+void CameraFeed::encodeNewest(JpegEncoder& encoder) {
+  std::shared_ptr<const Frame> frame;
+  uint64_t generation = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    frame = latest_;
+    generation = generation_;
+  }
+  if (!frame) return;
+  const uint64_t start = threadCpuNs();
+  auto bytes = encoder.encode(frame->image);
+  encode_ns_ += threadCpuNs() - start;
+  std::shared_ptr<EncodedJpeg> jpeg;
+  if (bytes) {
+    ++encoded_frames_;
+    jpeg = std::make_shared<EncodedJpeg>();
+    jpeg->generation = generation;
+    jpeg->sequence = frame->info.sequence;
+    jpeg->host_timestamp_ns = frame->info.host_timestamp_ns;
+    jpeg->bytes = std::move(*bytes);
+  } else {
+    logWarning("camera ", camera_, ": ", bytes.error().message);
+  }
+  std::lock_guard<std::mutex> lock(encode_mutex_);
+  // The encoder thread and a starved caller may both have encoded: the
+  // newest JPEG stays.
+  if (jpeg && (!jpeg_ || jpeg_->generation < generation)) jpeg_ = std::move(jpeg);
+  attempted_ = std::max(attempted_, generation);
+  encoded_.notify_all();
 }
 
 double CameraFeed::encodeSeconds() const { return static_cast<double>(encode_ns_.load()) * 1e-9; }

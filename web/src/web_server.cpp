@@ -241,9 +241,9 @@ void WebServer::Impl::frameJpeg(const std::string& camera, httplib::Response& re
   if (!feed->latest())
     return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
   auto jpeg = feed->jpeg();
-  // The encoder runs on idle cores only: on a machine busy for seconds, or
-  // with a frame that cannot be encoded, a clear refusal.
-  if (!jpeg) return sendJson(res, {{"error", "no JPEG of '" + camera + "' in time"}}, 503);
+  // A frame that cannot be encoded (or a server stopping): a clear refusal.
+  if (!jpeg)
+    return sendJson(res, {{"error", "no JPEG of the newest frame of '" + camera + "'"}}, 503);
   setFrameHeaders(res, jpeg->sequence, jpeg->host_timestamp_ns);
   res.set_content(jpeg->bytes, "image/jpeg");
 }

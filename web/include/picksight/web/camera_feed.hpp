@@ -5,11 +5,14 @@
 //
 // Threading: the feed's thread alone owns the SUB socket; it only swaps a
 // shared_ptr under mutex_ and wakes waiters, so no viewer ever slows it.
-// The encoder thread alone encodes (SCHED_IDLE: it runs on a core nothing
-// else wants), and only frames a viewer asked for through jpeg(), which may
-// be called from any thread and waits for it. A viewer that falls behind
-// simply gets the newest frame next time (frames in between are skipped for
-// it alone).
+// The encoder thread encodes (SCHED_IDLE: it runs on a core nothing else
+// wants), and only frames a viewer asked for through jpeg(), which may be
+// called from any thread and waits for it. When the cores stay busy for
+// kEncoderStarved, the waiting caller encodes the newest frame itself, at
+// its own (normal) priority, one caller at a time: a saturated machine
+// slows the page to about a frame per kEncoderStarved, never freezes it. A
+// viewer that falls behind simply gets the newest frame next time (frames in
+// between are skipped for it alone).
 #pragma once
 
 #include <atomic>
@@ -27,6 +30,12 @@
 #include "picksight/web/jpeg_encoder.hpp"
 
 namespace picksight::web {
+
+// How long a viewer waits for the idle-priority encoder before it encodes the
+// frame itself: rare enough that a saturated machine's robots hardly feel it
+// (at most one normal-priority JPEG per camera in that time), short enough
+// that the page is never frozen.
+constexpr std::chrono::milliseconds kEncoderStarved{3000};
 
 // A frame's JPEG, shared by all the viewers that send it.
 struct EncodedJpeg {
@@ -77,6 +86,8 @@ class CameraFeed {
  private:
   void run(zmq::context_t& context);
   void encodeLoop();
+  // Encodes the newest frame with `encoder` and publishes its JPEG.
+  void encodeNewest(JpegEncoder& encoder);
 
   const std::string frames_endpoint_;
   const std::string camera_;
@@ -91,6 +102,8 @@ class CameraFeed {
   std::condition_variable encode_wake_;      // wakes the encoder thread
   std::condition_variable encoded_;          // wakes the callers of jpeg()
   JpegEncoder encoder_;                      // the encoder thread's
+  std::mutex starved_mutex_;                 // one starved caller encodes at a time
+  JpegEncoder starved_encoder_;              // under starved_mutex_
   std::shared_ptr<const EncodedJpeg> jpeg_;  // under encode_mutex_
   uint64_t wanted_ = 0;                      // under encode_mutex_: generation asked for
   uint64_t attempted_ = 0;                   // under encode_mutex_: generation last encoded
