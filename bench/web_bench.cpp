@@ -192,10 +192,15 @@ int main(int argc, char** argv) {
     mode.mutable_set_mode()->set_fps(30);
     if (!client.call(mode)) return 1;
   }
-  auto vision = picksight::bench::startVision(server, data_dir);
+  // The results stream on a known endpoint, so that the web server follows
+  // it as in a cell (the page draws every result over the frame).
+  const std::string results = "ipc://" + data_dir + "/results";
+  auto vision = picksight::bench::startVision(server, data_dir, {"--results-bind", results});
   if (!vision) return 1;
+  // The page's commands would go to the third field; the bench sends none.
   picksight::Subprocess web({bin + "/picksight-web", "--listen", "127.0.0.1:0", "--video-server",
-                             server.frames + "," + server.control});
+                             server.frames + "," + server.control, "--vision-app",
+                             "cam0," + results + ",127.0.0.1:9"});
   const auto url = web.waitForLine("web http://127.0.0.1:", 10s);
   if (!url) return 1;
   const int port = std::stoi(*url);

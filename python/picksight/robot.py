@@ -19,6 +19,10 @@ Transform = namedtuple("Transform", "dx dy rz rms")
 Residual = namedtuple("Residual", "id dx dy distance")
 Exposure = namedtuple("Exposure", "feature value")
 Roi = namedtuple("Roi", "x y width height")
+# A model's tolerances (TOLERANCE): `values` maps each key of the reply, in
+# its order, to its value (float; bool for mirror_symmetric), so keys a later
+# vision app adds are kept too.
+Tolerances = namedtuple("Tolerances", "type name values")
 # mode "FREE" (fps), "SOFTWARE" or "HARDWARE" (line, timeout in s); None where
 # the mode has no such setting.
 CameraMode = namedtuple("CameraMode", "mode fps line timeout")
@@ -214,6 +218,32 @@ class RobotClient:
             return int(f[0]), f[1], float(f[2]), int(f[3]), float(f[4]), None
 
         return _groups(self.request("MODELS"), 5, Model, convert)
+
+    def tolerance(self, part_type, **changes):
+        """Reads a model's tolerances (TOLERANCE <type>), or changes some and
+        reads back the values in force: e.g. tolerance(1, area_tolerance=0.2,
+        mirror_symmetric=True). The vision app checks every pair before any
+        applies: an unknown key or a value out of its bounds is RobotError
+        code 11 naming the key, and nothing changes. Returns a Tolerances."""
+        line = f"TOLERANCE {int(part_type)}"
+        for key, value in changes.items():
+            if isinstance(value, bool):
+                value = int(value)
+            line += f" {key} {_number(value)}"
+        words = self.request(line)
+        values = {}
+        for word in words[2:]:
+            key, sep, text = word.partition("=")
+            if not sep:
+                raise ValueError(f"not a key=value field in the TOLERANCE reply: {word!r}")
+            if key == "mirror_symmetric":
+                values[key] = text == "1"
+            else:
+                try:
+                    values[key] = float(text)
+                except ValueError:
+                    values[key] = text  # a later key that is not a number
+        return Tolerances(int(words[0]), words[1], values)
 
     def forget(self, part_type):
         self.request(f"FORGET {int(part_type)}")

@@ -85,6 +85,44 @@ def test_camera_settings(synthetic_cell):
         assert robot.camera_mode("free", fps=5) == ("FREE", 5.0, None, None)
 
 
+def test_tolerances_read_changed_and_refused(cell_factory):
+    _, vision = cell_factory("--source", "cam0=synthetic:width=640,height=480,parts=1,seed=3",
+                             "--mode", "trigger")
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        with pytest.raises(RobotError) as e:
+            robot.tolerance(1)  # no model yet
+        assert e.value.code == 32
+        robot.learn(1, "part")
+        before = robot.tolerance(1)
+        assert (before.type, before.name) == (1, "part")
+        keys = ["area_tolerance", "hu_tolerance", "verify_percent", "edge_tolerance_px",
+                "mirror_symmetric"]
+        assert list(before.values)[: len(keys)] == keys
+        assert isinstance(before.values["mirror_symmetric"], bool)
+
+        after = robot.tolerance(1, area_tolerance=0.25, edge_tolerance_px=2.5,
+                                mirror_symmetric=not before.values["mirror_symmetric"])
+        assert after.values["area_tolerance"] == pytest.approx(0.25)
+        assert after.values["edge_tolerance_px"] == pytest.approx(2.5)
+        assert after.values["mirror_symmetric"] != before.values["mirror_symmetric"]
+        assert after.values["hu_tolerance"] == before.values["hu_tolerance"]
+        assert robot.tolerance(1) == after  # stored: read back the same
+
+        # One bad pair: refused naming its key, and nothing changes.
+        with pytest.raises(RobotError) as e:
+            robot.tolerance(1, hu_tolerance=1.0, area_tolerance=1.5)
+        assert e.value.code == 11 and "area_tolerance" in e.value.text
+        with pytest.raises(RobotError) as e:
+            robot.tolerance(1, wobble=3)
+        assert e.value.code == 11 and "wobble" in e.value.text
+        assert robot.tolerance(1) == after
+        # LEARN's own judgement of the part's symmetry back: the next LOCATE
+        # finds it with the wider area tolerance.
+        mirror = before.values["mirror_symmetric"]
+        assert robot.tolerance(1, mirror_symmetric=mirror).values["mirror_symmetric"] == mirror
+        assert len(robot.locate(1)) == 1
+
+
 def test_a_whole_set_up_calibrate_teach_grip_pick(cell_factory, tmp_path):
     scene = Scene(tmp_path)
     _, vision = cell_factory("--source", f"cam0=file:{scene.path}", "--mode", "trigger")

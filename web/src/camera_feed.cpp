@@ -1,7 +1,12 @@
-// The camera feed's subscriber thread and its shared, lazy JPEG.
+// The camera feed's subscriber thread and its shared, lazy JPEG encoder.
 #include "picksight/web/camera_feed.hpp"
 
+#include <pthread.h>
+#include <sched.h>
 #include <time.h>
+
+#include <algorithm>
+#include <cstring>
 
 #include "picksight/common/log.hpp"
 #include "picksight/transport/frame_message.hpp"
@@ -15,26 +20,46 @@ uint64_t threadCpuNs() {
   return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
 }
 
+// The calling thread runs only on a core nothing else wants: a JPEG for a
+// browser must never take a core from a vision pass, which nice alone does
+// not ensure (a nice 19 thread still gets its share of a busy core).
+// Allowed without privileges; a failure only costs that guarantee.
+void runAtIdlePriority(const std::string& camera) {
+  sched_param param{};
+  param.sched_priority = 0;
+  if (const int rc = pthread_setschedparam(pthread_self(), SCHED_IDLE, &param); rc != 0)
+    logWarning("camera ", camera, ": JPEG encoder at normal priority: ", std::strerror(rc));
+}
+
 }  // namespace
 
 CameraFeed::CameraFeed(zmq::context_t& context, std::string frames_endpoint, std::string camera,
                        int jpeg_quality)
     : frames_endpoint_(std::move(frames_endpoint)),
       camera_(std::move(camera)),
-      encoder_(jpeg_quality) {
+      encoder_(jpeg_quality),
+      starved_encoder_(jpeg_quality) {
   thread_ = std::thread([this, &context] { run(context); });
+  encode_thread_ = std::thread([this] { encodeLoop(); });
 }
 
 CameraFeed::~CameraFeed() {
   stop();
   if (thread_.joinable()) thread_.join();
+  if (encode_thread_.joinable()) encode_thread_.join();
 }
 
 void CameraFeed::stop() {
   stop_ = true;
-  std::lock_guard<std::mutex> lock(mutex_);
-  stopping_ = true;
-  changed_.notify_all();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+    changed_.notify_all();
+  }
+  std::lock_guard<std::mutex> lock(encode_mutex_);
+  encode_stopping_ = true;
+  encode_wake_.notify_all();
+  encoded_.notify_all();
 }
 
 void CameraFeed::run(zmq::context_t& context) {
@@ -72,27 +97,76 @@ uint64_t CameraFeed::waitNewer(uint64_t seen, std::chrono::milliseconds timeout)
   return generation_;
 }
 
-std::shared_ptr<const EncodedJpeg> CameraFeed::jpeg() {
-  auto frame = latest();
-  if (!frame) return nullptr;
-  std::lock_guard<std::mutex> lock(encode_mutex_);
-  if (jpeg_of_ == frame.get()) return jpeg_;
-  const uint64_t start = threadCpuNs();
-  auto bytes = encoder_.encode(frame->image);
-  encode_ns_ += threadCpuNs() - start;
-  if (!bytes) {
-    logWarning("camera ", camera_, ": ", bytes.error().message);
-    return nullptr;
+std::shared_ptr<const EncodedJpeg> CameraFeed::jpeg(uint64_t generation,
+                                                    std::chrono::milliseconds timeout) {
+  if (generation == 0) generation = this->generation();
+  if (generation == 0) return nullptr;  // no frame yet
+  std::unique_lock<std::mutex> lock(encode_mutex_);
+  if (jpeg_ && jpeg_->generation >= generation) return jpeg_;
+  if (wanted_ < generation) {
+    wanted_ = generation;
+    encode_wake_.notify_one();
   }
-  ++encoded_frames_;
-  auto jpeg = std::make_shared<EncodedJpeg>();
-  jpeg->sequence = frame->info.sequence;
-  jpeg->host_timestamp_ns = frame->info.host_timestamp_ns;
-  jpeg->bytes = std::move(*bytes);
-  jpeg_ = std::move(jpeg);
-  jpeg_of_ = frame.get();
-  jpeg_frame_ = std::move(frame);
-  return jpeg_;
+  const auto done = [&] { return attempted_ >= generation || encode_stopping_; };
+  if (!encoded_.wait_for(lock, std::min(timeout, kEncoderStarved), done) &&
+      timeout > kEncoderStarved) {
+    // The cores have been busy all along: encode at this thread's priority.
+    lock.unlock();
+    {
+      std::lock_guard<std::mutex> starved(starved_mutex_);
+      bool needed = false;
+      {
+        std::lock_guard<std::mutex> check(encode_mutex_);
+        needed = !done();  // another starved caller may have done it meanwhile
+      }
+      if (needed) encodeNewest(starved_encoder_);
+    }
+    lock.lock();
+  }
+  return jpeg_ && jpeg_->generation >= generation ? jpeg_ : nullptr;
+}
+
+void CameraFeed::encodeLoop() {
+  runAtIdlePriority(camera_);
+  std::unique_lock<std::mutex> lock(encode_mutex_);
+  while (true) {
+    encode_wake_.wait(lock, [&] { return wanted_ > attempted_ || encode_stopping_; });
+    if (encode_stopping_) return;
+    lock.unlock();
+    encodeNewest(encoder_);
+    lock.lock();
+  }
+}
+
+void CameraFeed::encodeNewest(JpegEncoder& encoder) {
+  std::shared_ptr<const Frame> frame;
+  uint64_t generation = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    frame = latest_;
+    generation = generation_;
+  }
+  if (!frame) return;
+  const uint64_t start = threadCpuNs();
+  auto bytes = encoder.encode(frame->image);
+  encode_ns_ += threadCpuNs() - start;
+  std::shared_ptr<EncodedJpeg> jpeg;
+  if (bytes) {
+    ++encoded_frames_;
+    jpeg = std::make_shared<EncodedJpeg>();
+    jpeg->generation = generation;
+    jpeg->sequence = frame->info.sequence;
+    jpeg->host_timestamp_ns = frame->info.host_timestamp_ns;
+    jpeg->bytes = std::move(*bytes);
+  } else {
+    logWarning("camera ", camera_, ": ", bytes.error().message);
+  }
+  std::lock_guard<std::mutex> lock(encode_mutex_);
+  // The encoder thread and a starved caller may both have encoded: the
+  // newest JPEG stays.
+  if (jpeg && (!jpeg_ || jpeg_->generation < generation)) jpeg_ = std::move(jpeg);
+  attempted_ = std::max(attempted_, generation);
+  encoded_.notify_all();
 }
 
 double CameraFeed::encodeSeconds() const { return static_cast<double>(encode_ns_.load()) * 1e-9; }

@@ -238,8 +238,12 @@ void WebServer::Impl::snapshot(const std::string& camera, httplib::Response& res
 void WebServer::Impl::frameJpeg(const std::string& camera, httplib::Response& res) {
   auto feed = feedOr404(camera, res);
   if (!feed) return;
+  if (!feed->latest())
+    return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
   auto jpeg = feed->jpeg();
-  if (!jpeg) return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
+  // A frame that cannot be encoded (or a server stopping): a clear refusal.
+  if (!jpeg)
+    return sendJson(res, {{"error", "no JPEG of the newest frame of '" + camera + "'"}}, 503);
   setFrameHeaders(res, jpeg->sequence, jpeg->host_timestamp_ns);
   res.set_content(jpeg->bytes, "image/jpeg");
 }
@@ -276,8 +280,10 @@ void WebServer::Impl::stream(const std::string& camera, httplib::Response& res) 
         const uint64_t now = viewer->feed->waitNewer(viewer->seen, 1s);
         if (stopping_) return false;
         if (now == viewer->seen) return true;  // no new frame: asked again
-        viewer->seen = now;
-        auto jpeg = viewer->feed->jpeg();
+        auto jpeg = viewer->feed->jpeg(now);
+        // A frame that could not be encoded in time is skipped, for this
+        // viewer alone.
+        viewer->seen = jpeg ? jpeg->generation : now;
         if (!jpeg) return true;
         const std::string head =
             std::string("--") + kBoundary + "\r\nContent-Type: image/jpeg\r\nContent-Length: " +

@@ -1,12 +1,18 @@
 // One camera's frames for the web server: a subscriber thread keeps the
-// newest frame, and its JPEG is made once, lazily, for every viewer.
+// newest frame, and an encoder thread makes its JPEG once, lazily, for every
+// viewer, at the lowest CPU priority so that it never competes with a
+// vision pass.
 //
 // Threading: the feed's thread alone owns the SUB socket; it only swaps a
 // shared_ptr under mutex_ and wakes waiters, so no viewer ever slows it.
-// jpeg() may be called from any thread: the first caller that needs a new
-// frame's JPEG encodes it under encode_mutex_, the others wait for it and
-// reuse it. A viewer that falls behind simply gets the newest frame next
-// time (frames in between are skipped for it alone).
+// The encoder thread encodes (SCHED_IDLE: it runs on a core nothing else
+// wants), and only frames a viewer asked for through jpeg(), which may be
+// called from any thread and waits for it. When the cores stay busy for
+// kEncoderStarved, the waiting caller encodes the newest frame itself, at
+// its own (normal) priority, one caller at a time: a saturated machine
+// slows the page to about a frame per kEncoderStarved, never freezes it. A
+// viewer that falls behind simply gets the newest frame next time (frames in
+// between are skipped for it alone).
 #pragma once
 
 #include <atomic>
@@ -25,8 +31,15 @@
 
 namespace picksight::web {
 
+// How long a viewer waits for the idle-priority encoder before it encodes the
+// frame itself: rare enough that a saturated machine's robots hardly feel it
+// (at most one normal-priority JPEG per camera in that time), short enough
+// that the page is never frozen.
+constexpr std::chrono::milliseconds kEncoderStarved{3000};
+
 // A frame's JPEG, shared by all the viewers that send it.
 struct EncodedJpeg {
+  uint64_t generation = 0;  // CameraFeed::generation() of its frame
   uint64_t sequence = 0;
   uint64_t host_timestamp_ns = 0;
   std::string bytes;
@@ -34,10 +47,10 @@ struct EncodedJpeg {
 
 class CameraFeed {
  public:
-  // Subscribes to `camera` on `frames_endpoint` and starts the thread.
+  // Subscribes to `camera` on `frames_endpoint` and starts the threads.
   CameraFeed(zmq::context_t& context, std::string frames_endpoint, std::string camera,
              int jpeg_quality = 80);
-  ~CameraFeed();  // stops and joins the thread
+  ~CameraFeed();  // stops and joins the threads
   CameraFeed(const CameraFeed&) = delete;
   CameraFeed& operator=(const CameraFeed&) = delete;
 
@@ -53,9 +66,13 @@ class CameraFeed {
   // feed stops; returns the generation.
   uint64_t waitNewer(uint64_t seen, std::chrono::milliseconds timeout) const;
 
-  // The newest frame's JPEG, encoded now if nobody did yet; null before the
-  // first frame or when encoding failed.
-  std::shared_ptr<const EncodedJpeg> jpeg();
+  // The JPEG of the newest frame, of generation `generation` or newer
+  // (generation() when 0), encoded for this call if nobody asked for it
+  // yet; waits for the encoder at most `timeout`. Null before the first
+  // frame, on timeout, when stopping or when that frame could not be
+  // encoded.
+  std::shared_ptr<const EncodedJpeg> jpeg(
+      uint64_t generation = 0, std::chrono::milliseconds timeout = std::chrono::milliseconds(5000));
 
   // Viewers of the MJPEG stream (for /metrics), counted by ViewerCount.
   int viewers() const { return viewers_.load(); }
@@ -68,6 +85,9 @@ class CameraFeed {
 
  private:
   void run(zmq::context_t& context);
+  void encodeLoop();
+  // Encodes the newest frame with `encoder` and publishes its JPEG.
+  void encodeNewest(JpegEncoder& encoder);
 
   const std::string frames_endpoint_;
   const std::string camera_;
@@ -79,16 +99,22 @@ class CameraFeed {
   bool stopping_ = false;                // under mutex_
 
   std::mutex encode_mutex_;
-  JpegEncoder encoder_;                      // under encode_mutex_
+  std::condition_variable encode_wake_;      // wakes the encoder thread
+  std::condition_variable encoded_;          // wakes the callers of jpeg()
+  JpegEncoder encoder_;                      // the encoder thread's
+  std::mutex starved_mutex_;                 // one starved caller encodes at a time
+  JpegEncoder starved_encoder_;              // under starved_mutex_
   std::shared_ptr<const EncodedJpeg> jpeg_;  // under encode_mutex_
-  const Frame* jpeg_of_ = nullptr;           // under encode_mutex_: the frame jpeg_ was made from
-  std::shared_ptr<const Frame> jpeg_frame_;  // under encode_mutex_: keeps jpeg_of_ unique
+  uint64_t wanted_ = 0;                      // under encode_mutex_: generation asked for
+  uint64_t attempted_ = 0;                   // under encode_mutex_: generation last encoded
+  bool encode_stopping_ = false;             // under encode_mutex_
 
   std::atomic<int> viewers_{0};
   std::atomic<uint64_t> encode_ns_{0};
   std::atomic<uint64_t> encoded_frames_{0};
   std::atomic<bool> stop_{false};
   std::thread thread_;
+  std::thread encode_thread_;
 };
 
 // Counts a viewer for as long as it lives.
