@@ -438,10 +438,13 @@ def test_hardware_trigger_from_the_camera_panel(cell, browser):
     edge and timeout: the synthetic camera has no trigger input, and its
     refusal is shown; the camera keeps running free."""
     select_tab(browser, "camera")
+    # Set and applied in one script: the panel's refresh from the camera's
+    # state could otherwise overwrite the inputs between two WebDriver calls
+    # (it did, once in CI).
     browser.js("""document.getElementById('cam-hw-line').value = 'Line2';
                   document.getElementById('cam-hw-activation').value = 'FallingEdge';
-                  document.getElementById('cam-hw-timeout').value = '2500';""")
-    click(browser, "cam-hw-apply")
+                  document.getElementById('cam-hw-timeout').value = '2500';
+                  document.getElementById('cam-hw-apply').click();""")
     reply = wait_until(lambda: (lambda t: t if "mode" in t else None)(
         browser.driver.find_element(By.ID, "camera-reply").text), what="the mode reply")
     first = reply.split("\n")[:2]
