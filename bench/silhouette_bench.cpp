@@ -34,6 +34,8 @@ namespace {
 namespace ps = picksight::synthetic;
 namespace pv = picksight::vision;
 using picksight::bench::TypeSpec;
+using Clock = std::chrono::steady_clock;
+using Ms = std::chrono::duration<double, std::milli>;
 
 // A result this close to a drawn part's centroid is about that part.
 constexpr double kMatchRadiusPx = 12;
@@ -76,6 +78,10 @@ struct Tally {
   Confusions confusions;
   std::vector<double> ours_ms;
   std::vector<double> plain_ms;
+  // The vision pass's stages, per frame: where its time goes.
+  std::vector<double> binarize_ms;
+  std::vector<double> regions_ms;
+  std::vector<double> recognize_ms;
   int parts = 0;
   int distractors = 0;
   int frames = 0;
@@ -194,6 +200,10 @@ void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
       "max %.2f ms\n",
       specs.size(), ours, picksight::bench::nearestRank(t.ours_ms, 99),
       picksight::bench::nearestRank(t.ours_ms, 100));
+  std::printf("  of which binarize %.2f ms, regions %.2f ms, recognize %.2f ms (medians)\n",
+              picksight::bench::nearestRank(t.binarize_ms, 50),
+              picksight::bench::nearestRank(t.regions_ms, 50),
+              picksight::bench::nearestRank(t.recognize_ms, 50));
   std::printf("  plain OpenCV pass (Otsu+findContours+moments) median %.2f ms p99 %.2f ms\n", plain,
               picksight::bench::nearestRank(t.plain_ms, 99));
   std::printf("  ratio of medians (vision / plain OpenCV) %.2fx\n", plain > 0 ? ours / plain : 0);
@@ -344,7 +354,11 @@ int main(int argc, char** argv) {
         picksight::bench::timeInTurn<2>(
             turn++,
             {[&] {
-               const auto regions = pv::findRegions(pv::binarize(grey, binarize), {}, grey);
+               const auto t0 = Clock::now();
+               const cv::Mat mask = pv::binarize(grey, binarize);
+               const auto t1 = Clock::now();
+               const auto regions = pv::findRegions(mask, {}, grey);
+               const auto t2 = Clock::now();
                if (from_edges) {
                  matches.clear();
                  for (size_t i = 0; i < regions.size(); ++i) {
@@ -354,6 +368,10 @@ int main(int argc, char** argv) {
                } else {
                  matches = pv::recognize(regions, list);
                }
+               const auto t3 = Clock::now();
+               tally.binarize_ms.push_back(Ms(t1 - t0).count());
+               tally.regions_ms.push_back(Ms(t2 - t1).count());
+               tally.recognize_ms.push_back(Ms(t3 - t2).count());
              },
              [&] { sink += picksight::bench::competentOpenCvPass(grey); }},
             {&tally.ours_ms, &tally.plain_ms});

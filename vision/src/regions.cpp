@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/common/angles.hpp"
+#include "picksight/vision/row_runs.hpp"
 
 namespace picksight::vision {
 
@@ -52,21 +54,18 @@ constexpr double kMaxBandTail = 0.01;
 // beyond it.
 constexpr int kBoxMargin = kMaxBand + 2;
 
-// Least-squares plane z = a + b x + c y through the grey levels of the ring
-// pixels (within `far`, outside `near`, in no region of `set`) in `grey`
-// (box coordinates). False when too few or degenerate.
-bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, const cv::Mat& set,
-              cv::Vec3d* plane) {
+// Least-squares plane z = a + b x + c y through the grey levels of `grey`
+// (box coordinates) over the pixels of `ring` that are in no region of
+// `set`. False when too few or degenerate.
+bool fitPlane(const cv::Mat& grey, const RowRuns& ring, const cv::Mat& set, cv::Vec3d* plane) {
   // Scalar sums: a 3x3 outer product per pixel costs more than the rest.
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sg = 0, sxg = 0, syg = 0;
-  for (int y = 0; y < grey.rows; ++y) {
+  ring.forEachRun([&](int y, int a, int b) {
     const uint8_t* g = grey.ptr<uint8_t>(y);
-    const uint8_t* f = far.ptr<uint8_t>(y);
-    const uint8_t* nr = near.ptr<uint8_t>(y);
     const uint8_t* st = set.ptr<uint8_t>(y);
     double rn = 0, rx = 0, rxx = 0, rg = 0, rxg = 0;
-    for (int x = 0; x < grey.cols; ++x) {
-      if (!f[x] || nr[x] || st[x]) continue;
+    for (int x = a; x < b; ++x) {
+      if (st[x]) continue;
       const double v = g[x];
       rn += 1;
       rx += x;
@@ -83,7 +82,7 @@ bool fitPlane(const cv::Mat& grey, const cv::Mat& far, const cv::Mat& near, cons
     sg += rg;
     sxg += rxg;
     syg += y * rg;
-  }
+  });
   if (n < 8) return false;
   const cv::Matx33d normal(n, sx, sy, sx, sxx, sxy, sy, sxy, syy);
   const cv::Vec3d rhs(sg, sxg, syg);
@@ -136,9 +135,71 @@ struct Moments10 {
   }
 };
 
-// Grey-level coverage moments of one region with a band of a given reach
-// (see greyMoments below). Returns false when the grey levels cannot be
-// trusted; the outputs are then unspecified.
+// A region's runs dilated by squares, each radius made once from the one
+// below it: the band of reach r needs radii r - 1, r and r + 2, and the
+// next reach shares two.
+class Dilations {
+ public:
+  explicit Dilations(const RowRuns& own) : own_(own) {}
+
+  const RowRuns& byRadius(int r) {
+    if (r <= 0) return own_;
+    RowRuns& runs = cache_.at(static_cast<size_t>(r));
+    if (runs.height() == 0) runs = byRadius(r - 1).dilated(1);
+    return runs;
+  }
+
+ private:
+  const RowRuns& own_;
+  std::array<RowRuns, kMaxBand + 3> cache_;
+};
+
+// How one band width reads a region's grey levels: the background plane,
+// the conversion of grey levels to coverage, and the moments.
+struct BandReading {
+  cv::Vec3d plane;  // background level a + b x + c y, box coordinates
+  bool lit = true;  // levels relative to the background (else additive)
+  float scale = 0;  // coverage = scale * level + offset
+  float offset = 0;
+  Moments10 sums;   // of the coverage: interior and band
+  double tail = 0;  // mean raw coverage of the band's outermost pixels
+
+  float background(int x, int y) const {
+    return static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
+  }
+};
+
+// The masks one band width is read through, over a region's box.
+struct BandPixels {
+  const cv::Mat& grey;  // the box of the frame
+  const cv::Mat& own;   // the region's pixels
+  const cv::Mat& set;   // every region's pixels
+};
+
+// f(y, x, raw) for every pixel of `runs` that is not another region's, raw
+// being its coverage read from its grey level, not clamped. Row pointers and
+// the background are taken once per run: this is the per-pixel work of the
+// region pass.
+template <class F>
+void forEachCoverage(const BandReading& reading, const BandPixels& pixels, const RowRuns& runs,
+                     F&& f) {
+  runs.forEachRun([&](int y, int a, int b) {
+    const uint8_t* g = pixels.grey.ptr<uint8_t>(y);
+    const uint8_t* o = pixels.own.ptr<uint8_t>(y);
+    const uint8_t* st = pixels.set.ptr<uint8_t>(y);
+    const double row_background = reading.plane[0] + reading.plane[2] * y;
+    for (int x = a; x < b; ++x) {
+      if (st[x] && !o[x]) continue;  // a neighbour's
+      const auto background = static_cast<float>(row_background + reading.plane[1] * x);
+      const auto level = static_cast<float>(g[x]);
+      f(y, x,
+        reading.scale * (reading.lit ? level / background : level - background) + reading.offset);
+    }
+  });
+}
+
+// Reads one region with a band of a given reach (see greyMoments below).
+// Returns false when the grey levels cannot be trusted.
 //
 // Light falls unevenly, and a part reflects a fixed fraction of the light
 // that reaches it, so grey levels are read relative to the local background:
@@ -148,141 +209,97 @@ struct Moments10 {
 // side of a part more than the other and pull its centroid by a tenth of a
 // pixel under a few percent of light gradient.
 //
-// `own` is the region's mask over `box` (the bounding box with a margin for
-// the edge blur and the background ring), `set` the mask of all regions
-// there. Two passes over the box and no full-box temporaries besides the
-// coverage itself: the interior (its runs, for the contrast and its
-// moments), then the band's coverage and moments (per-row sums of w x^p, as
-// cv::moments does).
+// Pixels deeper inside the binary boundary than the band (`interior`, with
+// the `histogram` of its grey levels) are the part's: their coverage is 1.
+// Only the band, where the edge blur is, carries sub-pixel information;
+// reading the interior from grey levels too would only add its noise, and
+// let a highlight or a printed mark on the part pull its centroid.
 //
-// `reach`: the band read from grey levels is `reach` pixels each side of the
-// binary boundary (see greyMoments). `tail` receives the mean coverage, not
-// clamped (so that noise averages out), of the band's outermost pixels.
-bool greyMomentsWithin(int reach, const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set,
-                       const cv::Rect& box, cv::Moments* moments, cv::Point2d* centroid,
-                       cv::Mat* weights, cv::Point* origin, double* tail) {
-  // One pass with a wide square is two or four passes of the 3x3 one
-  // (rectangles are separable), at a fraction of the cost.
-  const auto square = [](int side) {
-    return cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side));
-  };
-  cv::Mat interior;
-  cv::Mat near;
-  cv::Mat nearer;
-  cv::Mat far;
-  cv::erode(own, interior, square(2 * reach + 1));
-  cv::dilate(own, near, square(2 * reach + 1));
-  cv::dilate(own, nearer, square(2 * reach - 1));
-  cv::dilate(own, far, square(2 * reach + 5));
+// The ring, the band and the interior are run sets made by square
+// morphology on the region's runs, so the cost follows the boundary's length
+// and not the box's area. `tail` is the mean coverage, not clamped (so that
+// noise averages out), of the band's outermost pixels.
+bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
+              const std::array<int, 256>& histogram, Dilations& dilations, BandReading* reading) {
+  const RowRuns& near = dilations.byRadius(reach);
+  const RowRuns& nearer = dilations.byRadius(reach - 1);
+  const RowRuns& far = dilations.byRadius(reach + 2);
   // Background from a ring just outside the edge blur, free of other parts.
-  cv::Vec3d plane;
-  if (!fitPlane(grey_box, far, near, set, &plane)) return false;
-  const auto background = [&](int x, int y) {
-    return static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
-  };
+  if (!fitPlane(pixels.grey, far.minus(near), pixels.set, &reading->plane)) return false;
   // The plane's least value is at a corner of the box.
-  const int w = box.width;
-  const int h = box.height;
-  const float min_background = std::min(std::min(background(0, 0), background(w - 1, 0)),
-                                        std::min(background(0, h - 1), background(w - 1, h - 1)));
+  const int w = pixels.grey.cols;
+  const int h = pixels.grey.rows;
+  const BandReading& r = *reading;
+  const float min_background =
+      std::min(std::min(r.background(0, 0), r.background(w - 1, 0)),
+               std::min(r.background(0, h - 1), r.background(w - 1, h - 1)));
   // A black background carries no light to divide by: parts are lit on
   // their own, and levels are read against the background additively.
-  const bool lit = min_background >= kMinLitBackground;
+  reading->lit = min_background >= kMinLitBackground;
 
-  // Pixels deeper inside the binary boundary than the band are the part's:
-  // their coverage is 1. Only the band, where the edge blur is, carries
-  // sub-pixel information; reading the interior from grey levels too would
-  // only add its noise, and let a highlight or a printed mark on the part
-  // pull its centroid. The interior's moments are summed run by run in
-  // closed form, so the cost follows the boundary's length, not the part's
-  // area.
-  cv::Mat coverage(box.size(), CV_32F, cv::Scalar(0));
-  Moments10 sums;
+  // The interior's moments, run by run in closed form.
+  Moments10& sums = reading->sums;
+  sums = Moments10{};
   double interior_count = 0;
-  // The interior's grey levels, for their median.
-  std::array<int, 256> histogram{};
-  for (int y = 0; y < h; ++y) {
-    const uint8_t* in = interior.ptr<uint8_t>(y);
-    const uint8_t* g = grey_box.ptr<uint8_t>(y);
-    float* c = coverage.ptr<float>(y);
-    for (int x = 0; x < w;) {
-      if (!in[x]) {
-        ++x;
-        continue;
-      }
-      const int a = x;
-      for (; x < w && in[x]; ++x) {
-        ++histogram[g[x]];
-        c[x] = 1.0f;
-      }
-      sums.addRun(a, x, y);
-      interior_count += x - a;
-    }
-  }
+  interior.forEachRun([&](int y, int a, int b) {
+    sums.addRun(a, b, y);
+    interior_count += b - a;
+  });
   if (interior_count < 8) return false;
   // The interior's level: its median grey against the background at its
   // centroid (the plane is linear, so that is the background's mean there).
   // The median, so that a highlight or a mark on the part does not change
   // the contrast every edge pixel is read with.
   const double interior_background =
-      plane[0] + plane[1] * sums.m10 / sums.m00 + plane[2] * sums.m01 / sums.m00;
+      r.plane[0] + r.plane[1] * sums.m10 / sums.m00 + r.plane[2] * sums.m01 / sums.m00;
   const double part_grey = interpolatedMedian(histogram, interior_count);
-  if (lit && interior_background <= 0) return false;
-  const double part_level = lit ? part_grey / interior_background : part_grey - interior_background;
-  const double contrast = lit ? 1.0 - part_level : part_level;
-  if (std::abs(contrast) < (lit ? kMinContrast : kMinContrast * 255)) return false;
+  if (r.lit && interior_background <= 0) return false;
+  const double part_level =
+      r.lit ? part_grey / interior_background : part_grey - interior_background;
+  const double contrast = r.lit ? 1.0 - part_level : part_level;
+  if (std::abs(contrast) < (r.lit ? kMinContrast : kMinContrast * 255)) return false;
   // Coverage = scale * level + offset: (1 - R) / contrast, or offset / contrast.
-  const float scale = static_cast<float>(lit ? -1.0 / contrast : 1.0 / contrast);
-  const float offset = static_cast<float>(lit ? 1.0 / contrast : 0.0);
+  reading->scale = static_cast<float>(r.lit ? -1.0 / contrast : 1.0 / contrast);
+  reading->offset = static_cast<float>(r.lit ? 1.0 / contrast : 0.0);
 
   // The band: pixels near the region, not deep inside it, never a
-  // neighbour's.
+  // neighbour's; its moments summed row by row.
+  int row = -1;
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  forEachCoverage(r, pixels, near.minus(interior), [&](int y, int x, float raw) {
+    if (y != row) {
+      if (row >= 0) sums.addRow(row, s0, s1, s2, s3);
+      row = y;
+      s0 = s1 = s2 = s3 = 0;
+    }
+    const double v = std::min(std::max(raw, 0.0f), 1.0f);
+    const double xv = x * v;
+    const double xxv = xv * x;
+    s0 += v;
+    s1 += xv;
+    s2 += xxv;
+    s3 += xxv * x;
+  });
+  if (row >= 0) sums.addRow(row, s0, s1, s2, s3);
+  if (sums.m00 <= 0) return false;
+  // The band's outermost pixels.
   double tail_sum = 0;
   int tail_count = 0;
-  for (int y = 0; y < h; ++y) {
-    const uint8_t* g = grey_box.ptr<uint8_t>(y);
-    const uint8_t* nr = near.ptr<uint8_t>(y);
-    const uint8_t* st = set.ptr<uint8_t>(y);
-    const uint8_t* o = own.ptr<uint8_t>(y);
-    const uint8_t* in = interior.ptr<uint8_t>(y);
-    const uint8_t* nrr = nearer.ptr<uint8_t>(y);
-    float* c = coverage.ptr<float>(y);
-    const double row_background = plane[0] + plane[2] * y;
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    for (int x = 0; x < w; ++x) {
-      if (!nr[x] || in[x] || (st[x] && !o[x])) continue;
-      const auto b = static_cast<float>(row_background + plane[1] * x);
-      const float level = lit ? static_cast<float>(g[x]) / b : static_cast<float>(g[x]) - b;
-      const float raw = scale * level + offset;
-      if (!nrr[x]) {
-        tail_sum += raw;
-        ++tail_count;
-      }
-      const float v = std::min(std::max(raw, 0.0f), 1.0f);
-      c[x] = v;
-      const double xv = static_cast<double>(x) * v;
-      const double xxv = xv * x;
-      s0 += v;
-      s1 += xv;
-      s2 += xxv;
-      s3 += xxv * x;
-    }
-    sums.addRow(y, s0, s1, s2, s3);
-  }
-  const double m00 = sums.m00, m10 = sums.m10, m01 = sums.m01, m20 = sums.m20, m11 = sums.m11,
-               m02 = sums.m02, m30 = sums.m30, m21 = sums.m21, m12 = sums.m12, m03 = sums.m03;
-  if (m00 <= 0) return false;
-  *moments = cv::Moments(m00, m10, m01, m20, m11, m02, m30, m21, m12, m03);
-  *centroid = cv::Point2d(box.x + m10 / m00, box.y + m01 / m00);
-  *weights = coverage;
-  *origin = box.tl();
-  *tail = tail_count > 0 ? tail_sum / tail_count : 0.0;
+  forEachCoverage(r, pixels, near.minus(nearer), [&](int, int, float raw) {
+    tail_sum += raw;
+    ++tail_count;
+  });
+  reading->tail = tail_count > 0 ? tail_sum / tail_count : 0.0;
   return true;
 }
 
-// Grey-level coverage moments of one region (see findRegions and
-// greyMomentsWithin). Returns false, leaving the moments alone, when the grey
-// levels cannot be trusted.
+// Grey-level coverage moments of one region (see findRegions and readBand),
+// and its coverage over `box` in `weights`. Returns false, leaving the
+// outputs alone, when the grey levels cannot be trusted.
+//
+// `own` is the region's mask over `box` (the bounding box with a margin for
+// the edge blur and the background ring), `set` the mask of all regions
+// there.
 //
 // The band read from grey levels must hold the edge blur, and no more: each
 // pixel of it adds its noise. A sharp edge (blur sigma under a pixel) is
@@ -295,24 +312,52 @@ bool greyMomentsWithin(int reach, const cv::Mat& grey_box, const cv::Mat& own, c
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set,
                  const cv::Rect& box, cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights,
                  cv::Point* origin) {
-  bool measured = false;
+  const BandPixels pixels{grey_box, own, set};
+  const RowRuns own_runs = RowRuns::ofMask(own);
+  Dilations dilations(own_runs);
+  BandReading kept;
+  int kept_reach = 0;
+  RowRuns kept_interior;
+  // The histogram of the interior's grey levels, made once and then
+  // narrowed with the interior: a wider band's interior is the narrower
+  // one's less a shell.
+  std::array<int, 256> histogram{};
+  RowRuns interior;
   for (int reach = kMinBand; reach <= kMaxBand; ++reach) {
+    RowRuns narrower = own_runs.eroded(reach);
+    const int sign = interior.height() == 0 ? 1 : -1;
+    (sign > 0 ? narrower : interior.minus(narrower)).forEachRun([&](int y, int a, int b) {
+      const uint8_t* g = grey_box.ptr<uint8_t>(y);
+      for (int x = a; x < b; ++x) histogram[g[x]] += sign;
+    });
+    interior = std::move(narrower);
     // A wider band that cannot be read (its ring reaches a neighbour or the
-    // frame's edge) leaves the narrower one's moments.
-    cv::Moments m;
-    cv::Point2d c;
-    cv::Mat w;
-    cv::Point o;
-    double tail = 0;
-    if (!greyMomentsWithin(reach, grey_box, own, set, box, &m, &c, &w, &o, &tail)) break;
-    *moments = m;
-    *centroid = c;
-    *weights = w;
-    *origin = o;
-    measured = true;
-    if (tail <= kMaxBandTail) break;
+    // frame's edge) leaves the narrower one's reading.
+    BandReading reading;
+    if (!readBand(reach, pixels, interior, histogram, dilations, &reading)) break;
+    kept = reading;
+    kept_reach = reach;
+    kept_interior = interior;
+    if (reading.tail <= kMaxBandTail) break;
   }
-  return measured;
+  if (kept_reach == 0) return false;
+
+  // The coverage of the band width kept: 1 in the interior, read in the band.
+  cv::Mat coverage(box.size(), CV_32F, cv::Scalar(0));
+  kept_interior.forEachRun([&](int y, int a, int b) {
+    float* c = coverage.ptr<float>(y);
+    std::fill(c + a, c + b, 1.0f);
+  });
+  forEachCoverage(kept, pixels, dilations.byRadius(kept_reach).minus(kept_interior),
+                  [&](int y, int x, float raw) {
+                    coverage.ptr<float>(y)[x] = std::min(std::max(raw, 0.0f), 1.0f);
+                  });
+  const Moments10& s = kept.sums;
+  *moments = cv::Moments(s.m00, s.m10, s.m01, s.m20, s.m11, s.m02, s.m30, s.m21, s.m12, s.m03);
+  *centroid = cv::Point2d(box.x + s.m10 / s.m00, box.y + s.m01 / s.m00);
+  *weights = coverage;
+  *origin = box.tl();
+  return true;
 }
 
 // The pixels of one region over `box`: inside its outer boundary, outside its

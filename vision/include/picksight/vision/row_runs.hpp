@@ -1,0 +1,72 @@
+// A binary mask as runs of set pixels per row, with the square dilations,
+// erosions and differences the grey-level region measurement needs, at a
+// cost per run instead of per pixel.
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace picksight::vision {
+
+// The set pixels of a width x height mask, row by row, as sorted disjoint
+// half-open column runs [begin, end). A part's mask has a few runs per row
+// whatever its width, so morphology with a square of side 2r + 1 costs
+// O(runs x r) here where it costs O(pixels x r) on the mask; the region
+// measurement needs four of them per part per band width (see regions.cpp).
+// Values; not synchronized (one owner at a time).
+class RowRuns {
+ public:
+  using Run = std::pair<int, int>;  // [first, second) columns
+
+  RowRuns() = default;
+
+  // The runs of the non-zero pixels of `mask` (CV_8UC1).
+  static RowRuns ofMask(const cv::Mat& mask);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  // Number of set pixels.
+  long long count() const;
+
+  // cv::dilate with a (2r+1)-square and OpenCV's default border (nothing
+  // set outside the box).
+  RowRuns dilated(int r) const;
+  // cv::erode with a (2r+1)-square and OpenCV's default border (everything
+  // set outside the box, so pixels at the box's edge are not eroded by it).
+  RowRuns eroded(int r) const;
+  // The pixels set here and not in `other` (same size).
+  RowRuns minus(const RowRuns& other) const;
+
+  // f(y, begin, end) for every run, rows in order, runs left to right.
+  template <class F>
+  void forEachRun(F&& f) const {
+    for (int y = 0; y < height_; ++y) {
+      for (int i = first_[static_cast<size_t>(y)]; i < first_[static_cast<size_t>(y) + 1]; ++i) {
+        const Run& run = runs_[static_cast<size_t>(i)];
+        f(y, run.first, run.second);
+      }
+    }
+  }
+
+  // A mask of the runs (CV_8UC1, 255 where set): for tests and drawing.
+  cv::Mat toMask() const;
+
+ private:
+  RowRuns(int width, int height) : width_(width), height_(height) { first_.push_back(0); }
+  // Appends row after row: `row` must be the next row's sorted disjoint runs.
+  void pushRow(const std::vector<Run>& row);
+  const Run* rowBegin(int y) const { return runs_.data() + first_[static_cast<size_t>(y)]; }
+  const Run* rowEnd(int y) const { return runs_.data() + first_[static_cast<size_t>(y) + 1]; }
+  // Each run widened (r > 0) or narrowed (r < 0) by |r| along the row, kept
+  // within the box; when narrowing, runs at the box's edge keep that end.
+  RowRuns horizontally(int r) const;
+
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<int> first_;  // runs of row y: runs_[first_[y] .. first_[y + 1])
+  std::vector<Run> runs_;
+};
+
+}  // namespace picksight::vision
