@@ -181,34 +181,56 @@ std::complex<double> rowPowerSums(const Region& region, int k, double scale) {
       term *= dx;
     }
   }
-  std::complex<double> sum(0, 0);
-  for (int y = 0; y < w.rows; ++y) {
-    const float* row = w.ptr<float>(y);
-    Sums sums{};
-    if constexpr (K < 0) sums.resize(un);
-    bool any = false;
-    for (size_t x = 0; x < cols;) {
+  // One row's power sums over the columns [a, b).
+  const auto addSpan = [&](const float* row, size_t a, size_t b, Sums& sums) {
+    for (size_t x = a; x < b;) {
       const float v = row[x];
       if (v <= 0) {
         ++x;
         continue;
       }
-      any = true;
       if (v < 1.0f) {
         for (size_t p = 0; p < un; ++p) sums[p] += v * power[x * un + p];
         ++x;
         continue;
       }
-      const size_t a = x;
-      while (x < cols && row[x] >= 1.0f) ++x;
-      for (size_t p = 0; p < un; ++p) sums[p] += before[x * un + p] - before[a * un + p];
+      const size_t start = x;
+      while (x < b && row[x] >= 1.0f) ++x;
+      for (size_t p = 0; p < un; ++p) sums[p] += before[x * un + p] - before[start * un + p];
     }
-    if (!any) continue;
+  };
+  // Horner in (i y): the p = 0 sum takes (i y)^k.
+  std::complex<double> sum(0, 0);
+  const auto addRow = [&](int y, const Sums& sums) {
     const std::complex<double> iy(0, (region.coverage_origin.y + y - region.centroid.y) * scale);
-    // Horner in (i y): the p = 0 sum takes (i y)^k.
     std::complex<double> acc(0, 0);
     for (int p = 0; p < n; ++p) acc = acc * iy + binomial[p] * sums[p];
     sum += acc;
+  };
+  const auto emptySums = [&] {
+    Sums sums{};
+    if constexpr (K < 0) sums.resize(un);
+    return sums;
+  };
+  if (region.covered.height() == w.rows && region.covered.width() == w.cols) {
+    // Only where the coverage may be non-zero.
+    int row_y = -1;
+    Sums sums = emptySums();
+    region.covered.forEachRun([&](int y, int a, int b) {
+      if (y != row_y) {
+        if (row_y >= 0) addRow(row_y, sums);
+        row_y = y;
+        sums = emptySums();
+      }
+      addSpan(w.ptr<float>(y), static_cast<size_t>(a), static_cast<size_t>(b), sums);
+    });
+    if (row_y >= 0) addRow(row_y, sums);
+    return sum;
+  }
+  for (int y = 0; y < w.rows; ++y) {
+    Sums sums = emptySums();
+    addSpan(w.ptr<float>(y), 0, cols, sums);
+    addRow(y, sums);
   }
   return sum;
 }

@@ -311,7 +311,7 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
 // pixels are still measurably covered.
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set,
                  const cv::Rect& box, cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights,
-                 cv::Point* origin) {
+                 cv::Point* origin, RowRuns* covered) {
   const BandPixels pixels{grey_box, own, set};
   const RowRuns own_runs = RowRuns::ofMask(own);
   Dilations dilations(own_runs);
@@ -357,6 +357,7 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
   *centroid = cv::Point2d(box.x + s.m10 / s.m00, box.y + s.m01 / s.m00);
   *weights = coverage;
   *origin = box.tl();
+  *covered = dilations.byRadius(kept_reach);
   return true;
 }
 
@@ -449,7 +450,7 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
       r.holes = static_cast<int>(r.hole_boundaries.size());
 
       if (!grey.empty() && greyMoments(grey(box), own, mask(box), box, &r.moments, &r.centroid,
-                                       &r.coverage, &r.coverage_origin)) {
+                                       &r.coverage, &r.coverage_origin, &r.covered)) {
         r.area = r.moments.m00;
       } else {
         // Binary moments only where the grey levels cannot be trusted.
@@ -459,6 +460,7 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
         r.centroid = cv::Point2d(bbox.x + m.m10 / m.m00, bbox.y + m.m01 / m.m00);
         inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
         r.coverage_origin = bbox.tl();
+        r.covered = RowRuns::ofMask(inner);
       }
       r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
       const cv::Moments& rm = r.moments;

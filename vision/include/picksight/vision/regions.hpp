@@ -7,6 +7,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "picksight/vision/row_runs.hpp"
+
 namespace picksight::vision {
 
 struct Region {
@@ -32,6 +34,11 @@ struct Region {
   // (complex moments for the rotation of symmetric parts) need no second pass.
   cv::Mat coverage;
   cv::Point coverage_origin;
+  // The runs of `coverage` outside which it is 0 (same box; a superset of
+  // its non-zero pixels), so that a pass over the coverage skips the rest
+  // of the box: outside a curved or slender part, and its holes, that is
+  // most of it. Empty (height 0) when not known: the whole box is read.
+  RowRuns covered;
 };
 
 struct RegionOptions {
