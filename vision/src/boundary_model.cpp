@@ -514,6 +514,25 @@ double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centr
   return total > 0 ? on / total : 0;
 }
 
+bool verifiesAtLeast(const std::vector<BoundarySample>& samples, double total, cv::Point2d centre,
+                     double c, double s, double flip, const EdgeDistance& edges, double tolerance,
+                     double needed) {
+  const double goal = needed * total;
+  double on = 0;
+  double left = total;
+  for (const auto& sample : samples) {
+    const double x = sample.point.x;
+    const double y = flip * sample.point.y;
+    if (edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}) <= tolerance) {
+      on += sample.weight;
+      if (on >= goal) return true;
+    }
+    left -= sample.weight;
+    if (on + left < goal) return false;
+  }
+  return on >= goal;
+}
+
 double meanEdgeDistance(const std::vector<BoundarySample>& samples, cv::Point2d centre,
                         double angle_deg, const EdgeDistance& edges, double clip, bool mirrored) {
   double sum = 0;

@@ -197,8 +197,10 @@ constexpr double kMaxCopyScale = 1.6;
 // boundary, scaled, verifies on the region's edges.
 bool isScaledCopy(RegionCache& cache, const PartModel& model, double scale) {
   std::vector<BoundarySample> scaled = model.samples;
+  double total = 0;
   for (auto& s : scaled) {
     s.point *= scale;
+    total += s.weight;
   }
   const Region& r = cache.region();
   const EdgeDistance& edges = cache.edges();
@@ -208,8 +210,11 @@ bool isScaledCopy(RegionCache& cache, const PartModel& model, double scale) {
     const double model_phase =
         mirrored ? -model.orientation_phase_deg : model.orientation_phase_deg;
     for (double t : candidates(phase, model_phase, k)) {
-      const double v = verifyScore(scaled, r.centroid, t, edges, model.edge_tolerance, mirrored);
-      if (v * 100 >= model.verify_percent) return true;
+      // A yes or no: the walk along the boundary stops once it is decided.
+      if (verifiesAtLeast(scaled, total, r.centroid, std::cos(t * kRadPerDeg),
+                          std::sin(t * kRadPerDeg), mirrored ? -1.0 : 1.0, edges,
+                          model.edge_tolerance, model.verify_percent / 100.0))
+        return true;
     }
   }
   return false;

@@ -89,29 +89,6 @@ constexpr double kCornerTurnFinestDeg = 0.5;
 constexpr double kExplainedPx = 3.0;
 constexpr double kExplainedDeg = kCornerAngleSlackDeg;
 
-// Whether at least `needed` (a fraction) of the samples' weight lies within
-// `tolerance` of an edge at the pose (centre, turn with cosine c and sine s,
-// mirrored when flip is -1), as verifyScore would say; stops as soon as the
-// rest cannot decide otherwise, which most wrong hypotheses show within a
-// few samples.
-bool verifiesAtLeast(const std::vector<BoundarySample>& samples, double total, cv::Point2d centre,
-                     double c, double s, double flip, const EdgeDistance& edges, double tolerance,
-                     double needed) {
-  const double goal = needed * total;
-  double on = 0;
-  double left = total;
-  for (const auto& sample : samples) {
-    const double x = sample.point.x;
-    const double y = flip * sample.point.y;
-    if (edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}) <= tolerance) {
-      on += sample.weight;
-      if (on >= goal) return true;
-    }
-    left -= sample.weight;
-    if (on + left < goal) return false;
-  }
-  return on >= goal;
-}
 }  // namespace
 
 void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
