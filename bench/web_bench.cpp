@@ -1,8 +1,9 @@
 // The web HMI's cost to a cell, against the real processes: a video server
 // with two synthetic cameras (cam0 in trigger mode for the vision app, cam1
 // free-running at 30 fps), picksight-vision and picksight-web.
-//   1. LOCATE median and p99 with no viewer and with 4 MJPEG viewers of every
-//      camera, after a warm-up of both, in rounds that alternate which goes
+//   1. LOCATE median and p99 with no viewer and with 4 browsers on every
+//      camera (each an MJPEG stream and the page's /events stream of
+//      results), after a warm-up of both, in rounds that alternate which goes
 //      first so machine noise hits both (goal: p99 with viewers <= 1.1x
 //      without);
 //   2. camera-to-client latency at the camera's size: from the frame's host
@@ -150,6 +151,45 @@ class Viewer {
   std::thread thread_;
 };
 
+// One page's event stream (/events) on its own thread, as every browser
+// keeps open beside its MJPEG stream: counts the results received, at the
+// viewers' low priority.
+class EventsClient {
+ public:
+  explicit EventsClient(int port) : client_("127.0.0.1", port), thread_([this] { run(); }) {}
+  ~EventsClient() {
+    stop_ = true;
+    client_.stop();
+    thread_.join();
+  }
+  EventsClient(const EventsClient&) = delete;
+  EventsClient& operator=(const EventsClient&) = delete;
+  int results() const { return results_.load(); }
+
+ private:
+  void run() {
+    client_.set_read_timeout(30s);  // a keepalive comes every 15 s
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+    std::string buffer;
+    while (!stop_) {
+      buffer.clear();
+      client_.Get("/events", [&](const char* data, size_t size) {
+        buffer.append(data, size);
+        for (size_t end; (end = buffer.find("\n\n")) != std::string::npos;) {
+          if (buffer.rfind("event: result\n", 0) == 0) ++results_;
+          buffer.erase(0, end + 2);
+        }
+        return !stop_;
+      });
+    }
+  }
+
+  httplib::Client client_;  // its thread's, but for stop()
+  std::atomic<bool> stop_{false};
+  std::atomic<int> results_{0};
+  std::thread thread_;
+};
+
 // The value of a metric line "name{labels} value" in /metrics, or -1.
 double metric(int port, const std::string& series) {
   httplib::Client client("127.0.0.1", port);
@@ -243,22 +283,31 @@ int main(int argc, char** argv) {
   if (auto learned = robot->request("LEARN 1", 30s); !learned || learned->rfind("OK", 0) != 0)
     std::printf("LEARN failed: LOCATE finds no part\n");
   setParts(args.parts);
+  // A browser: an MJPEG viewer and the page's event stream.
+  struct Browser {
+    Browser(int port, const char* camera) : viewer(port, camera, false), events(port) {}
+    Viewer viewer;
+    EventsClient events;
+  };
   const auto openViewers = [&] {
-    std::vector<std::unique_ptr<Viewer>> viewers;
+    std::vector<std::unique_ptr<Browser>> browsers;
     for (const char* camera : {"cam0", "cam1"})
       for (int v = 0; v < kViewersPerCamera; ++v)
-        viewers.push_back(std::make_unique<Viewer>(port, camera, false));
+        browsers.push_back(std::make_unique<Browser>(port, camera));
     // Measure once the free-running camera's viewers receive frames.
     const auto deadline = Clock::now() + 10s;
-    while (viewers.back()->frames() < 2 && Clock::now() < deadline)
+    while (browsers.back()->viewer.frames() < 2 && Clock::now() < deadline)
       std::this_thread::sleep_for(1ms);
-    return viewers;
+    return browsers;
   };
   // The server learns that a viewer left only when it next writes to it,
   // which for the triggered camera is at its next frame: without this the
   // first LOCATE of a no-viewer phase would pay for encoding a JPEG nobody
-  // reads. One trigger, then wait until /metrics counts no viewer.
+  // reads. One trigger, then wait until /metrics counts no viewer. An event
+  // stream, likewise, ends at the first result that cannot be written: two
+  // LOCATEs outside the measures.
   const auto settle = [&] {
+    for (int i = 0; i < 2; ++i) locate(ignored);
     picksight::ControlClient client(context, server.control, 5000ms);
     picksight::proto::ControlRequest trigger;
     trigger.mutable_trigger()->set_camera("cam0");
@@ -281,16 +330,21 @@ int main(int argc, char** argv) {
   std::vector<double> alone;
   std::vector<double> watched;
   int viewer_frames = 0;
+  int event_results = 0;
   double watched_s = 0;
   const auto watchedPhase = [&] {
-    const auto viewers = openViewers();
+    const auto browsers = openViewers();
     int before = 0;
-    for (const auto& v : viewers) before += v->frames();
+    int results_before = 0;
+    for (const auto& b : browsers) before += b->viewer.frames();
+    for (const auto& b : browsers) results_before += b->events.results();
     const auto t0 = Clock::now();
     for (int i = 0; i < per_round; ++i) locate(watched);
     watched_s += std::chrono::duration<double>(Clock::now() - t0).count();
-    for (const auto& v : viewers) viewer_frames += v->frames();
+    for (const auto& b : browsers) viewer_frames += b->viewer.frames();
+    for (const auto& b : browsers) event_results += b->events.results();
     viewer_frames -= before;
+    event_results -= results_before;
   };
   // Rounds alternate which condition goes first, so that a drift of the
   // machine over a round falls on both.
@@ -311,11 +365,13 @@ int main(int argc, char** argv) {
               args.parts, kRounds, per_round, failures);
   std::printf("  %-52s %8s %8s\n", "ms", "median", "p99");
   std::printf("  %-52s %8.2f %8.2f\n", "no viewer", a50, a99);
-  std::printf("  %-52s %8.2f %8.2f\n", "4 MJPEG viewers of each camera (8 streams)", w50, w99);
+  std::printf("  %-52s %8.2f %8.2f\n", "4 browsers on each camera (8 MJPEG + 8 /events)", w50, w99);
   std::printf("  %-52s %7.2fx %7.2fx   (goal p99 <= 1.10x)\n", "ratio (viewers / none)",
               a50 > 0 ? w50 / a50 : 0.0, a99 > 0 ? w99 / a99 : 0.0);
-  std::printf("  (the viewers received %.1f frames/s in all during the watched rounds)\n",
-              watched_s > 0 ? viewer_frames / watched_s : 0.0);
+  std::printf(
+      "  (the viewers received %.1f frames/s in all during the watched rounds, and %d results "
+      "as events)\n",
+      watched_s > 0 ? viewer_frames / watched_s : 0.0, event_results);
   // Where the slowest requests fell: a systematic one (the same place in
   // every round) shows in its index.
   const auto slowest = [&](const char* what, const std::vector<double>& times) {

@@ -12,6 +12,10 @@ import numpy as np
 import pytest
 
 BIN_DIR = os.environ.get("PICKSIGHT_BIN_DIR", "")
+# How long a starting process may take to print its endpoints: generous,
+# since a sanitizer build under a loaded CI machine starts several times
+# slower, and a passing test never waits for the deadline.
+START_TIMEOUT = 30.0
 
 
 def bin_path(name):
@@ -46,7 +50,12 @@ class Process:
             if ready:
                 chunk = os.read(fd, 4096)
                 if not chunk:
-                    raise RuntimeError(f"{self.argv[0]} exited: {self.proc.wait()}")
+                    # Its stdout closed: it is exiting; waited for with a bound all the same.
+                    try:
+                        code = self.proc.wait(5)
+                    except subprocess.TimeoutExpired:
+                        code = "still running with its stdout closed"
+                    raise RuntimeError(f"{self.argv[0]} exited: {code}")
                 self._buffer += chunk
 
     def stop(self):
@@ -60,23 +69,28 @@ class Process:
         self.proc.stdout.close()
 
 
+# The servers are added to `started` as soon as they run, before their
+# start lines are awaited: one that fails to start in time is stopped with
+# the others instead of running on beside the next tests.
 class VideoServer:
-    def __init__(self, *args):
+    def __init__(self, *args, started):
         self.process = Process([bin_path("picksight-video-server"), "--frames",
                                 "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", *args])
-        self.frames = self.process.wait_line("frames ")
-        self.control = self.process.wait_line("control ")
+        started.append(self.process)
+        self.frames = self.process.wait_line("frames ", START_TIMEOUT)
+        self.control = self.process.wait_line("control ", START_TIMEOUT)
 
 
 class Vision:
-    def __init__(self, server, data_dir, camera="cam0"):
+    def __init__(self, server, data_dir, started, camera="cam0"):
         self.process = Process([bin_path("picksight-vision"), "--frames", server.frames,
                                 "--control", server.control, "--camera", camera,
                                 "--robot-port", "0", "--bind", "127.0.0.1",
                                 "--data-dir", str(data_dir)])
-        self.port = int(self.process.wait_line("robot "))
-        self.results = self.process.wait_line("results ")
-        self.process.wait_line("ready")
+        started.append(self.process)
+        self.port = int(self.process.wait_line("robot ", START_TIMEOUT))
+        self.results = self.process.wait_line("results ", START_TIMEOUT)
+        self.process.wait_line("ready", START_TIMEOUT)
 
 
 @pytest.fixture
@@ -85,14 +99,12 @@ def cell_factory(tmp_path):
     started = []
 
     def start(*server_args, vision=True):
-        server = VideoServer(*server_args)
-        started.append(server.process)
+        server = VideoServer(*server_args, started=started)
         app = None
         if vision:
             data = tmp_path / f"data{len(started)}"
             data.mkdir()
-            app = Vision(server, data)
-            started.append(app.process)
+            app = Vision(server, data, started)
         return server, app
 
     yield start

@@ -21,9 +21,9 @@ FAKE_CAMERA = os.environ.get("ARV_FAKE_GV_CAMERA", "arv-fake-gv-camera-0.8")
 def fake_camera_server():
     fake = subprocess.Popen([FAKE_CAMERA, "-i", "127.0.0.1"], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
-    server = None
+    started = []
     try:
-        server = VideoServer("--source", "cam0=aravis:Aravis-Fake-GV01", "--fps", "10")
+        server = VideoServer("--source", "cam0=aravis:Aravis-Fake-GV01", "--fps", "10", started=started)
         with CameraControl(server.control, timeout=10.0) as control:
             # Generous: a loaded machine is slow to start the fake camera.
             deadline = time.monotonic() + 60
@@ -32,8 +32,8 @@ def fake_camera_server():
                 time.sleep(0.1)
         yield server
     finally:
-        if server is not None:
-            server.process.stop()
+        for process in started:
+            process.stop()
         fake.kill()
         fake.wait()
 

@@ -100,6 +100,52 @@
     return row;
   };
 
+  // ---- fields refreshed from the server ------------------------------------------
+  // An input marked data-refreshed shows a value the server holds and is
+  // rewritten by refreshes. Once the user edits it (an input or change event,
+  // which a script's writes never fire) it is dirty, class "dirty", until the
+  // server accepts the value (ps.applyFields) or the user selects another
+  // camera or app: a refresh never overwrites it, so a value typed and left
+  // for the Apply button is still there when the button is pressed.
+  const fieldOf = (f) => (typeof f === "string" ? $(f) : f);
+  const valueOf = (el) => (el.type === "checkbox" ? el.checked : el.value);
+  ps.isDirty = (f) => fieldOf(f).classList.contains("dirty");
+
+  // Shows the server's value unless the user's edit is pending; with
+  // `force` (the user asked for this value: a rectangle dragged, a row
+  // picked) it replaces the edit and leaves the field dirty when `dirty`.
+  ps.setField = function (f, value, force, dirty) {
+    const el = fieldOf(f);
+    if (!force && ps.isDirty(el)) return false;
+    if (el.type === "checkbox") el.checked = !!value; else el.value = value;
+    el.classList.toggle("dirty", !!dirty);
+    return true;
+  };
+
+  // Sends the fields' values with `send` (a camera action's {ok} or a
+  // protocol reply line); when the server accepts, the fields still holding
+  // what was sent are clean again (a refused edit stays dirty, with the
+  // refusal shown beside it). The result of `send`.
+  ps.applyFields = async function (fields, send) {
+    const els = fields.map(fieldOf);
+    const sent = els.map(valueOf);
+    const r = await send();
+    const ok = typeof r === "string" ? r.startsWith("OK") : !!(r && r.ok);
+    if (ok) els.forEach((el, i) => { if (valueOf(el) === sent[i]) el.classList.remove("dirty"); });
+    return r;
+  };
+
+  ps.clearDirty = function (root) {
+    for (const el of (root || document).querySelectorAll(".dirty")) el.classList.remove("dirty");
+  };
+
+  function markDirty(e) {
+    const el = e.target;
+    if (el && el.hasAttribute && el.hasAttribute("data-refreshed")) el.classList.add("dirty");
+  }
+  document.addEventListener("input", markDirty, true);
+  document.addEventListener("change", markDirty, true);
+
   // A camera action; shows the server's message in the camera panel.
   ps.cameraAction = async function (action, body) {
     if (!ps.camera) return { ok: false, body: { error: "no camera" } };
@@ -228,6 +274,7 @@
   function selectCamera(name) {
     if (name === ps.camera) return;
     ps.camera = name;
+    ps.clearDirty();  // the fields now show another camera's values
     localStorage.setItem("picksight.camera", name);
     fillSelect($("camera-select"), ps.cameras.map((c) => c.name), name);
     const apps = appsOfCamera();
@@ -254,6 +301,7 @@
     document.body.classList.toggle("simulated", !!c.simulated_robot);
   }
 
+  ps.cameraRefreshes = 0;  // camera lists shown so far (read by the tests)
   function setCameras(list) {
     if (!Array.isArray(list)) return;
     ps.cameras = list;
@@ -266,6 +314,7 @@
     showStats();
     sizeLayers();
     emit("cameras", list);
+    ++ps.cameraRefreshes;
   }
 
   async function refreshCameras() {
@@ -395,7 +444,11 @@
   document.addEventListener("DOMContentLoaded", () => {
     for (const b of document.querySelectorAll("#tabs button")) b.addEventListener("click", () => selectTab(b.dataset.tab));
     $("camera-select").addEventListener("change", (e) => selectCamera(e.target.value));
-    $("app-select").addEventListener("change", (e) => { selectApp(e.target.value); emit("camera", ps.camera); });
+    $("app-select").addEventListener("change", (e) => {
+      ps.clearDirty();
+      selectApp(e.target.value);
+      emit("camera", ps.camera);
+    });
     $("frame").addEventListener("load", () => { sizeLayers(); drawRects(); });
     window.addEventListener("resize", () => emit("camera", ps.camera));
     ps.on("camera", drawRects);

@@ -130,7 +130,7 @@
       const m = ps.mapping();
       const w = m.sensorW, h = m.sensorH;
       const radius = Number(robot.target_radius_mm) || Number($("cal-radius").value) || 5;
-      $("cal-radius").value = radius;
+      ps.setField("cal-radius", radius, true);
       await say("CLEARCAL");
       const centre = sensorToRobot(robot.robot_to_sensor, 0.5 * (w - 1), 0.5 * (h - 1));
       await moveTarget({ x_mm: centre[0], y_mm: centre[1] });
@@ -143,8 +143,8 @@
         const fy = i < cols ? 0.15 + 0.05 * (i % 2) : 0.8 + 0.05 * (i % 2);
         const r = sensorToRobot(robot.robot_to_sensor, fx * (w - 1), fy * (h - 1));
         const x = r[0].toFixed(3), y = r[1].toFixed(3);
-        $("cal-robot-x").value = x;
-        $("cal-robot-y").value = y;
+        ps.setField("cal-robot-x", x, true);  // the point being stored
+        ps.setField("cal-robot-y", y, true);
         await moveTarget({ x_mm: Number(x), y_mm: Number(y) });
         await say("STORE " + x + " " + y);
       }
@@ -162,11 +162,16 @@
     ps.toolDrawers.push(drawPoints);
     ps.on("tab", (tab) => { if (tab === "calibrate") refreshPoints(); });
     $("cal-status").addEventListener("click", status);
-    $("cal-calcam").addEventListener("click", async () => { await say("CALCAM " + val("cal-radius")); status(); });
-    $("cal-move").addEventListener("click", () => moveTarget({ x_mm: val("cal-robot-x"), y_mm: val("cal-robot-y") }));
+    const robotFields = ["cal-robot-x", "cal-robot-y"];
+    $("cal-calcam").addEventListener("click", async () => {
+      await ps.applyFields(["cal-radius"], () => say("CALCAM " + val("cal-radius")));
+      status();
+    });
+    $("cal-move").addEventListener("click", () =>
+      ps.applyFields(robotFields, () => moveTarget({ x_mm: val("cal-robot-x"), y_mm: val("cal-robot-y") })));
     $("cal-hide").addEventListener("click", () => moveTarget({ hide: true }));
     $("cal-store").addEventListener("click", async () => {
-      await say("STORE " + val("cal-robot-x") + " " + val("cal-robot-y"));
+      await ps.applyFields(robotFields, () => say("STORE " + val("cal-robot-x") + " " + val("cal-robot-y")));
       refreshPoints();
     });
     $("cal-list").addEventListener("click", refreshPoints);

@@ -36,47 +36,54 @@
       const range = f.choices && f.choices.length ? f.choices.join(" | ")
         : f.has_range ? (f.min || 0) + " .. " + (f.max || 0) + (f.unit ? " " + f.unit : "") : "";
       const row = ps.tableRow(tbody, [f.name, f.value === undefined ? "" : String(f.value), range]);
-      row.addEventListener("click", () => { $("feature-name").value = f.name; $("feature-value").value = f.value || ""; });
+      row.addEventListener("click", () => {
+        ps.setField("feature-name", f.name, true);
+        ps.setField("feature-value", f.value === undefined ? "" : f.value, true);
+      });
       const o = document.createElement("option");
       o.value = f.name;
       $("feature-names").appendChild(o);
     }
-    $("cam-exposure").value = featureValue(exposureName());
-    $("cam-gain").value = featureValue(gainName());
+    ps.setField("cam-exposure", featureValue(exposureName()));
+    ps.setField("cam-gain", featureValue(gainName()));
   }
 
-  async function setFeature(name, value) {
+  // Sets a feature to the value of its field(s); the list and the exposure
+  // and gain fields are read back.
+  async function setFeature(name, fields) {
     if (!name) return;
-    await ps.cameraAction("feature", { name, value: String(value) });
+    const value = $(fields[fields.length - 1]).value;
+    await ps.applyFields(fields, () => ps.cameraAction("feature", { name, value: String(value) }));
     refreshFeatures();
   }
 
+  const roiFields = ["roi-x", "roi-y", "roi-w", "roi-h"];
+
+  // The camera's ROI, or a rectangle just dragged on the image: that one
+  // replaces any edit and stays marked until it is applied.
   function showRoi(rect) {
     const c = ps.cameraInfo() || {};
     const r = rect || c.roi || {};
-    $("roi-x").value = r.x || 0;
-    $("roi-y").value = r.y || 0;
-    $("roi-w").value = r.width || 0;
-    $("roi-h").value = r.height || 0;
+    [r.x, r.y, r.width, r.height].forEach((v, i) => ps.setField(roiFields[i], v || 0, !!rect, !!rect));
   }
 
   function showCamera() {
     const c = ps.cameraInfo();
     if (!c) return;
     for (const radio of document.querySelectorAll("input[name=cam-mode]")) radio.checked = radio.value === c.mode;
-    const keep = (id) => document.activeElement === $(id);
-    if (c.trigger_line && !keep("cam-hw-line")) $("cam-hw-line").value = c.trigger_line;
-    if (c.trigger_activation !== undefined && !keep("cam-hw-activation")) $("cam-hw-activation").value = c.trigger_activation;
-    if (c.trigger_timeout_ms && !keep("cam-hw-timeout")) $("cam-hw-timeout").value = c.trigger_timeout_ms;
-    if (!ps.rect.roi) showRoi();
-    if (document.activeElement !== $("size-w")) $("size-w").value = c.width || 0;
-    if (document.activeElement !== $("size-h")) $("size-h").value = c.height || 0;
+    if (c.trigger_line) ps.setField("cam-hw-line", c.trigger_line);
+    if (c.trigger_activation !== undefined) ps.setField("cam-hw-activation", c.trigger_activation);
+    if (c.trigger_timeout_ms) ps.setField("cam-hw-timeout", c.trigger_timeout_ms);
+    showRoi();
+    ps.setField("size-w", c.width || 0);
+    ps.setField("size-h", c.height || 0);
   }
 
   const intOf = (id) => Math.max(0, Math.round(Number($(id).value) || 0));
 
   // The hardware mode with the input, edge and timeout of the fields (empty
   // ones left to the video server's defaults).
+  const hwFields = ["cam-hw-line", "cam-hw-activation", "cam-hw-timeout"];
   function hardwareMode() {
     const body = { mode: "hardware" };
     const line = $("cam-hw-line").value.trim();
@@ -84,7 +91,7 @@
     if ($("cam-hw-activation").value) body.activation = $("cam-hw-activation").value;
     const ms = intOf("cam-hw-timeout");
     if (ms > 0) body.timeout_ms = ms;
-    return ps.cameraAction("mode", body);
+    return ps.applyFields(hwFields, () => ps.cameraAction("mode", body));
   }
 
   document.addEventListener("DOMContentLoaded", () => {
@@ -100,20 +107,22 @@
         radio.value === "hardware" ? hardwareMode() : ps.cameraAction("mode", { mode: radio.value }));
     }
     $("cam-hw-apply").addEventListener("click", hardwareMode);
-    $("cam-exposure-set").addEventListener("click", () => setFeature(exposureName(), $("cam-exposure").value));
-    $("cam-gain-set").addEventListener("click", () => setFeature(gainName(), $("cam-gain").value));
+    $("cam-exposure-set").addEventListener("click", () => setFeature(exposureName(), ["cam-exposure"]));
+    $("cam-gain-set").addEventListener("click", () => setFeature(gainName(), ["cam-gain"]));
     $("roi-apply").addEventListener("click", async () => {
       const body = { x: intOf("roi-x"), y: intOf("roi-y"), width: intOf("roi-w"), height: intOf("roi-h") };
-      const r = await ps.cameraAction("roi", body);
+      const r = await ps.applyFields(roiFields, () => ps.cameraAction("roi", body));
       if (r.ok) { ps.rect.roi = null; ps.drawTool(); }
     });
     $("roi-full").addEventListener("click", async () => {
       const r = await ps.cameraAction("roi", { x: 0, y: 0, width: 0, height: 0 });
-      if (r.ok) { ps.rect.roi = null; ps.drawTool(); }
+      // The full sensor replaces whatever the ROI fields held.
+      if (r.ok) { ps.rect.roi = null; ps.drawTool(); ps.clearDirty($("roi-fields")); }
     });
-    $("size-apply").addEventListener("click", () => ps.cameraAction("size", { width: intOf("size-w"), height: intOf("size-h") }));
+    $("size-apply").addEventListener("click", () => ps.applyFields(["size-w", "size-h"],
+      () => ps.cameraAction("size", { width: intOf("size-w"), height: intOf("size-h") })));
     $("scale-apply").addEventListener("click", () => ps.cameraAction("size", { scale: Number($("size-scale").value) || 1 }));
-    $("feature-set").addEventListener("click", () => setFeature($("feature-name").value.trim(), $("feature-value").value));
+    $("feature-set").addEventListener("click", () => setFeature($("feature-name").value.trim(), ["feature-name", "feature-value"]));
     $("feature-refresh").addEventListener("click", refreshFeatures);
   });
 })();

@@ -40,7 +40,7 @@
     $("teach-reply").dataset.lastReply = reply;
     if (reply.startsWith("OK")) {
       refreshModels();
-      $("grasp-type").value = type;  // its grasps next
+      ps.setField("grasp-type", type);  // its grasps next, unless another type is being typed
       loadGrasp();
     }
   }
@@ -56,7 +56,7 @@
         refreshModels();
       });
       row.dataset.type = m[0];
-      row.addEventListener("click", () => { $("grasp-type").value = m[0]; loadGrasp(); });
+      row.addEventListener("click", () => { ps.setField("grasp-type", m[0], true); loadGrasp(); });
     }
     await refreshTolerances(groups(reply, 5).map((m) => m[0]));
   }
@@ -81,10 +81,11 @@
   // "0.100000" as "0.1": the fields are narrow.
   const shownValue = (t, key) => (t.values[key] === undefined ? "" : String(Number(t.values[key])));
 
+  // A row of a model's tolerance fields; row.dataset.shown holds the values
+  // the vision app last reported (what Save compares the fields with).
   function toleranceRow(tbody, t) {
     const row = document.createElement("tr");
     row.dataset.type = t.type;
-    row.dataset.shown = JSON.stringify(t);
     const cell = (child) => {
       const td = document.createElement("td");
       if (typeof child === "string") td.textContent = child; else td.appendChild(child);
@@ -95,14 +96,13 @@
     for (const [key, step] of toleranceKeys) {
       const input = document.createElement("input");
       input.dataset.key = key;
+      input.setAttribute("data-refreshed", "");
       input.className = "tolerance-input";
       if (step) {
         input.type = "number";
         input.step = step;
-        input.value = shownValue(t, key);
       } else {
         input.type = "checkbox";
-        input.checked = t.values[key] === "1";
       }
       cell(input);
     }
@@ -110,29 +110,48 @@
     save.type = "button";
     save.className = "tolerance-save";
     save.textContent = "Save";
-    save.addEventListener("click", () => saveTolerances(row, t));
+    save.addEventListener("click", () => saveTolerances(row));
     cell(save);
+    showTolerances(row, t);
     tbody.appendChild(row);
     return row;
   }
 
+  // The values in force, in the fields the user has not edited.
+  function showTolerances(row, t) {
+    const before = row.dataset.shown ? JSON.parse(row.dataset.shown) : null;
+    if (before && before.name !== t.name) ps.clearDirty(row);  // another model of that type
+    row.dataset.shown = JSON.stringify(t);
+    row.cells[1].textContent = t.name;
+    for (const input of row.querySelectorAll("input[data-key]")) {
+      const key = input.dataset.key;
+      ps.setField(input, input.type === "checkbox" ? t.values[key] === "1" : shownValue(t, key));
+    }
+  }
+
   // Sends the changed fields of a row in one TOLERANCE line (the vision app
   // checks them all before it changes any), then shows what is in force.
-  async function saveTolerances(row, t) {
+  async function saveTolerances(row) {
+    const t = JSON.parse(row.dataset.shown);
+    const inputs = Array.from(row.querySelectorAll("input[data-key]"));
     let line = "TOLERANCE " + t.type;
-    for (const input of row.querySelectorAll("input[data-key]")) {
+    for (const input of inputs) {
       const key = input.dataset.key;
       const value = input.type === "checkbox" ? (input.checked ? "1" : "0") : input.value.trim();
       if (value !== (input.type === "checkbox" ? t.values[key] : shownValue(t, key))) line += " " + key + " " + (value === "" ? "none" : value);
     }
-    if (line === "TOLERANCE " + t.type) { ps.show("tolerance-reply", line, "nothing changed"); return; }
-    const reply = await say("tolerance-reply", line);
+    if (line === "TOLERANCE " + t.type) {
+      ps.clearDirty(row);  // edited back to the values in force
+      ps.show("tolerance-reply", line, "nothing changed");
+      return;
+    }
+    const reply = await ps.applyFields(inputs, () => say("tolerance-reply", line));
     const now = parseTolerances(reply);
-    if (now && row.parentNode) row.parentNode.replaceChild(toleranceRow(row.parentNode, now), row);
+    if (now) showTolerances(row, now);
   }
 
-  // A row whose model still has the values it shows is kept as it is, so a
-  // refresh (a tab switch, another LEARN) never drops an edit not yet saved.
+  // One row per model, in the models' order; a refresh (a tab switch,
+  // another LEARN) shows the values in force but never an edited field's.
   async function refreshTolerances(types) {
     const tbody = $("tolerance-list").querySelector("tbody");
     const wanted = [];
@@ -140,15 +159,14 @@
       const t = parseTolerances(await ps.command("TOLERANCE " + type));
       if (t) wanted.push(t);
     }
-    const shown = new Map();
-    for (const row of Array.from(tbody.rows)) shown.set(row.dataset.shown, row);
+    const rows = new Map();
+    for (const row of Array.from(tbody.rows)) rows.set(row.dataset.type, row);
     for (const t of wanted) {
-      const key = JSON.stringify(t);
-      let row = shown.get(key);
-      if (row) shown.delete(key); else row = toleranceRow(tbody, t);
-      tbody.appendChild(row);  // in the models' order
+      let row = rows.get(t.type);
+      if (row) { rows.delete(t.type); showTolerances(row, t); } else row = toleranceRow(tbody, t);
+      tbody.appendChild(row);
     }
-    for (const row of shown.values()) row.remove();
+    for (const row of rows.values()) row.remove();
   }
 
   function list(ol, items, format) {
@@ -163,6 +181,7 @@
   async function loadGrasp() {
     const type = Math.round(Number($("grasp-type").value));
     grasp.type = type;
+    $("grasp-type").classList.remove("dirty");  // the type shown below from now on
     const status = ps.okFields(await ps.command("STATUS")) || [];
     const scale = status.find((w) => w.startsWith("scale="));
     const mm = scale && scale !== "scale=none" ? scale.slice(6).split("x").map(Number) : [1, 1];

@@ -1,15 +1,13 @@
 // The camera feed's subscriber thread and its shared, lazy JPEG encoder.
 #include "picksight/web/camera_feed.hpp"
 
-#include <pthread.h>
-#include <sched.h>
 #include <time.h>
 
 #include <algorithm>
-#include <cstring>
 
 #include "picksight/common/log.hpp"
 #include "picksight/transport/frame_message.hpp"
+#include "picksight/web/idle_priority.hpp"
 
 namespace picksight::web {
 namespace {
@@ -18,17 +16,6 @@ uint64_t threadCpuNs() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<uint64_t>(ts.tv_sec) * 1000000000ull + static_cast<uint64_t>(ts.tv_nsec);
-}
-
-// The calling thread runs only on a core nothing else wants: a JPEG for a
-// browser must never take a core from a vision pass, which nice alone does
-// not ensure (a nice 19 thread still gets its share of a busy core).
-// Allowed without privileges; a failure only costs that guarantee.
-void runAtIdlePriority(const std::string& camera) {
-  sched_param param{};
-  param.sched_priority = 0;
-  if (const int rc = pthread_setschedparam(pthread_self(), SCHED_IDLE, &param); rc != 0)
-    logWarning("camera ", camera, ": JPEG encoder at normal priority: ", std::strerror(rc));
 }
 
 }  // namespace
@@ -127,7 +114,7 @@ std::shared_ptr<const EncodedJpeg> CameraFeed::jpeg(uint64_t generation,
 }
 
 void CameraFeed::encodeLoop() {
-  runAtIdlePriority(camera_);
+  runAtIdlePriority("camera " + camera_ + ": JPEG encoder");
   std::unique_lock<std::mutex> lock(encode_mutex_);
   while (true) {
     encode_wake_.wait(lock, [&] { return wanted_ > attempted_ || encode_stopping_; });

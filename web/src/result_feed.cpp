@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "picksight/common/log.hpp"
+#include "picksight/web/idle_priority.hpp"
 #include "picksight/web/proto_json.hpp"
 #include "picksight/web/web_errors.hpp"
 
@@ -34,6 +35,7 @@ class ConnectionMonitor : public zmq::monitor_t {
 
 ResultFeed::ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events)
     : app_(std::move(app)), events_(events) {
+  convert_thread_ = std::thread([this] { convertLoop(); });
   if (app_.results != "none") thread_ = std::thread([this, &context] { run(context); });
 }
 
@@ -41,7 +43,53 @@ ResultFeed::~ResultFeed() { stop(); }
 
 void ResultFeed::stop() {
   stop_ = true;
+  {
+    std::lock_guard<std::mutex> lock(convert_mutex_);
+    stopping_ = true;
+    convert_wake_.notify_all();
+  }
   if (thread_.joinable()) thread_.join();
+  if (convert_thread_.joinable()) convert_thread_.join();
+}
+
+void ResultFeed::convertLoop() {
+  runAtIdlePriority("vision app " + app_.name + ": results to JSON");
+  std::unique_lock<std::mutex> lock(convert_mutex_);
+  while (true) {
+    convert_wake_.wait(lock, [&] { return pending_ || stopping_; });
+    if (stopping_) return;
+    lock.unlock();
+    publishPending();
+    lock.lock();
+  }
+}
+
+bool ResultFeed::pendingStarved() const {
+  std::lock_guard<std::mutex> lock(convert_mutex_);
+  return pending_ && std::chrono::steady_clock::now() - pending_since_ >= kResultsStarved;
+}
+
+void ResultFeed::publishPending() {
+  std::shared_ptr<const proto::VisionResult> result;
+  uint64_t number = 0;
+  {
+    std::lock_guard<std::mutex> lock(convert_mutex_);
+    if (!pending_) return;
+    result = std::move(pending_);
+    pending_.reset();
+    number = pending_number_;
+  }
+  std::string json = protoJsonText(*result);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (latest_ == result) latest_json_ = json;
+  }
+  // The converter and a starved feed thread may both be converting: an
+  // older result is never sent after a newer one.
+  std::lock_guard<std::mutex> lock(publish_mutex_);
+  if (number <= published_number_) return;
+  published_number_ = number;
+  events_.publish("result", json);
 }
 
 void ResultFeed::run(zmq::context_t& context) {
@@ -59,6 +107,7 @@ void ResultFeed::run(zmq::context_t& context) {
     zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
     while (!stop_) {
       monitor.check_event(0);
+      if (pendingStarved()) publishPending();  // the converter has had no core
       zmq::poll(&item, 1, 200ms);
       if (!(item.revents & ZMQ_POLLIN)) continue;
       zmq::message_t topic;
@@ -87,8 +136,13 @@ void ResultFeed::run(zmq::context_t& context) {
 
 void ResultFeed::accept(proto::VisionResult result) {
   if (result.app().empty()) result.set_app(app_.name);
-  std::string json = protoJsonText(result);
   auto shared = std::make_shared<const proto::VisionResult>(std::move(result));
+  // The JSON of a LOCATE of 20 parts with their outlines took as much CPU
+  // as the LOCATE itself (protobuf prints and re-reads every double), and
+  // was made right when the robot's next request starts: now only for an
+  // /events client, by the idle-priority converter, else when /api/results
+  // asks for it.
+  const bool wanted = events_.clients() > 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     RequestFigures& f = figures_[shared->request().empty() ? "unknown" : shared->request()];
@@ -98,9 +152,14 @@ void ResultFeed::accept(proto::VisionResult result) {
     for (size_t i = 0; i < kRequestBuckets.size(); ++i)
       if (seconds <= kRequestBuckets[i]) ++f.buckets[i];
     latest_ = shared;
-    latest_json_ = json;
+    latest_json_.clear();
   }
-  events_.publish("result", json);
+  if (!wanted) return;
+  std::lock_guard<std::mutex> lock(convert_mutex_);
+  if (!pending_) pending_since_ = std::chrono::steady_clock::now();
+  pending_ = std::move(shared);  // replaces one the converter has not taken yet
+  ++pending_number_;
+  convert_wake_.notify_one();
 }
 
 std::string ResultFeed::camera() const {
@@ -119,8 +178,16 @@ std::shared_ptr<const proto::VisionResult> ResultFeed::latest() const {
 }
 
 std::string ResultFeed::latestJson() const {
+  std::shared_ptr<const proto::VisionResult> result;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!latest_ || !latest_json_.empty()) return latest_json_;
+    result = latest_;
+  }
+  std::string json = protoJsonText(*result);  // outside the lock: the feed goes on meanwhile
   std::lock_guard<std::mutex> lock(mutex_);
-  return latest_json_;
+  if (latest_ == result) latest_json_ = json;
+  return json;
 }
 
 std::map<std::string, RequestFigures> ResultFeed::figures() const {

@@ -5,6 +5,8 @@ mouse, and sets the camera's ROI from a rectangle drawn on the image."""
 
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from selenium.webdriver.support.ui import Select
 
 from conftest import APP, CAMERA, wait_until
 
@@ -433,18 +435,89 @@ def test_calibrate_the_simulated_cell(cell, browser):
     assert browser.severe() == []
 
 
+def type_into(browser, element_id, text):
+    """Replaces a field's text from the keyboard, as a user does."""
+    field = browser.driver.find_element(By.ID, element_id)
+    field.click()
+    field.send_keys(Keys.CONTROL, "a")
+    field.send_keys(text)
+    return field
+
+
+def field_values(browser, ids):
+    return browser.js("return arguments[0].map(i => document.getElementById(i).value)", ids)
+
+
+def dirty(browser, ids):
+    return browser.js("return arguments[0].map(i => document.getElementById(i).classList.contains('dirty'))", ids)
+
+
+def wait_for_a_camera_refresh(browser):
+    """Until the page has shown the camera list again (event: cameras, once
+    a second) after this call: a refresh that would overwrite an edit made
+    before it."""
+    seen = browser.js("return window.picksight.cameraRefreshes")
+    wait_until(lambda: browser.js("return window.picksight.cameraRefreshes") > seen,
+               what="the page's refresh of the cameras")
+
+
+def test_fields_edited_and_not_applied_survive_refreshes(cell, browser):
+    """ROI and size typed in the Camera panel and left for the Apply button:
+    the once-a-second refresh from the camera's state shows them as edited
+    (class dirty) and leaves them; Apply sends them, the camera takes them
+    and the fields follow the camera again."""
+    select_tab(browser, "camera")
+    roi_ids, size_ids = ["roi-x", "roi-y", "roi-w", "roi-h"], ["size-w", "size-h"]
+    try:
+        wait_until(lambda: field_values(browser, roi_ids) == ["0", "0", "640", "480"], what="the full sensor's ROI")
+        for i, text in zip(roi_ids, ("40", "24", "320", "240")):
+            type_into(browser, i, text)
+        browser.driver.find_element(By.ID, "roi-h").send_keys(Keys.TAB)  # the focus leaves the fields
+        wait_for_a_camera_refresh(browser)
+        assert field_values(browser, roi_ids) == ["40", "24", "320", "240"]
+        assert dirty(browser, roi_ids) == [True] * 4
+        browser.screenshot("camera-edited")
+        click(browser, "roi-apply")
+        wait_until(lambda: [cell.camera()["roi"].get(k, 0) for k in ("x", "y", "width", "height")] == [40, 24, 320, 240],
+                   what="the camera's ROI from the fields")
+        wait_until(lambda: dirty(browser, roi_ids) == [False] * 4, what="the ROI fields applied")
+
+        wait_until(lambda: field_values(browser, size_ids) == ["320", "240"], what="the cropped frame's size")
+        type_into(browser, "size-w", "160")
+        type_into(browser, "size-h", "120").send_keys(Keys.TAB)
+        wait_for_a_camera_refresh(browser)
+        assert field_values(browser, size_ids) == ["160", "120"]
+        assert dirty(browser, size_ids) == [True, True]
+        click(browser, "size-apply")
+        wait_until(lambda: (cell.camera()["width"], cell.camera()["height"]) == (160, 120),
+                   what="the camera's output size from the fields")
+        wait_until(lambda: dirty(browser, size_ids) == [False, False], what="the size fields applied")
+    finally:
+        for action, body in (("size", {"width": 0, "height": 0}), ("roi", {"x": 0, "y": 0, "width": 0, "height": 0})):
+            cell.http("POST", f"/api/cameras/{CAMERA}/{action}", body)
+        wait_until(lambda: cell.camera()["width"] == 640, what="the full frame again")
+    # A value from the camera again, in fields no longer edited.
+    wait_until(lambda: field_values(browser, size_ids) == ["640", "480"], what="the fields following the camera")
+    assert browser.severe() == []
+
+
 def test_hardware_trigger_from_the_camera_panel(cell, browser):
     """The hardware trigger mode chosen in the Camera panel with its input,
-    edge and timeout: the synthetic camera has no trigger input, and its
-    refusal is shown; the camera keeps running free."""
+    edge and timeout, typed and left for the button while the panel refreshes
+    from the camera's state (which holds Line1): they go out as typed. The
+    synthetic camera has no trigger input: its refusal is shown, the fields
+    stay marked as not applied, and the camera keeps running free."""
     select_tab(browser, "camera")
-    # Set and applied in one script: the panel's refresh from the camera's
-    # state could otherwise overwrite the inputs between two WebDriver calls
-    # (it did, once in CI).
-    browser.js("""document.getElementById('cam-hw-line').value = 'Line2';
-                  document.getElementById('cam-hw-activation').value = 'FallingEdge';
-                  document.getElementById('cam-hw-timeout').value = '2500';
-                  document.getElementById('cam-hw-apply').click();""")
+    hw_ids = ["cam-hw-line", "cam-hw-activation", "cam-hw-timeout"]
+    wait_until(lambda: field_values(browser, hw_ids)[0] == cell.camera().get("trigger_line") != "Line2",
+               what="the camera's trigger input in the panel")
+    type_into(browser, "cam-hw-line", "Line2")
+    Select(browser.driver.find_element(By.ID, "cam-hw-activation")).select_by_visible_text("FallingEdge")
+    type_into(browser, "cam-hw-timeout", "2500").send_keys(Keys.TAB)
+    wait_for_a_camera_refresh(browser)
+    assert field_values(browser, hw_ids) == ["Line2", "FallingEdge", "2500"]
+    assert dirty(browser, hw_ids) == [True] * 3
+    click(browser, "cam-hw-apply")
     reply = wait_until(lambda: (lambda t: t if "mode" in t else None)(
         browser.driver.find_element(By.ID, "camera-reply").text), what="the mode reply")
     first = reply.split("\n")[:2]
@@ -453,6 +526,9 @@ def test_hardware_trigger_from_the_camera_panel(cell, browser):
         assert sent in first[0], first
     assert first[1].startswith("< ERROR ") and "has no hardware trigger input" in first[1], first
     browser.screenshot("camera-hardware")
+    wait_for_a_camera_refresh(browser)
+    assert field_values(browser, hw_ids) == ["Line2", "FallingEdge", "2500"]
+    assert dirty(browser, hw_ids) == [True] * 3
     assert cell.camera()["mode"] == "freerun"
     # The refusal is an HTTP 400, which Chromium logs; nothing else may be.
     refused = [e for e in browser.severe() if "/api/cameras/cam0/mode" in e.get("message", "")]

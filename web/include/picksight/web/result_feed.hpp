@@ -1,16 +1,25 @@
 // One vision app for the web server: its results stream (a SUB socket on the
-// app's results endpoint, decoded to VisionResult, turned into JSON once and
-// sent to every /events client), the counters /metrics shows, and the robot
-// (or setup) connection that commands from the page go through.
+// app's results endpoint, decoded to VisionResult), the counters /metrics
+// shows, each result's JSON for the /events clients and /api/results, and
+// the robot (or setup) connection that commands from the page go through.
 //
-// Threading: the feed's thread owns the SUB socket and its monitor; readers
-// take snapshots under mutex_. command() holds line_mutex_ for one request
-// and reply, on a kept connection (so WHY speaks of the page's last LOCATE).
+// Threading: the feed's thread owns the SUB socket and its monitor, and
+// keeps the latest result and the counters; readers take snapshots under
+// mutex_. The JSON of a LOCATE of many parts costs about as much CPU as the
+// LOCATE, so it is made only while an /events client is connected, by a
+// converter thread at SCHED_IDLE (never on a core a vision pass wants), for
+// the newest result only: a page that cannot be served in time skips
+// results, never delays a robot. When that thread has had no core for
+// kResultsStarved, the feed's thread converts at its own priority, so a
+// saturated machine still shows results. latestJson() converts on demand
+// in the caller's thread. command() holds line_mutex_ for one request and
+// reply, on a kept connection (so WHY speaks of the page's last LOCATE).
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -38,6 +47,10 @@ struct RequestFigures {
   std::array<uint64_t, kRequestBuckets.size()> buckets{};  // cumulative at read time
 };
 
+// How long a result may wait for the idle-priority converter before the
+// feed's thread converts it itself (as CameraFeed's JPEGs, kEncoderStarved).
+constexpr std::chrono::milliseconds kResultsStarved{3000};
+
 // The longest robot line the page may send (bytes, without the newline).
 constexpr size_t kMaxCommandBytes = 256;
 
@@ -54,7 +67,8 @@ class ResultFeed {
   std::string camera() const;
   bool connected() const { return connected_.load(); }
   uint64_t lastResultId() const;
-  // The latest result (null before the first) and its JSON.
+  // The latest result (null before the first) and its JSON (made on the
+  // first call after a result no /events client saw; empty before the first).
   std::shared_ptr<const proto::VisionResult> latest() const;
   std::string latestJson() const;
   std::map<std::string, RequestFigures> figures() const;
@@ -71,14 +85,30 @@ class ResultFeed {
 
  private:
   void run(zmq::context_t& context);
+  void convertLoop();
+  // Converts the pending result, if any, and publishes it unless a newer
+  // one was published meanwhile.
+  void publishPending();
+  bool pendingStarved() const;
 
   const VisionAppEndpoint app_;
   EventHub& events_;
 
   mutable std::mutex mutex_;
   std::shared_ptr<const proto::VisionResult> latest_;  // under mutex_
-  std::string latest_json_;                            // under mutex_
+  mutable std::string latest_json_;                    // under mutex_; empty: not made yet
   std::map<std::string, RequestFigures> figures_;      // under mutex_
+  // The newest result not yet sent as an event, its number in arrival order
+  // and since when it waits; a lock of its own, so that the idle-priority
+  // converter never holds the one the HTTP threads read under.
+  mutable std::mutex convert_mutex_;
+  std::condition_variable convert_wake_;
+  std::shared_ptr<const proto::VisionResult> pending_;   // under convert_mutex_
+  uint64_t pending_number_ = 0;                          // under convert_mutex_
+  std::chrono::steady_clock::time_point pending_since_;  // under convert_mutex_
+  bool stopping_ = false;                                // under convert_mutex_
+  std::mutex publish_mutex_;                             // one event published at a time, in order
+  uint64_t published_number_ = 0;                        // under publish_mutex_
 
   std::mutex line_mutex_;
   LineClient line_;  // under line_mutex_
@@ -86,6 +116,7 @@ class ResultFeed {
   std::atomic<bool> connected_{false};
   std::atomic<bool> stop_{false};
   std::thread thread_;
+  std::thread convert_thread_;
 };
 
 }  // namespace picksight::web
