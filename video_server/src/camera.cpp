@@ -76,7 +76,7 @@ void Camera::stop() {
   std::unique_lock<std::mutex> lock(mutex_);
   closeSource(lock);
   // Commands queued after the thread ended still get an answer.
-  runCommands(lock);
+  runCommands(lock, true);
   status_.state = "stopped";
 }
 
@@ -205,8 +205,8 @@ std::optional<Frame> Camera::waitForFrame(uint64_t sequence, std::chrono::millis
   return last_frame_;
 }
 
-void Camera::runCommands(std::unique_lock<std::mutex>& lock) {
-  while (!commands_.empty()) {
+void Camera::runCommands(std::unique_lock<std::mutex>& lock, bool all) {
+  for (size_t queued = commands_.size(); !commands_.empty() && (all || queued-- > 0);) {
     Command command = std::move(commands_.front());
     commands_.pop_front();
     lock.unlock();
@@ -279,7 +279,7 @@ void Camera::run() {
   last_frame_ns_ = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
-    runCommands(lock);
+    runCommands(lock, false);
     if (!open_requested_) {
       waitWhileClosed(lock);
       continue;

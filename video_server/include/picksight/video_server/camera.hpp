@@ -201,7 +201,11 @@ class Camera {
   void startOutage(std::unique_lock<std::mutex>& lock);
   // A frame that could not be used: counted, logged at a bounded rate.
   void logBadFrame(const Error& error);
-  void runCommands(std::unique_lock<std::mutex>& lock);
+  // Runs the queued commands. `all`: also those queued while they run
+  // (when stopping); else only those queued before, so that a command whose
+  // caller queues the next one when answered (a feature listing's slices)
+  // lets a grab come between the two, whoever gets the CPU first.
+  void runCommands(std::unique_lock<std::mutex>& lock, bool all);
   // How long one slice of a feature listing may hold the acquisition thread.
   std::chrono::milliseconds featureSlice() const;
   // Runs `fn` on the acquisition thread and waits for it.
