@@ -152,7 +152,11 @@ int sharedPixels(const Placed& a, const Placed& b) {
 // outline of another type verifies within the edge tolerance on a part
 // whose rest another hides, and is then first by its score; it lies on
 // the part's edges for only short stretches.
-std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canvas) {
+// `mirrored(candidate)`: whether the part there shows the mirror image of
+// the candidate's model; asked only of a candidate about to be taken.
+template <typename MirrorTest>
+std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canvas,
+                                MirrorTest&& mirrored) {
   const size_t n = placed.size();
   // Rivals: pairs that cannot both be parts, whichever is taken first.
   std::vector<std::vector<size_t>> better(n);  // the rivals that explain more, per candidate
@@ -170,7 +174,7 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canv
     const Placed& p = placed[i];
     cv::Mat shared;
     cv::bitwise_and(p.drawn, claimed(p.box), shared);
-    if (cv::countNonZero(shared) > kMaxOverlap * p.area) {
+    if (cv::countNonZero(shared) > kMaxOverlap * p.area || mirrored(*p.candidate)) {
       state[i] = State::kRefused;
       return;
     }
@@ -350,18 +354,25 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     cv::Mat outside;
     cv::bitwise_and(p.drawn, ~inside(box), outside);
     if (cv::countNonZero(outside) > kMaxOutside * p.area) continue;
+    placed.push_back(std::move(p));
+  }
+  // A part shown mirrored is not reported: the mirror image verifies about
+  // as well and where the hands differ fits better. Only asked of a
+  // candidate about to be taken (placing the mirror image costs an edge
+  // fit).
+  const auto mirrored = [&](const Candidate& c) {
+    const PartModel& m = *c.model;
     const auto as_good = [&](const Candidate& q) {
       return q.model == c.model &&
              std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
                  0.5 * m.radius &&
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     };
-    if (std::any_of(mirror.begin(), mirror.end(), as_good)) continue;
+    if (std::any_of(mirror.begin(), mirror.end(), as_good)) return true;
     const auto aligned = alignedMirror(m, region, c.pose, edges);
-    if (aligned && as_good(*aligned)) continue;
-    placed.push_back(std::move(p));
-  }
-  for (const size_t i : chooseParts(placed, inside.size())) {
+    return aligned && as_good(*aligned);
+  };
+  for (const size_t i : chooseParts(placed, inside.size(), mirrored)) {
     const Candidate& c = *placed[i].candidate;
     Match match;
     match.model = c.model;
