@@ -34,6 +34,13 @@ constexpr int kMaxRefinedPerBlob = 48;
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
 constexpr double kMirrorMargin = 0.03;
+// The mirror image placed on a part is refined on the edges when it
+// verifies within this of the margin before (a hypothesis a few pixels and
+// degrees off loses that much at the rim, kCoarseSlack), and when no mirror
+// image the search refined lies within the edge fit's reach of it.
+constexpr double kMirrorScreenSlack = 0.25;
+constexpr double kKnownMirrorPx = 4.0;
+constexpr double kKnownMirrorDeg = 5.0;
 // Parts that touch share at most their contact pixels, parts that overlap
 // (one lying on another, a quarter of its outline hidden) a fifth of their
 // area; a part lies in its blob.
@@ -67,14 +74,25 @@ bool hiddenUnderOthers(const PartModel& m, const ImagePose& pose, const EdgeDist
   return on + missing > 0 && on / (on + missing) * 100 >= m.verify_percent;
 }
 
+bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double px, double deg) {
+  if (a.mirrored != b.mirrored) return false;
+  if (std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) > px) return false;
+  // A period of 0 (any turn looks the same): the angles always agree.
+  return angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
+}
+
 // The mirror image of a chiral model placed where it best covers the part
 // at `direct`: turned by one of the angles where its complex moment lines
 // up with the model's (2 phase / k + j 360 / k, as in training), the best
 // verified of them refined on the grey-level edges. The hypothesis search
 // finds the mirror image only from the corners and arcs it happens to
 // screen; the hand of every part reported is decided against this one.
+// Like any hypothesis it is refined only when it screens at `screen`
+// (a fraction verified), and not when one of `searched` (refined mirror
+// images) already lies there: nullopt then.
 std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
-                                       const ImagePose& direct, const EdgeDistance& edges) {
+                                       const ImagePose& direct, const EdgeDistance& edges,
+                                       double screen, const std::vector<Candidate>& searched) {
   const int k = m.orientation_order;
   if (k <= 0 || m.body.mirror_symmetric) return std::nullopt;
   Candidate best;
@@ -86,19 +104,17 @@ std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
         verifyScore(m.samples, direct.centre, angle, edges, m.edge_tolerance, true);
     if (score > best.score) best = {&m, {direct.centre, angle, true}, score, 0, 0};
   }
+  if (best.score < screen) return std::nullopt;
+  const bool known = std::any_of(searched.begin(), searched.end(), [&](const Candidate& q) {
+    return q.model == &m && samePose(m, q.pose, best.pose, kKnownMirrorPx, kKnownMirrorDeg);
+  });
+  if (known) return std::nullopt;
   const EdgeFit fit = refinePoseOnEdges(m, region, best.pose);
   if (!fit.ok) return best;
   const double score =
       verifyScore(m.samples, fit.pose.centre, fit.pose.angle_deg, edges, m.edge_tolerance, true);
   if (score < best.score) return best;
   return Candidate{&m, fit.pose, score, fit.rms_px, fit.precise_length};
-}
-
-bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double px, double deg) {
-  if (a.mirrored != b.mirrored) return false;
-  if (std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) > px) return false;
-  // A period of 0 (any turn looks the same): the angles always agree.
-  return angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
 }
 
 // The model's loops placed at a pose, as polygons in canvas coordinates:
@@ -369,7 +385,8 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     };
     if (std::any_of(mirror.begin(), mirror.end(), as_good)) return true;
-    const auto aligned = alignedMirror(m, region, c.pose, edges);
+    const auto aligned = alignedMirror(m, region, c.pose, edges,
+                                       c.score - kMirrorMargin - kMirrorScreenSlack, mirror);
     return aligned && as_good(*aligned);
   };
   for (const size_t i : chooseParts(placed, inside.size(), mirrored)) {
