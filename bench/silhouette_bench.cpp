@@ -112,8 +112,22 @@ cv::Point2d referenceOf(const ps::SilhouettePart& t, const std::vector<cv::Point
          cv::Point2d(o.x * std::cos(a) - o.y * std::sin(a), o.x * std::sin(a) + o.y * std::cos(a));
 }
 
+// Prints a false report: what was reported, and what is drawn there.
+void listFalse(const char* what, const pv::Match& m, const ps::SilhouettePart* t,
+               const std::vector<TypeSpec>& specs) {
+  std::printf("    false report (%s): %s at %.1f, %.1f turned %.2f%s", what, m.model->name.c_str(),
+              m.centroid.x, m.centroid.y, m.angle_deg, m.touching ? " in a blob" : " whole region");
+  if (t) {
+    std::printf("; drawn: %s kind %d turned %.2f, %.0f%% of its outline hidden",
+                specs[t->type].name.c_str(), static_cast<int>(t->kind), t->angle_deg,
+                100 * t->hidden);
+  }
+  std::printf("\n");
+}
+
 void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pv::Match>& matches,
-           const std::vector<cv::Point2d>& reference, Tally& tally) {
+           const std::vector<cv::Point2d>& reference, const std::vector<TypeSpec>* list_errors,
+           Tally& tally) {
   std::vector<bool> claimed(truth.size(), false);
   for (const auto& t : truth) {
     if (t.kind == ps::PartKind::kTrue) tally.per_type[t.type].truths += 1;
@@ -133,9 +147,16 @@ void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pv::M
     }
     if (best < 0) {
       tally.confusions.nothing += 1;
+      if (list_errors) listFalse("on nothing", m, nullptr, *list_errors);
       continue;
     }
     const ps::SilhouettePart& t = truth[static_cast<size_t>(best)];
+    const char* wrong = t.type != type                       ? "other type"
+                        : t.kind == ps::PartKind::kMirrored  ? "mirror"
+                        : t.kind != ps::PartKind::kTrue      ? "size"
+                        : claimed[static_cast<size_t>(best)] ? "duplicate"
+                                                             : nullptr;
+    if (wrong && list_errors) listFalse(wrong, m, &t, *list_errors);
     if (t.type != type) {
       tally.confusions.other += 1;
       continue;
@@ -165,6 +186,14 @@ void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pv::M
       s.angles += 1;
       s.worst_ang = std::max(s.worst_ang, e);
     }
+  }
+  if (!list_errors) return;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const ps::SilhouettePart& t = truth[i];
+    if (t.kind != ps::PartKind::kTrue || claimed[i]) continue;
+    std::printf("    missed: %s at %.1f, %.1f turned %.2f, %.0f%% of its outline hidden%s\n",
+                (*list_errors)[t.type].name.c_str(), t.centre.x, t.centre.y, t.angle_deg,
+                100 * t.hidden, t.touching ? ", touching" : "");
   }
 }
 
@@ -269,6 +298,10 @@ int main(int argc, char** argv) {
   app.add_flag("--from-edges", from_edges,
                "locate every blob's parts the way touching parts are (hypotheses and the edge "
                "fit), to measure that path on separated parts");
+  bool list_false = false;
+  app.add_flag("--list-errors", list_false,
+               "print each false report (the type reported, where, and what is drawn there) and "
+               "each part missed");
   std::vector<std::string> custom;
   app.add_option("--types", custom,
                  "train these drawings instead of the default 15 (family \"other\"): "
@@ -400,7 +433,7 @@ int main(int argc, char** argv) {
              },
              [&] { sink += picksight::bench::competentOpenCvPass(grey); }},
             {&tally.ours_ms, &tally.plain_ms});
-        score(scene.truth(), matches, reference, tally);
+        score(scene.truth(), matches, reference, list_false ? &specs : nullptr, tally);
         tally.parts += static_cast<int>(scene.truth().size());
         for (const auto& t : scene.truth()) tally.distractors += t.kind != ps::PartKind::kTrue;
         tally.frames += 1;

@@ -1,7 +1,8 @@
 // Parts inside merged blobs: the hypotheses of every model (see
 // touching_parts_hypotheses.cpp) refined on the grey-level edges
-// (touching_parts_edge_fit.cpp), then accepted best first where they fit the
-// blob and not each other.
+// (touching_parts_edge_fit.cpp), each checked against its mirror image, then
+// accepted best first where they fit the blob and not each other, two
+// hypotheses of the same pixels settled by which lies on more of its edges.
 #include "picksight/vision/touching_parts.hpp"
 
 #include <opencv2/imgproc.hpp>
@@ -33,6 +34,13 @@ constexpr int kMaxRefinedPerBlob = 48;
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
 constexpr double kMirrorMargin = 0.03;
+// The mirror image placed on a part is refined on the edges when it
+// verifies within this of the margin before (a hypothesis a few pixels and
+// degrees off loses that much at the rim, kCoarseSlack), and when no mirror
+// image the search refined lies within the edge fit's reach of it.
+constexpr double kMirrorScreenSlack = 0.25;
+constexpr double kKnownMirrorPx = 4.0;
+constexpr double kKnownMirrorDeg = 5.0;
 // Parts that touch share at most their contact pixels, parts that overlap
 // (one lying on another, a quarter of its outline hidden) a fifth of their
 // area; a part lies in its blob.
@@ -73,6 +81,42 @@ bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double
   return angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
 }
 
+// The mirror image of a chiral model placed where it best covers the part
+// at `direct`: turned by one of the angles where its complex moment lines
+// up with the model's (2 phase / k + j 360 / k, as in training), the best
+// verified of them refined on the grey-level edges. The hypothesis search
+// finds the mirror image only from the corners and arcs it happens to
+// screen; the hand of every part reported is decided against this one.
+// Like any hypothesis it is refined only when it screens at `screen`
+// (a fraction verified), and not when one of `searched` (refined mirror
+// images) already lies there: nullopt then.
+std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
+                                       const ImagePose& direct, const EdgeDistance& edges,
+                                       double screen, const std::vector<Candidate>& searched) {
+  const int k = m.orientation_order;
+  if (k <= 0 || m.body.mirror_symmetric) return std::nullopt;
+  Candidate best;
+  best.model = &m;
+  best.score = -1;
+  for (int j = 0; j < k; ++j) {
+    const double angle = direct.angle_deg + 2 * m.orientation_phase_deg / k + j * 360.0 / k;
+    const double score =
+        verifyScore(m.samples, direct.centre, angle, edges, m.edge_tolerance, true);
+    if (score > best.score) best = {&m, {direct.centre, angle, true}, score, 0, 0};
+  }
+  if (best.score < screen) return std::nullopt;
+  const bool known = std::any_of(searched.begin(), searched.end(), [&](const Candidate& q) {
+    return q.model == &m && samePose(m, q.pose, best.pose, kKnownMirrorPx, kKnownMirrorDeg);
+  });
+  if (known) return std::nullopt;
+  const EdgeFit fit = refinePoseOnEdges(m, region, best.pose);
+  if (!fit.ok) return best;
+  const double score =
+      verifyScore(m.samples, fit.pose.centre, fit.pose.angle_deg, edges, m.edge_tolerance, true);
+  if (score < best.score) return best;
+  return Candidate{&m, fit.pose, score, fit.rms_px, fit.precise_length};
+}
+
 // The model's loops placed at a pose, as polygons in canvas coordinates:
 // filled together, the holes stay empty.
 std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose,
@@ -95,6 +139,96 @@ std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Imag
     polys.push_back(std::move(poly));
   }
   return polys;
+}
+
+// A candidate that fits the blob on its own, drawn on its box of a canvas
+// about the blob.
+struct Placed {
+  const Candidate* candidate = nullptr;
+  cv::Rect box;
+  cv::Mat drawn;  // 255 on the part, over `box`
+  int area = 0;
+};
+
+// Pixels two placed candidates share.
+int sharedPixels(const Placed& a, const Placed& b) {
+  const cv::Rect both = a.box & b.box;
+  if (both.empty()) return 0;
+  cv::Mat shared;
+  cv::bitwise_and(a.drawn(both - a.box.tl()), b.drawn(both - b.box.tl()), shared);
+  return cv::countNonZero(shared);
+}
+
+// Which of the placed candidates (best score first) are the blob's parts:
+// best first, each where it does not overlap those already taken by more
+// than parts can (kMaxOverlap). Two candidates that cannot both be parts
+// explain the same pixels two ways: the one whose boundary lies on more
+// of the blob's edges (EdgeFit::precise_length) is the part, whatever
+// their scores, and the other waits for it to be refused. A similar
+// outline of another type verifies within the edge tolerance on a part
+// whose rest another hides, and is then first by its score; it lies on
+// the part's edges for only short stretches.
+// `mirrored(candidate)`: whether the part there shows the mirror image of
+// the candidate's model; asked only of a candidate about to be taken.
+template <typename MirrorTest>
+std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canvas,
+                                MirrorTest&& mirrored) {
+  const size_t n = placed.size();
+  // Rivals: pairs that cannot both be parts, whichever is taken first.
+  std::vector<std::vector<size_t>> better(n);  // the rivals that explain more, per candidate
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j) {
+      if (i == j || placed[j].candidate->precise <= placed[i].candidate->precise) continue;
+      const int shared = sharedPixels(placed[i], placed[j]);
+      if (shared > kMaxOverlap * std::max(placed[i].area, placed[j].area)) better[i].push_back(j);
+    }
+  }
+  enum class State { kOpen, kTaken, kRefused };
+  std::vector<State> state(n, State::kOpen);
+  cv::Mat claimed(canvas, CV_8UC1, cv::Scalar(0));
+  const auto tryTake = [&](size_t i) {
+    const Placed& p = placed[i];
+    cv::Mat shared;
+    cv::bitwise_and(p.drawn, claimed(p.box), shared);
+    if (cv::countNonZero(shared) > kMaxOverlap * p.area || mirrored(*p.candidate)) {
+      state[i] = State::kRefused;
+      return;
+    }
+    state[i] = State::kTaken;
+    cv::Mat claimed_here = claimed(p.box);
+    cv::bitwise_or(claimed_here, p.drawn, claimed_here);
+  };
+  // Best score first; a candidate with an open rival that explains more
+  // waits.
+  std::vector<size_t> waiting;
+  for (size_t i = 0; i < n; ++i) {
+    const bool rival_open = std::any_of(better[i].begin(), better[i].end(),
+                                        [&](size_t j) { return state[j] != State::kRefused; });
+    if (rival_open) {
+      waiting.push_back(i);
+    } else {
+      tryTake(i);
+    }
+  }
+  // Then those that waited, the one explaining most first, each once every
+  // rival that explains more has been refused.
+  std::stable_sort(waiting.begin(), waiting.end(), [&](size_t a, size_t b) {
+    return placed[a].candidate->precise > placed[b].candidate->precise;
+  });
+  for (const size_t i : waiting) {
+    const bool rival_taken = std::any_of(better[i].begin(), better[i].end(),
+                                         [&](size_t j) { return state[j] != State::kRefused; });
+    if (rival_taken) {
+      state[i] = State::kRefused;
+    } else {
+      tryTake(i);
+    }
+  }
+  std::vector<size_t> taken;
+  for (size_t i = 0; i < n; ++i) {
+    if (state[i] == State::kTaken) taken.push_back(i);
+  }
+  return taken;
 }
 
 }  // namespace
@@ -196,7 +330,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     if (std::any_of(to.begin(), to.end(), same)) continue;
     const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
                                      m->edge_tolerance, p.pose.mirrored);
-    to.push_back({m, fit.pose, score, fit.rms_px});
+    to.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
   }
 
   // Best first; among equal scores the closer fit to the grey-level edges.
@@ -213,47 +347,56 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
                  cv::Scalar(0));
   cv::compare(region.coverage, 0.5, inside(cv::Rect(cv::Point(pad, pad), region.coverage.size())),
               cv::CMP_GE);
-  cv::Mat claimed(inside.size(), CV_8UC1, cv::Scalar(0));
-  cv::Mat shape(inside.size(), CV_8UC1);
   const Coverage coverage(region);
+
+  // The candidates that fit the blob on their own, each drawn on its box of
+  // the canvas.
+  std::vector<Placed> placed;
   for (const auto& c : direct) {
     const PartModel& m = *c.model;
     if (c.score * 100 < m.verify_percent &&
         !hiddenUnderOthers(m, c.pose, edges, coverage, c.score)) {
       continue;
     }
-    const bool mirror_as_good = std::any_of(mirror.begin(), mirror.end(), [&](const Candidate& q) {
+    const auto outline = placedOutline(m, c.pose, origin);
+    cv::Rect box;
+    for (const auto& poly : outline) box |= cv::boundingRect(poly);
+    box = (box + cv::Size(1, 1)) & cv::Rect(cv::Point(0, 0), inside.size());
+    if (box.empty()) continue;
+    Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
+    cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
+    p.area = cv::countNonZero(p.drawn);
+    if (p.area <= 0) continue;
+    cv::Mat outside;
+    cv::bitwise_and(p.drawn, ~inside(box), outside);
+    if (cv::countNonZero(outside) > kMaxOutside * p.area) continue;
+    placed.push_back(std::move(p));
+  }
+  // A part shown mirrored is not reported: the mirror image verifies about
+  // as well and where the hands differ fits better. Only asked of a
+  // candidate about to be taken (placing the mirror image costs an edge
+  // fit).
+  const auto mirrored = [&](const Candidate& c) {
+    const PartModel& m = *c.model;
+    const auto as_good = [&](const Candidate& q) {
       return q.model == c.model &&
              std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
                  0.5 * m.radius &&
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
-    });
-    if (mirror_as_good) continue;
-    // Only the placed part's box of the canvas is read and written.
-    const auto outline = placedOutline(m, c.pose, origin);
-    cv::Rect box;
-    for (const auto& poly : outline) box |= cv::boundingRect(poly);
-    box = (box + cv::Size(1, 1)) & cv::Rect(cv::Point(0, 0), shape.size());
-    if (box.empty()) continue;
-    cv::Mat drawn_here = shape(box);
-    drawn_here.setTo(0);
-    cv::fillPoly(drawn_here, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
-    const int drawn = cv::countNonZero(drawn_here);
-    if (drawn <= 0) continue;
-    cv::Mat scratch;
-    cv::bitwise_and(drawn_here, ~inside(box), scratch);
-    const double outside = cv::countNonZero(scratch);
-    cv::bitwise_and(drawn_here, claimed(box), scratch);
-    const double overlap = cv::countNonZero(scratch);
-    if (overlap > kMaxOverlap * drawn || outside > kMaxOutside * drawn) continue;
-    cv::Mat claimed_here = claimed(box);
-    cv::bitwise_or(claimed_here, drawn_here, claimed_here);
+    };
+    if (std::any_of(mirror.begin(), mirror.end(), as_good)) return true;
+    const auto aligned = alignedMirror(m, region, c.pose, edges,
+                                       c.score - kMirrorMargin - kMirrorScreenSlack, mirror);
+    return aligned && as_good(*aligned);
+  };
+  for (const size_t i : chooseParts(placed, inside.size(), mirrored)) {
+    const Candidate& c = *placed[i].candidate;
     Match match;
     match.model = c.model;
     match.region = index;
     match.score = c.score;
     match.centroid = c.pose.centre;
-    match.symmetry_deg = m.symmetryDeg();
+    match.symmetry_deg = c.model->symmetryDeg();
     match.angle_deg = wrapDeg(c.pose.angle_deg, match.symmetry_deg);
     match.touching = true;
     found.push_back(match);

@@ -39,6 +39,11 @@ constexpr int kSparseFitStride = 3;
 // A sparse iteration that moves the boundary by less than this (pixels, at
 // the rim) has settled: the remaining sparse ones are skipped.
 constexpr double kSettledPx = 0.01;
+// An edge crossing this close to the fitted boundary is one the pose
+// explains: a right model's visible boundary lies within a few tenths of a
+// pixel of its edges, and a primitive deviates from them by up to the
+// conformity (1 px), a similar outline of another type by more.
+constexpr double kPreciseEdgePx = 1.0;
 // Edge samples this close to a primitive's end see the neighbouring edge.
 constexpr double kCornerClearancePx = 2.0;
 
@@ -152,6 +157,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     cv::Matx44d a = cv::Matx44d::zeros();
     cv::Vec4d b(0, 0, 0, 0);
     double found = 0;
+    double precise = 0;
     double sum2 = 0;
     int used = 0;
     const size_t stride = it == iterations - 1 ? 1 : dense ? 2 : kSparseFitStride;
@@ -164,6 +170,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
       if (!crossing || std::abs(*crossing - offset) > gate) continue;
       const double residual = *crossing - offset;
       found += e.weight;
+      if (std::abs(residual) <= kPreciseEdgePx) precise += e.weight;
       sum2 += residual * residual;
       ++used;
       const cv::Vec4d j(n.x, n.y, n.x * -r.y + n.y * r.x, 1.0);
@@ -176,6 +183,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     const double rms = std::sqrt(sum2 / used);
     fit.rms_px = rms;
     fit.inlier_fraction = found * static_cast<double>(stride) / total;
+    fit.precise_length = precise * static_cast<double>(stride);
     cv::Vec4d x;
     if (!cv::solve(a, b, x, cv::DECOMP_CHOLESKY)) return fit;
     fit.pose.centre += cv::Point2d(x[0], x[1]);

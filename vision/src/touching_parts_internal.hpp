@@ -89,6 +89,7 @@ struct Candidate {
   ImagePose pose;
   double score = 0;
   double rms = 0;
+  double precise = 0;  // EdgeFit::precise_length, once refined
 };
 
 // A corner's first look counts boundary samples within this many edge

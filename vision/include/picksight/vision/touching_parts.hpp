@@ -24,6 +24,9 @@ struct EdgeFit {
   ImagePose pose;
   double rms_px = 0;           // of the inlier edge points about the fitted boundary
   double inlier_fraction = 0;  // of the model's edge samples (weighted) found on an edge
+  // The weighted boundary length (pixels) whose edge lies within a pixel of
+  // the fitted boundary: how much of the region's edges the pose explains.
+  double precise_length = 0;
 };
 
 // Moves `start` so that the model boundary lies on the region's grey-level
@@ -47,7 +50,9 @@ void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Poi
 
 // The parts of the given models inside region `index` of `regions`, a blob
 // that matched no model as a whole. Best score first; Match::touching set.
-// A part whose mirrored model verifies about as well is not reported.
+// A part whose mirrored model verifies about as well is not reported. Of two
+// poses that cannot both be parts (they would share more than parts lying
+// on each other do), the one lying on more of the blob's edges is reported.
 std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
                                 const std::vector<const PartModel*>& models);
 
