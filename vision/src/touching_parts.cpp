@@ -34,6 +34,9 @@ constexpr int kMaxRefinedPerBlob = 48;
 // makes the handedness a question: where the two hands differ decides it
 // (showsMirrorImage), and a part shown mirrored is not reported.
 constexpr double kMirrorMargin = 0.03;
+// A screened pose this close to one already refined is not refined again.
+constexpr double kRefinedNearPx = 3.0;
+constexpr double kRefinedNearDeg = 4.0;
 // The mirror image placed on a part is refined on the edges when it
 // verifies within this of the margin before (a hypothesis a few pixels and
 // degrees off loses that much at the rim, kCoarseSlack), and when no mirror
@@ -321,6 +324,13 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   std::vector<Candidate> mirror;
   for (const auto& p : screened) {
     const PartModel* m = p.model;
+    // A screened pose next to one already refined converges to it: the
+    // edge fit is the costliest step here.
+    const auto refined_near = [&](const Candidate& q) {
+      return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
+    };
+    const auto& done = p.pose.mirrored ? mirror : direct;
+    if (std::any_of(done.begin(), done.end(), refined_near)) continue;
     const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
     if (!fit.ok) continue;
     auto& to = p.pose.mirrored ? mirror : direct;
