@@ -417,6 +417,8 @@ BoundaryDistanceMap::BoundaryDistanceMap(const std::vector<BoundaryLoop>& loops,
 float BoundaryDistanceMap::at(cv::Point2d p) const {
   const double x = (p.x - origin_.x) * inv_cell_;
   const double y = (p.y - origin_.y) * inv_cell_;
+  // Outside (NaN and infinities included) before any conversion to int.
+  if (!(x >= 0 && y >= 0 && x < distance_.cols - 1 && y < distance_.rows - 1)) return reach_;
   const int x0 = static_cast<int>(std::floor(x));
   const int y0 = static_cast<int>(std::floor(y));
   if (x0 < 0 || y0 < 0 || x0 + 1 >= distance_.cols || y0 + 1 >= distance_.rows) return reach_;
@@ -481,6 +483,12 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
 }
 
 float EdgeDistance::at(cv::Point2d p) const {
+  // Outside the map (in doubles first: a pose from degenerate geometry can
+  // put a point at infinity or NaN, which no integer holds).
+  const double dx = p.x - origin_.x;
+  const double dy = p.y - origin_.y;
+  if (!(dx > -0.5 && dy > -0.5 && dx < distance_.cols - 0.5 && dy < distance_.rows - 0.5))
+    return 1e9f;
   const int x = cvRound(p.x) - origin_.x;
   const int y = cvRound(p.y) - origin_.y;
   if (x < 0 || y < 0 || x >= distance_.cols || y >= distance_.rows) return 1e9f;

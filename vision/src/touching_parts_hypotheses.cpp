@@ -28,6 +28,10 @@ constexpr double kMinArcRadiusPx = 4;
 // after a first look at a few of them (fewer let more wrong poses through
 // to the screening; 12 found the most parts in the silhouette bench).
 constexpr size_t kSparseSamples = 64;
+// Two edges whose directions' cross product is below this (sine of the
+// angle between them) are taken as parallel: their tangents' meeting point
+// would be far away or at infinity.
+constexpr double kMinCornerSine = 1e-6;
 constexpr size_t kGlanceSamples = 12;
 // The first look's score may fall this far below the screening threshold
 // (the few samples judge a pose more roughly).
@@ -120,6 +124,8 @@ void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>
         // a.end + p in = b.start - q out, solved for p.
         const cv::Point2d gap = b.start - a.end;
         const double det = in.x * out.y - in.y * out.x;
+        // Edges that double back on each other (a hairpin) meet nowhere.
+        if (std::abs(det) < kMinCornerSine) continue;
         const double along = (gap.x * out.y - gap.y * out.x) / det;
         const bool loop_convex = (turn > 0) == left_interior;
         corners->push_back({a.end + in * along, angleOf(u), u / std::hypot(u.x, u.y),

@@ -69,6 +69,8 @@ class Coverage {
   float at(cv::Point2d p) const {
     const double x = p.x - origin_.x;
     const double y = p.y - origin_.y;
+    // Outside (NaN and infinities included) before any conversion to int.
+    if (!(x >= 0 && y >= 0 && x < c_.cols - 1 && y < c_.rows - 1)) return 0.f;
     const int x0 = static_cast<int>(std::floor(x));
     const int y0 = static_cast<int>(std::floor(y));
     if (x0 < 0 || y0 < 0 || x0 + 1 >= c_.cols || y0 + 1 >= c_.rows) return 0.f;
