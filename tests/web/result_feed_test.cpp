@@ -27,7 +27,10 @@ uint64_t requestIdOf(const std::string& event) {
 
 }  // namespace
 
-TEST_CASE("a result without an events client is turned into JSON only when asked", "[web]") {
+TEST_CASE(
+    "a result without an events client is turned into JSON when asked and later clients get later "
+    "results",
+    "[web]") {
   zmq::context_t context;
   EventHub hub;
   ResultFeed feed(context, {"cell", "none", "127.0.0.1", 9}, hub);

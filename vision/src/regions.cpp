@@ -163,6 +163,7 @@ struct BandReading {
   float offset = 0;
   Moments10 sums;   // of the coverage: interior and band
   double tail = 0;  // mean raw coverage of the band's outermost pixels
+  RowRuns band;     // read from grey levels (other regions' pixels skipped)
 
   float background(int x, int y) const {
     return static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
@@ -264,9 +265,10 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
 
   // The band: pixels near the region, not deep inside it, never a
   // neighbour's; its moments summed row by row.
+  reading->band = near.minus(interior);
   int row = -1;
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  forEachCoverage(r, pixels, near.minus(interior), [&](int y, int x, float raw) {
+  forEachCoverage(r, pixels, r.band, [&](int y, int x, float raw) {
     if (y != row) {
       if (row >= 0) sums.addRow(row, s0, s1, s2, s3);
       row = y;
@@ -335,10 +337,11 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
     // frame's edge) leaves the narrower one's reading.
     BandReading reading;
     if (!readBand(reach, pixels, interior, histogram, dilations, &reading)) break;
-    kept = reading;
+    const bool wide_enough = reading.tail <= kMaxBandTail;
+    kept = std::move(reading);
     kept_reach = reach;
     kept_interior = interior;
-    if (reading.tail <= kMaxBandTail) break;
+    if (wide_enough) break;
   }
   if (kept_reach == 0) return false;
 
@@ -348,10 +351,9 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
     float* c = coverage.ptr<float>(y);
     std::fill(c + a, c + b, 1.0f);
   });
-  forEachCoverage(kept, pixels, dilations.byRadius(kept_reach).minus(kept_interior),
-                  [&](int y, int x, float raw) {
-                    coverage.ptr<float>(y)[x] = std::min(std::max(raw, 0.0f), 1.0f);
-                  });
+  forEachCoverage(kept, pixels, kept.band, [&](int y, int x, float raw) {
+    coverage.ptr<float>(y)[x] = std::min(std::max(raw, 0.0f), 1.0f);
+  });
   const Moments10& s = kept.sums;
   *moments = cv::Moments(s.m00, s.m10, s.m01, s.m20, s.m11, s.m02, s.m30, s.m21, s.m12, s.m03);
   *centroid = cv::Point2d(box.x + s.m10 / s.m00, box.y + s.m01 / s.m00);

@@ -201,13 +201,17 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canv
     cv::Mat claimed_here = claimed(p.box);
     cv::bitwise_or(claimed_here, p.drawn, claimed_here);
   };
+  // Whether a rival that explains more of candidate i's pixels is still
+  // open or taken.
+  const auto rivalIn = [&](size_t i) {
+    return std::any_of(better[i].begin(), better[i].end(),
+                       [&](size_t j) { return state[j] != State::kRefused; });
+  };
   // Best score first; a candidate with an open rival that explains more
   // waits.
   std::vector<size_t> waiting;
   for (size_t i = 0; i < n; ++i) {
-    const bool rival_open = std::any_of(better[i].begin(), better[i].end(),
-                                        [&](size_t j) { return state[j] != State::kRefused; });
-    if (rival_open) {
+    if (rivalIn(i)) {
       waiting.push_back(i);
     } else {
       tryTake(i);
@@ -219,9 +223,7 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canv
     return placed[a].candidate->precise > placed[b].candidate->precise;
   });
   for (const size_t i : waiting) {
-    const bool rival_taken = std::any_of(better[i].begin(), better[i].end(),
-                                         [&](size_t j) { return state[j] != State::kRefused; });
-    if (rival_taken) {
+    if (rivalIn(i)) {
       state[i] = State::kRefused;
     } else {
       tryTake(i);
@@ -329,11 +331,10 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     const auto refined_near = [&](const Candidate& q) {
       return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
     };
-    const auto& done = p.pose.mirrored ? mirror : direct;
-    if (std::any_of(done.begin(), done.end(), refined_near)) continue;
+    auto& to = p.pose.mirrored ? mirror : direct;
+    if (std::any_of(to.begin(), to.end(), refined_near)) continue;
     const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
     if (!fit.ok) continue;
-    auto& to = p.pose.mirrored ? mirror : direct;
     const auto same = [&](const Candidate& q) {
       return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
     };
