@@ -482,19 +482,6 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
   cv::distanceTransform(free, distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
 }
 
-float EdgeDistance::at(cv::Point2d p) const {
-  // Outside the map (in doubles first: a pose from degenerate geometry can
-  // put a point at infinity or NaN, which no integer holds).
-  const double dx = p.x - origin_.x;
-  const double dy = p.y - origin_.y;
-  if (!(dx > -0.5 && dy > -0.5 && dx < distance_.cols - 0.5 && dy < distance_.rows - 0.5))
-    return 1e9f;
-  const int x = cvRound(p.x) - origin_.x;
-  const int y = cvRound(p.y) - origin_.y;
-  if (x < 0 || y < 0 || x >= distance_.cols || y >= distance_.rows) return 1e9f;
-  return distance_.at<float>(y, x);
-}
-
 namespace {
 // Calls f(weight, distance to the nearest edge) for every placed sample.
 template <typename F>

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 
@@ -84,32 +85,68 @@ void alongPrimitive(const Primitive& p, bool whole_loop, double weight, double s
 // Where, along p + s n (n pointing away from the body), the coverage falls
 // through 0.5 from a clean inside to a clean outside, nearest to `expected`;
 // none where the part touches another (no outside) or the edge is a mess.
-// Read every `step` pixels; `halve`: the chosen crossing is then placed
-// between readings half a step apart (one more reading), as precisely as
-// a scan at half the step would place it.
+// Read every `step` pixels from -window to window; `halve`: the chosen
+// crossing is then placed between readings half a step apart (one more
+// reading), as precisely as a scan at half the step would place it.
+// The readings are taken outward from `expected`, interval by interval,
+// and stop once no interval left can hold a nearer crossing: once the pose
+// has settled the edge is within a reading or two of where it is expected,
+// and most of the window is never read.
 std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point2d n, double window,
                                    double expected, double step, bool halve = false) {
-  std::optional<double> best;
-  double best_from = 0;  // the reading before the chosen crossing, its value, the next
-  double best_before = 0;
-  double best_after = 0;
-  double previous = cov.at(p - n * window);
-  for (double s = -window + step; s <= window + 1e-9; s += step) {
-    const double v = cov.at(p + n * s);
-    if (previous >= 0.5 && v < 0.5) {
-      const double at = s - step + step * (previous - 0.5) / (previous - v);
-      if (!best || std::abs(at - expected) < std::abs(*best - expected)) {
-        if (cov.at(p + n * (at - 1.5)) >= 0.7 && cov.at(p + n * (at + 1.5)) <= 0.3) {
-          best = at;
-          best_from = s - step;
-          best_before = previous;
-          best_after = v;
-        }
-      }
+  constexpr int kMaxReadings = 64;
+  const int readings =
+      std::min(kMaxReadings, static_cast<int>(std::floor((2 * window + 1e-9) / step)) + 1);
+  if (readings < 2) return std::nullopt;
+  std::array<float, kMaxReadings> value;
+  std::array<bool, kMaxReadings> read{};
+  const auto reading = [&](int k) {
+    if (!read[k]) {
+      value[k] = cov.at(p + n * (-window + k * step));
+      read[k] = true;
     }
-    previous = v;
+    return value[k];
+  };
+  // The interval (k - 1, k) nearest to `expected` first, then outward on
+  // both sides by the distance of their near ends.
+  const int intervals = readings - 1;
+  const double from = (expected + window) / step;  // `expected` in readings
+  int below = std::clamp(static_cast<int>(std::floor(from)) + 1, 1, intervals);
+  int above = below + 1;
+  const auto nearEnd = [&](int k) {
+    const double lo = -window + (k - 1) * step;
+    const double hi = lo + step;
+    return expected < lo ? lo - expected : expected > hi ? expected - hi : 0.0;
+  };
+  std::optional<double> best;
+  int best_k = 0;
+  while (below >= 1 || above <= intervals) {
+    int k;
+    if (above > intervals || (below >= 1 && nearEnd(below) <= nearEnd(above))) {
+      k = below--;
+    } else {
+      k = above++;
+    }
+    // The intervals come nearest first: none left can do better.
+    if (best && nearEnd(k) > std::abs(*best - expected)) break;
+    const double previous = reading(k - 1);
+    const double v = reading(k);
+    if (!(previous >= 0.5 && v < 0.5)) continue;
+    const double s = -window + k * step;
+    const double at = s - step + step * (previous - 0.5) / (previous - v);
+    const double d = std::abs(at - expected);
+    // Equally near: the lower one, as a scan from -window would keep.
+    if (best && (d > std::abs(*best - expected) || (d == std::abs(*best - expected) && k > best_k)))
+      continue;
+    if (cov.at(p + n * (at - 1.5)) >= 0.7 && cov.at(p + n * (at + 1.5)) <= 0.3) {
+      best = at;
+      best_k = k;
+    }
   }
   if (!best || !halve) return best;
+  const double best_from = -window + (best_k - 1) * step;
+  const double best_before = value[best_k - 1];
+  const double best_after = value[best_k];
   const double half = 0.5 * step;
   const double middle = cov.at(p + n * (best_from + half));
   if (middle >= 0.5) return best_from + half + half * (middle - 0.5) / (middle - best_after);

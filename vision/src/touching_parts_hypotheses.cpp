@@ -191,10 +191,27 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       return std::hypot(at.x - image_point.x, at.y - image_point.y) <= kExplainedPx;
     });
   };
+  // The image corners by opening angle: each model corner visits only
+  // those it may be (a few in ten), in the blob's order.
+  std::vector<size_t> by_opening(image_corners.size());
+  for (size_t i = 0; i < by_opening.size(); ++i) by_opening[i] = i;
+  std::sort(by_opening.begin(), by_opening.end(), [&](size_t a, size_t b) {
+    return image_corners[a].opening_deg < image_corners[b].opening_deg;
+  });
+  std::vector<size_t> visit;
   for (const auto& mc : search.corners) {
-    for (const auto& ic : image_corners) {
-      if (mc.convex != ic.convex) continue;
-      if (std::abs(mc.opening_deg - ic.opening_deg) > kCornerAngleSlackDeg) continue;
+    const auto first = std::lower_bound(
+        by_opening.begin(), by_opening.end(), mc.opening_deg - kCornerAngleSlackDeg,
+        [&](size_t i, double v) { return image_corners[i].opening_deg < v; });
+    visit.clear();
+    for (auto it = first; it != by_opening.end() &&
+                          image_corners[*it].opening_deg <= mc.opening_deg + kCornerAngleSlackDeg;
+         ++it) {
+      if (image_corners[*it].convex == mc.convex) visit.push_back(*it);
+    }
+    std::sort(visit.begin(), visit.end());
+    for (const size_t i : visit) {
+      const CornerAnchor& ic = image_corners[i];
       const double angle = ic.bisector_deg - f * mc.bisector_deg;
       if (explained(mc.at, ic.at, angle)) continue;
       // cos and sin of the difference of the two bisectors' directions.
@@ -241,16 +258,23 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       const double step = 2 * half / (steps - 1);
       scan.resize(static_cast<size_t>(steps));
       // A step whose glance cannot reach the threshold is neither kept nor
-      // a better neighbour of one that is: -1 stands for its score.
+      // a better neighbour of one that is: -1 stands for its score. The
+      // turn advances by a fixed rotation (no sine and cosine per step).
+      const double start = (middle - half) * kRadPerDeg;
+      const double step_cos = std::cos(step * kRadPerDeg);
+      const double step_sin = std::sin(step * kRadPerDeg);
+      double c = std::cos(start);
+      double s = std::sin(start);
       for (int k = 0; k < steps; ++k) {
         const double angle = middle - half + k * step;
-        const double c = std::cos(angle * kRadPerDeg);
-        const double s = std::sin(angle * kRadPerDeg);
         const cv::Point2d centre = ia.centre - rotate({ma.centre.x, f * ma.centre.y}, c, s);
         scan[k] = verifiesAtLeast(glance, search.glance_weight, centre, c, s, f, edges,
                                   model.edge_tolerance, threshold - kGlanceSlack)
                       ? screen(ma.centre, ia.centre, angle, glance).score
                       : -1.0;
+        const double next_c = c * step_cos - s * step_sin;
+        s = s * step_cos + c * step_sin;
+        c = next_c;
       }
       for (int k = 0; k < steps; ++k) {
         const double s = scan[k];

@@ -116,8 +116,20 @@ class EdgeDistance {
   // much cheaper than the exact transform of the whole region of interest.
   EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
                double max_distance = 0);
-  // Pixels; a large value outside the region of interest.
-  float at(cv::Point2d p) const;
+  // Pixels; a large value outside the region of interest. Inline: the
+  // hypothesis search asks it millions of times a frame.
+  float at(cv::Point2d p) const {
+    // Outside the map (in doubles first: a pose from degenerate geometry can
+    // put a point at infinity or NaN, which no integer holds).
+    const double dx = p.x - origin_.x;
+    const double dy = p.y - origin_.y;
+    if (!(dx > -0.5 && dy > -0.5 && dx < distance_.cols - 0.5 && dy < distance_.rows - 0.5))
+      return 1e9f;
+    const int x = cvRound(p.x) - origin_.x;
+    const int y = cvRound(p.y) - origin_.y;
+    if (x < 0 || y < 0 || x >= distance_.cols || y >= distance_.rows) return 1e9f;
+    return distance_.at<float>(y, x);
+  }
   bool empty() const { return distance_.empty(); }
 
  private:
