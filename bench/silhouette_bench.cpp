@@ -181,7 +181,9 @@ void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pv::M
     s.mask_pos2 += best_d * best_d;
     s.worst_pos = std::max(s.worst_pos, pos);
     if (m.symmetry_deg > 0) {
-      const double e = picksight::angleDiffDeg(m.angle_deg, t.angle_deg, m.symmetry_deg);
+      // The model's frame is the part as trained: turned by kTrainAngleDeg.
+      const double e = picksight::angleDiffDeg(
+          m.angle_deg, t.angle_deg - picksight::bench::kTrainAngleDeg, m.symmetry_deg);
       s.ang2 += e * e;
       s.angles += 1;
       s.worst_ang = std::max(s.worst_ang, e);
@@ -353,7 +355,8 @@ int main(int argc, char** argv) {
               binarize.adaptive_window);
   for (size_t i = 0; i < types.size(); ++i) {
     const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;
-    const cv::Mat image = ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr);
+    const cv::Mat image = ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr,
+                                                    picksight::bench::kTrainAngleDeg);
     // The reference point's offset from the drawn centroid is what the
     // camera's blur takes from the drawing: measured without noise and
     // under even light, so that one image's noise is not counted in every
@@ -362,9 +365,15 @@ int main(int argc, char** argv) {
     clean.noise_sigma = 0;
     clean.uneven_light = false;
     cv::Point2d drawn;
-    const cv::Mat sharp = ps::renderSilhouetteAlone(types[i], side, clean, 7 + i, &drawn);
+    const cv::Mat sharp = ps::renderSilhouetteAlone(types[i], side, clean, 7 + i, &drawn,
+                                                    picksight::bench::kTrainAngleDeg);
     const auto seen = pv::findRegions(pv::binarize(sharp, binarize), {}, sharp);
-    reference.push_back(seen.empty() ? cv::Point2d() : seen.front().centroid - drawn);
+    // Measured on the part as trained, turned back to the drawing's frame
+    // (referenceOf turns it with each scene part).
+    const cv::Point2d offset = seen.empty() ? cv::Point2d() : seen.front().centroid - drawn;
+    const double back = -picksight::bench::kTrainAngleDeg * M_PI / 180.0;
+    reference.push_back({offset.x * std::cos(back) - offset.y * std::sin(back),
+                         offset.x * std::sin(back) + offset.y * std::cos(back)});
     auto outcome = pv::trainModel(image, static_cast<int>(i), specs[i].name, train);
     if (!outcome.ok()) {
       std::fprintf(stderr, "training %s failed: %s\n", specs[i].name.c_str(),

@@ -82,7 +82,8 @@ int main(int argc, char** argv) {
   std::vector<bool> chiral;
   for (size_t i = 0; i < types.size(); ++i) {
     const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;
-    const cv::Mat image = ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr);
+    const cv::Mat image = ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr,
+                                                    picksight::bench::kTrainAngleDeg);
     auto model = pv::trainModel(image, static_cast<int>(i) + 1, specs[i].name, train);
     if (!model.ok()) {
       std::fprintf(stderr, "training %s failed: %s\n", specs[i].name.c_str(),

@@ -357,8 +357,8 @@ cv::Mat SilhouetteScene::render(uint64_t frame_index) const {
 
 cv::Mat renderSilhouetteAlone(const SilhouetteType& type, int side,
                               const SilhouetteSceneOptions& look, uint64_t seed,
-                              cv::Point2d* centre) {
-  const Posed p = pose(type.mask, 0, false, 1.0);
+                              cv::Point2d* centre, double angle_deg) {
+  const Posed p = pose(type.mask, angle_deg, false, 1.0);
   cv::Mat canvas = cv::Mat::zeros(side * kS, side * kS, CV_8UC1);
   const cv::Point at(static_cast<int>(std::lround(0.5 * side * kS - p.centroid.x)),
                      static_cast<int>(std::lround(0.5 * side * kS - p.centroid.y)));

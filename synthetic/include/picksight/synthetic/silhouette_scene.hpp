@@ -96,11 +96,14 @@ class SilhouetteScene {
   cv::Mat clean_;  // CV_32F grey levels before noise
 };
 
-// A training image: one part of `type` at rotation 0 in the middle of a
-// `side` x `side` image lit and blurred like the scenes. Returns the image;
-// `centre` receives the drawn centroid.
+// A training image: one part of `type` turned by `angle_deg` in the middle
+// of a `side` x `side` image lit and blurred like the scenes. Returns the
+// image; `centre` receives the drawn centroid. At 0 the drawing is copied
+// as it is; at any other angle it is resampled as every scene part is,
+// which rounds tips and stems thinner than a pixel or two of the
+// supersampled drawing.
 cv::Mat renderSilhouetteAlone(const SilhouetteType& type, int side,
                               const SilhouetteSceneOptions& look, uint64_t seed,
-                              cv::Point2d* centre);
+                              cv::Point2d* centre, double angle_deg = 0);
 
 }  // namespace picksight::synthetic
