@@ -41,12 +41,30 @@ void douglasPeucker(const std::vector<cv::Point2d>& pts, size_t a, size_t b, dou
   if (b <= a + 1) return;
   double worst = -1;
   size_t at = a;
-  for (size_t i = a + 1; i < b; ++i) {
-    const double d = pointLineDistance(pts[i % n], pts[a % n], pts[b % n]);
-    if (d > worst) {
-      worst = d;
-      at = i;
+  const cv::Point2d from = pts[a % n];
+  const cv::Point2d d = pts[b % n] - from;
+  const double length = std::hypot(d.x, d.y);
+  if (length == 0) {
+    for (size_t i = a + 1; i < b; ++i) {
+      const double e = std::hypot(pts[i % n].x - from.x, pts[i % n].y - from.y);
+      if (e > worst) {
+        worst = e;
+        at = i;
+      }
     }
+  } else {
+    // The farthest point from the chord: the largest cross product, divided
+    // by the chord's length once (this runs over every boundary pixel of
+    // every blob).
+    for (size_t i = a + 1; i < b; ++i) {
+      const cv::Point2d v = pts[i % n] - from;
+      const double e = std::abs(d.x * v.y - d.y * v.x);
+      if (e > worst) {
+        worst = e;
+        at = i;
+      }
+    }
+    worst /= length;
   }
   if (worst <= eps) return;
   douglasPeucker(pts, a, at, eps, out);
