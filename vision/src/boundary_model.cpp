@@ -399,6 +399,7 @@ BoundaryDistanceMap::BoundaryDistanceMap(const std::vector<BoundaryLoop>& loops,
   distance_.create(static_cast<int>(std::ceil((hi.y - lo.y + 2 * margin) * inv_cell_)) + 2,
                    static_cast<int>(std::ceil((hi.x - lo.x + 2 * margin) * inv_cell_)) + 2, CV_32F);
   distance_.setTo(reach_);
+  last_ = cv::Point2d(distance_.cols - 1, distance_.rows - 1);
   // Each primitive writes its exact distance over its box grown by the
   // reach: work in proportion to the boundary's length, not the box's area.
   for (const auto& loop : loops) {
@@ -430,21 +431,6 @@ BoundaryDistanceMap::BoundaryDistanceMap(const std::vector<BoundaryLoop>& loops,
       }
     }
   }
-}
-
-float BoundaryDistanceMap::at(cv::Point2d p) const {
-  const double x = (p.x - origin_.x) * inv_cell_;
-  const double y = (p.y - origin_.y) * inv_cell_;
-  // Outside (NaN and infinities included) before any conversion to int.
-  if (!(x >= 0 && y >= 0 && x < distance_.cols - 1 && y < distance_.rows - 1)) return reach_;
-  const int x0 = static_cast<int>(std::floor(x));
-  const int y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= distance_.cols || y0 + 1 >= distance_.rows) return reach_;
-  const float fx = static_cast<float>(x - x0);
-  const float fy = static_cast<float>(y - y0);
-  const float* r0 = distance_.ptr<float>(y0) + x0;
-  const float* r1 = distance_.ptr<float>(y0 + 1) + x0;
-  return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
 }
 
 EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
@@ -488,6 +474,7 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
         }
       }
     }
+    keepBounds();
     return;
   }
   cv::Mat free(roi.size(), CV_8UC1, cv::Scalar(255));
@@ -498,6 +485,14 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
     }
   }
   cv::distanceTransform(free, distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  keepBounds();
+}
+
+void EdgeDistance::keepBounds() {
+  low_ = cv::Point2d(origin_.x - 0.5, origin_.y - 0.5);
+  high_ = cv::Point2d(origin_.x + distance_.cols - 0.5, origin_.y + distance_.rows - 0.5);
+  data_ = distance_.data;
+  step_ = distance_.step[0];
 }
 
 namespace {

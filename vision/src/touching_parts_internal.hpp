@@ -65,15 +65,16 @@ std::vector<EdgeSample> edgeSamples(const PartModel& model, double step);
 // Bilinear reading of a region's coverage (0 outside its box).
 class Coverage {
  public:
-  explicit Coverage(const Region& r) : c_(r.coverage), origin_(r.coverage_origin) {}
+  explicit Coverage(const Region& r)
+      : c_(r.coverage), origin_(r.coverage_origin), last_(c_.cols - 1, c_.rows - 1) {}
   float at(cv::Point2d p) const {
     const double x = p.x - origin_.x;
     const double y = p.y - origin_.y;
-    // Outside (NaN and infinities included) before any conversion to int.
-    if (!(x >= 0 && y >= 0 && x < c_.cols - 1 && y < c_.rows - 1)) return 0.f;
-    const int x0 = static_cast<int>(std::floor(x));
-    const int y0 = static_cast<int>(std::floor(y));
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= c_.cols || y0 + 1 >= c_.rows) return 0.f;
+    // Outside (NaN and infinities included) before any conversion to int;
+    // inside, a pixel and its right and lower neighbours are in the image.
+    if (!(x >= 0 && y >= 0 && x < last_.x && y < last_.y)) return 0.f;
+    const int x0 = static_cast<int>(x);
+    const int y0 = static_cast<int>(y);
     const float fx = static_cast<float>(x - x0);
     const float fy = static_cast<float>(y - y0);
     const float* r0 = c_.ptr<float>(y0) + x0;
@@ -84,6 +85,7 @@ class Coverage {
  private:
   const cv::Mat& c_;
   cv::Point origin_;
+  cv::Point2d last_;  // the last column and row
 };
 
 struct Candidate {

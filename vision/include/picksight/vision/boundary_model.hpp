@@ -95,13 +95,29 @@ class BoundaryDistanceMap {
  public:
   BoundaryDistanceMap() = default;
   BoundaryDistanceMap(const std::vector<BoundaryLoop>& loops, double reach, double cell = 0.5);
-  float at(cv::Point2d p) const;
+  // Bilinear between cells; the reach outside the map. Inline: the hand
+  // test asks it for every boundary sample of every candidate.
+  float at(cv::Point2d p) const {
+    const double x = (p.x - origin_.x) * inv_cell_;
+    const double y = (p.y - origin_.y) * inv_cell_;
+    // Outside (NaN and infinities included) before any conversion to int;
+    // inside, a cell and its right and lower neighbours are in the map.
+    if (!(x >= 0 && y >= 0 && x < last_.x && y < last_.y)) return reach_;
+    const int x0 = static_cast<int>(x);
+    const int y0 = static_cast<int>(y);
+    const float fx = static_cast<float>(x - x0);
+    const float fy = static_cast<float>(y - y0);
+    const float* r0 = distance_.ptr<float>(y0) + x0;
+    const float* r1 = distance_.ptr<float>(y0 + 1) + x0;
+    return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+  }
   bool empty() const { return distance_.empty(); }
   float reach() const { return reach_; }
 
  private:
   cv::Mat distance_;  // CV_32F
   cv::Point2d origin_;
+  cv::Point2d last_;  // the last cell's column and row (cols - 1, rows - 1)
   double inv_cell_ = 2.0;
   float reach_ = 0;
 };
@@ -120,21 +136,27 @@ class EdgeDistance {
   // hypothesis search asks it millions of times a frame.
   float at(cv::Point2d p) const {
     // Outside the map (in doubles first: a pose from degenerate geometry can
-    // put a point at infinity or NaN, which no integer holds).
-    const double dx = p.x - origin_.x;
-    const double dy = p.y - origin_.y;
-    if (!(dx > -0.5 && dy > -0.5 && dx < distance_.cols - 0.5 && dy < distance_.rows - 0.5))
-      return 1e9f;
+    // put a point at infinity or NaN, which no integer holds). Inside, the
+    // rounded point is a pixel of the map.
+    if (!(p.x > low_.x && p.y > low_.y && p.x < high_.x && p.y < high_.y)) return 1e9f;
     const int x = cvRound(p.x) - origin_.x;
     const int y = cvRound(p.y) - origin_.y;
-    if (x < 0 || y < 0 || x >= distance_.cols || y >= distance_.rows) return 1e9f;
-    return distance_.at<float>(y, x);
+    return reinterpret_cast<const float*>(data_ + static_cast<size_t>(y) * step_)[x];
   }
   bool empty() const { return distance_.empty(); }
 
  private:
+  // The bounds and rows at() reads, kept beside the map.
+  void keepBounds();
+
   cv::Mat distance_;  // CV_32F
   cv::Point origin_;
+  // Pixel centres are at origin_ + (i, j): a point rounds into the map when
+  // strictly between low_ and high_.
+  cv::Point2d low_;
+  cv::Point2d high_;
+  const uchar* data_ = nullptr;
+  size_t step_ = 0;
 };
 
 // The fraction (0..1) of the samples' weight that lies within `tolerance`
