@@ -347,7 +347,7 @@ int main(int argc, char** argv) {
   std::vector<ps::SilhouetteType> types;
   if (!picksight::bench::loadSilhouetteTypes(specs, data_dir, &types)) return 1;
 
-  // One model per type, trained on the part alone at rotation 0.
+  // One model per type, trained on the part alone turned by kTrainAngleDeg.
   std::vector<pv::PartModel> models;
   std::vector<bool> chiral;
   std::vector<cv::Point2d> reference;  // per type: trained centroid - drawn centroid
