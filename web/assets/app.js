@@ -13,7 +13,7 @@
     latest: {},         // app name -> latest VisionResult (JSON)
     lastOverlay: null,  // what overlay.js drew last (read by the tests)
     tab: "live",
-    listeners: { camera: [], result: [], cameras: [], tab: [], rect: [] },
+    listeners: { camera: [], result: [], cameras: [], tab: [], rect: [], frame: [] },
     errors: [],         // failed requests, newest last (also shown on the page)
   };
   window.picksight = ps;
@@ -218,17 +218,40 @@
   ps.showFrame = showFrame;
 
   // The frame as large as the column and the window allow, keeping its
-  // aspect (the overlay layers follow the image element's box).
+  // aspect (the overlay layers follow the image element's box), with the
+  // status lines under it in the window: the page does not scroll. Those
+  // lines have a fixed height (style.css), so the fit depends only on the
+  // window and the frame's aspect, never on the texts shown.
   function fitFrame() {
     const img = $("frame");
     if (!img.naturalWidth || !img.naturalHeight) return;
-    const top = $("viewer").getBoundingClientRect().top + window.scrollY;
+    const viewer = $("viewer").getBoundingClientRect();
+    const below = $("view-column").getBoundingClientRect().bottom - viewer.bottom +
+                  parseFloat(getComputedStyle(document.querySelector("main")).paddingBottom);
     const maxW = $("view-column").clientWidth;
-    const maxH = Math.max(200, window.innerHeight - top - 48);
+    const maxH = Math.max(200, window.innerHeight - (viewer.top + window.scrollY) - below);
     const w = Math.floor(Math.min(maxW, maxH * img.naturalWidth / img.naturalHeight));
     if (img.style.width !== w + "px") img.style.width = w + "px";
   }
   ps.fitFrame = fitFrame;
+
+  // A frame of another size or aspect (the camera's ROI or output size
+  // changed) replaces the previous one in the MJPEG stream without a load
+  // event, and often before the camera event that announces it. The image
+  // kept the width fitted to the previous aspect until that event (up to a
+  // second) and then jumped under a rectangle being drawn. The natural size
+  // is checked before every paint: a new one is fitted (event "frame")
+  // before it is first shown.
+  let frameSize = "";
+  function watchFrameSize() {
+    const img = $("frame");
+    const size = img.naturalWidth + "x" + img.naturalHeight;
+    if (size !== frameSize) {
+      frameSize = size;
+      emit("frame", size);
+    }
+    window.requestAnimationFrame(watchFrameSize);
+  }
 
   function sizeLayers() {
     fitFrame();
@@ -298,6 +321,7 @@
     const r = c.roi || {};
     text("stat-roi", (r.x || 0) + "," + (r.y || 0) + " " + (r.width || 0) + "x" + (r.height || 0));
     text("stat-error", c.last_error || "");
+    $("stat-error").title = c.last_error || "";  // the whole text; the line shows what fits
     document.body.classList.toggle("simulated", !!c.simulated_robot);
   }
 
@@ -454,6 +478,8 @@
     ps.on("camera", drawRects);
     ps.on("tab", drawRects);
     ps.on("cameras", drawRects);
+    ps.on("frame", drawRects);
+    watchFrameSize();
     rectTool();
     refreshCameras().then(refreshApps);
     setInterval(refreshApps, 5000);

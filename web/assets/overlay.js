@@ -152,6 +152,7 @@
     ps.on("result", (r) => { if (r.app === ps.app) refresh(); });
     ps.on("camera", refresh);
     ps.on("cameras", draw);
+    ps.on("frame", draw);
     $("frame").addEventListener("load", draw);
     for (const id of ["live-overlay", "live-regions"]) $(id).addEventListener("change", draw);
     $("live-binary").addEventListener("change", (e) => { ps.binaryWanted = e.target.checked; ps.showFrame(); });

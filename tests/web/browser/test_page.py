@@ -63,6 +63,48 @@ def drag(browser, box, start, end):
     actions.perform()
 
 
+def layout(browser):
+    """What a drag's aim depends on: the image's box and natural size, and
+    the page's mapping of frame pixels to sensor pixels."""
+    return frame_box(browser), browser.js("return window.picksight.mapping()")
+
+
+def settled_layout(browser):
+    """The layout once a camera refresh (event: cameras, once a second: it
+    refits the image and updates the mapping) has left it as it was."""
+    def unchanged_over_a_refresh():
+        before = layout(browser)
+        seen = browser.js("return window.picksight.cameraRefreshes")
+        wait_until(lambda: browser.js("return window.picksight.cameraRefreshes") > seen,
+                   what="a refresh of the cameras")
+        return before if layout(browser) == before else None
+
+    return wait_until(unchanged_over_a_refresh, what="a layout that a camera refresh leaves as it is")
+
+
+def drag_a_rectangle(browser, camera, mode, start, end, attempts=3):
+    """Drags with the mouse from sensor pixel `start` to `end` in the tab of
+    `mode` (teach or roi): (the image's box the drag was aimed with, the
+    rectangle the page drew, in sensor pixels). Aimed once the layout has
+    settled; if the image moved, changed size or was mapped otherwise by the
+    end of the drag, the mouse hit other pixels than aimed at and the drag is
+    made again, a bounded number of times."""
+    for _ in range(attempts):
+        before = settled_layout(browser)
+        box = before[0]
+        browser.js("window.picksight.rect[arguments[0]] = null; window.picksight.drawTool();", mode)
+        drag(browser, box, sensor_to_display(camera, box, *start), sensor_to_display(camera, box, *end))
+        rect = wait_until(lambda: browser.js("""
+            const r = document.getElementById(arguments[0] + '-rect');
+            return r ? ['x', 'y', 'width', 'height'].map(k => Number(r.dataset[k])) : null;""", mode),
+            what=f"the drawn {mode} rectangle")
+        after = layout(browser)
+        if after == before:
+            return box, rect
+        print(f"the image moved during a drag: {before} -> {after}")
+    raise AssertionError(f"the image moved under the mouse during each of {attempts} drags")
+
+
 def click(browser, element_id):
     browser.driver.find_element(By.ID, element_id).click()
 
@@ -120,11 +162,17 @@ def test_frames_arrive_and_change(cell, browser):
     assert browser.severe() == []
 
 
-def overlay_after(browser, request_id_before):
+def overlay_after(browser, before):
+    """The overlay of the result of the request sent after `before` (from
+    locate_on_page): a newer result of another request (the BLOBS or LEARN
+    before it, published when their replies went out) may reach the page
+    after `before` was read, and is not the one wanted."""
     return wait_until(lambda: browser.js("""
         const o = window.picksight.lastOverlay;
-        return o && o.request_id !== null && o.request_id !== arguments[0] ? o : null;""",
-        request_id_before), what="the overlay of the new result")
+        const r = o && window.picksight.latest[o.app];
+        return o && o.request_id !== null && o.request_id !== arguments[0] &&
+               r && String(r.request_id || '0') === o.request_id && r.request_line === arguments[1] ? o : null;""",
+        before["request_id"], before["line"]), what=f"the overlay of the result of {before['line']}")
 
 
 def check_overlay_matches(cell, browser, reply, overlay):
@@ -149,7 +197,8 @@ def check_overlay_matches(cell, browser, reply, overlay):
 def locate_on_page(browser, type_text):
     browser.js("""document.getElementById('live-type').value = arguments[0];
                   document.getElementById('live-reply').textContent = '';""", type_text)
-    before = browser.js("return window.picksight.lastOverlay ? window.picksight.lastOverlay.request_id : null")
+    before = {"request_id": browser.js("return window.picksight.lastOverlay ? window.picksight.lastOverlay.request_id : null"),
+              "line": f"LOCATE {type_text}"}
     click(browser, "live-locate")
     reply = wait_until(lambda: browser.js("""
         const t = document.getElementById('live-reply').textContent.split('\\n');
@@ -237,12 +286,7 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
                 m["roiY"] == roi.get("y", 0) and m["scaleX"] == (camera.get("scale_x") or 1.0))
 
     wait_until(page_knows_the_camera, what="the page's mapping of the current camera")
-    box = frame_box(browser)
-    drag(browser, box, sensor_to_display(camera, box, x0, y0), sensor_to_display(camera, box, x1, y1))
-    rect = wait_until(lambda: browser.js("""
-        const r = document.getElementById('teach-rect');
-        return r ? ['x', 'y', 'width', 'height'].map(k => Number(r.dataset[k])) : null;"""),
-        what="the drawn rectangle")
+    box, rect = drag_a_rectangle(browser, camera, "teach", (x0, y0), (x1, y1))
     # The rectangle in sensor pixels, to within the mouse's whole CSS pixels.
     slack = 2 * box["natural_width"] / box["width"] / (camera.get("scale_x") or 1.0) + 1
     assert abs(rect[0] - x0) <= slack and abs(rect[1] - y0) <= slack, rect
@@ -277,14 +321,8 @@ def check_locate_finds_the_taught_part(cell, browser, centroid):
 
 def test_roi_drawn_on_the_image_sets_the_camera_roi(cell, browser):
     select_tab(browser, "camera")
-    camera, box = cell.camera(), frame_box(browser)
-    start = sensor_to_display(camera, box, 100, 80)
-    end = sensor_to_display(camera, box, 420, 330)
-    drag(browser, box, start, end)
-    wanted = wait_until(lambda: browser.js("""
-        const r = document.getElementById('roi-rect');
-        return r ? ['x', 'y', 'width', 'height'].map(k => Number(r.dataset[k])) : null;"""),
-        what="the drawn ROI")
+    camera = cell.camera()
+    box, wanted = drag_a_rectangle(browser, camera, "roi", (100, 80), (420, 330))
     slack = 2 * box["natural_width"] / box["width"] + 1
     assert abs(wanted[0] - 100) <= slack and abs(wanted[1] - 80) <= slack, wanted
     assert abs(wanted[0] + wanted[2] - 420) <= slack and abs(wanted[1] + wanted[3] - 330) <= slack, wanted
