@@ -68,18 +68,7 @@ class Coverage {
   explicit Coverage(const Region& r)
       : c_(r.coverage), origin_(r.coverage_origin), last_(c_.cols - 1, c_.rows - 1) {}
   float at(cv::Point2d p) const {
-    const double x = p.x - origin_.x;
-    const double y = p.y - origin_.y;
-    // Outside (NaN and infinities included) before any conversion to int;
-    // inside, a pixel and its right and lower neighbours are in the image.
-    if (!(x >= 0 && y >= 0 && x < last_.x && y < last_.y)) return 0.f;
-    const int x0 = static_cast<int>(x);
-    const int y0 = static_cast<int>(y);
-    const float fx = static_cast<float>(x - x0);
-    const float fy = static_cast<float>(y - y0);
-    const float* r0 = c_.ptr<float>(y0) + x0;
-    const float* r1 = c_.ptr<float>(y0 + 1) + x0;
-    return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+    return bilinearAt(c_, p.x - origin_.x, p.y - origin_.y, last_, 0.f);
   }
 
  private:

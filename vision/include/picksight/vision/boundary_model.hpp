@@ -91,6 +91,23 @@ double primitiveDistance(const Primitive& prim, cv::Point2d p);
 // grid nodes up to `reach` pixels from the boundary (`reach` farther, and
 // outside the grid), bilinear between nodes `cell` pixels apart. Built once
 // per model; immutable, so any number of threads may read it.
+// The bilinear reading of a CV_32F image at (x, y), in its pixel
+// coordinates; `outside` unless 0 <= x < last.x and 0 <= y < last.y
+// (`last`: the image's last column and row), which is tested in doubles
+// before any conversion to int (a pose from degenerate geometry can put a
+// point at NaN or infinity) and leaves a pixel's right and lower neighbours
+// in the image.
+inline float bilinearAt(const cv::Mat& image, double x, double y, cv::Point2d last, float outside) {
+  if (!(x >= 0 && y >= 0 && x < last.x && y < last.y)) return outside;
+  const int x0 = static_cast<int>(x);
+  const int y0 = static_cast<int>(y);
+  const float fx = static_cast<float>(x - x0);
+  const float fy = static_cast<float>(y - y0);
+  const float* r0 = image.ptr<float>(y0) + x0;
+  const float* r1 = image.ptr<float>(y0 + 1) + x0;
+  return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+}
+
 class BoundaryDistanceMap {
  public:
   BoundaryDistanceMap() = default;
@@ -98,18 +115,8 @@ class BoundaryDistanceMap {
   // Bilinear between cells; the reach outside the map. Inline: the hand
   // test asks it for every boundary sample of every candidate.
   float at(cv::Point2d p) const {
-    const double x = (p.x - origin_.x) * inv_cell_;
-    const double y = (p.y - origin_.y) * inv_cell_;
-    // Outside (NaN and infinities included) before any conversion to int;
-    // inside, a cell and its right and lower neighbours are in the map.
-    if (!(x >= 0 && y >= 0 && x < last_.x && y < last_.y)) return reach_;
-    const int x0 = static_cast<int>(x);
-    const int y0 = static_cast<int>(y);
-    const float fx = static_cast<float>(x - x0);
-    const float fy = static_cast<float>(y - y0);
-    const float* r0 = distance_.ptr<float>(y0) + x0;
-    const float* r1 = distance_.ptr<float>(y0 + 1) + x0;
-    return (1 - fy) * ((1 - fx) * r0[0] + fx * r0[1]) + fy * ((1 - fx) * r1[0] + fx * r1[1]);
+    return bilinearAt(distance_, (p.x - origin_.x) * inv_cell_, (p.y - origin_.y) * inv_cell_,
+                      last_, reach_);
   }
   bool empty() const { return distance_.empty(); }
   float reach() const { return reach_; }
