@@ -94,10 +94,13 @@ void alongPrimitive(const Primitive& p, bool whole_loop, double weight, double s
 // and most of the window is never read.
 std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point2d n, double window,
                                    double expected, double step, bool halve = false) {
+  // The readings taken so far, on the stack: a window wider than they can
+  // hold (the fits use 17 and 21 readings) is narrowed to them, about p.
   constexpr int kMaxReadings = 64;
-  const int readings =
-      std::min(kMaxReadings, static_cast<int>(std::floor((2 * window + 1e-9) / step)) + 1);
-  if (readings < 2) return std::nullopt;
+  window = std::min(window, 0.5 * (kMaxReadings - 1) * step);
+  const double span = (2 * window + 1e-9) / step;  // in steps; tested before conversion
+  if (!(span >= 1)) return std::nullopt;
+  const int readings = static_cast<int>(std::floor(span)) + 1;
   std::array<float, kMaxReadings> value;
   std::array<bool, kMaxReadings> read{};
   const auto reading = [&](int k) {
