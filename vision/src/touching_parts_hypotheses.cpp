@@ -263,18 +263,19 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       const double start = (middle - half) * kRadPerDeg;
       const double step_cos = std::cos(step * kRadPerDeg);
       const double step_sin = std::sin(step * kRadPerDeg);
-      double c = std::cos(start);
-      double s = std::sin(start);
+      double turn_c = std::cos(start);
+      double turn_s = std::sin(start);
       for (int k = 0; k < steps; ++k) {
         const double angle = middle - half + k * step;
-        const cv::Point2d centre = ia.centre - rotate({ma.centre.x, f * ma.centre.y}, c, s);
-        scan[k] = verifiesAtLeast(glance, search.glance_weight, centre, c, s, f, edges,
+        const cv::Point2d centre =
+            ia.centre - rotate({ma.centre.x, f * ma.centre.y}, turn_c, turn_s);
+        scan[k] = verifiesAtLeast(glance, search.glance_weight, centre, turn_c, turn_s, f, edges,
                                   model.edge_tolerance, threshold - kGlanceSlack)
                       ? screen(ma.centre, ia.centre, angle, glance).score
                       : -1.0;
-        const double next_c = c * step_cos - s * step_sin;
-        s = s * step_cos + c * step_sin;
-        c = next_c;
+        const double next_c = turn_c * step_cos - turn_s * step_sin;
+        turn_s = turn_s * step_cos + turn_c * step_sin;
+        turn_c = next_c;
       }
       for (int k = 0; k < steps; ++k) {
         const double s = scan[k];
