@@ -199,7 +199,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
     return image_corners[a].opening_deg < image_corners[b].opening_deg;
   });
   std::vector<size_t> visit;
-  for (const auto& mc : search.corners) {
+  for (size_t mi = 0; mi < search.corners.size(); ++mi) {
+    const CornerAnchor& mc = search.corners[mi];
     const auto first = std::lower_bound(
         by_opening.begin(), by_opening.end(), mc.opening_deg - kCornerAngleSlackDeg,
         [&](size_t i, double v) { return image_corners[i].opening_deg < v; });
@@ -218,8 +219,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       const double cosine = ic.bisector.x * mc.bisector.x + f * ic.bisector.y * mc.bisector.y;
       const double sine = ic.bisector.y * mc.bisector.x - f * ic.bisector.x * mc.bisector.y;
       const cv::Point2d centre = ic.at - rotate({mc.at.x, f * mc.at.y}, cosine, sine);
-      if (!verifiesAtLeast(glance, search.glance_weight, centre, cosine, sine, f, edges, loose,
-                           threshold - kGlanceSlack)) {
+      if (!verifiesAtLeast(search.corner_glance[mi], search.glance_weight, centre, cosine, sine, f,
+                           edges, loose, threshold - kGlanceSlack)) {
         continue;
       }
       Candidate c = screen(mc.at, ic.at, angle, sparse);
@@ -242,7 +243,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
   const double fine = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   std::vector<double> scan;
-  for (const auto& ma : search.arcs) {
+  for (size_t mi = 0; mi < search.arcs.size(); ++mi) {
+    const ArcAnchor& ma = search.arcs[mi];
     for (const auto& ia : image_arcs) {
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
       if ((ia.sweep_deg > 0) != (f * ma.sweep_deg > 0)) continue;
@@ -269,8 +271,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
         const double angle = middle - half + k * step;
         const cv::Point2d centre =
             ia.centre - rotate({ma.centre.x, f * ma.centre.y}, turn_c, turn_s);
-        scan[k] = verifiesAtLeast(glance, search.glance_weight, centre, turn_c, turn_s, f, edges,
-                                  model.edge_tolerance, threshold - kGlanceSlack)
+        scan[k] = verifiesAtLeast(search.arc_glance[mi], search.glance_weight, centre, turn_c,
+                                  turn_s, f, edges, model.edge_tolerance, threshold - kGlanceSlack)
                       ? screen(ma.centre, ia.centre, angle, glance).score
                       : -1.0;
         const double next_c = turn_c * step_cos - turn_s * step_sin;
@@ -307,6 +309,16 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   b->sparse = sparseSamples(model.samples, kSparseSamples);
   b->glance = sparseSamples(model.samples, kGlanceSamples);
   for (const auto& g : b->glance) b->glance_weight += g.weight;
+  const auto farthestFirst = [&](cv::Point2d from) {
+    std::vector<BoundarySample> order = b->glance;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](const BoundarySample& u, const BoundarySample& v) {
+                       return cv::norm(u.point - from) > cv::norm(v.point - from);
+                     });
+    return order;
+  };
+  for (const auto& c : b->corners) b->corner_glance.push_back(farthestFirst(c.at));
+  for (const auto& a : b->arcs) b->arc_glance.push_back(farthestFirst(a.centre));
   b->edges = edgeSamples(model, 1.0);
   return b;
 }

@@ -96,8 +96,13 @@ struct BlobSearchModel {
   std::vector<touching::ArcAnchor> arcs;        // likewise
   std::vector<BoundarySample> sparse;           // hypotheses are screened on these
   std::vector<BoundarySample> glance;           // after a first look at these
-  std::vector<touching::EdgeSample> edges;      // poses are refined on these, 1 px apart
-  double glance_weight = 0;                     // the glance samples' total
+  // The glance samples farthest first from each corner (by index in
+  // `corners`) and each arc's centre (`arcs`): a pose put on a wrong anchor
+  // matches near it and fails far from it, so the first look ends sooner.
+  std::vector<std::vector<BoundarySample>> corner_glance;
+  std::vector<std::vector<BoundarySample>> arc_glance;
+  std::vector<touching::EdgeSample> edges;  // poses are refined on these, 1 px apart
+  double glance_weight = 0;                 // the glance samples' total
 };
 
 namespace touching {
