@@ -38,6 +38,15 @@ constexpr double kMirrorMargin = 0.03;
 // A screened pose this close to one already refined is not refined again.
 constexpr double kRefinedNearPx = 3.0;
 constexpr double kRefinedNearDeg = 4.0;
+// The edge fit of a screened pose: how far it looks for the edges at first,
+// its passes.
+constexpr double kEdgeSearchPx = 4.0;
+constexpr int kEdgeIterations = 6;
+// A fit whose coarse passes settle this close to a pose already refined
+// ends there (the dense passes move a pose by hundredths of a pixel; two
+// refined poses within a pixel and a degree are one).
+constexpr double kConvergedPx = 0.5;
+constexpr double kConvergedDeg = 0.5;
 // The mirror image placed on a part is refined on the edges when it
 // verifies within this of the margin before (a hypothesis a few pixels and
 // degrees off loses that much at the rim, kCoarseSlack), and when no mirror
@@ -58,6 +67,8 @@ constexpr double kMaxOutside = 0.06;
 // not on an edge lies on the other part's body. It then needs this much of
 // its boundary on edges.
 constexpr double kMinVisible = 0.7;
+// The verified fraction the dense passes of the edge fit may still add.
+constexpr double kUnsettledSlack = 0.1;
 // A part's boundary is on the blob's edges or hidden under another part's
 // body, never on the background, but where the model's primitives cut a
 // sharp tip or notch by more than the edge tolerance: at most 1 % of the
@@ -342,7 +353,20 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     };
     auto& to = p.pose.mirrored ? mirror : direct;
     if (std::any_of(to.begin(), to.end(), refined_near)) continue;
-    const EdgeFit fit = refinePoseOnEdges(*m, region, p.pose);
+    // Settled on a pose already refined (it would end as the same pose), or
+    // on one too little of whose boundary lies on edges for a part, even a
+    // partly hidden one, or a mirror image a part might show: not worth the
+    // dense passes.
+    const auto worth = [&](const ImagePose& pose) {
+      const auto converged = [&](const Candidate& q) {
+        return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
+      };
+      if (std::any_of(to.begin(), to.end(), converged)) return false;
+      return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
+                         pose.mirrored) >= kMinVisible - kUnsettledSlack;
+    };
+    const EdgeFit fit =
+        refinePoseOnEdges(*m, region, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
     if (!fit.ok) continue;
     const auto same = [&](const Candidate& q) {
       return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);

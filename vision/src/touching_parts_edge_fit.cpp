@@ -175,7 +175,8 @@ std::vector<EdgeSample> edgeSamples(const PartModel& model, double step) {
 using namespace touching;
 
 EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
-                          double search_px, int iterations) {
+                          double search_px, int iterations,
+                          const std::function<bool(const ImagePose&)>& worth_finishing) {
   const auto search = searchOf(model);
   const auto& samples = search->edges;
   const Coverage cov(region);
@@ -194,6 +195,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
     // Coarse readings place the crossing well enough while the pose
     // settles; the two dense passes halve them.
     const bool dense = it >= iterations - 2;
+    if (it == iterations - 2 && worth_finishing && !worth_finishing(fit.pose)) return fit;
     cv::Matx44d a = cv::Matx44d::zeros();
     cv::Vec4d b(0, 0, 0, 0);
     double found = 0;

@@ -3,6 +3,7 @@
 // sub-pixel refinement on the grey-level edges, best-first acceptance.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -36,8 +37,12 @@ struct EdgeFit {
 // to pixel centres lies inside the true edge. Edge points with no clean
 // crossing (where the part touches another) are left out. `search_px`: how
 // far along the normals an edge is looked for in the first iteration.
+// `worth_finishing`, when given, is asked once with the pose the coarse
+// passes settled on, before the dense passes that cost most of the fit:
+// false ends the fit there (not ok), for a pose that can no longer matter.
 EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
-                          double search_px = 4.0, int iterations = 6);
+                          double search_px = 4.0, int iterations = 6,
+                          const std::function<bool(const ImagePose&)>& worth_finishing = {});
 
 // Moves each primitive of `loops` (model frame: image point minus `origin`)
 // onto the grey-level edges of `region`, the part it was fitted to: lines by
