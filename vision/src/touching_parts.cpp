@@ -3,13 +3,18 @@
 // (touching_parts_edge_fit.cpp), each checked against its mirror image, then
 // accepted best first where they fit the blob (their boundary on its edges
 // or its body, not on the background) and not each other, two hypotheses
-// of the same pixels settled by which lies on more of its edges.
+// of the same pixels settled by which lies on more of its edges. A quick
+// search from each model's most telling anchors comes first; the full one
+// goes on, model by model, only while the parts found leave some of the
+// blob unexplained.
 #include "picksight/vision/touching_parts.hpp"
 
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <map>
 #include <optional>
 
 #include "picksight/common/angles.hpp"
@@ -69,6 +74,13 @@ constexpr double kMaxOutside = 0.06;
 constexpr double kMinVisible = 0.7;
 // The verified fraction the dense passes of the edge fit may still add.
 constexpr double kUnsettledSlack = 0.1;
+// The search of a blob ends once the parts found explain it whole: each
+// fits its edges within this (pixels, rms; a part fits within a few tenths,
+// a look-alike of another size or shape does not), and together they cover
+// every pixel of the blob but a seam this wide (pixels) where the drawn
+// outlines and the thresholded pixels disagree.
+constexpr double kWholeFitRmsPx = 0.6;
+constexpr int kSeamPx = 2;
 // A part's boundary is on the blob's edges or hidden under another part's
 // body, never on the background, but where the model's primitives cut a
 // sharp tip or notch by more than the edge tolerance: at most 1 % of the
@@ -115,7 +127,7 @@ bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double
 // images) already lies there: nullopt then.
 std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
                                        const ImagePose& direct, const EdgeDistance& edges,
-                                       double screen, const std::vector<Candidate>& searched) {
+                                       double screen, const std::deque<Candidate>& searched) {
   const int k = m.orientation_order;
   if (k <= 0 || m.body.mirror_symmetric) return std::nullopt;
   Candidate best;
@@ -290,11 +302,37 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   std::vector<ArcAnchor> image_arcs;
   anchorsOf(fitLoops(loops2d, conformity), &image_corners, &image_arcs);
 
-  // The best screened poses of each model and hand, then the best of all.
-  std::vector<Candidate> screened;
+  // A canvas around the blob wide enough for any part placed on it, so that
+  // what a placed part has outside the blob is counted.
+  double reach = 0;
   double smallest = region.area;
   for (const PartModel* m : fitting) {
+    reach = std::max(reach, m->radius);
     smallest = std::min(smallest, m->body.area);
+  }
+  const int pad = static_cast<int>(std::ceil(reach)) + 2;
+  const cv::Point origin = region.coverage_origin - cv::Point(pad, pad);
+  cv::Mat inside(region.coverage.rows + 2 * pad, region.coverage.cols + 2 * pad, CV_8UC1,
+                 cv::Scalar(0));
+  const cv::Rect blob_box(cv::Point(pad, pad), region.coverage.size());
+  cv::compare(region.coverage, 0.5, inside(blob_box), cv::CMP_GE);
+  const Coverage coverage(region);
+  const int parts = std::max(1, static_cast<int>(region.area / std::max(smallest, 1.0)));
+  const auto budget =
+      static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
+
+  // Refined poses (deques: the placed ones point into them), and those that
+  // fit the blob on their own, each drawn on its box of the canvas.
+  std::deque<Candidate> direct;
+  std::deque<Candidate> mirror;
+  std::vector<Placed> placed;
+  size_t refinements = 0;
+  // Whether a choice made now could differ from the last one.
+  bool changed = false;
+
+  // The best screened poses of one model, each hand, best first.
+  const auto screen = [&](const PartModel* m, bool quick) {
+    std::vector<Candidate> screened;
     std::vector<ImagePose> direct_poses;
     for (const bool mirrored : {false, true}) {
       if (mirrored && m->body.mirror_symmetric) continue;
@@ -303,10 +341,10 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       // mirrored is never reported), and the corners and arcs elsewhere in
       // the blob cannot place it there.
       if (mirrored && direct_poses.empty()) continue;
-      const double reach = m->radius + kMirrorSearchMarginPx;
+      const double near_reach = m->radius + kMirrorSearchMarginPx;
       const auto nearDirect = [&](cv::Point2d p) {
         return std::any_of(direct_poses.begin(), direct_poses.end(), [&](const ImagePose& q) {
-          return std::hypot(p.x - q.centre.x, p.y - q.centre.y) <= reach;
+          return std::hypot(p.x - q.centre.x, p.y - q.centre.y) <= near_reach;
         });
       };
       std::vector<CornerAnchor> mirror_corners;
@@ -320,7 +358,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
         }
       }
       std::vector<Candidate> proposed;
-      propose(*m, *searchOf(*m), mirrored, mirrored ? mirror_corners : image_corners,
+      propose(*m, *searchOf(*m), mirrored, quick, mirrored ? mirror_corners : image_corners,
               mirrored ? mirror_arcs : image_arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
@@ -334,93 +372,83 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       }
       if (!mirrored) direct_poses = kept;
     }
-  }
-  std::stable_sort(screened.begin(), screened.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  const int parts = std::max(1, static_cast<int>(region.area / std::max(smallest, 1.0)));
-  const auto budget =
-      static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
-  if (screened.size() > budget) screened.resize(budget);
+    std::stable_sort(screened.begin(), screened.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+    return screened;
+  };
 
-  std::vector<Candidate> direct;
-  std::vector<Candidate> mirror;
-  for (const auto& p : screened) {
-    const PartModel* m = p.model;
-    // A screened pose next to one already refined converges to it: the
-    // edge fit is the costliest step here.
-    const auto refined_near = [&](const Candidate& q) {
-      return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
-    };
-    auto& to = p.pose.mirrored ? mirror : direct;
-    if (std::any_of(to.begin(), to.end(), refined_near)) continue;
-    // Settled on a pose already refined (it would end as the same pose), or
-    // on one too little of whose boundary lies on edges for a part, even a
-    // partly hidden one, or a mirror image a part might show: not worth the
-    // dense passes.
-    const auto worth = [&](const ImagePose& pose) {
-      const auto converged = [&](const Candidate& q) {
-        return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
-      };
-      if (std::any_of(to.begin(), to.end(), converged)) return false;
-      return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
-                         pose.mirrored) >= kMinVisible - kUnsettledSlack;
-    };
-    const EdgeFit fit =
-        refinePoseOnEdges(*m, region, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
-    if (!fit.ok) continue;
-    const auto same = [&](const Candidate& q) {
-      return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
-    };
-    if (std::any_of(to.begin(), to.end(), same)) continue;
-    const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
-                                     m->edge_tolerance, p.pose.mirrored);
-    to.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
-  }
-
-  // Best first; among equal scores the closer fit to the grey-level edges.
-  std::stable_sort(direct.begin(), direct.end(), [](const Candidate& a, const Candidate& b) {
-    return a.score > b.score + 1e-9 || (std::abs(a.score - b.score) <= 1e-9 && a.rms < b.rms);
-  });
-  // A canvas around the blob wide enough for any part placed on it, so that
-  // what a placed part has outside the blob is counted.
-  double reach = 0;
-  for (const PartModel* m : fitting) reach = std::max(reach, m->radius);
-  const int pad = static_cast<int>(std::ceil(reach)) + 2;
-  const cv::Point origin = region.coverage_origin - cv::Point(pad, pad);
-  cv::Mat inside(region.coverage.rows + 2 * pad, region.coverage.cols + 2 * pad, CV_8UC1,
-                 cv::Scalar(0));
-  cv::compare(region.coverage, 0.5, inside(cv::Rect(cv::Point(pad, pad), region.coverage.size())),
-              cv::CMP_GE);
-  const Coverage coverage(region);
-
-  // The candidates that fit the blob on their own, each drawn on its box of
-  // the canvas.
-  std::vector<Placed> placed;
-  for (const auto& c : direct) {
+  // Places a refined candidate that fits the blob on its own.
+  const auto place = [&](const Candidate& c) {
     const PartModel& m = *c.model;
     // Below the verify fraction, a part may be partly hidden (kMinVisible).
     if (c.score * 100 < m.verify_percent &&
         (c.score < kMinVisible || crossesBackground(m, c.pose, edges, coverage))) {
-      continue;
+      return;
     }
     const auto outline = placedOutline(m, c.pose, origin);
     cv::Rect box;
     for (const auto& poly : outline) box |= cv::boundingRect(poly);
     box = (box + cv::Size(1, 1)) & cv::Rect(cv::Point(0, 0), inside.size());
-    if (box.empty()) continue;
+    if (box.empty()) return;
     Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
     cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
     p.area = cv::countNonZero(p.drawn);
-    if (p.area <= 0) continue;
+    if (p.area <= 0) return;
     cv::Mat outside;
     cv::bitwise_and(p.drawn, ~inside(box), outside);
-    if (cv::countNonZero(outside) > kMaxOutside * p.area) continue;
+    if (cv::countNonZero(outside) > kMaxOutside * p.area) return;
     placed.push_back(std::move(p));
-  }
+    changed = true;
+  };
+
+  // Refines screened poses, best first, and places those that fit.
+  const auto refine = [&](const std::vector<Candidate>& screened) {
+    for (const auto& p : screened) {
+      const PartModel* m = p.model;
+      // A screened pose next to one already refined converges to it: the
+      // edge fit is the costliest step here.
+      const auto refined_near = [&](const Candidate& q) {
+        return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
+      };
+      auto& to = p.pose.mirrored ? mirror : direct;
+      if (std::any_of(to.begin(), to.end(), refined_near)) continue;
+      if (refinements >= budget) return;
+      ++refinements;
+      // Settled on a pose already refined (it would end as the same pose), or
+      // on one too little of whose boundary lies on edges for a part, even a
+      // partly hidden one, or a mirror image a part might show: not worth the
+      // dense passes.
+      const auto worth = [&](const ImagePose& pose) {
+        const auto converged = [&](const Candidate& q) {
+          return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
+        };
+        if (std::any_of(to.begin(), to.end(), converged)) return false;
+        return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
+                           pose.mirrored) >= kMinVisible - kUnsettledSlack;
+      };
+      const EdgeFit fit =
+          refinePoseOnEdges(*m, region, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
+      if (!fit.ok) continue;
+      const auto same = [&](const Candidate& q) {
+        return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
+      };
+      if (std::any_of(to.begin(), to.end(), same)) continue;
+      const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
+                                       m->edge_tolerance, p.pose.mirrored);
+      to.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
+      if (p.pose.mirrored) {
+        changed = true;
+      } else {
+        place(to.back());
+      }
+    }
+  };
+
   // A part shown mirrored is not reported: the mirror image verifies about
   // as well and where the hands differ fits better. Only asked of a
   // candidate about to be taken (placing the mirror image costs an edge
-  // fit).
+  // fit, made once per candidate).
+  std::map<const Candidate*, std::optional<Candidate>> aligned_mirrors;
   const auto mirrored = [&](const Candidate& c) {
     const PartModel& m = *c.model;
     const auto as_good = [&](const Candidate& q) {
@@ -430,11 +458,85 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     };
     if (std::any_of(mirror.begin(), mirror.end(), as_good)) return true;
-    const auto aligned = alignedMirror(m, region, c.pose, edges,
-                                       c.score - kMirrorMargin - kMirrorScreenSlack, mirror);
-    return aligned && as_good(*aligned);
+    auto aligned = aligned_mirrors.find(&c);
+    if (aligned == aligned_mirrors.end()) {
+      aligned =
+          aligned_mirrors
+              .emplace(&c, alignedMirror(m, region, c.pose, edges,
+                                         c.score - kMirrorMargin - kMirrorScreenSlack, mirror))
+              .first;
+    }
+    return aligned->second && as_good(*aligned->second);
   };
-  for (const size_t i : chooseParts(placed, inside.size(), mirrored)) {
+
+  // The parts among those placed: best first; among equal scores the
+  // closer fit to the grey-level edges.
+  std::vector<size_t> taken;
+  const auto choose = [&] {
+    changed = false;
+    std::stable_sort(placed.begin(), placed.end(), [](const Placed& a, const Placed& b) {
+      const Candidate& u = *a.candidate;
+      const Candidate& v = *b.candidate;
+      return u.score > v.score + 1e-9 || (std::abs(u.score - v.score) <= 1e-9 && u.rms < v.rms);
+    });
+    taken = chooseParts(placed, inside.size(), mirrored);
+  };
+  // The blob's pixels the parts taken leave unexplained.
+  const auto unexplained = [&] {
+    cv::Mat rest = inside(blob_box).clone();
+    for (const size_t i : taken) {
+      const Placed& p = placed[i];
+      const cv::Rect both = p.box & blob_box;
+      if (!both.empty()) rest(both - blob_box.tl()).setTo(0, p.drawn(both - p.box.tl()));
+    }
+    return rest;
+  };
+  // Whether the parts taken are the whole blob: each fits its edges closely,
+  // and together they cover every pixel of it but a thin seam.
+  const auto explainsWhole = [&] {
+    if (taken.empty()) return false;
+    for (const size_t i : taken) {
+      if (placed[i].candidate->rms > kWholeFitRmsPx) return false;
+    }
+    cv::Mat rest = unexplained();
+    cv::erode(
+        rest, rest,
+        cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1)));
+    return cv::countNonZero(rest) == 0;
+  };
+
+  // First a quick search of every model, from its most telling corners and
+  // arc: the parts that show whole are mostly found there. Then, while the
+  // parts found do not explain the blob whole, the full search of each model,
+  // those the quick search found something of first.
+  std::vector<std::pair<double, size_t>> order;
+  for (size_t k = 0; k < fitting.size(); ++k) {
+    const auto screened = screen(fitting[k], true);
+    order.emplace_back(screened.empty() ? -1.0 : screened.front().score, k);
+    refine(screened);
+  }
+  choose();
+  if (!explainsWhole()) {
+    // With parts found, the rest of the blob is most likely one part more:
+    // the models closest to its area first. Otherwise those the quick
+    // search saw most of.
+    if (!taken.empty()) {
+      const double rest_area = std::max(1, cv::countNonZero(unexplained()));
+      for (auto& entry : order) {
+        entry.first = -std::abs(fitting[entry.second]->body.area - rest_area) / rest_area;
+      }
+    }
+    std::stable_sort(order.begin(), order.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (const auto& entry : order) {
+      refine(screen(fitting[entry.second], false));
+      if (!changed) continue;
+      choose();
+      if (explainsWhole()) break;
+    }
+  }
+  if (changed) choose();
+  for (const size_t i : taken) {
     const Candidate& c = *placed[i].candidate;
     Match match;
     match.model = c.model;

@@ -41,6 +41,10 @@ constexpr double kGlanceSlack = 0.1;
 // part is found from any one of its corners or arcs that shows.
 constexpr size_t kMaxModelCorners = 32;
 constexpr size_t kMaxModelArcs = 4;
+// A blob's quick search starts from this many of a model's sharpest corners
+// and its longest arc: enough to find most parts that show whole.
+constexpr size_t kQuickCorners = 8;
+constexpr size_t kQuickArcs = 1;
 // The rotation scan about an arc first steps this far at the model's rim.
 constexpr double kCoarseScanStepPx = 4.0;
 // Screening score a hypothesis needs, below the verify fraction: a pose from
@@ -147,7 +151,7 @@ std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m) {
 }
 
 // Screens the poses proposed for one model (direct or mirrored) in a blob.
-void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored,
+void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored, bool quick,
              const std::vector<CornerAnchor>& image_corners,
              const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
              std::vector<Candidate>* out) {
@@ -199,7 +203,11 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
     return image_corners[a].opening_deg < image_corners[b].opening_deg;
   });
   std::vector<size_t> visit;
+  const auto visits = [&](size_t mi, const std::vector<size_t>& quick_ones) {
+    return !quick || std::find(quick_ones.begin(), quick_ones.end(), mi) != quick_ones.end();
+  };
   for (size_t mi = 0; mi < search.corners.size(); ++mi) {
+    if (!visits(mi, search.quick_corners)) continue;
     const CornerAnchor& mc = search.corners[mi];
     const auto first = std::lower_bound(
         by_opening.begin(), by_opening.end(), mc.opening_deg - kCornerAngleSlackDeg,
@@ -244,6 +252,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
   const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   std::vector<double> scan;
   for (size_t mi = 0; mi < search.arcs.size(); ++mi) {
+    if (!visits(mi, search.quick_arcs)) continue;
     const ArcAnchor& ma = search.arcs[mi];
     for (const auto& ia : image_arcs) {
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
@@ -317,6 +326,20 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
                      });
     return order;
   };
+  // The quick anchors: the sharpest corners and the longest arcs.
+  const auto firstOf = [](size_t n, size_t count, const auto& before) {
+    std::vector<size_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), before);
+    order.resize(std::min(n, count));
+    return order;
+  };
+  b->quick_corners = firstOf(b->corners.size(), kQuickCorners, [&](size_t u, size_t v) {
+    return std::abs(180 - b->corners[u].opening_deg) > std::abs(180 - b->corners[v].opening_deg);
+  });
+  b->quick_arcs = firstOf(b->arcs.size(), kQuickArcs, [&](size_t u, size_t v) {
+    return b->arcs[u].length > b->arcs[v].length;
+  });
   for (const auto& c : b->corners) b->corner_glance.push_back(farthestFirst(c.at));
   for (const auto& a : b->arcs) b->arc_glance.push_back(farthestFirst(a.centre));
   b->edges = edgeSamples(model, 1.0);

@@ -94,8 +94,12 @@ constexpr double kLooseScreenFactor = 2.0;
 struct BlobSearchModel {
   std::vector<touching::CornerAnchor> corners;  // the most telling (keepTelling)
   std::vector<touching::ArcAnchor> arcs;        // likewise
-  std::vector<BoundarySample> sparse;           // hypotheses are screened on these
-  std::vector<BoundarySample> glance;           // after a first look at these
+  // The few most telling corners and arcs (indices into the above), which
+  // a first, quick search of a blob starts from.
+  std::vector<size_t> quick_corners;
+  std::vector<size_t> quick_arcs;
+  std::vector<BoundarySample> sparse;  // hypotheses are screened on these
+  std::vector<BoundarySample> glance;  // after a first look at these
   // The glance samples farthest first from each corner (by index in
   // `corners`) and each arc's centre (`arcs`): a pose put on a wrong anchor
   // matches near it and fails far from it, so the first look ends sooner.
@@ -112,8 +116,9 @@ namespace touching {
 std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m);
 
 // Screens the poses proposed for one model (direct or mirrored) in a blob:
-// appends those that verify well enough on `edges` to `out`.
-void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored,
+// appends those that verify well enough on `edges` to `out`. `quick`: from
+// the model's quick corners and arcs only.
+void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored, bool quick,
              const std::vector<CornerAnchor>& image_corners,
              const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
              std::vector<Candidate>* out);
