@@ -81,6 +81,9 @@ constexpr double kUnsettledSlack = 0.1;
 // outlines and the thresholded pixels disagree.
 constexpr double kWholeFitRmsPx = 0.6;
 constexpr int kSeamPx = 2;
+// A corner or arc of the blob within this of what the parts found leave
+// unexplained may belong to a part still to find (pixels).
+constexpr int kRestAnchorPx = 6;
 // A part's boundary is on the blob's edges or hidden under another part's
 // body, never on the background, but where the model's primitives cut a
 // sharp tip or notch by more than the edge tolerance: at most 1 % of the
@@ -331,6 +334,10 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   bool changed = false;
 
   // The best screened poses of one model, each hand, best first.
+  // The blob's anchors the search starts from (all, or those near what the
+  // parts found leave unexplained).
+  const std::vector<CornerAnchor>* corners = &image_corners;
+  const std::vector<ArcAnchor>* arcs = &image_arcs;
   const auto screen = [&](const PartModel* m, bool quick) {
     std::vector<Candidate> screened;
     std::vector<ImagePose> direct_poses;
@@ -350,16 +357,16 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       std::vector<CornerAnchor> mirror_corners;
       std::vector<ArcAnchor> mirror_arcs;
       if (mirrored) {
-        for (const auto& c : image_corners) {
+        for (const auto& c : *corners) {
           if (nearDirect(c.at)) mirror_corners.push_back(c);
         }
-        for (const auto& a : image_arcs) {
+        for (const auto& a : *arcs) {
           if (nearDirect(a.centre)) mirror_arcs.push_back(a);
         }
       }
       std::vector<Candidate> proposed;
-      propose(*m, *searchOf(*m), mirrored, quick, mirrored ? mirror_corners : image_corners,
-              mirrored ? mirror_arcs : image_arcs, edges, &proposed);
+      propose(*m, *searchOf(*m), mirrored, quick, mirrored ? mirror_corners : *corners,
+              mirrored ? mirror_arcs : *arcs, edges, &proposed);
       std::stable_sort(proposed.begin(), proposed.end(),
                        [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
       std::vector<ImagePose> kept;
@@ -520,8 +527,38 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     // With parts found, the rest of the blob is most likely one part more:
     // the models closest to its area first. Otherwise those the quick
     // search saw most of.
+    std::vector<CornerAnchor> rest_corners;
+    std::vector<ArcAnchor> rest_arcs;
     if (!taken.empty()) {
-      const double rest_area = std::max(1, cv::countNonZero(unexplained()));
+      cv::Mat rest = unexplained();
+      const double rest_area = std::max(1, cv::countNonZero(rest));
+      // The parts to find lie in the rest, and their corners and arcs on its
+      // rim (or where it meets the parts found): the full search starts from
+      // those, not from the outlines of the parts found.
+      const auto square = [](int r) {
+        return cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1));
+      };
+      cv::erode(rest, rest, square(kSeamPx));
+      if (cv::countNonZero(rest) > 0) {
+        cv::dilate(rest, rest, square(kSeamPx + kRestAnchorPx));
+        const cv::Point at = origin + blob_box.tl();
+        const auto inRest = [&](cv::Point2d p) {
+          const cv::Point q(static_cast<int>(std::lround(p.x)) - at.x,
+                            static_cast<int>(std::lround(p.y)) - at.y);
+          return q.x >= 0 && q.y >= 0 && q.x < rest.cols && q.y < rest.rows &&
+                 rest.at<uint8_t>(q) != 0;
+        };
+        for (const auto& c : image_corners) {
+          if (inRest(c.at)) rest_corners.push_back(c);
+        }
+        for (const auto& a : image_arcs) {
+          const double mid = a.mid_deg * kRadPerDeg;
+          if (inRest(a.centre + a.radius * cv::Point2d(std::cos(mid), std::sin(mid))))
+            rest_arcs.push_back(a);
+        }
+        corners = &rest_corners;
+        arcs = &rest_arcs;
+      }
       for (auto& entry : order) {
         entry.first = -std::abs(fitting[entry.second]->body.area - rest_area) / rest_area;
       }
