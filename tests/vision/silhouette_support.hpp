@@ -88,16 +88,23 @@ inline std::vector<vision::Match> recognizeSilhouettes(const synthetic::Silhouet
 
 // The drawn part a report is about: the one whose centroid lies within
 // `radius` of the reported one (parts lie farther apart than that, their
-// gap, so at most one does). Fails the test case when there is none.
-inline const synthetic::SilhouettePart& drawnUnder(
+// gap, so at most one does); nullptr when there is none.
+inline const synthetic::SilhouettePart* drawnNear(
     const std::vector<synthetic::SilhouettePart>& truth, const vision::Match& m, double radius) {
-  INFO(m.model->name << " reported at " << m.centroid.x << ", " << m.centroid.y
-                     << (m.touching ? " from its edges" : ""));
   const auto near =
       std::find_if(truth.begin(), truth.end(), [&](const synthetic::SilhouettePart& t) {
         return std::hypot(t.centre.x - m.centroid.x, t.centre.y - m.centroid.y) < radius;
       });
-  REQUIRE(near != truth.end());
+  return near == truth.end() ? nullptr : &*near;
+}
+
+// As drawnNear, but fails the test case when there is none.
+inline const synthetic::SilhouettePart& drawnUnder(
+    const std::vector<synthetic::SilhouettePart>& truth, const vision::Match& m, double radius) {
+  INFO(m.model->name << " reported at " << m.centroid.x << ", " << m.centroid.y
+                     << (m.touching ? " from its edges" : ""));
+  const synthetic::SilhouettePart* near = drawnNear(truth, m, radius);
+  REQUIRE(near != nullptr);
   return *near;
 }
 
