@@ -159,10 +159,9 @@ std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
   return Candidate{&m, fit.pose, score, fit.rms_px, fit.precise_length};
 }
 
-// The model's loops placed at a pose, as polygons in canvas coordinates:
+// The model's loops placed at a pose, as polygons in image coordinates:
 // filled together, the holes stay empty.
-std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose,
-                                                  cv::Point origin) {
+std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose) {
   std::vector<std::vector<cv::Point>> polys;
   const double c = std::cos(pose.angle_deg * kRadPerDeg);
   const double s = std::sin(pose.angle_deg * kRadPerDeg);
@@ -174,8 +173,7 @@ std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Imag
       for (int i = 0; i < n; ++i) {
         const cv::Point2d q = p.pointAt(static_cast<double>(i) / n);
         const cv::Point2d r = pose.centre + rotate({q.x, flip * q.y}, c, s);
-        poly.emplace_back(static_cast<int>(std::lround(r.x)) - origin.x,
-                          static_cast<int>(std::lround(r.y)) - origin.y);
+        poly.emplace_back(static_cast<int>(std::lround(r.x)), static_cast<int>(std::lround(r.y)));
       }
     }
     polys.push_back(std::move(poly));
@@ -183,11 +181,10 @@ std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Imag
   return polys;
 }
 
-// A candidate that fits the blob on its own, drawn on its box of a canvas
-// about the blob.
+// A candidate that fits the blob on its own, drawn over its box.
 struct Placed {
   const Candidate* candidate = nullptr;
-  cv::Rect box;
+  cv::Rect box;   // image coordinates
   cv::Mat drawn;  // 255 on the part, over `box`
   int area = 0;
 };
@@ -213,8 +210,7 @@ int sharedPixels(const Placed& a, const Placed& b) {
 // `mirrored(candidate)`: whether the part there shows the mirror image of
 // the candidate's model; asked only of a candidate about to be taken.
 template <typename MirrorTest>
-std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canvas,
-                                MirrorTest&& mirrored) {
+std::vector<size_t> chooseParts(const std::vector<Placed>& placed, MirrorTest&& mirrored) {
   const size_t n = placed.size();
   // Rivals: pairs that cannot both be parts, whichever is taken first.
   std::vector<std::vector<size_t>> better(n);  // the rivals that explain more, per candidate
@@ -227,17 +223,20 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, cv::Size canv
   }
   enum class State { kOpen, kTaken, kRefused };
   std::vector<State> state(n, State::kOpen);
-  cv::Mat claimed(canvas, CV_8UC1, cv::Scalar(0));
+  // The pixels taken, over the boxes of all.
+  cv::Rect all;
+  for (const auto& p : placed) all |= p.box;
+  cv::Mat claimed(all.size(), CV_8UC1, cv::Scalar(0));
   const auto tryTake = [&](size_t i) {
     const Placed& p = placed[i];
     cv::Mat shared;
-    cv::bitwise_and(p.drawn, claimed(p.box), shared);
+    cv::bitwise_and(p.drawn, claimed(p.box - all.tl()), shared);
     if (cv::countNonZero(shared) > kMaxOverlap * p.area || mirrored(*p.candidate)) {
       state[i] = State::kRefused;
       return;
     }
     state[i] = State::kTaken;
-    cv::Mat claimed_here = claimed(p.box);
+    cv::Mat claimed_here = claimed(p.box - all.tl());
     cv::bitwise_or(claimed_here, p.drawn, claimed_here);
   };
   // Whether a rival that explains more of candidate i's pixels is still
@@ -309,22 +308,23 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   std::vector<ArcAnchor> image_arcs;
   anchorsOf(fitLoops(loops2d, conformity), &image_corners, &image_arcs);
 
-  // A canvas around the blob wide enough for any part placed on it, so that
-  // what a placed part has outside the blob is counted.
-  double reach = 0;
+  // The blob's pixels (over its box, image coordinates), which placed parts
+  // are compared with.
   double smallest = region.area;
-  for (const PartModel* m : fitting) {
-    reach = std::max(reach, m->radius);
-    smallest = std::min(smallest, m->body.area);
-  }
-  const int pad = static_cast<int>(std::ceil(reach)) + 2;
-  const cv::Point origin = region.coverage_origin - cv::Point(pad, pad);
-  cv::Mat inside(region.coverage.rows + 2 * pad, region.coverage.cols + 2 * pad, CV_8UC1,
-                 cv::Scalar(0));
-  const cv::Rect blob_box(cv::Point(pad, pad), region.coverage.size());
-  cv::compare(region.coverage, 0.5, inside(blob_box), cv::CMP_GE);
+  for (const PartModel* m : fitting) smallest = std::min(smallest, m->body.area);
+  const cv::Rect blob_box(region.coverage_origin, region.coverage.size());
+  cv::Mat blob;
+  cv::compare(region.coverage, 0.5, blob, cv::CMP_GE);
   const Coverage coverage(region);
-  const int blob_pixels = cv::countNonZero(inside);
+  const int blob_pixels = cv::countNonZero(blob);
+  // The blob's pixels in `box` that `drawn` (over `box`) covers.
+  const auto coveredIn = [&](const cv::Mat& drawn, const cv::Rect& box) {
+    const cv::Rect both = box & blob_box;
+    if (both.empty()) return 0;
+    cv::Mat covered;
+    cv::bitwise_and(drawn(both - box.tl()), blob(both - blob_box.tl()), covered);
+    return cv::countNonZero(covered);
+  };
   const int parts = std::max(1, static_cast<int>(region.area / std::max(smallest, 1.0)));
   const auto budget =
       static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
@@ -397,18 +397,15 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     if (!verified && c.score < kMinVisible) return;
     const bool crosses = crossesBackground(m, c.pose, edges, coverage);
     if (!verified && crosses) return;
-    const auto outline = placedOutline(m, c.pose, origin);
+    const auto outline = placedOutline(m, c.pose);
     cv::Rect box;
     for (const auto& poly : outline) box |= cv::boundingRect(poly);
-    box = (box + cv::Size(1, 1)) & cv::Rect(cv::Point(0, 0), inside.size());
-    if (box.empty()) return;
+    box += cv::Size(1, 1);
     Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
     cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
     p.area = cv::countNonZero(p.drawn);
     if (p.area <= 0) return;
-    cv::Mat outside;
-    cv::bitwise_and(p.drawn, ~inside(box), outside);
-    const int off_blob = cv::countNonZero(outside);
+    const int off_blob = p.area - coveredIn(p.drawn, box);
     if (off_blob > kMaxOutside * p.area) return;
     // Crossing the background, only a candidate that is its blob whole
     // stays (kMaxOnBackground).
@@ -495,11 +492,14 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       const Candidate& v = *b.candidate;
       return u.score > v.score + 1e-9 || (std::abs(u.score - v.score) <= 1e-9 && u.rms < v.rms);
     });
-    taken = chooseParts(placed, inside.size(), mirrored);
+    taken = chooseParts(placed, mirrored);
   };
+  // What erodes a seam away.
+  const cv::Mat seam =
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1));
   // The blob's pixels the parts taken leave unexplained.
   const auto unexplained = [&] {
-    cv::Mat rest = inside(blob_box).clone();
+    cv::Mat rest = blob.clone();
     for (const size_t i : taken) {
       const Placed& p = placed[i];
       const cv::Rect both = p.box & blob_box;
@@ -515,9 +515,17 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       if (placed[i].candidate->rms > kWholeFitRmsPx) return false;
     }
     cv::Mat rest = unexplained();
-    cv::erode(
-        rest, rest,
-        cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1)));
+    // A seam runs along the blob's outline or a part's: more pixels than
+    // fit in seams that long, and some piece is wider.
+    double seam_length = static_cast<double>(region.outer.size());
+    for (const auto& h : region.hole_boundaries) seam_length += static_cast<double>(h.size());
+    for (const size_t i : taken) {
+      seam_length += static_cast<double>(searchOf(*placed[i].candidate->model)->edges.size());
+    }
+    const int left = cv::countNonZero(rest);
+    if (left == 0) return true;
+    if (left > (2 * kSeamPx + 1) * (seam_length + 2 * kSeamPx + 1)) return false;
+    cv::erode(rest, rest, seam);
     return cv::countNonZero(rest) == 0;
   };
 
@@ -544,18 +552,25 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       // The parts to find lie in the rest, and their corners and arcs on its
       // rim (or where it meets the parts found): the full search starts from
       // those, not from the outlines of the parts found.
-      const auto square = [](int r) {
-        return cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1));
-      };
-      cv::erode(rest, rest, square(kSeamPx));
+      cv::erode(rest, rest, seam);
       if (cv::countNonZero(rest) > 0) {
-        cv::dilate(rest, rest, square(kSeamPx + kRestAnchorPx));
-        const cv::Point at = origin + blob_box.tl();
+        // Whether any pixel of the rest lies in the square of `reach`
+        // about p (the dilation of the rest by it, read at p): a sum over the
+        // integral image.
+        cv::Mat sums;
+        cv::integral(rest, sums, CV_32S);
+        const int reach = kSeamPx + kRestAnchorPx;
         const auto inRest = [&](cv::Point2d p) {
-          const cv::Point q(static_cast<int>(std::lround(p.x)) - at.x,
-                            static_cast<int>(std::lround(p.y)) - at.y);
-          return q.x >= 0 && q.y >= 0 && q.x < rest.cols && q.y < rest.rows &&
-                 rest.at<uint8_t>(q) != 0;
+          const int x = static_cast<int>(std::lround(p.x)) - blob_box.x;
+          const int y = static_cast<int>(std::lround(p.y)) - blob_box.y;
+          const int x0 = std::clamp(x - reach, 0, rest.cols);
+          const int x1 = std::clamp(x + reach + 1, 0, rest.cols);
+          const int y0 = std::clamp(y - reach, 0, rest.rows);
+          const int y1 = std::clamp(y + reach + 1, 0, rest.rows);
+          if (x0 >= x1 || y0 >= y1) return false;
+          return sums.at<int>(y1, x1) - sums.at<int>(y0, x1) - sums.at<int>(y1, x0) +
+                     sums.at<int>(y0, x0) >
+                 0;
         };
         for (const auto& c : image_corners) {
           if (inRest(c.at)) rest_corners.push_back(c);
