@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -77,39 +78,73 @@ struct Circle {
   double radius = 0;
 };
 
-// Algebraic (Kasa) circle fit over points first..last (cyclic, inclusive).
-bool fitCircle(const std::vector<cv::Point2d>& pts, size_t first, size_t last, Circle* circle) {
-  const size_t n = pts.size();
-  const size_t count = last - first + 1;
-  if (count < 3) return false;
-  cv::Point2d mean(0, 0);
-  for (size_t i = first; i <= last; ++i) mean += pts[i % n];
-  mean /= static_cast<double>(count);
-  cv::Matx33d a = cv::Matx33d::zeros();
-  cv::Vec3d rhs(0, 0, 0);
-  for (size_t i = first; i <= last; ++i) {
-    const cv::Point2d p = pts[i % n] - mean;
-    const cv::Vec3d v(p.x, p.y, 1.0);
-    a += v * v.t();
-    rhs += v * -(p.x * p.x + p.y * p.y);
+// Running sums of a closed contour's coordinates and their products up to
+// the third order, over the contour walked twice (indices 0..2n), about a
+// point near its middle: the sums over any stretch first..last in two
+// reads, so that fitting circles to stretches that grow point by point
+// costs the same at any length.
+class ContourSums {
+ public:
+  explicit ContourSums(const std::vector<cv::Point2d>& pts) {
+    cv::Point2d lo = pts.front();
+    cv::Point2d hi = lo;
+    for (const auto& p : pts) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    origin_ = 0.5 * (lo + hi);
+    const size_t n = pts.size();
+    sums_.resize(2 * n + 1);
+    for (size_t i = 0; i < 2 * n; ++i) {
+      const double u = pts[i % n].x - origin_.x;
+      const double v = pts[i % n].y - origin_.y;
+      const Sums term{1, u, v, u * u, v * v, u * v, u * u * u, v * v * v, u * u * v, u * v * v};
+      for (size_t k = 0; k < term.size(); ++k) sums_[i + 1][k] = sums_[i][k] + term[k];
+    }
   }
-  cv::Vec3d s;
-  if (!cv::solve(a, rhs, s, cv::DECOMP_LU)) return false;
-  const double r2 = 0.25 * (s[0] * s[0] + s[1] * s[1]) - s[2];
-  if (!(r2 > 0)) return false;
-  circle->centre = mean + cv::Point2d(-0.5 * s[0], -0.5 * s[1]);
-  circle->radius = std::sqrt(r2);
-  return true;
-}
 
-double circleResidual(const std::vector<cv::Point2d>& pts, size_t first, size_t last,
-                      const Circle& c) {
-  double worst = 0;
+  // Kasa fit over first..last (inclusive, first <= last < 2n).
+  bool fitCircle(size_t first, size_t last, Circle* circle) const {
+    if (last < first || last - first + 1 < 3) return false;
+    Sums t;
+    for (size_t k = 0; k < t.size(); ++k) t[k] = sums_[last + 1][k] - sums_[first][k];
+    const double n = t[0];
+    const double mu = t[1] / n;
+    const double mv = t[2] / n;
+    // Central sums (about the stretch's mean) from the raw ones.
+    const double pp = t[3] - n * mu * mu;
+    const double qq = t[4] - n * mv * mv;
+    const double pq = t[5] - n * mu * mv;
+    const double ppp = t[6] - 3 * mu * t[3] + 2 * n * mu * mu * mu;
+    const double qqq = t[7] - 3 * mv * t[4] + 2 * n * mv * mv * mv;
+    const double ppq = t[8] - 2 * mu * t[5] - mv * t[3] + 2 * n * mu * mu * mv;
+    const double pqq = t[9] - 2 * mv * t[5] - mu * t[4] + 2 * n * mu * mv * mv;
+    // x^2 + y^2 + D x + E y + F = 0 about the mean; its sums of x and y are 0.
+    const cv::Matx33d a(pp, pq, 0, pq, qq, 0, 0, 0, n);
+    const cv::Vec3d rhs(-(ppp + pqq), -(ppq + qqq), -(pp + qq));
+    cv::Vec3d s;
+    if (!cv::solve(a, rhs, s, cv::DECOMP_LU)) return false;
+    const double r2 = 0.25 * (s[0] * s[0] + s[1] * s[1]) - s[2];
+    if (!(r2 > 0)) return false;
+    circle->centre = origin_ + cv::Point2d(mu - 0.5 * s[0], mv - 0.5 * s[1]);
+    circle->radius = std::sqrt(r2);
+    return true;
+  }
+
+ private:
+  using Sums = std::array<double, 10>;
+  cv::Point2d origin_;
+  std::vector<Sums> sums_;
+};
+
+// Whether every point first..last lies within `limit` of the circle.
+bool withinOfCircle(const std::vector<cv::Point2d>& pts, size_t first, size_t last, const Circle& c,
+                    double limit) {
   for (size_t i = first; i <= last; ++i) {
     const cv::Point2d d = pts[i % pts.size()] - c.centre;
-    worst = std::max(worst, std::abs(std::hypot(d.x, d.y) - c.radius));
+    if (std::abs(std::hypot(d.x, d.y) - c.radius) > limit) return false;
   }
-  return worst;
+  return true;
 }
 
 // Signed sweep of the arc through points first..last about `centre`.
@@ -230,10 +265,11 @@ std::vector<Primitive> fitPrimitives(const std::vector<cv::Point2d>& pts, double
   }
   idx[m] = idx[0] + n;
 
+  const ContourSums sums(pts);
   const auto arcFits = [&](size_t first, size_t last, Circle* c) {
-    if (!fitCircle(pts, first, last, c)) return false;
+    if (!sums.fitCircle(first, last, c)) return false;
     if (c->radius > kMaxRadiusFactor * extent) return false;
-    if (circleResidual(pts, first, last, *c) > conformity) return false;
+    if (!withinOfCircle(pts, first, last, *c, conformity)) return false;
     // An arc flatter than the conformity is a line.
     const cv::Point2d chord = pts[last % n] - pts[first % n];
     const double half = 0.5 * std::hypot(chord.x, chord.y);
@@ -244,7 +280,7 @@ std::vector<Primitive> fitPrimitives(const std::vector<cv::Point2d>& pts, double
 
   // A loop that is one circle (a hole, a disc) has no corner at all.
   Circle whole;
-  if (fitCircle(pts, 0, n - 1, &whole) && circleResidual(pts, 0, n - 1, whole) <= conformity &&
+  if (sums.fitCircle(0, n - 1, &whole) && withinOfCircle(pts, 0, n - 1, whole, conformity) &&
       whole.radius <= kMaxRadiusFactor * extent) {
     Primitive p;
     p.kind = PrimitiveKind::kArc;
