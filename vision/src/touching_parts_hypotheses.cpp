@@ -41,8 +41,10 @@ constexpr double kGlanceSlack = 0.1;
 // part is found from any one of its corners or arcs that shows.
 constexpr size_t kMaxModelCorners = 32;
 constexpr size_t kMaxModelArcs = 4;
-// A blob's quick search starts from this many of a model's sharpest corners
-// and its longest arc: enough to find most parts that show whole.
+// A blob's quick search starts from this many of a model's sharpest corners,
+// and from its longest arc only when it has fewer corners (a scan about an
+// arc costs as many first looks as a few dozen corners): enough to find
+// most parts that show whole.
 constexpr size_t kQuickCorners = 8;
 constexpr size_t kQuickArcs = 1;
 // The rotation scan about an arc first steps this far at the model's rim.
@@ -337,7 +339,8 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   b->quick_corners = firstOf(b->corners.size(), kQuickCorners, [&](size_t u, size_t v) {
     return std::abs(180 - b->corners[u].opening_deg) > std::abs(180 - b->corners[v].opening_deg);
   });
-  b->quick_arcs = firstOf(b->arcs.size(), kQuickArcs, [&](size_t u, size_t v) {
+  const size_t quick_arcs = b->corners.size() < kQuickCorners ? kQuickArcs : 0;
+  b->quick_arcs = firstOf(b->arcs.size(), quick_arcs, [&](size_t u, size_t v) {
     return b->arcs[u].length > b->arcs[v].length;
   });
   for (const auto& c : b->corners) b->corner_glance.push_back(farthestFirst(c.at));
