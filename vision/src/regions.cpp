@@ -164,6 +164,9 @@ struct BandReading {
   Moments10 sums;   // of the coverage: interior and band
   double tail = 0;  // mean raw coverage of the band's outermost pixels
   RowRuns band;     // read from grey levels (other regions' pixels skipped)
+  // The band's coverage, clamped to [0, 1], pixel after pixel in the order
+  // forEachCoverage visits them: the coverage image is written from it.
+  std::vector<float> band_coverage;
 
   float background(int x, int y) const {
     return static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
@@ -268,13 +271,18 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
   reading->band = near.minus(interior);
   int row = -1;
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  std::vector<float>& band_coverage = reading->band_coverage;
+  band_coverage.clear();
+  band_coverage.reserve(static_cast<size_t>(r.band.count()));
   forEachCoverage(r, pixels, r.band, [&](int y, int x, float raw) {
     if (y != row) {
       if (row >= 0) sums.addRow(row, s0, s1, s2, s3);
       row = y;
       s0 = s1 = s2 = s3 = 0;
     }
-    const double v = std::min(std::max(raw, 0.0f), 1.0f);
+    const float clamped = std::min(std::max(raw, 0.0f), 1.0f);
+    band_coverage.push_back(clamped);
+    const double v = clamped;
     const double xv = x * v;
     const double xxv = xv * x;
     s0 += v;
@@ -311,11 +319,10 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
 // px off with 2 pixels, 0.018 with 4; sigma 2.5, 0.158 with 2 and 0.028 as
 // widened). So the band starts at 2 pixels and widens while its outermost
 // pixels are still measurably covered.
-bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set,
-                 const cv::Rect& box, cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights,
-                 cv::Point* origin, RowRuns* covered) {
+bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
+                 const cv::Mat& set, const cv::Rect& box, cv::Moments* moments,
+                 cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin, RowRuns* covered) {
   const BandPixels pixels{grey_box, own, set};
-  const RowRuns own_runs = RowRuns::ofMask(own);
   Dilations dilations(own_runs);
   BandReading kept;
   int kept_reach = 0;
@@ -326,7 +333,8 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
   std::array<int, 256> histogram{};
   RowRuns interior;
   for (int reach = kMinBand; reach <= kMaxBand; ++reach) {
-    RowRuns narrower = own_runs.eroded(reach);
+    // Each reach's interior is the narrower reach's eroded by one more.
+    RowRuns narrower = interior.height() == 0 ? own_runs.eroded(reach) : interior.eroded(1);
     const int sign = interior.height() == 0 ? 1 : -1;
     (sign > 0 ? narrower : interior.minus(narrower)).forEachRun([&](int y, int a, int b) {
       const uint8_t* g = grey_box.ptr<uint8_t>(y);
@@ -351,8 +359,16 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const cv::Mat& set
     float* c = coverage.ptr<float>(y);
     std::fill(c + a, c + b, 1.0f);
   });
-  forEachCoverage(kept, pixels, kept.band, [&](int y, int x, float raw) {
-    coverage.ptr<float>(y)[x] = std::min(std::max(raw, 0.0f), 1.0f);
+  // The band's pixels in the order they were read (neighbours' skipped).
+  const float* value = kept.band_coverage.data();
+  kept.band.forEachRun([&](int y, int a, int b) {
+    const uint8_t* o = own.ptr<uint8_t>(y);
+    const uint8_t* st = set.ptr<uint8_t>(y);
+    float* c = coverage.ptr<float>(y);
+    for (int x = a; x < b; ++x) {
+      if (st[x] && !o[x]) continue;  // a neighbour's
+      c[x] = *value++;
+    }
   });
   const Moments10& s = kept.sums;
   *moments = cv::Moments(s.m00, s.m10, s.m01, s.m20, s.m11, s.m02, s.m30, s.m21, s.m12, s.m03);
@@ -437,7 +453,13 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
         fillRegion(mask, box, contours, hierarchy, i, own);
       }
       const cv::Mat inner = own(bbox - box.tl());
-      if (cv::countNonZero(inner) < options.min_area) continue;
+      // The region's pixels are all in its bounding box, so its runs over
+      // the wider box count them.
+      RowRuns own_runs;
+      if (!grey.empty()) own_runs = RowRuns::ofMask(own);
+      const double count =
+          grey.empty() ? cv::countNonZero(inner) : static_cast<double>(own_runs.count());
+      if (count < options.min_area) continue;
 
       Region& r = found[static_cast<size_t>(k)];
       r.bbox = bbox;
@@ -451,8 +473,8 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
       }
       r.holes = static_cast<int>(r.hole_boundaries.size());
 
-      if (!grey.empty() && greyMoments(grey(box), own, mask(box), box, &r.moments, &r.centroid,
-                                       &r.coverage, &r.coverage_origin, &r.covered)) {
+      if (!grey.empty() && greyMoments(grey(box), own, own_runs, mask(box), box, &r.moments,
+                                       &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
         r.area = r.moments.m00;
       } else {
         // Binary moments only where the grey levels cannot be trusted.

@@ -54,14 +54,18 @@ class RowRuns {
   cv::Mat toMask() const;
 
  private:
-  RowRuns(int width, int height) : width_(width), height_(height) { first_.push_back(0); }
-  // Appends row after row: `row` must be the next row's sorted disjoint runs.
-  void pushRow(const std::vector<Run>& row);
+  RowRuns(int width, int height) : width_(width), height_(height) {
+    first_.reserve(static_cast<size_t>(height) + 1);
+    first_.push_back(0);
+  }
+  // Closes the row whose runs were appended to runs_ (sorted, disjoint,
+  // not touching: the one form of a set, so equal sets are equal lists).
+  void endRow() { first_.push_back(static_cast<int>(runs_.size())); }
   const Run* rowBegin(int y) const { return runs_.data() + first_[static_cast<size_t>(y)]; }
   const Run* rowEnd(int y) const { return runs_.data() + first_[static_cast<size_t>(y) + 1]; }
-  // Each run widened (r > 0) or narrowed (r < 0) by |r| along the row, kept
-  // within the box; when narrowing, runs at the box's edge keep that end.
-  RowRuns horizontally(int r) const;
+  // One 3x3 step of dilated() and eroded().
+  RowRuns dilatedByOne() const;
+  RowRuns erodedByOne() const;
 
   int width_ = 0;
   int height_ = 0;
