@@ -157,3 +157,44 @@ TEST_CASE("row-run morphology on boxes one pixel wide or high") {
     }
   }
 }
+
+TEST_CASE("the runs connected to a pixel are its 8-connected component") {
+  std::mt19937 rng(31);
+  for (int trial = 0; trial < 20; ++trial) {
+    const cv::Mat mask = randomMask(rng, 60 + trial * 5, 40 + trial * 3);
+    const RowRuns runs = RowRuns::ofMask(mask);
+    cv::Mat labels;
+    cv::connectedComponents(mask, labels, 8, CV_32S);
+    std::vector<cv::Point> set;
+    cv::findNonZero(mask, set);
+    for (int k = 0; k < 5 && !set.empty(); ++k) {
+      const cv::Point seed = set[rng() % set.size()];
+      const RowRuns part = runs.connectedTo(seed);
+      INFO("trial " << trial << " seed " << seed);
+      CHECK(same(part.toMask(), labels == labels.at<int>(seed)));
+      CHECK(canonical(part));
+    }
+    // A seed on the background, or outside the box, reaches nothing.
+    cv::Point empty(-1, -1);
+    for (int y = 0; y < mask.rows && empty.x < 0; ++y) {
+      for (int x = 0; x < mask.cols && empty.x < 0; ++x) {
+        if (mask.at<uint8_t>(y, x) == 0) empty = cv::Point(x, y);
+      }
+    }
+    if (empty.x >= 0) CHECK(runs.connectedTo(empty).count() == 0);
+    CHECK(runs.connectedTo(cv::Point(0, mask.rows)).count() == 0);
+  }
+}
+
+TEST_CASE("runs touching only at a corner are one component") {
+  // Two diagonal staircases and a pixel alone: 8-connectivity joins corners.
+  cv::Mat mask(6, 8, CV_8UC1, cv::Scalar(0));
+  for (int i = 0; i < 4; ++i) mask.at<uint8_t>(i, i) = 255;
+  mask.at<uint8_t>(0, 6) = 255;
+  mask.at<uint8_t>(5, 7) = 255;
+  const RowRuns runs = RowRuns::ofMask(mask);
+  CHECK(runs.connectedTo(cv::Point(0, 0)).count() == 4);
+  CHECK(runs.connectedTo(cv::Point(3, 3)).count() == 4);
+  CHECK(runs.connectedTo(cv::Point(6, 0)).count() == 1);
+  CHECK(runs.connectedTo(cv::Point(7, 5)).count() == 1);
+}

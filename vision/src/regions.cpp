@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/common/angles.hpp"
@@ -178,26 +179,53 @@ struct BandPixels {
   const cv::Mat& grey;  // the box of the frame
   const cv::Mat& own;   // the region's pixels
   const cv::Mat& set;   // every region's pixels
+  float* raw;           // room for a row of the box
 };
 
+// raw[x - a] = the coverage of pixel x of row y read from its grey level
+// `g[x]`, not clamped, for x in [a, b). Four pixels at a time where the CPU
+// can: the same operations in the same precision on each pixel as the
+// scalar tail, so the values are the same to the bit.
+void rawCoverage(const BandReading& reading, const uint8_t* g, int y, int a, int b, float* raw) {
+  const double row_background = reading.plane[0] + reading.plane[2] * y;
+  int x = a;
+#if CV_SIMD128_64F
+  const cv::v_float64x2 v_row = cv::v_setall_f64(row_background);
+  const cv::v_float64x2 v_slope = cv::v_setall_f64(reading.plane[1]);
+  const cv::v_float32x4 v_scale = cv::v_setall_f32(reading.scale);
+  const cv::v_float32x4 v_offset = cv::v_setall_f32(reading.offset);
+  const cv::v_int32x4 v_step(0, 1, 2, 3);
+  for (; x + 4 <= b; x += 4) {
+    const cv::v_int32x4 xs = cv::v_setall_s32(x) + v_step;
+    const cv::v_float32x4 background = cv::v_cvt_f32(v_row + v_slope * cv::v_cvt_f64(xs),
+                                                     v_row + v_slope * cv::v_cvt_f64_high(xs));
+    const cv::v_float32x4 level =
+        cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(g + x)));
+    const cv::v_float32x4 ratio = reading.lit ? level / background : level - background;
+    cv::v_store(raw + (x - a), v_scale * ratio + v_offset);
+  }
+#endif
+  for (; x < b; ++x) {
+    const auto background = static_cast<float>(row_background + reading.plane[1] * x);
+    const auto level = static_cast<float>(g[x]);
+    raw[x - a] =
+        reading.scale * (reading.lit ? level / background : level - background) + reading.offset;
+  }
+}
+
 // f(y, x, raw) for every pixel of `runs` that is not another region's, raw
-// being its coverage read from its grey level, not clamped. Row pointers and
-// the background are taken once per run: this is the per-pixel work of the
-// region pass.
+// being its coverage read from its grey level, not clamped: the per-pixel
+// work of the region pass.
 template <class F>
 void forEachCoverage(const BandReading& reading, const BandPixels& pixels, const RowRuns& runs,
                      F&& f) {
   runs.forEachRun([&](int y, int a, int b) {
-    const uint8_t* g = pixels.grey.ptr<uint8_t>(y);
     const uint8_t* o = pixels.own.ptr<uint8_t>(y);
     const uint8_t* st = pixels.set.ptr<uint8_t>(y);
-    const double row_background = reading.plane[0] + reading.plane[2] * y;
+    rawCoverage(reading, pixels.grey.ptr<uint8_t>(y), y, a, b, pixels.raw);
     for (int x = a; x < b; ++x) {
       if (st[x] && !o[x]) continue;  // a neighbour's
-      const auto background = static_cast<float>(row_background + reading.plane[1] * x);
-      const auto level = static_cast<float>(g[x]);
-      f(y, x,
-        reading.scale * (reading.lit ? level / background : level - background) + reading.offset);
+      f(y, x, pixels.raw[x - a]);
     }
   });
 }
@@ -322,7 +350,8 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
                  const cv::Mat& set, const cv::Rect& box, cv::Moments* moments,
                  cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin, RowRuns* covered) {
-  const BandPixels pixels{grey_box, own, set};
+  std::vector<float> raw_row(static_cast<size_t>(box.width));
+  const BandPixels pixels{grey_box, own, set, raw_row.data()};
   Dilations dilations(own_runs);
   BandReading kept;
   int kept_reach = 0;
@@ -379,26 +408,6 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
   return true;
 }
 
-// The pixels of one region over `box`: inside its outer boundary, outside its
-// holes. Islands in a hole (other regions) and pixels of other regions the
-// fill reaches are masked off by `mask`.
-void fillRegion(const cv::Mat& mask, const cv::Rect& box,
-                const std::vector<std::vector<cv::Point>>& contours,
-                const std::vector<cv::Vec4i>& hierarchy, int outer, cv::Mat& own) {
-  own.create(box.size(), CV_8UC1);
-  own.setTo(0);
-  const cv::Point shift = -box.tl();
-  cv::fillPoly(own, std::vector<std::vector<cv::Point>>{contours[outer]}, cv::Scalar(255),
-               cv::LINE_8, 0, shift);
-  for (int h = hierarchy[outer][2]; h >= 0; h = hierarchy[h][0]) {
-    // A hole's boundary runs through the region's own pixels: clear the
-    // hole's polygon, then put its boundary pixels back.
-    cv::fillPoly(own, std::vector<std::vector<cv::Point>>{contours[h]}, cv::Scalar(0), cv::LINE_8,
-                 0, shift);
-    for (const cv::Point& p : contours[h]) own.at<uint8_t>(p + shift) = 255;
-  }
-  own &= mask(box);
-}
 }  // namespace
 
 std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& options,
@@ -414,7 +423,7 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   const cv::Rect frame(0, 0, mask.cols, mask.rows);
   std::vector<int> outers;
   // Boxes of every region, noise too: a region whose box meets no other
-  // region's box owns every set pixel of its box, and needs no fill.
+  // region's box owns every set pixel of its box, and needs no labelling.
   std::vector<cv::Rect> boxes(contours.size());
   for (int i = 0; i < static_cast<int>(contours.size()); ++i) {
     if (hierarchy[i][3] < 0) boxes[static_cast<size_t>(i)] = cv::boundingRect(contours[i]);
@@ -434,7 +443,6 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   std::vector<Region> found(outers.size());
   std::vector<char> kept(outers.size(), 0);
   cv::parallel_for_(cv::Range(0, static_cast<int>(outers.size())), [&](const cv::Range& range) {
-    cv::Mat own;
     for (int k = range.start; k < range.end; ++k) {
       const int i = outers[static_cast<size_t>(k)];
       const cv::Rect bbox = boxes[static_cast<size_t>(i)];
@@ -447,19 +455,18 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
       for (size_t j = 0; j < boxes.size() && alone; ++j) {
         alone = static_cast<int>(j) == i || hierarchy[j][3] >= 0 || (boxes[j] & box).empty();
       }
-      if (alone) {
-        mask(box).copyTo(own);
-      } else {
-        fillRegion(mask, box, contours, hierarchy, i, own);
+      // The region's pixels over the box: the set pixels 8-connected to its
+      // boundary (islands in its holes and neighbours are other regions).
+      RowRuns own_runs = RowRuns::ofMask(mask(box));
+      cv::Mat own = mask(box);
+      if (!alone) {
+        own_runs = own_runs.connectedTo(contours[i][0] - box.tl());
+        own = own_runs.toMask();
       }
       const cv::Mat inner = own(bbox - box.tl());
       // The region's pixels are all in its bounding box, so its runs over
       // the wider box count them.
-      RowRuns own_runs;
-      if (!grey.empty()) own_runs = RowRuns::ofMask(own);
-      const double count =
-          grey.empty() ? cv::countNonZero(inner) : static_cast<double>(own_runs.count());
-      if (count < options.min_area) continue;
+      if (static_cast<double>(own_runs.count()) < options.min_area) continue;
 
       Region& r = found[static_cast<size_t>(k)];
       r.bbox = bbox;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 namespace picksight::vision {
 
@@ -56,7 +57,7 @@ RowRuns RowRuns::ofMask(const cv::Mat& mask) {
       runs.runs_.emplace_back(a, b);
       a = nextChange(m, b, mask.cols, false);
     }
-    runs.endRow();
+    runs.first_.push_back(static_cast<int>(runs.runs_.size()));
   }
   return runs;
 }
@@ -79,11 +80,13 @@ RowRuns RowRuns::dilatedByOne() const {
   // A 3x3 dilation is each row joined with its two neighbours, every run
   // widened by one: a merge of three sorted lists by start column, widening
   // and joining touching runs on the way (widening keeps the order).
+  constexpr int kDone = std::numeric_limits<int>::max();
   RowRuns out(width_, height_);
-  out.runs_.reserve(runs_.size() + static_cast<size_t>(height_) * 2);
+  // A row has at most as many runs as the three it is made of.
+  Run* put = out.startRuns(3 * runs_.size());
   for (int y = 0; y < height_; ++y) {
-    const Run* at[3] = {rowBegin(y), nullptr, nullptr};
-    const Run* end[3] = {rowEnd(y), nullptr, nullptr};
+    const Run* at[3] = {rowBegin(y), rowEnd(y), rowEnd(y)};
+    const Run* end[3] = {rowEnd(y), rowEnd(y), rowEnd(y)};
     if (y > 0) {
       at[1] = rowBegin(y - 1);
       end[1] = rowEnd(y - 1);
@@ -92,30 +95,31 @@ RowRuns RowRuns::dilatedByOne() const {
       at[2] = rowBegin(y + 1);
       end[2] = rowEnd(y + 1);
     }
-    bool open = false;
+    // Each list's next start column, kDone when it is used up.
+    int start[3];
+    for (int k = 0; k < 3; ++k) start[k] = at[k] != end[k] ? at[k]->first : kDone;
     int a = 0;
-    int b = 0;
+    int b = -1;  // no run open
     for (;;) {
-      int pick = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (at[k] != end[k] && (pick < 0 || at[k]->first < at[pick]->first)) pick = k;
-      }
-      if (pick < 0) break;
-      const int ra = std::max(0, at[pick]->first - 1);
-      const int rb = std::min(width_, at[pick]->second + 1);
-      ++at[pick];
-      if (open && ra <= b) {
+      int k = start[0] <= start[1] ? 0 : 1;
+      if (start[2] < start[k]) k = 2;
+      if (start[k] == kDone) break;
+      const int ra = std::max(0, start[k] - 1);
+      const int rb = std::min(width_, at[k]->second + 1);
+      ++at[k];
+      start[k] = at[k] != end[k] ? at[k]->first : kDone;
+      if (ra <= b) {
         b = std::max(b, rb);
       } else {
-        if (open) out.runs_.emplace_back(a, b);
+        if (b >= 0) *put++ = {a, b};
         a = ra;
         b = rb;
-        open = true;
       }
     }
-    if (open) out.runs_.emplace_back(a, b);
-    out.endRow();
+    if (b >= 0) *put++ = {a, b};
+    out.endRow(put);
   }
+  out.endRuns(put);
   return out;
 }
 
@@ -134,7 +138,9 @@ RowRuns RowRuns::erodedByOne() const {
   // all keep; rows beyond the box count as set (OpenCV's default erosion
   // border), so they take nothing away.
   RowRuns out(width_, height_);
-  out.runs_.reserve(runs_.size());
+  // Each piece of the intersection ends where a run of one of the three
+  // rows ends.
+  Run* put = out.startRuns(3 * runs_.size());
   for (int y = 0; y < height_; ++y) {
     NarrowedRow rows[3] = {
         {rowBegin(y), rowEnd(y), width_}, {nullptr, nullptr, width_}, {nullptr, nullptr, width_}};
@@ -158,18 +164,20 @@ RowRuns RowRuns::erodedByOne() const {
           first_end = k;
         }
       }
-      if (lo < hi) out.runs_.emplace_back(lo, hi);
+      if (lo < hi) *put++ = {lo, hi};
       done = !rows[first_end].next(&a[first_end], &b[first_end]);
     }
-    out.endRow();
+    out.endRow(put);
   }
+  out.endRuns(put);
   return out;
 }
 
 RowRuns RowRuns::minus(const RowRuns& other) const {
   CV_Assert(other.width_ == width_ && other.height_ == height_);
   RowRuns out(width_, height_);
-  out.runs_.reserve(runs_.size() + runs_.size() / 2);
+  // Each cut splits a run in two at most.
+  Run* put = out.startRuns(runs_.size() + other.runs_.size());
   for (int y = 0; y < height_; ++y) {
     const Run* cut = other.rowBegin(y);
     const Run* cut_end = other.rowEnd(y);
@@ -178,13 +186,59 @@ RowRuns RowRuns::minus(const RowRuns& other) const {
       const int b = run->second;
       while (cut != cut_end && cut->second <= a) ++cut;
       for (const Run* c = cut; c != cut_end && c->first < b; ++c) {
-        if (c->first > a) out.runs_.emplace_back(a, c->first);
+        if (c->first > a) *put++ = {a, c->first};
         a = std::max(a, c->second);
       }
-      if (a < b) out.runs_.emplace_back(a, b);
+      if (a < b) *put++ = {a, b};
     }
-    out.endRow();
+    out.endRow(put);
   }
+  out.endRuns(put);
+  return out;
+}
+
+RowRuns RowRuns::connectedTo(cv::Point seed) const {
+  // A walk over runs, not pixels: runs of neighbouring rows are 8-connected
+  // when they overlap once each is widened by one.
+  std::vector<char> reached(runs_.size(), 0);
+  std::vector<std::pair<int, int>> pending;  // (run index, row)
+  if (seed.y >= 0 && seed.y < height_) {
+    for (int i = first_[static_cast<size_t>(seed.y)]; i < first_[static_cast<size_t>(seed.y) + 1];
+         ++i) {
+      const Run& run = runs_[static_cast<size_t>(i)];
+      if (run.first <= seed.x && seed.x < run.second) {
+        reached[static_cast<size_t>(i)] = 1;
+        pending.emplace_back(i, seed.y);
+      }
+    }
+  }
+  while (!pending.empty()) {
+    const auto [i, y] = pending.back();
+    pending.pop_back();
+    const Run run = runs_[static_cast<size_t>(i)];
+    for (const int next : {y - 1, y + 1}) {
+      if (next < 0 || next >= height_) continue;
+      for (int j = first_[static_cast<size_t>(next)]; j < first_[static_cast<size_t>(next) + 1];
+           ++j) {
+        const Run& other = runs_[static_cast<size_t>(j)];
+        if (other.first > run.second) break;
+        if (other.second >= run.first && !reached[static_cast<size_t>(j)]) {
+          reached[static_cast<size_t>(j)] = 1;
+          pending.emplace_back(j, next);
+        }
+      }
+    }
+  }
+  // Whole runs of a set in their order: the result's runs are maximal too.
+  RowRuns out(width_, height_);
+  Run* put = out.startRuns(runs_.size());
+  for (int y = 0; y < height_; ++y) {
+    for (int i = first_[static_cast<size_t>(y)]; i < first_[static_cast<size_t>(y) + 1]; ++i) {
+      if (reached[static_cast<size_t>(i)]) *put++ = runs_[static_cast<size_t>(i)];
+    }
+    out.endRow(put);
+  }
+  out.endRuns(put);
   return out;
 }
 

@@ -38,6 +38,9 @@ class RowRuns {
   RowRuns eroded(int r) const;
   // The pixels set here and not in `other` (same size).
   RowRuns minus(const RowRuns& other) const;
+  // The 8-connected part of the set that holds pixel `seed` (nothing when
+  // `seed` is not set).
+  RowRuns connectedTo(cv::Point seed) const;
 
   // f(y, begin, end) for every run, rows in order, runs left to right.
   template <class F>
@@ -58,9 +61,16 @@ class RowRuns {
     first_.reserve(static_cast<size_t>(height) + 1);
     first_.push_back(0);
   }
-  // Closes the row whose runs were appended to runs_ (sorted, disjoint,
-  // not touching: the one form of a set, so equal sets are equal lists).
-  void endRow() { first_.push_back(static_cast<int>(runs_.size())); }
+  // Writing a result: room for `most` runs, written through the pointer
+  // returned, row after row, each row's runs sorted, disjoint and not
+  // touching (the one form of a set, so equal sets are equal lists);
+  // endRow(put) closes a row, endRuns(put) the whole.
+  Run* startRuns(size_t most) {
+    runs_.resize(most);
+    return runs_.data();
+  }
+  void endRow(const Run* put) { first_.push_back(static_cast<int>(put - runs_.data())); }
+  void endRuns(const Run* put) { runs_.resize(static_cast<size_t>(put - runs_.data())); }
   const Run* rowBegin(int y) const { return runs_.data() + first_[static_cast<size_t>(y)]; }
   const Run* rowEnd(int y) const { return runs_.data() + first_[static_cast<size_t>(y) + 1]; }
   // One 3x3 step of dilated() and eroded().
