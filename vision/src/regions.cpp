@@ -182,47 +182,74 @@ struct BandPixels {
   float* raw;           // room for a row of the box
 };
 
-// raw[x - a] = the coverage of pixel x of row y read from its grey level
-// `g[x]`, not clamped, for x in [a, b). Four pixels at a time where the CPU
-// can: the same operations in the same precision on each pixel as the
-// scalar tail, so the values are the same to the bit.
-void rawCoverage(const BandReading& reading, const uint8_t* g, int y, int a, int b, float* raw) {
-  const double row_background = reading.plane[0] + reading.plane[2] * y;
-  int x = a;
+// Coverage read from grey levels, not clamped, a run of a row at a time:
+// four pixels at a time where the CPU can, with the same operations in the
+// same precision on each pixel as the scalar tail, so the values are the
+// same to the bit.
+class RawCoverage {
+ public:
+  explicit RawCoverage(const BandReading& reading)
+      : reading_(reading)
 #if CV_SIMD128_64F
-  const cv::v_float64x2 v_row = cv::v_setall_f64(row_background);
-  const cv::v_float64x2 v_slope = cv::v_setall_f64(reading.plane[1]);
-  const cv::v_float32x4 v_scale = cv::v_setall_f32(reading.scale);
-  const cv::v_float32x4 v_offset = cv::v_setall_f32(reading.offset);
-  const cv::v_int32x4 v_step(0, 1, 2, 3);
-  for (; x + 4 <= b; x += 4) {
-    const cv::v_int32x4 xs = cv::v_setall_s32(x) + v_step;
-    const cv::v_float32x4 background = cv::v_cvt_f32(v_row + v_slope * cv::v_cvt_f64(xs),
-                                                     v_row + v_slope * cv::v_cvt_f64_high(xs));
-    const cv::v_float32x4 level =
-        cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(g + x)));
-    const cv::v_float32x4 ratio = reading.lit ? level / background : level - background;
-    cv::v_store(raw + (x - a), v_scale * ratio + v_offset);
-  }
+        ,
+        slope_(cv::v_setall_f64(reading.plane[1])),
+        scale_(cv::v_setall_f32(reading.scale)),
+        offset_(cv::v_setall_f32(reading.offset))
 #endif
-  for (; x < b; ++x) {
-    const auto background = static_cast<float>(row_background + reading.plane[1] * x);
-    const auto level = static_cast<float>(g[x]);
-    raw[x - a] =
-        reading.scale * (reading.lit ? level / background : level - background) + reading.offset;
+  {
   }
-}
+
+  // raw[x - a] for pixel x of row y, x in [a, b); `g` is the row's grey levels.
+  void run(const uint8_t* g, int y, int a, int b, float* raw) const {
+    const BandReading& r = reading_;
+    const double row_background = r.plane[0] + r.plane[2] * y;
+    int x = a;
+#if CV_SIMD128_64F
+    const cv::v_float64x2 row = cv::v_setall_f64(row_background);
+    const cv::v_int32x4 step(0, 1, 2, 3);
+    for (; x + 4 <= b; x += 4) {
+      const cv::v_int32x4 xs = cv::v_setall_s32(x) + step;
+      const cv::v_float32x4 background =
+          cv::v_cvt_f32(row + slope_ * cv::v_cvt_f64(xs), row + slope_ * cv::v_cvt_f64_high(xs));
+      const cv::v_float32x4 level =
+          cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(g + x)));
+      const cv::v_float32x4 ratio = r.lit ? level / background : level - background;
+      cv::v_store(raw + (x - a), scale_ * ratio + offset_);
+    }
+#endif
+    for (; x < b; ++x) {
+      const auto background = static_cast<float>(row_background + r.plane[1] * x);
+      const auto level = static_cast<float>(g[x]);
+      raw[x - a] = r.scale * (r.lit ? level / background : level - background) + r.offset;
+    }
+  }
+
+ private:
+  const BandReading& reading_;
+#if CV_SIMD128_64F
+  cv::v_float64x2 slope_;
+  cv::v_float32x4 scale_;
+  cv::v_float32x4 offset_;
+#endif
+};
 
 // f(y, x, raw) for every pixel of `runs` that is not another region's, raw
 // being its coverage read from its grey level, not clamped: the per-pixel
-// work of the region pass.
+// work of the region pass. A region alone in its box (its mask is the
+// frame's) has no neighbour's pixel to skip.
 template <class F>
 void forEachCoverage(const BandReading& reading, const BandPixels& pixels, const RowRuns& runs,
                      F&& f) {
+  const RawCoverage coverage(reading);
+  const bool shared = pixels.own.data != pixels.set.data;
   runs.forEachRun([&](int y, int a, int b) {
+    coverage.run(pixels.grey.ptr<uint8_t>(y), y, a, b, pixels.raw);
+    if (!shared) {
+      for (int x = a; x < b; ++x) f(y, x, pixels.raw[x - a]);
+      return;
+    }
     const uint8_t* o = pixels.own.ptr<uint8_t>(y);
     const uint8_t* st = pixels.set.ptr<uint8_t>(y);
-    rawCoverage(reading, pixels.grey.ptr<uint8_t>(y), y, a, b, pixels.raw);
     for (int x = a; x < b; ++x) {
       if (st[x] && !o[x]) continue;  // a neighbour's
       f(y, x, pixels.raw[x - a]);
@@ -382,8 +409,26 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
   }
   if (kept_reach == 0) return false;
 
-  // The coverage of the band width kept: 1 in the interior, read in the band.
-  cv::Mat coverage(box.size(), CV_32F, cv::Scalar(0));
+  // The coverage of the band width kept: 1 in the interior, read in the band,
+  // 0 elsewhere; the interior and the band make up the covered runs, so
+  // every pixel is written once.
+  const RowRuns& covered_runs = dilations.byRadius(kept_reach);
+  cv::Mat coverage(box.size(), CV_32F);
+  int zero_row = 0;  // pixels before (zero_x, zero_row) in raster order are written
+  int zero_x = 0;
+  const auto zeroUpTo = [&](int y, int x) {
+    for (; zero_row < y; ++zero_row, zero_x = 0) {
+      float* c = coverage.ptr<float>(zero_row);
+      std::fill(c + zero_x, c + coverage.cols, 0.0f);
+    }
+    float* c = coverage.ptr<float>(y);
+    std::fill(c + zero_x, c + x, 0.0f);
+  };
+  covered_runs.forEachRun([&](int y, int a, int b) {
+    zeroUpTo(y, a);
+    zero_x = b;
+  });
+  if (coverage.rows > 0) zeroUpTo(coverage.rows - 1, coverage.cols);
   kept_interior.forEachRun([&](int y, int a, int b) {
     float* c = coverage.ptr<float>(y);
     std::fill(c + a, c + b, 1.0f);
@@ -394,17 +439,14 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
     const uint8_t* o = own.ptr<uint8_t>(y);
     const uint8_t* st = set.ptr<uint8_t>(y);
     float* c = coverage.ptr<float>(y);
-    for (int x = a; x < b; ++x) {
-      if (st[x] && !o[x]) continue;  // a neighbour's
-      c[x] = *value++;
-    }
+    for (int x = a; x < b; ++x) c[x] = st[x] && !o[x] ? 0.0f : *value++;
   });
   const Moments10& s = kept.sums;
   *moments = cv::Moments(s.m00, s.m10, s.m01, s.m20, s.m11, s.m02, s.m30, s.m21, s.m12, s.m03);
   *centroid = cv::Point2d(box.x + s.m10 / s.m00, box.y + s.m01 / s.m00);
   *weights = coverage;
   *origin = box.tl();
-  *covered = dilations.byRadius(kept_reach);
+  *covered = covered_runs;
   return true;
 }
 
