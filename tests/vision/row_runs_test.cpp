@@ -198,3 +198,21 @@ TEST_CASE("runs touching only at a corner are one component") {
   CHECK(runs.connectedTo(cv::Point(6, 0)).count() == 1);
   CHECK(runs.connectedTo(cv::Point(7, 5)).count() == 1);
 }
+
+TEST_CASE("row runs take any non-zero level for set") {
+  // Levels 1 and 128 as well as 255, with runs starting and ending at every
+  // place within eight pixels.
+  std::mt19937 rng(37);
+  const uint8_t levels[] = {0, 1, 128, 255};
+  for (int trial = 0; trial < 20; ++trial) {
+    cv::Mat mask(9, 5 + trial * 3, CV_8UC1);
+    for (int y = 0; y < mask.rows; ++y) {
+      for (int x = 0; x < mask.cols; ++x) {
+        mask.at<uint8_t>(y, x) = rng() % 3 == 0 ? levels[rng() % 4] : levels[(y + x / 5) % 2 * 3];
+      }
+    }
+    INFO("trial " << trial);
+    CHECK(same(RowRuns::ofMask(mask).toMask(), mask != 0));
+    CHECK(RowRuns::ofMask(mask).count() == cv::countNonZero(mask));
+  }
+}

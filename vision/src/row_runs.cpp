@@ -10,15 +10,25 @@ namespace picksight::vision {
 
 namespace {
 // The first pixel of `row` at or after x whose "is set" differs from `set`
-// (w when none). Eight pixels are skipped at a time while all of them are
-// on the same side: a part's box is mostly long stretches of one or the
-// other.
+// (w when none). Eight pixels are read at a time: a part's box is mostly
+// long stretches of one or the other, and where a word holds a change, its
+// first changed byte is found from the word's bits.
 int nextChange(const uint8_t* row, int x, int w, bool set) {
-  const uint64_t same = set ? ~uint64_t{0} : 0;
+  constexpr uint64_t kLow = 0x0101010101010101ULL;
+  constexpr uint64_t kHigh = 0x8080808080808080ULL;
   for (; x + 8 <= w; x += 8) {
     uint64_t eight = 0;
     std::memcpy(&eight, row + x, sizeof eight);
-    if (eight != same) break;
+    // A bit at the top of each byte that differs; for zero bytes the
+    // lowest flag is exact (a borrow only flags bytes above a zero one).
+    const uint64_t changed = set ? (eight - kLow) & ~eight & kHigh : eight;
+    if (changed != 0) {
+#if defined(__GNUC__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+      return x + (__builtin_ctzll(changed) >> 3);
+#else
+      break;
+#endif
+    }
   }
   for (; x < w && (row[x] != 0) == set; ++x) {
   }
