@@ -397,15 +397,30 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
   // narrowed with the interior: a wider band's interior is the narrower
   // one's less a shell.
   std::array<int, 256> histogram{};
+  // Four counts per level while counting, summed after: a part's interior
+  // is mostly one level, and one count bumped pixel after pixel waits for
+  // its own last store every time.
+  std::array<std::array<int, 256>, 4> partial{};
   RowRuns interior;
   for (int reach = kMinBand; reach <= kMaxBand; ++reach) {
     // Each reach's interior is the narrower reach's eroded by one more.
     RowRuns narrower = interior.height() == 0 ? own_runs.eroded(reach) : interior.eroded(1);
     const int sign = interior.height() == 0 ? 1 : -1;
+    for (auto& counts : partial) counts.fill(0);
     (sign > 0 ? narrower : interior.minus(narrower)).forEachRun([&](int y, int a, int b) {
       const uint8_t* g = grey_box.ptr<uint8_t>(y);
-      for (int x = a; x < b; ++x) histogram[g[x]] += sign;
+      int x = a;
+      for (; x + 4 <= b; x += 4) {
+        ++partial[0][g[x]];
+        ++partial[1][g[x + 1]];
+        ++partial[2][g[x + 2]];
+        ++partial[3][g[x + 3]];
+      }
+      for (; x < b; ++x) ++partial[0][g[x]];
     });
+    for (size_t v = 0; v < histogram.size(); ++v) {
+      histogram[v] += sign * (partial[0][v] + partial[1][v] + partial[2][v] + partial[3][v]);
+    }
     interior = std::move(narrower);
     // A wider band that cannot be read (its ring reaches a neighbour or the
     // frame's edge) leaves the narrower one's reading.
@@ -441,10 +456,16 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
       [&](int y, int a, int b) { fillRow(coverage.ptr<float>(y), a, b, 1.0f); });
   // The band's pixels in the order they were read (neighbours' skipped).
   const float* value = kept.band_coverage.data();
+  const bool shared = own.data != set.data;  // as in forEachCoverage
   kept.band.forEachRun([&](int y, int a, int b) {
+    float* c = coverage.ptr<float>(y);
+    if (!shared) {
+      std::copy(value, value + (b - a), c + a);
+      value += b - a;
+      return;
+    }
     const uint8_t* o = own.ptr<uint8_t>(y);
     const uint8_t* st = set.ptr<uint8_t>(y);
-    float* c = coverage.ptr<float>(y);
     for (int x = a; x < b; ++x) c[x] = st[x] && !o[x] ? 0.0f : *value++;
   });
   const Moments10& s = kept.sums;
