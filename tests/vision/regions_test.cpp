@@ -347,3 +347,92 @@ TEST_CASE("a defocused part is placed as well as a sharp one", "[vision][regions
     CHECK(worst < 0.02);
   }
 }
+
+namespace {
+// Every field of two regions, to the bit.
+void checkSame(const Region& a, const Region& b) {
+  CHECK(a.area == b.area);
+  CHECK(a.centroid == b.centroid);
+  CHECK(a.angle_deg == b.angle_deg);
+  CHECK(a.elongation == b.elongation);
+  CHECK(a.holes == b.holes);
+  CHECK(a.bbox == b.bbox);
+  CHECK(a.touches_border == b.touches_border);
+  CHECK(a.moments.m00 == b.moments.m00);
+  CHECK(a.moments.m10 == b.moments.m10);
+  CHECK(a.moments.m01 == b.moments.m01);
+  CHECK(a.moments.mu20 == b.moments.mu20);
+  CHECK(a.moments.mu11 == b.moments.mu11);
+  CHECK(a.moments.mu02 == b.moments.mu02);
+  CHECK(a.moments.mu30 == b.moments.mu30);
+  CHECK(a.moments.mu03 == b.moments.mu03);
+  CHECK(a.outer == b.outer);
+  CHECK(a.hole_boundaries == b.hole_boundaries);
+  CHECK(a.coverage_origin == b.coverage_origin);
+  REQUIRE(a.coverage.size() == b.coverage.size());
+  CHECK(cv::norm(a.coverage, b.coverage, cv::NORM_INF) == 0);
+  CHECK(cv::countNonZero(a.covered.toMask() != b.covered.toMask()) == 0);
+}
+}  // namespace
+
+TEST_CASE("a one-pixel speck in a part's box changes nothing of the part", "[vision][regions]") {
+  // A speck inside the box a part's grey levels are read over, beyond the
+  // band and the background ring, makes the part share its box: its pixels
+  // are then told from the speck's by connectivity, with the same result.
+  // A part with a hole, sharp and blurred.
+  for (const double blur : {0.0, 1.5}) {
+    cv::Mat mask(240, 260, CV_8UC1, cv::Scalar(0));
+    cv::circle(mask, {120, 120}, 60, cv::Scalar(255), cv::FILLED);
+    cv::circle(mask, {120, 120}, 25, cv::Scalar(0), cv::FILLED);
+    cv::Mat grey;
+    mask.convertTo(grey, CV_8U, -170.0 / 255.0, 220.0);
+    if (blur > 0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), blur);
+    const cv::Mat cut = grey < 135;
+    cv::Mat specked = cut.clone();
+    cv::Mat specked_grey = grey.clone();
+    // The disc's box is (60, 60) to (180, 180); its corner is 17 px from
+    // the disc's edge, well beyond the band and the ring.
+    specked.at<uint8_t>(55, 55) = 255;
+    specked_grey.at<uint8_t>(55, 55) = 50;
+    for (const bool use_grey : {false, true}) {
+      INFO("blur " << blur << " grey " << use_grey);
+      const auto alone = findRegions(cut, {}, use_grey ? grey : cv::Mat());
+      const auto shared = findRegions(specked, {}, use_grey ? specked_grey : cv::Mat());
+      REQUIRE(alone.size() == 1);  // the speck is noise
+      REQUIRE(shared.size() == 1);
+      checkSame(alone[0], shared[0]);
+      CHECK(alone[0].holes == 1);
+    }
+  }
+}
+
+TEST_CASE("a part cut by the frame's edge is measured inside the frame", "[vision][regions]") {
+  // Kept on request, its box clipped by the frame, the band and the ring
+  // meet the edge: the coverage stays a fraction, zero outside the covered
+  // runs, and the area the part's share of the frame.
+  Drawn d = drawShape({{0, 0}, {120, 0}, {120, 30}, {30, 30}, {30, 70}, {0, 70}}, 30, false,
+                      {30.4, 200.2});
+  cv::GaussianBlur(d.grey, d.grey, cv::Size(0, 0), 1.0);
+  const cv::Mat mask = d.grey < 135;
+  picksight::vision::RegionOptions keep;
+  keep.keep_border_regions = true;
+  const auto regions = findRegions(mask, keep, d.grey);
+  REQUIRE(regions.size() == 1);
+  const Region& r = regions[0];
+  CHECK(r.touches_border);
+  CHECK(r.bbox.x == 0);
+  CHECK(r.coverage_origin.x == 0);
+  REQUIRE(r.covered.width() == r.coverage.cols);
+  REQUIRE(r.covered.height() == r.coverage.rows);
+  double least = 0, most = 0;
+  cv::minMaxLoc(r.coverage, &least, &most);
+  CHECK(least >= 0.0);
+  CHECK(most == 1.0);
+  cv::Mat outside;
+  cv::bitwise_not(r.covered.toMask(), outside);
+  CHECK(cv::countNonZero((r.coverage != 0) & outside) == 0);
+  // The drawn part's pixels inside the frame, from its grey levels.
+  cv::Mat part;
+  d.grey.convertTo(part, CV_32F, -1.0 / 170.0, 220.0 / 170.0);
+  CHECK(r.area == Approx(cv::sum(part)[0]).epsilon(0.01));
+}

@@ -38,6 +38,9 @@ class RowRuns {
   RowRuns eroded(int r) const;
   // The pixels set here and not in `other` (same size).
   RowRuns minus(const RowRuns& other) const;
+  // The 8-connected part of the set that holds pixel `seed` (nothing when
+  // `seed` is not set).
+  RowRuns connectedTo(cv::Point seed) const;
 
   // f(y, begin, end) for every run, rows in order, runs left to right.
   template <class F>
@@ -54,14 +57,25 @@ class RowRuns {
   cv::Mat toMask() const;
 
  private:
-  RowRuns(int width, int height) : width_(width), height_(height) { first_.push_back(0); }
-  // Appends row after row: `row` must be the next row's sorted disjoint runs.
-  void pushRow(const std::vector<Run>& row);
+  RowRuns(int width, int height) : width_(width), height_(height) {
+    first_.reserve(static_cast<size_t>(height) + 1);
+    first_.push_back(0);
+  }
+  // Writing a result: room for `most` runs, written through the pointer
+  // returned, row after row, each row's runs sorted, disjoint and not
+  // touching (the one form of a set, so equal sets are equal lists);
+  // endRow(put) closes a row, endRuns(put) the whole.
+  Run* startRuns(size_t most) {
+    runs_.resize(most);
+    return runs_.data();
+  }
+  void endRow(const Run* put) { first_.push_back(static_cast<int>(put - runs_.data())); }
+  void endRuns(const Run* put) { runs_.resize(static_cast<size_t>(put - runs_.data())); }
   const Run* rowBegin(int y) const { return runs_.data() + first_[static_cast<size_t>(y)]; }
   const Run* rowEnd(int y) const { return runs_.data() + first_[static_cast<size_t>(y) + 1]; }
-  // Each run widened (r > 0) or narrowed (r < 0) by |r| along the row, kept
-  // within the box; when narrowing, runs at the box's edge keep that end.
-  RowRuns horizontally(int r) const;
+  // One 3x3 step of dilated() and eroded().
+  RowRuns dilatedByOne() const;
+  RowRuns erodedByOne() const;
 
   int width_ = 0;
   int height_ = 0;
