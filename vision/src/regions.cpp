@@ -221,8 +221,10 @@ class RawCoverage {
       const cv::v_int32x4 xs = cv::v_setall_s32(x) + step;
       const cv::v_float32x4 background =
           cv::v_cvt_f32(row + slope_ * cv::v_cvt_f64(xs), row + slope_ * cv::v_cvt_f64_high(xs));
+      // Four bytes as four ints, read one by one: a row's run starts at any
+      // byte, and a four-byte load from there is misaligned.
       const cv::v_float32x4 level =
-          cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(g + x)));
+          cv::v_cvt_f32(cv::v_int32x4(g[x], g[x + 1], g[x + 2], g[x + 3]));
       const cv::v_float32x4 ratio = r.lit ? level / background : level - background;
       cv::v_store(raw + (x - a), scale_ * ratio + offset_);
     }
