@@ -190,6 +190,10 @@ struct BandPixels {
   const cv::Mat& own;   // the region's pixels
   const cv::Mat& set;   // every region's pixels
   float* raw;           // room for a row of the box
+
+  // Whether other regions' pixels lie in the box (a region alone in its
+  // box is read from the frame's mask itself, so `own` is `set`).
+  bool shared() const { return own.data != set.data; }
 };
 
 // Coverage read from grey levels, not clamped, a run of a row at a time:
@@ -253,7 +257,7 @@ template <class F>
 void forEachCoverage(const BandReading& reading, const BandPixels& pixels, const RowRuns& runs,
                      F&& f) {
   const RawCoverage coverage(reading);
-  const bool shared = pixels.own.data != pixels.set.data;
+  const bool shared = pixels.shared();
   runs.forEachRun([&](int y, int a, int b) {
     coverage.run(pixels.grey.ptr<uint8_t>(y), y, a, b, pixels.raw);
     if (!shared) {
@@ -458,7 +462,7 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
       [&](int y, int a, int b) { fillRow(coverage.ptr<float>(y), a, b, 1.0f); });
   // The band's pixels in the order they were read (neighbours' skipped).
   const float* value = kept.band_coverage.data();
-  const bool shared = own.data != set.data;  // as in forEachCoverage
+  const bool shared = pixels.shared();
   kept.band.forEachRun([&](int y, int a, int b) {
     float* c = coverage.ptr<float>(y);
     if (!shared) {

@@ -78,12 +78,16 @@ long long RowRuns::count() const {
   return n;
 }
 
-RowRuns RowRuns::dilated(int r) const {
+RowRuns RowRuns::repeated(int r, RowRuns (RowRuns::*step)() const) const {
   if (r <= 0) return *this;
-  // A (2r+1)-square is r 3x3 squares one after another.
-  RowRuns out = dilatedByOne();
-  for (int step = 1; step < r; ++step) out = out.dilatedByOne();
+  RowRuns out = (this->*step)();
+  for (int k = 1; k < r; ++k) out = (out.*step)();
   return out;
+}
+
+RowRuns RowRuns::dilated(int r) const {
+  // A (2r+1)-square is r 3x3 squares one after another.
+  return repeated(r, &RowRuns::dilatedByOne);
 }
 
 RowRuns RowRuns::dilatedByOne() const {
@@ -134,13 +138,10 @@ RowRuns RowRuns::dilatedByOne() const {
 }
 
 RowRuns RowRuns::eroded(int r) const {
-  if (r <= 0) return *this;
   // A (2r+1)-square is r 3x3 squares one after another, and that holds
   // with OpenCV's border too: a pixel beyond the box's edge is never less
   // set than the nearest one inside after a step.
-  RowRuns out = erodedByOne();
-  for (int step = 1; step < r; ++step) out = out.erodedByOne();
-  return out;
+  return repeated(r, &RowRuns::erodedByOne);
 }
 
 RowRuns RowRuns::erodedByOne() const {

@@ -76,6 +76,8 @@ class RowRuns {
   // One 3x3 step of dilated() and eroded().
   RowRuns dilatedByOne() const;
   RowRuns erodedByOne() const;
+  // `step` applied r times (a copy for r <= 0).
+  RowRuns repeated(int r, RowRuns (RowRuns::*step)() const) const;
 
   int width_ = 0;
   int height_ = 0;
