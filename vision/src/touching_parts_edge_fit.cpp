@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "picksight/common/angles.hpp"
@@ -111,7 +112,8 @@ std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point
     return value[k];
   };
   // The interval (k - 1, k) nearest to `expected` first, then outward on
-  // both sides by the distance of their near ends.
+  // both sides by the distance of their near ends (each side's next one
+  // worked out once, when its turn comes).
   const int intervals = readings - 1;
   const double from = (expected + window) / step;  // `expected` in readings
   int below = std::clamp(static_cast<int>(std::floor(from)) + 1, 1, intervals);
@@ -121,28 +123,38 @@ std::optional<double> edgeCrossing(const Coverage& cov, cv::Point2d p, cv::Point
     const double hi = lo + step;
     return expected < lo ? lo - expected : expected > hi ? expected - hi : 0.0;
   };
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  double below_near = nearEnd(below);
+  double above_near = above <= intervals ? nearEnd(above) : kNone;
   std::optional<double> best;
+  double best_d = kNone;  // |*best - expected|
   int best_k = 0;
-  while (below >= 1 || above <= intervals) {
+  while (below_near != kNone || above_near != kNone) {
     int k;
-    if (above > intervals || (below >= 1 && nearEnd(below) <= nearEnd(above))) {
-      k = below--;
+    double near;
+    if (below_near <= above_near) {
+      k = below;
+      near = below_near;
+      below_near = --below >= 1 ? nearEnd(below) : kNone;
     } else {
-      k = above++;
+      k = above;
+      near = above_near;
+      above_near = ++above <= intervals ? nearEnd(above) : kNone;
     }
     // The intervals come nearest first: none left can do better.
-    if (best && nearEnd(k) > std::abs(*best - expected)) break;
+    if (near > best_d) break;
     const double previous = reading(k - 1);
+    if (!(previous >= 0.5)) continue;
     const double v = reading(k);
-    if (!(previous >= 0.5 && v < 0.5)) continue;
+    if (!(v < 0.5)) continue;
     const double s = -window + k * step;
     const double at = s - step + step * (previous - 0.5) / (previous - v);
     const double d = std::abs(at - expected);
     // Equally near: the lower one, as a scan from -window would keep.
-    if (best && (d > std::abs(*best - expected) || (d == std::abs(*best - expected) && k > best_k)))
-      continue;
+    if (d > best_d || (d == best_d && k > best_k)) continue;
     if (cov.at(p + n * (at - 1.5)) >= 0.7 && cov.at(p + n * (at + 1.5)) <= 0.3) {
       best = at;
+      best_d = d;
       best_k = k;
     }
   }
