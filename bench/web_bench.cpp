@@ -5,13 +5,17 @@
 //      camera (each an MJPEG stream and the page's /events stream of
 //      results), after a warm-up of both, in rounds that alternate which goes
 //      first so machine noise hits both (goal: p99 with viewers <= 1.1x
-//      without);
+//      without); beside them, with no viewer but one thread of arithmetic
+//      at the web server's idle priority: what any work sharing the cores
+//      with the cell costs on this machine;
 //   2. camera-to-client latency at the camera's size: from the frame's host
 //      timestamp to a client's receipt and turbojpeg decode of the JPEG
 //      (goal: median <= 100 ms at 1920x1080, 30 fps);
 //   3. the JPEG encoding's CPU per camera (the server's own counter) and the
 //      web server's CPU per extra viewer (getrusage of the process, /proc).
 // Prints figures, never fails on them.
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <time.h>
@@ -154,6 +158,36 @@ class Viewer {
 // One page's event stream (/events) on its own thread, as every browser
 // keeps open beside its MJPEG stream: counts the results received, at the
 // viewers' low priority.
+// One thread of pure arithmetic at SCHED_IDLE, the priority the web
+// server's encoders and converters run at: it only ever gets a core the
+// cell leaves free. The LOCATE figures beside it are the floor that any
+// work at all sharing the machine with the cell costs here (two virtual
+// cores), against which the viewers' cost is read.
+class IdleBusyThread {
+ public:
+  IdleBusyThread()
+      : thread_([this] {
+          sched_param param{};
+          pthread_setschedparam(pthread_self(), SCHED_IDLE, &param);
+          double x = 1.0;
+          while (!stop_) {
+            for (int i = 0; i < 100000; ++i) x = x * 1.0000001 + 1e-9;
+          }
+          sink_ = x;
+        }) {}
+  ~IdleBusyThread() {
+    stop_ = true;
+    thread_.join();
+  }
+  IdleBusyThread(const IdleBusyThread&) = delete;
+  IdleBusyThread& operator=(const IdleBusyThread&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  double sink_ = 0;
+  std::thread thread_;
+};
+
 class EventsClient {
  public:
   explicit EventsClient(int port) : client_("127.0.0.1", port), thread_([this] { run(); }) {}
@@ -329,6 +363,7 @@ int main(int argc, char** argv) {
   settle();
   std::vector<double> alone;
   std::vector<double> watched;
+  std::vector<double> busy;
   int viewer_frames = 0;
   int event_results = 0;
   double watched_s = 0;
@@ -358,6 +393,10 @@ int main(int argc, char** argv) {
       watchedPhase();
       settle();
     }
+    // No viewer, one idle-priority busy thread: half a round, between the
+    // two conditions of the next.
+    const IdleBusyThread busy_thread;
+    for (int i = 0; i < per_round / 2; ++i) locate(busy);
   }
   const double a50 = nearestRank(alone, 50), a99 = nearestRank(alone, 99);
   const double w50 = nearestRank(watched, 50), w99 = nearestRank(watched, 99);
@@ -368,6 +407,10 @@ int main(int argc, char** argv) {
   std::printf("  %-52s %8.2f %8.2f\n", "4 browsers on each camera (8 MJPEG + 8 /events)", w50, w99);
   std::printf("  %-52s %7.2fx %7.2fx   (goal p99 <= 1.10x)\n", "ratio (viewers / none)",
               a50 > 0 ? w50 / a50 : 0.0, a99 > 0 ? w99 / a99 : 0.0);
+  const double b50 = nearestRank(busy, 50), b99 = nearestRank(busy, 99);
+  std::printf("  %-52s %8.2f %8.2f\n", "no viewer, one SCHED_IDLE arithmetic thread", b50, b99);
+  std::printf("  %-52s %7.2fx %7.2fx   (the machine's floor for any work beside the cell)\n",
+              "ratio (busy thread / none)", a50 > 0 ? b50 / a50 : 0.0, a99 > 0 ? b99 / a99 : 0.0);
   std::printf(
       "  (the viewers received %.1f frames/s in all during the watched rounds, and %d results "
       "as events)\n",
