@@ -348,6 +348,11 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     std::vector<ImagePose> direct_poses;
     for (const bool mirrored : {false, true}) {
       if (mirrored && m->body.mirror_symmetric) continue;
+      // The quick search looks for the model's own hand only: whether a part
+      // it finds shows mirrored is asked of the part's aligned mirror image
+      // when it is about to be taken (alignedMirror), which mirror images
+      // found here only duplicated.
+      if (mirrored && quick) continue;
       // The mirror image is looked for only where the model itself may lie:
       // it is there to tell a part from its mirror image (a part shown
       // mirrored is never reported), and the corners and arcs elsewhere in
