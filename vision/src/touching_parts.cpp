@@ -27,10 +27,6 @@ using picksight::angleDiffDeg;
 using picksight::wrapDeg;
 
 constexpr int kMaxRefinedPerModel = 8;
-// The mirror image of a model is searched for among the blob's corners and
-// arcs this far beyond the model's reach from where the model itself may
-// lie (pixels).
-constexpr double kMirrorSearchMarginPx = 10;
 // Poses refined per blob, for each part the blob can hold: the best
 // screened hypotheses of all models, so that a blob costs about the same
 // whatever the number of trained types.
@@ -54,11 +50,8 @@ constexpr double kConvergedPx = 0.5;
 constexpr double kConvergedDeg = 0.5;
 // The mirror image placed on a part is refined on the edges when it
 // verifies within this of the margin before (a hypothesis a few pixels and
-// degrees off loses that much at the rim, kCoarseSlack), and when no mirror
-// image the search refined lies within the edge fit's reach of it.
+// degrees off loses that much at the rim, kCoarseSlack).
 constexpr double kMirrorScreenSlack = 0.25;
-constexpr double kKnownMirrorPx = 4.0;
-constexpr double kKnownMirrorDeg = 5.0;
 // Parts that touch share at most their contact pixels; a part lying on
 // another, up to a quarter of its outline hidden, shares up to a third of
 // its area with it (0.31 at most of 193 parts taken in 12 overlapping
@@ -126,15 +119,16 @@ bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double
 // The mirror image of a chiral model placed where it best covers the part
 // at `direct`: turned by one of the angles where its complex moment lines
 // up with the model's (2 phase / k + j 360 / k, as in training), the best
-// verified of them refined on the grey-level edges. The hypothesis search
-// finds the mirror image only from the corners and arcs it happens to
-// screen; the hand of every part reported is decided against this one.
-// Like any hypothesis it is refined only when it screens at `screen`
-// (a fraction verified), and not when one of `searched` (refined mirror
-// images) already lies there: nullopt then.
+// verified of them refined on the grey-level edges. The hand of every part
+// reported is decided against this one: the hypothesis search looks for
+// each model's own hand only (searching the mirror image from the blob's
+// corners and arcs as well cost a tenth of the search and changed no
+// decision on the benchmark's type sets). Like any hypothesis it is refined
+// only when it screens at `screen` (a fraction verified): nullopt
+// otherwise.
 std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
                                        const ImagePose& direct, const EdgeDistance& edges,
-                                       double screen, const std::deque<Candidate>& searched) {
+                                       double screen) {
   const int k = m.orientation_order;
   if (k <= 0 || m.body.mirror_symmetric) return std::nullopt;
   Candidate best;
@@ -147,10 +141,6 @@ std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
     if (score > best.score) best = {&m, {direct.centre, angle, true}, score, 0, 0};
   }
   if (best.score < screen) return std::nullopt;
-  const bool known = std::any_of(searched.begin(), searched.end(), [&](const Candidate& q) {
-    return q.model == &m && samePose(m, q.pose, best.pose, kKnownMirrorPx, kKnownMirrorDeg);
-  });
-  if (known) return std::nullopt;
   const EdgeFit fit = refinePoseOnEdges(m, region, best.pose);
   if (!fit.ok) return best;
   const double score =
@@ -329,68 +319,32 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   const auto budget =
       static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
 
-  // Refined poses (deques: the placed ones point into them), and those that
+  // Refined poses (a deque: the placed ones point into it), and those that
   // fit the blob on their own, each drawn on its box of the canvas.
   std::deque<Candidate> direct;
-  std::deque<Candidate> mirror;
   std::vector<Placed> placed;
   size_t refinements = 0;
   // Whether a choice made now could differ from the last one.
   bool changed = false;
 
-  // The best screened poses of one model, each hand, best first.
+  // The best screened poses of one model (its own hand: see
+  // alignedMirror), best first, no two alike.
   // The blob's anchors the search starts from (all, or those near what the
   // parts found leave unexplained).
   const std::vector<CornerAnchor>* corners = &image_corners;
   const std::vector<ArcAnchor>* arcs = &image_arcs;
   const auto screen = [&](const PartModel* m, bool quick) {
-    std::vector<Candidate> screened;
-    std::vector<ImagePose> direct_poses;
-    for (const bool mirrored : {false, true}) {
-      if (mirrored && m->body.mirror_symmetric) continue;
-      // The quick search looks for the model's own hand only: whether a part
-      // it finds shows mirrored is asked of the part's aligned mirror image
-      // when it is about to be taken (alignedMirror), which mirror images
-      // found here only duplicated.
-      if (mirrored && quick) continue;
-      // The mirror image is looked for only where the model itself may lie:
-      // it is there to tell a part from its mirror image (a part shown
-      // mirrored is never reported), and the corners and arcs elsewhere in
-      // the blob cannot place it there.
-      if (mirrored && direct_poses.empty()) continue;
-      const double near_reach = m->radius + kMirrorSearchMarginPx;
-      const auto nearDirect = [&](cv::Point2d p) {
-        return std::any_of(direct_poses.begin(), direct_poses.end(), [&](const ImagePose& q) {
-          return std::hypot(p.x - q.centre.x, p.y - q.centre.y) <= near_reach;
-        });
-      };
-      std::vector<CornerAnchor> mirror_corners;
-      std::vector<ArcAnchor> mirror_arcs;
-      if (mirrored) {
-        for (const auto& c : *corners) {
-          if (nearDirect(c.at)) mirror_corners.push_back(c);
-        }
-        for (const auto& a : *arcs) {
-          if (nearDirect(a.centre)) mirror_arcs.push_back(a);
-        }
-      }
-      std::vector<Candidate> proposed;
-      propose(*m, *searchOf(*m), mirrored, quick, mirrored ? mirror_corners : *corners,
-              mirrored ? mirror_arcs : *arcs, edges, &proposed);
-      std::stable_sort(proposed.begin(), proposed.end(),
-                       [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-      std::vector<ImagePose> kept;
-      for (const auto& p : proposed) {
-        if (static_cast<int>(kept.size()) >= kMaxRefinedPerModel) break;
-        const auto near = [&](const ImagePose& q) { return samePose(*m, p.pose, q, 2.0, 3.0); };
-        if (std::any_of(kept.begin(), kept.end(), near)) continue;
-        kept.push_back(p.pose);
-        screened.push_back(p);
-      }
-      if (!mirrored) direct_poses = kept;
-    }
-    std::stable_sort(screened.begin(), screened.end(),
+    std::vector<Candidate> proposed;
+    propose(*m, *searchOf(*m), quick, *corners, *arcs, edges, &proposed);
+    std::stable_sort(proposed.begin(), proposed.end(),
                      [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+    std::vector<Candidate> screened;
+    for (const auto& p : proposed) {
+      if (static_cast<int>(screened.size()) >= kMaxRefinedPerModel) break;
+      const auto near = [&](const Candidate& q) { return samePose(*m, p.pose, q.pose, 2.0, 3.0); };
+      if (std::any_of(screened.begin(), screened.end(), near)) continue;
+      screened.push_back(p);
+    }
     return screened;
   };
 
@@ -428,21 +382,19 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       const auto refined_near = [&](const Candidate& q) {
         return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
       };
-      auto& to = p.pose.mirrored ? mirror : direct;
-      if (std::any_of(to.begin(), to.end(), refined_near)) continue;
+      if (std::any_of(direct.begin(), direct.end(), refined_near)) continue;
       if (refinements >= budget) return;
       ++refinements;
       // Settled on a pose already refined (it would end as the same pose), or
       // on one too little of whose boundary lies on edges for a part, even a
-      // partly hidden one, or a mirror image a part might show: not worth the
-      // dense passes.
+      // partly hidden one: not worth the dense passes.
       const auto worth = [&](const ImagePose& pose) {
         const auto converged = [&](const Candidate& q) {
           return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
         };
-        if (std::any_of(to.begin(), to.end(), converged)) return false;
+        if (std::any_of(direct.begin(), direct.end(), converged)) return false;
         return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
-                           pose.mirrored) >= kMinVisible - kUnsettledSlack;
+                           false) >= kMinVisible - kUnsettledSlack;
       };
       const EdgeFit fit =
           refinePoseOnEdges(*m, region, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
@@ -450,15 +402,11 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       const auto same = [&](const Candidate& q) {
         return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
       };
-      if (std::any_of(to.begin(), to.end(), same)) continue;
+      if (std::any_of(direct.begin(), direct.end(), same)) continue;
       const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
-                                       m->edge_tolerance, p.pose.mirrored);
-      to.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
-      if (p.pose.mirrored) {
-        changed = true;
-      } else {
-        place(to.back());
-      }
+                                       m->edge_tolerance, false);
+      direct.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
+      place(direct.back());
     }
   };
 
@@ -475,14 +423,12 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
                  0.5 * m.radius &&
              q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
     };
-    if (std::any_of(mirror.begin(), mirror.end(), as_good)) return true;
     auto aligned = aligned_mirrors.find(&c);
     if (aligned == aligned_mirrors.end()) {
-      aligned =
-          aligned_mirrors
-              .emplace(&c, alignedMirror(m, region, c.pose, edges,
-                                         c.score - kMirrorMargin - kMirrorScreenSlack, mirror))
-              .first;
+      aligned = aligned_mirrors
+                    .emplace(&c, alignedMirror(m, region, c.pose, edges,
+                                               c.score - kMirrorMargin - kMirrorScreenSlack))
+                    .first;
     }
     return aligned->second && as_good(*aligned->second);
   };

@@ -152,24 +152,23 @@ std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m) {
   return m.blob_search ? m.blob_search : makeBlobSearchModel(m);
 }
 
-// Screens the poses proposed for one model (direct or mirrored) in a blob.
-void propose(const PartModel& model, const BlobSearchModel& search, bool mirrored, bool quick,
+// Screens the poses proposed for one model (its own hand) in a blob.
+void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
              const std::vector<CornerAnchor>& image_corners,
              const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
              std::vector<Candidate>* out) {
   const auto& sparse = search.sparse;
   const auto& glance = search.glance;
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
-  const double f = mirrored ? -1.0 : 1.0;
   // The pose putting model point `model_point` on `image_point` turned by
   // `angle`, scored on `samples`.
   const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
                           const std::vector<BoundarySample>& samples) {
     const double c = std::cos(angle * kRadPerDeg);
     const double s = std::sin(angle * kRadPerDeg);
-    const cv::Point2d centre = image_point - rotate({model_point.x, f * model_point.y}, c, s);
-    const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, mirrored);
-    return Candidate{&model, ImagePose{centre, normalizeDeg(angle), mirrored}, score, 0};
+    const cv::Point2d centre = image_point - rotate(model_point, c, s);
+    const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, false);
+    return Candidate{&model, ImagePose{centre, normalizeDeg(angle), false}, score, 0};
   };
   // A corner's direction is a few degrees off (its edges are short): the
   // first look forgives that with a wider tolerance, and the turn about the
@@ -193,7 +192,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
   const auto explained = [&](cv::Point2d model_point, cv::Point2d image_point, double angle) {
     return std::any_of(settled.begin(), settled.end(), [&](const Settled& q) {
       if (std::abs(signedDeg(q.pose.angle_deg - angle)) > kExplainedDeg) return false;
-      const cv::Point2d at = q.pose.centre + rotate({model_point.x, f * model_point.y}, q.c, q.s);
+      const cv::Point2d at = q.pose.centre + rotate(model_point, q.c, q.s);
       return std::hypot(at.x - image_point.x, at.y - image_point.y) <= kExplainedPx;
     });
   };
@@ -223,14 +222,14 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
     std::sort(visit.begin(), visit.end());
     for (const size_t i : visit) {
       const CornerAnchor& ic = image_corners[i];
-      const double angle = ic.bisector_deg - f * mc.bisector_deg;
+      const double angle = ic.bisector_deg - mc.bisector_deg;
       if (explained(mc.at, ic.at, angle)) continue;
       // cos and sin of the difference of the two bisectors' directions.
-      const double cosine = ic.bisector.x * mc.bisector.x + f * ic.bisector.y * mc.bisector.y;
-      const double sine = ic.bisector.y * mc.bisector.x - f * ic.bisector.x * mc.bisector.y;
-      const cv::Point2d centre = ic.at - rotate({mc.at.x, f * mc.at.y}, cosine, sine);
-      if (!verifiesAtLeast(search.corner_glance[mi], search.glance_weight, centre, cosine, sine, f,
-                           edges, loose, threshold - kGlanceSlack)) {
+      const double cosine = ic.bisector.x * mc.bisector.x + ic.bisector.y * mc.bisector.y;
+      const double sine = ic.bisector.y * mc.bisector.x - ic.bisector.x * mc.bisector.y;
+      const cv::Point2d centre = ic.at - rotate(mc.at, cosine, sine);
+      if (!verifiesAtLeast(search.corner_glance[mi], search.glance_weight, centre, cosine, sine,
+                           1.0, edges, loose, threshold - kGlanceSlack)) {
         continue;
       }
       Candidate c = screen(mc.at, ic.at, angle, sparse);
@@ -248,8 +247,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
   }
   // An arc fixes where its centre goes; the turn about it lines up the two
   // arcs (kArcSlideDeg), scanned coarsely at a glance, and around each
-  // promising step finely. The placed hand walks the model's arc the way
-  // the blob's arc goes: a mirror reverses it.
+  // promising step finely. The model's arc must turn the way the blob's
+  // arc goes.
   const double fine = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
   std::vector<double> scan;
@@ -258,8 +257,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
     const ArcAnchor& ma = search.arcs[mi];
     for (const auto& ia : image_arcs) {
       if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
-      if ((ia.sweep_deg > 0) != (f * ma.sweep_deg > 0)) continue;
-      const double middle = ia.mid_deg - f * ma.mid_deg;
+      if ((ia.sweep_deg > 0) != (ma.sweep_deg > 0)) continue;
+      const double middle = ia.mid_deg - ma.mid_deg;
       if (explained(ma.centre, ia.centre, middle)) continue;
       // A whole circle's ends are wherever its loop started: any turn.
       const bool circle = std::max(std::abs(ma.sweep_deg), std::abs(ia.sweep_deg)) >= kCircleDeg;
@@ -280,12 +279,12 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool mirrore
       double turn_s = std::sin(start);
       for (int k = 0; k < steps; ++k) {
         const double angle = middle - half + k * step;
-        const cv::Point2d centre =
-            ia.centre - rotate({ma.centre.x, f * ma.centre.y}, turn_c, turn_s);
-        scan[k] = verifiesAtLeast(search.arc_glance[mi], search.glance_weight, centre, turn_c,
-                                  turn_s, f, edges, model.edge_tolerance, threshold - kGlanceSlack)
-                      ? screen(ma.centre, ia.centre, angle, glance).score
-                      : -1.0;
+        const cv::Point2d centre = ia.centre - rotate(ma.centre, turn_c, turn_s);
+        scan[k] =
+            verifiesAtLeast(search.arc_glance[mi], search.glance_weight, centre, turn_c, turn_s,
+                            1.0, edges, model.edge_tolerance, threshold - kGlanceSlack)
+                ? screen(ma.centre, ia.centre, angle, glance).score
+                : -1.0;
         const double next_c = turn_c * step_cos - turn_s * step_sin;
         turn_s = turn_s * step_cos + turn_c * step_sin;
         turn_c = next_c;
