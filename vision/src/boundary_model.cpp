@@ -475,19 +475,32 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
   if (max_distance > 0) {
     // Every boundary pixel stamps the exact distances of a disc of radius
     // max_distance around it: a few dozen pixels per boundary pixel instead
-    // of a transform of every pixel of the box.
+    // of a transform of every pixel of the box. The disc is stamped a row at
+    // a time (a run of floats the compiler can take several at once).
     const int reach = static_cast<int>(std::floor(max_distance));
     struct Offset {
       int dx, dy;
       float d;
     };
+    struct DiscRow {
+      int dy;
+      int half;          // the row spans dx in [-half, half]
+      size_t first = 0;  // its distances in `row_distances`
+    };
     std::vector<Offset> disc;
+    std::vector<DiscRow> rows;
+    std::vector<float> row_distances;
     for (int dy = -reach; dy <= reach; ++dy) {
+      DiscRow row{dy, -1, row_distances.size()};
       for (int dx = -reach; dx <= reach; ++dx) {
         const int d2 = dx * dx + dy * dy;
-        if (d2 <= max_distance * max_distance)
+        if (d2 <= max_distance * max_distance) {
           disc.push_back({dx, dy, std::sqrt(static_cast<float>(d2))});
+          row_distances.push_back(disc.back().d);
+          row.half = std::max(row.half, dx);
+        }
       }
+      if (row.half >= 0) rows.push_back(row);
     }
     distance_.create(roi.size(), CV_32F);
     distance_.setTo(1e9f);
@@ -496,9 +509,11 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
       for (const auto& p : c) {
         const cv::Point q = p - origin_;
         if (inside.contains(q)) {
-          for (const Offset& o : disc) {
-            float& v = distance_.at<float>(q.y + o.dy, q.x + o.dx);
-            v = std::min(v, o.d);
+          for (const DiscRow& row : rows) {
+            float* to = distance_.ptr<float>(q.y + row.dy) + (q.x - row.half);
+            const float* d = row_distances.data() + row.first;
+            const int n = 2 * row.half + 1;
+            for (int k = 0; k < n; ++k) to[k] = std::min(to[k], d[k]);
           }
           continue;
         }
