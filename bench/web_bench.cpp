@@ -155,9 +155,6 @@ class Viewer {
   std::thread thread_;
 };
 
-// One page's event stream (/events) on its own thread, as every browser
-// keeps open beside its MJPEG stream: counts the results received, at the
-// viewers' low priority.
 // One thread of pure arithmetic at SCHED_IDLE, the priority the web
 // server's encoders and converters run at: it only ever gets a core the
 // cell leaves free. The LOCATE figures beside it are the floor that any
@@ -188,6 +185,9 @@ class IdleBusyThread {
   std::thread thread_;
 };
 
+// One page's event stream (/events) on its own thread, as every browser
+// keeps open beside its MJPEG stream: counts the results received, at the
+// viewers' low priority.
 class EventsClient {
  public:
   explicit EventsClient(int port) : client_("127.0.0.1", port), thread_([this] { run(); }) {}
