@@ -12,6 +12,7 @@
 #include "picksight/common/angles.hpp"
 #include "picksight/synthetic/scene.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/region_judge.hpp"
 #include "picksight/vision/touching_parts.hpp"
 
 using namespace picksight::vision;
@@ -168,6 +169,15 @@ TEST_CASE("a part located from its edges lands on its drawn centroid", "[vision]
     REQUIRE(matches.size() == 1);
     CHECK(static_cast<size_t>(matches[0].model->type) == t.type);
     CHECK(cv::norm(matches[0].centroid - t.centre) < 0.1);
+    // Searched on the edge map the region tests build (wider reach and
+    // box), the same part at the same pose to the last bit.
+    RegionCache cache(regions[index],
+                      std::max(models[0].edge_tolerance, models[1].edge_tolerance) + 0.5);
+    const auto shared = locateInBlob(regions, index, list, &cache.edges());
+    REQUIRE(shared.size() == 1);
+    CHECK(shared[0].model == matches[0].model);
+    CHECK(shared[0].centroid == matches[0].centroid);
+    CHECK(shared[0].angle_deg == matches[0].angle_deg);
     ++located;
   }
   CHECK(located >= 6);

@@ -41,7 +41,7 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
   if (best.model) return {best};
   if (whole_part) return {};
   // No model explains the blob whole: parts that touch, or none.
-  return locateInBlob(regions, i, models);
+  return locateInBlob(regions, i, models, cache.builtEdges());
 }
 }  // namespace
 

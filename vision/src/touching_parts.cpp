@@ -267,7 +267,8 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, MirrorTest&& 
 }  // namespace
 
 std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
-                                const std::vector<const PartModel*>& models) {
+                                const std::vector<const PartModel*>& models,
+                                const EdgeDistance* built_edges) {
   std::vector<Match> found;
   const Region& region = regions[index];
   double tolerance = 0;
@@ -284,14 +285,17 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
 
   std::vector<std::vector<cv::Point>> contours{region.outer};
   contours.insert(contours.end(), region.hole_boundaries.begin(), region.hole_boundaries.end());
-  const double screen_reach = kLooseScreenFactor * tolerance;
-  const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
-  // Only verifyScore reads it, at no more than the loose screening tolerance.
-  const EdgeDistance edges(
-      contours,
-      cv::Rect(region.bbox.x - margin, region.bbox.y - margin, region.bbox.width + 2 * margin,
-               region.bbox.height + 2 * margin),
-      screen_reach);
+  // Read at no more than the loose screening tolerance (and clipped there).
+  std::optional<EdgeDistance> own_edges;
+  if (!built_edges) {
+    const double screen_reach = kLooseScreenFactor * tolerance;
+    const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
+    own_edges.emplace(contours,
+                      cv::Rect(region.bbox.x - margin, region.bbox.y - margin,
+                               region.bbox.width + 2 * margin, region.bbox.height + 2 * margin),
+                      screen_reach);
+  }
+  const EdgeDistance& edges = built_edges ? *built_edges : *own_edges;
   std::vector<std::vector<cv::Point2d>> loops2d;
   for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
   std::vector<CornerAnchor> image_corners;

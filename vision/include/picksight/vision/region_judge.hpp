@@ -51,6 +51,8 @@ class RegionCache {
   const Region& region() const { return region_; }
   const HuArray& logHu();
   const EdgeDistance& edges();
+  // The edge map if edges() has built it, else null.
+  const EdgeDistance* builtEdges() const { return edges_.get(); }
   // Phase of the complex moment of order k, degrees (0 for k <= 0).
   double phaseDeg(int k);
 

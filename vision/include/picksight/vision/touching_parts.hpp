@@ -58,7 +58,13 @@ void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Poi
 // A part whose mirrored model verifies about as well is not reported. Of two
 // poses that cannot both be parts (they would share more than parts lying
 // on each other do), the one lying on more of the blob's edges is reported.
+// `edges`: the blob's edge map if its region tests built one (see
+// RegionCache::edges; reaching twice the largest edge tolerance of
+// `models`, past the region's box by more), which the search then reads
+// instead of building its own: the same distances as far as anything here
+// reads them.
 std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
-                                const std::vector<const PartModel*>& models);
+                                const std::vector<const PartModel*>& models,
+                                const EdgeDistance* edges = nullptr);
 
 }  // namespace picksight::vision
