@@ -179,6 +179,37 @@ TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vi
                                << " deg");
 }
 
+TEST_CASE("the bounded edge map has the exact distances within its reach", "[vision][model]") {
+  // Boundary pixels anywhere, some near the box's edges and some outside it,
+  // against the distance to the nearest of them, pixel by pixel.
+  cv::RNG rng(11);
+  std::vector<std::vector<cv::Point>> contours(3);
+  for (auto& c : contours) {
+    for (int i = 0; i < 40; ++i) c.emplace_back(rng.uniform(-6, 66), rng.uniform(-6, 46));
+  }
+  const cv::Rect box(0, 0, 60, 40);
+  const double reach = 4.3;
+  const EdgeDistance bounded(contours, box, reach);
+  int within = 0;
+  for (int y = 0; y < box.height; ++y) {
+    for (int x = 0; x < box.width; ++x) {
+      double nearest = 1e9;
+      for (const auto& c : contours) {
+        for (const auto& q : c) nearest = std::min(nearest, std::hypot(q.x - x, q.y - y));
+      }
+      const cv::Point2d p(x, y);
+      INFO(x << ", " << y << ": nearest " << nearest << ", map " << bounded.at(p));
+      if (nearest <= reach) {
+        CHECK(std::abs(bounded.at(p) - nearest) < 1e-5);
+        ++within;
+      } else {
+        CHECK(bounded.at(p) > reach);
+      }
+    }
+  }
+  CHECK(within > box.area() / 4);
+}
+
 TEST_CASE("verification fails when the model is off the part", "[vision][model]") {
   const Trained l = train("l_shape", 1);
   const ps::SceneRenderer s(scene(400, 400, 1, 78, {"l_shape"}));

@@ -479,16 +479,11 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
     // of a transform of every pixel of the box. The disc is stamped a row at
     // a time, four floats at once.
     const int reach = static_cast<int>(std::floor(max_distance));
-    struct Offset {
-      int dx, dy;
-      float d;
-    };
     struct DiscRow {
       int dy;
       int half;          // the row spans dx in [-half, half]
       size_t first = 0;  // its distances in `row_distances`
     };
-    std::vector<Offset> disc;
     std::vector<DiscRow> rows;
     std::vector<float> row_distances;
     for (int dy = -reach; dy <= reach; ++dy) {
@@ -496,8 +491,7 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
       for (int dx = -reach; dx <= reach; ++dx) {
         const int d2 = dx * dx + dy * dy;
         if (d2 <= max_distance * max_distance) {
-          disc.push_back({dx, dy, std::sqrt(static_cast<float>(d2))});
-          row_distances.push_back(disc.back().d);
+          row_distances.push_back(std::sqrt(static_cast<float>(d2)));
           row.half = std::max(row.half, dx);
         }
       }
@@ -505,29 +499,33 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
     }
     distance_.create(roi.size(), CV_32F);
     distance_.setTo(1e9f);
+    const auto stamp = [](float* to, const float* d, int n) {
+      int k = 0;
+#if CV_SIMD128
+      for (; k + 4 <= n; k += 4)
+        cv::v_store(to + k, cv::v_min(cv::v_load(to + k), cv::v_load(d + k)));
+#endif
+      for (; k < n; ++k) to[k] = std::min(to[k], d[k]);
+    };
     const cv::Rect inside(reach, reach, roi.width - 2 * reach, roi.height - 2 * reach);
     for (const auto& c : contours) {
       for (const auto& p : c) {
         const cv::Point q = p - origin_;
         if (inside.contains(q)) {
           for (const DiscRow& row : rows) {
-            float* to = distance_.ptr<float>(q.y + row.dy) + (q.x - row.half);
-            const float* d = row_distances.data() + row.first;
-            const int n = 2 * row.half + 1;
-            int k = 0;
-#if CV_SIMD128
-            for (; k + 4 <= n; k += 4)
-              cv::v_store(to + k, cv::v_min(cv::v_load(to + k), cv::v_load(d + k)));
-#endif
-            for (; k < n; ++k) to[k] = std::min(to[k], d[k]);
+            stamp(distance_.ptr<float>(q.y + row.dy) + (q.x - row.half),
+                  row_distances.data() + row.first, 2 * row.half + 1);
           }
           continue;
         }
-        for (const Offset& o : disc) {
-          const cv::Point t(q.x + o.dx, q.y + o.dy);
-          if (t.x < 0 || t.y < 0 || t.x >= roi.width || t.y >= roi.height) continue;
-          float& v = distance_.at<float>(t);
-          v = std::min(v, o.d);
+        // Near the box's edge (or outside it): each row clipped to the box.
+        for (const DiscRow& row : rows) {
+          const int y = q.y + row.dy;
+          const int from = std::max(q.x - row.half, 0);
+          const int last = std::min(q.x + row.half, roi.width - 1);
+          if (y < 0 || y >= roi.height || from > last) continue;
+          stamp(distance_.ptr<float>(y) + from,
+                row_distances.data() + row.first + (from - (q.x - row.half)), last - from + 1);
         }
       }
     }
