@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -165,7 +166,13 @@ class IdleBusyThread {
   IdleBusyThread()
       : thread_([this] {
           sched_param param{};
-          pthread_setschedparam(pthread_self(), SCHED_IDLE, &param);
+          // Left at normal priority, the row would overstate the floor.
+          if (const int error = pthread_setschedparam(pthread_self(), SCHED_IDLE, &param)) {
+            std::fprintf(stderr,
+                         "the busy thread stays at normal priority (SCHED_IDLE: %s): the "
+                         "floor row is not the idle priority's\n",
+                         std::strerror(error));
+          }
           double x = 1.0;
           while (!stop_) {
             for (int i = 0; i < 100000; ++i) x = x * 1.0000001 + 1e-9;
