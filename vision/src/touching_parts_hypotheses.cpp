@@ -96,6 +96,11 @@ constexpr double kCircleDeg = 359;
 // to the finest.
 constexpr double kCornerTurnStepDeg = 2.0;
 constexpr double kCornerTurnFinestDeg = 0.5;
+// A turn whose coarsest steps leave it this far below the screening
+// threshold is given up: the finer steps raised no pose that passed by
+// more than 0.1 (2410 corner searches of 6 touching and overlapping bench
+// scenes; 9 in 10 are given up here).
+constexpr double kCornerTurnGiveUp = 0.2;
 // A settled pose explains a corner or arc of the blob when it puts the
 // model's within this many pixels of it, turned within this many degrees
 // (a corner's bisector is a few degrees off; an arc's middle is wherever
@@ -238,6 +243,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
       }
       Candidate c = screen(mc.at, ic.at, angle, sparse);
       for (double step = kCornerTurnStepDeg; step >= kCornerTurnFinestDeg; step /= 2) {
+        if (step < kCornerTurnStepDeg && c.score < threshold - kCornerTurnGiveUp) break;
         const double at = c.pose.angle_deg;
         for (int k = -2; k <= 2; ++k) {
           if (k == 0 || (step < kCornerTurnStepDeg && std::abs(k) > 1)) continue;
