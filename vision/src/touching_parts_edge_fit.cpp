@@ -18,16 +18,23 @@ namespace picksight::vision {
 namespace touching {
 
 double loopOrientation(const BoundaryLoop& loop) {
-  std::vector<cv::Point2d> pts;
-  for (const auto& p : loop.primitives) {
-    const int n = p.kind == PrimitiveKind::kArc ? 16 : 1;
-    for (int i = 0; i < n; ++i) pts.push_back(p.pointAt(static_cast<double>(i) / n));
-  }
+  // The integral of x dy - y dx around the loop: along each primitive in
+  // closed form (an arc's is cx dy - cy dx + r^2 sweep, no points on it to
+  // place), then along the chord to the next one's start.
+  const auto& prims = loop.primitives;
   double a = 0;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const cv::Point2d& p = pts[i];
-    const cv::Point2d& q = pts[(i + 1) % pts.size()];
-    a += p.x * q.y - q.x * p.y;
+  for (size_t i = 0; i < prims.size(); ++i) {
+    const Primitive& p = prims[i];
+    const cv::Point2d s = p.pointAt(0);
+    const cv::Point2d e = p.pointAt(1);
+    if (p.kind == PrimitiveKind::kArc) {
+      a += p.centre.x * (e.y - s.y) - p.centre.y * (e.x - s.x) +
+           p.radius * p.radius * p.sweep_deg * kRadPerDeg;
+    } else {
+      a += s.x * e.y - e.x * s.y;
+    }
+    const cv::Point2d next = prims[(i + 1) % prims.size()].pointAt(0);
+    a += e.x * next.y - next.x * e.y;
   }
   return a;
 }
