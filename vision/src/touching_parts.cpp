@@ -124,11 +124,12 @@ bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double
 // each model's own hand only (searching the mirror image from the blob's
 // corners and arcs as well cost a tenth of the search and changed no
 // decision on the benchmark's type sets). Like any hypothesis it is refined
-// only when it screens at `screen` (a fraction verified): nullopt
-// otherwise.
+// only when it screens at `screen` (a fraction verified), and only to the
+// end while it may still verify at `needed` (what the part's mirror image
+// must reach): nullopt otherwise.
 std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
                                        const ImagePose& direct, const EdgeDistance& edges,
-                                       double screen) {
+                                       double screen, double needed) {
   const int k = m.orientation_order;
   if (k <= 0 || m.body.mirror_symmetric) return std::nullopt;
   Candidate best;
@@ -141,7 +142,19 @@ std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
     if (score > best.score) best = {&m, {direct.centre, angle, true}, score, 0, 0};
   }
   if (best.score < screen) return std::nullopt;
-  const EdgeFit fit = refinePoseOnEdges(m, region, best.pose);
+  // Settled where it verifies too little for the dense passes to lift it to
+  // `needed`, and short of it unrefined too, it cannot be as good as the
+  // part either way: no mirror image, and no dense passes.
+  bool given_up = false;
+  const auto worth = [&](const ImagePose& pose) {
+    given_up = best.score < needed &&
+               verifyScore(m.samples, pose.centre, pose.angle_deg, edges, m.edge_tolerance, true) <
+                   needed - kUnsettledSlack;
+    return !given_up;
+  };
+  const EdgeFit fit =
+      refinePoseOnEdges(m, region, best.pose, kEdgeSearchPx, kEdgeIterations, worth);
+  if (given_up) return std::nullopt;
   if (!fit.ok) return best;
   const double score =
       verifyScore(m.samples, fit.pose.centre, fit.pose.angle_deg, edges, m.edge_tolerance, true);
@@ -431,7 +444,8 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     if (aligned == aligned_mirrors.end()) {
       aligned = aligned_mirrors
                     .emplace(&c, alignedMirror(m, region, c.pose, edges,
-                                               c.score - kMirrorMargin - kMirrorScreenSlack))
+                                               c.score - kMirrorMargin - kMirrorScreenSlack,
+                                               c.score - kMirrorMargin))
                     .first;
     }
     return aligned->second && as_good(*aligned->second);
