@@ -348,7 +348,8 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   // alignedMirror), best first, no two alike.
   // The blob's anchors the search starts from (all, or those near what the
   // parts found leave unexplained).
-  const std::vector<CornerAnchor>* corners = &image_corners;
+  const BlobCorners all_corners(image_corners);
+  const BlobCorners* corners = &all_corners;
   const std::vector<ArcAnchor>* arcs = &image_arcs;
   const auto screen = [&](const PartModel* m, bool quick) {
     std::vector<Candidate> proposed;
@@ -513,7 +514,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     // With parts found, the rest of the blob is most likely one part more:
     // the models closest to its area first. Otherwise those the quick
     // search saw most of.
-    std::vector<CornerAnchor> rest_corners;
+    std::optional<BlobCorners> rest_corners;
     std::vector<ArcAnchor> rest_arcs;
     if (!taken.empty()) {
       cv::Mat rest = unexplained();
@@ -541,15 +542,17 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
                      sums.at<int>(y0, x0) >
                  0;
         };
+        std::vector<CornerAnchor> near_rest;
         for (const auto& c : image_corners) {
-          if (inRest(c.at)) rest_corners.push_back(c);
+          if (inRest(c.at)) near_rest.push_back(c);
         }
+        rest_corners.emplace(std::move(near_rest));
         for (const auto& a : image_arcs) {
           const double mid = a.mid_deg * kRadPerDeg;
           if (inRest(a.centre + a.radius * cv::Point2d(std::cos(mid), std::sin(mid))))
             rest_arcs.push_back(a);
         }
-        corners = &rest_corners;
+        corners = &*rest_corners;
         arcs = &rest_arcs;
       }
       for (auto& entry : order) {

@@ -161,11 +161,19 @@ std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m) {
   return m.blob_search ? m.blob_search : makeBlobSearchModel(m);
 }
 
+BlobCorners::BlobCorners(std::vector<CornerAnchor> all)
+    : corners(std::move(all)), by_opening(corners.size()) {
+  for (size_t i = 0; i < by_opening.size(); ++i) by_opening[i] = i;
+  std::sort(by_opening.begin(), by_opening.end(),
+            [&](size_t a, size_t b) { return corners[a].opening_deg < corners[b].opening_deg; });
+}
+
 // Screens the poses proposed for one model (its own hand) in a blob.
 void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
-             const std::vector<CornerAnchor>& image_corners,
-             const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
-             std::vector<Candidate>* out) {
+             const BlobCorners& blob_corners, const std::vector<ArcAnchor>& image_arcs,
+             const EdgeDistance& edges, std::vector<Candidate>* out) {
+  const std::vector<CornerAnchor>& image_corners = blob_corners.corners;
+  const std::vector<size_t>& by_opening = blob_corners.by_opening;
   const auto& sparse = search.sparse;
   const auto& glance = search.glance;
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
@@ -205,13 +213,8 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
       return std::hypot(at.x - image_point.x, at.y - image_point.y) <= kExplainedPx;
     });
   };
-  // The image corners by opening angle: each model corner visits only
-  // those it may be (a few in ten), in the blob's order.
-  std::vector<size_t> by_opening(image_corners.size());
-  for (size_t i = 0; i < by_opening.size(); ++i) by_opening[i] = i;
-  std::sort(by_opening.begin(), by_opening.end(), [&](size_t a, size_t b) {
-    return image_corners[a].opening_deg < image_corners[b].opening_deg;
-  });
+  // Each model corner visits only the image corners it may be (a few in
+  // ten), in the blob's order.
   std::vector<size_t> visit;
   const auto visits = [&](size_t mi, const std::vector<size_t>& quick_ones) {
     return !quick || std::find(quick_ones.begin(), quick_ones.end(), mi) != quick_ones.end();

@@ -115,14 +115,21 @@ namespace touching {
 // for a model put together without it.
 std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m);
 
+// The corners of a blob the search starts from, with their indices in
+// order of opening angle (each model corner visits only those it may be).
+struct BlobCorners {
+  explicit BlobCorners(std::vector<CornerAnchor> corners);
+  std::vector<CornerAnchor> corners;
+  std::vector<size_t> by_opening;
+};
+
 // Screens the poses proposed for one model (its own hand; the mirror image
 // is asked of each part about to be taken, in touching_parts.cpp) in a
 // blob: appends those that verify well enough on `edges` to `out`. `quick`:
 // from the model's quick corners and arcs only.
 void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
-             const std::vector<CornerAnchor>& image_corners,
-             const std::vector<ArcAnchor>& image_arcs, const EdgeDistance& edges,
-             std::vector<Candidate>* out);
+             const BlobCorners& image_corners, const std::vector<ArcAnchor>& image_arcs,
+             const EdgeDistance& edges, std::vector<Candidate>* out);
 
 }  // namespace touching
 }  // namespace picksight::vision
