@@ -519,6 +519,8 @@ EdgeDistance::EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, 
           continue;
         }
         // Near the box's edge (or outside it): each row clipped to the box.
+        // Kept apart from the path above, which most boundary pixels take:
+        // clipping every row there cost 1.6 % of recognize().
         for (const DiscRow& row : rows) {
           const int y = q.y + row.dy;
           const int from = std::max(q.x - row.half, 0);

@@ -338,7 +338,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
 
   // Refined poses (a deque: the placed ones point into it), and those that
   // fit the blob on their own, each drawn on its box of the canvas.
-  std::deque<Candidate> direct;
+  std::deque<Candidate> refined;
   std::vector<Placed> placed;
   size_t refinements = 0;
   // Whether a choice made now could differ from the last one.
@@ -348,7 +348,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
   // alignedMirror), best first, no two alike.
   // The blob's anchors the search starts from (all, or those near what the
   // parts found leave unexplained).
-  const BlobCorners all_corners(image_corners);
+  const BlobCorners all_corners(std::move(image_corners));
   const BlobCorners* corners = &all_corners;
   const std::vector<ArcAnchor>* arcs = &image_arcs;
   const auto screen = [&](const PartModel* m, bool quick) {
@@ -400,7 +400,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       const auto refined_near = [&](const Candidate& q) {
         return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
       };
-      if (std::any_of(direct.begin(), direct.end(), refined_near)) continue;
+      if (std::any_of(refined.begin(), refined.end(), refined_near)) continue;
       if (refinements >= budget) return;
       ++refinements;
       // Settled on a pose already refined (it would end as the same pose), or
@@ -410,7 +410,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
         const auto converged = [&](const Candidate& q) {
           return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
         };
-        if (std::any_of(direct.begin(), direct.end(), converged)) return false;
+        if (std::any_of(refined.begin(), refined.end(), converged)) return false;
         return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
                            false) >= kMinVisible - kUnsettledSlack;
       };
@@ -420,11 +420,11 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
       const auto same = [&](const Candidate& q) {
         return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
       };
-      if (std::any_of(direct.begin(), direct.end(), same)) continue;
+      if (std::any_of(refined.begin(), refined.end(), same)) continue;
       const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
                                        m->edge_tolerance, false);
-      direct.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
-      place(direct.back());
+      refined.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
+      place(refined.back());
     }
   };
 
@@ -543,7 +543,7 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
                  0;
         };
         std::vector<CornerAnchor> near_rest;
-        for (const auto& c : image_corners) {
+        for (const auto& c : all_corners.corners) {
           if (inRest(c.at)) near_rest.push_back(c);
         }
         rest_corners.emplace(std::move(near_rest));
