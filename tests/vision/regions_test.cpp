@@ -27,6 +27,8 @@ struct Drawn {
 struct Look {
   double part = 50;
   double background = 220;
+  // Light falling unevenly: every level times 1 + slope . (p - (200, 200)).
+  cv::Vec2d light_slope{0, 0};
 };
 
 // The polygon `local` (its own axes, about (45, 25)) turned by `deg` about
@@ -50,7 +52,16 @@ Drawn drawShape(const std::vector<cv::Point2d>& local, double deg, bool mirrored
   Drawn d;
   cv::Mat coverage;
   cv::resize(big, coverage, cv::Size(400, 400), 0, 0, cv::INTER_AREA);
-  coverage.convertTo(d.grey, CV_8U, (look.part - look.background) / 255.0, look.background);
+  cv::Mat level;
+  coverage.convertTo(level, CV_32F, (look.part - look.background) / 255.0, look.background);
+  for (int y = 0; y < level.rows; ++y) {
+    float* v = level.ptr<float>(y);
+    for (int x = 0; x < level.cols; ++x) {
+      v[x] *=
+          static_cast<float>(1 + look.light_slope[0] * (x - 200) + look.light_slope[1] * (y - 200));
+    }
+  }
+  level.convertTo(d.grey, CV_8U);
   const cv::Moments m = cv::moments(big, true);
   d.centroid =
       cv::Point2d((m.m10 / m.m00 + 0.5) / kSuper - 0.5, (m.m01 / m.m00 + 0.5) / kSuper - 0.5);
@@ -238,7 +249,7 @@ TEST_CASE("grey-level moments beat binary ones on diagonal edges for dark and li
   // sign), and light parts on a black background, read additively (there is
   // no light to divide by, down to none at all): the grey centroid keeps its
   // accuracy in every case.
-  for (const Look look :
+  for (const Look& look :
        {Look{50, 220}, Look{180, 220}, Look{240, 100}, Look{200, 5}, Look{220, 0}}) {
     INFO("part " << look.part << " on " << look.background);
     const Drawn d = drawL(315, false, look);
@@ -252,6 +263,32 @@ TEST_CASE("grey-level moments beat binary ones on diagonal edges for dark and li
     CHECK(binary_error > 5 * grey_error);
     // The L's area: 120 x 30 + 40 x 30 px (read 0.3 % high today).
     CHECK(grey[0].area == Approx(4800).epsilon(0.005));
+  }
+}
+
+TEST_CASE("parts are placed under uneven light whichever is darker, part or background",
+          "[vision][regions]") {
+  // Light 8 % stronger on one side of the L than on the other (a lamp off to
+  // one side). Both levels follow the light; each edge pixel is read between
+  // the two as the light there gives them. Read against the background's
+  // light alone (or, on a near-black background, against fixed levels), a
+  // light part was placed up to 0.11 px off here, and a low-contrast one
+  // 0.024 px.
+  for (const cv::Vec2d& slope : {cv::Vec2d(0.0006, -0.0003), cv::Vec2d(-0.0002, 0.0007)}) {
+    for (const Look& base : {Look{50, 220}, Look{200, 30}, Look{230, 15}, Look{150, 200}}) {
+      Look look = base;
+      look.light_slope = slope;
+      INFO("part " << look.part << " on " << look.background << ", light slope " << slope[0] << ", "
+                   << slope[1]);
+      for (const double deg : {10.0, 100.0, 215.0}) {
+        INFO("turned " << deg);
+        const Drawn d = drawL(deg, false, look);
+        const auto grey = regionsOf(d, true, look);
+        REQUIRE(grey.size() == 1);
+        CHECK(cv::norm(grey[0].centroid - d.centroid) < 0.02);
+        CHECK(grey[0].area == Approx(4800).epsilon(0.005));
+      }
+    }
   }
 }
 
@@ -307,24 +344,32 @@ TEST_CASE("a highlight inside a part does not move its centroid", "[vision][regi
   // A shiny spot on the long leg, 6 px round, lighter than the part but not
   // enough to be cut out of it: the part's pixels all the same. Read from
   // its grey levels as partly uncovered, it would pull the centroid about a
-  // third of a pixel away; the interior is the part's whole.
-  for (const double deg : {0.0, 37.0, 141.0}) {
-    INFO("turned " << deg);
-    Drawn d = drawL(deg, false);
-    const double a = deg * M_PI / 180.0;
-    // The long leg's middle, 40 px along it from the L's own origin.
-    const cv::Point2d local(100 - 45, 15 - 25);
-    const cv::Point2d spot(200 + local.x * std::cos(a) - local.y * std::sin(a),
-                           200 + local.x * std::sin(a) + local.y * std::cos(a));
-    cv::circle(d.grey,
-               cv::Point(static_cast<int>(std::lround(spot.x * 16)),
-                         static_cast<int>(std::lround(spot.y * 16))),
-               6 * 16, cv::Scalar(110), cv::FILLED, cv::LINE_AA, 4);
-    const auto regions = regionsOf(d, true);
-    REQUIRE(regions.size() == 1);
-    CHECK(regions[0].holes == 0);
-    CHECK(cv::norm(regions[0].centroid - d.centroid) < 0.02);
-    CHECK(regions[0].area == Approx(4800).epsilon(0.005));
+  // third of a pixel away; the interior is the part's whole. On a light part
+  // (whose own levels give the light it is read under) the spot is a dark
+  // mark, and it must not tilt that light either.
+  struct Case {
+    Look look;
+    double spot_level;
+  };
+  for (const Case& c : {Case{Look{50, 220}, 110}, Case{Look{200, 30}, 140}}) {
+    for (const double deg : {0.0, 37.0, 141.0}) {
+      INFO("part " << c.look.part << " on " << c.look.background << ", turned " << deg);
+      Drawn d = drawL(deg, false, c.look);
+      const double a = deg * M_PI / 180.0;
+      // The long leg's middle, 40 px along it from the L's own origin.
+      const cv::Point2d local(100 - 45, 15 - 25);
+      const cv::Point2d spot(200 + local.x * std::cos(a) - local.y * std::sin(a),
+                             200 + local.x * std::sin(a) + local.y * std::cos(a));
+      cv::circle(d.grey,
+                 cv::Point(static_cast<int>(std::lround(spot.x * 16)),
+                           static_cast<int>(std::lround(spot.y * 16))),
+                 6 * 16, cv::Scalar(c.spot_level), cv::FILLED, cv::LINE_AA, 4);
+      const auto regions = regionsOf(d, true, c.look);
+      REQUIRE(regions.size() == 1);
+      CHECK(regions[0].holes == 0);
+      CHECK(cv::norm(regions[0].centroid - d.centroid) < 0.02);
+      CHECK(regions[0].area == Approx(4800).epsilon(0.005));
+    }
   }
 }
 
