@@ -17,18 +17,6 @@ namespace {
 // A report this close to a drawn part's centroid is about that part; parts
 // lie gap_px (8) apart, so no report is near two.
 constexpr double kNearPx = 12;
-
-// A scene of `parts` parts on a 1280 x 720 frame.
-ps::SilhouetteSceneOptions smallScene(const ps::SilhouetteSceneOptions& look, uint64_t seed,
-                                      int parts, double distractor_share) {
-  ps::SilhouetteSceneOptions o = look;
-  o.width = 1280;
-  o.height = 720;
-  o.parts = parts;
-  o.seed = seed;
-  o.distractor_share = distractor_share;
-  return o;
-}
 }  // namespace
 
 TEST_CASE("mirrored and rescaled public silhouettes are never reported", "[vision][mirror]") {

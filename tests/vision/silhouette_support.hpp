@@ -76,6 +76,21 @@ inline SilhouetteModels trainSilhouettes(const std::vector<SilhouetteSpec>& spec
   return out;
 }
 
+// A scene of `parts` parts on a 1280 x 720 frame.
+inline synthetic::SilhouetteSceneOptions smallScene(
+    const synthetic::SilhouetteSceneOptions& look, uint64_t seed, int parts,
+    double distractor_share,
+    synthetic::Arrangement arrangement = synthetic::Arrangement::kSeparated) {
+  synthetic::SilhouetteSceneOptions o = look;
+  o.width = 1280;
+  o.height = 720;
+  o.parts = parts;
+  o.seed = seed;
+  o.distractor_share = distractor_share;
+  o.arrangement = arrangement;
+  return o;
+}
+
 // Frame `frame` of a scene recognized with every model.
 inline std::vector<vision::Match> recognizeSilhouettes(const synthetic::SilhouetteScene& scene,
                                                        uint64_t frame,
