@@ -44,7 +44,8 @@ constexpr double kGlanceSlack = 0.1;
 // its first look had 5 of 12 samples where 5.4 were needed, 12 of 12
 // turned by 4 degrees, and numerical noise of 1e-9 in the model decided
 // whether it was found. Costs 2.6 % more instructions in recognize() on
-// touching scenes (the full search too: 11 %, for the poses it adds).
+// touching scenes (taken in the full search as well: 11 %, for the poses it
+// adds to refine).
 constexpr double kGlanceNearMiss = 0.5 / kGlanceSamples;
 constexpr double kGlanceTurnDeg = 4.0;
 // Curved outlines break into many primitives: the hypotheses come from the
