@@ -212,9 +212,6 @@ struct BandReading {
   // forEachCoverage visits them: the coverage image is written from it.
   std::vector<float> band_coverage;
 
-  float background(int x, int y) const {
-    return static_cast<float>(plane[0] + plane[1] * x + plane[2] * y);
-  }
   // The part's level less the background's.
   double span(double x, double y) const {
     return (part[0] - plane[0]) + (part[1] - plane[1]) * x + (part[2] - plane[2]) * y;
