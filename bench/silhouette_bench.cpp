@@ -296,6 +296,12 @@ int main(int argc, char** argv) {
   app.add_option("--background-level", look.background_level, "grey level of the background")
       ->check(CLI::Range(0.0, 255.0))
       ->capture_default_str();
+  int jpeg_quality = 0;
+  app.add_option("--jpeg-quality", jpeg_quality,
+                 "deliver every image (training and scenes) through JPEG at this quality, as an "
+                 "IP camera or a phone's stream does (0: lossless)")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
   bool from_edges = false;
   app.add_flag("--from-edges", from_edges,
                "locate every blob's parts the way touching parts are (hypotheses and the edge "
@@ -310,6 +316,13 @@ int main(int argc, char** argv) {
                  "FILE[:SIZE_PX] under the data directory, e.g. "
                  "shapes/tari1000/obj3_1.png:220 (size default 220)");
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  // What the camera delivers of a rendered image.
+  const auto delivered = [jpeg_quality](const cv::Mat& image) {
+    if (jpeg_quality <= 0) return image;
+    std::vector<uchar> bytes;
+    cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+    return cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+  };
   if (threads >= 0) cv::setNumThreads(threads);
 
   // Adaptive binarization needs a window wider than the widest part: the
@@ -355,8 +368,8 @@ int main(int argc, char** argv) {
               binarize.adaptive_window);
   for (size_t i = 0; i < types.size(); ++i) {
     const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;
-    const cv::Mat image = ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr,
-                                                    picksight::bench::kTrainAngleDeg);
+    const cv::Mat image = delivered(ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr,
+                                                              picksight::bench::kTrainAngleDeg));
     // The reference point's offset from the drawn centroid is what the
     // camera's blur takes from the drawing: measured without noise and
     // under even light, so that one image's noise is not counted in every
@@ -408,7 +421,7 @@ int main(int argc, char** argv) {
       o.seed = 1000 * (static_cast<uint64_t>(arrangement) + 1) + static_cast<uint64_t>(n);
       const ps::SilhouetteScene scene(types, chiral, o);
       for (int r = 0; r < rounds; ++r) {
-        const cv::Mat grey = scene.render(static_cast<uint64_t>(r));
+        const cv::Mat grey = delivered(scene.render(static_cast<uint64_t>(r)));
         std::vector<pv::Match> matches;
         double sink = 0;
         picksight::bench::timeInTurn<2>(
