@@ -6,9 +6,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <utility>
 
 #include "picksight/common/angles.hpp"
 
@@ -197,14 +199,59 @@ bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOp
 }
 }  // namespace
 
+namespace {
+// Invariants 2 to 6 are powers of how far a part departs from a disc: its
+// ellipticity squared (H2), its skew squared (H3, H4), higher products of
+// the two (H5, H6). Compared as plain logs, a near-round part's tiny values
+// weigh as much as a long part's large ones, so two real pieces of one
+// round part (a washer 3 % out of round, a coin, a cap; the trained one 5 %
+// out of round) lie 2-3 apart from where only one's pixels changed, while
+// both are discs to anyone. Below a floor, a deviation of kHuFloorShare of
+// the part's own second moment (H1) in each moment it is made of, an
+// invariant is taken for "round enough": log10(1 + |h| / floor) is 0 there
+// and log10|h| less a constant above it, where the distance is the plain
+// one. Both sides of a comparison take the model's floors.
+constexpr double kHuFloorShare = 0.1;
+// Degree of each invariant in the second-order (a) and third-order (b)
+// normalized moments, which scale as H1 and H1^1.5.
+constexpr std::array<std::pair<int, int>, 6> kHuDegrees = {
+    {{1, 0}, {2, 0}, {0, 2}, {0, 2}, {0, 4}, {1, 2}}};
+
+// The floors of H2..H6 for a part whose H1 is `h1`.
+std::array<double, 6> huFloors(double h1) {
+  const double second = kHuFloorShare * h1;                 // a second-order moment's
+  const double third = kHuFloorShare * h1 * std::sqrt(h1);  // a third-order one's
+  std::array<double, 6> floors{};
+  for (size_t i = 1; i < floors.size(); ++i) {
+    floors[i] = 1;
+    for (int k = 0; k < kHuDegrees[i].first; ++k) floors[i] *= second;
+    for (int k = 0; k < kHuDegrees[i].second; ++k) floors[i] *= third;
+  }
+  return floors;
+}
+
+double flooredLog(double log_h, size_t i, double floor) {
+  if (i == 0) return log_h;
+  // logHu writes 0 for an invariant that is exactly 0 (a square's H2).
+  if (log_h == 0) return 0;
+  // H2..H4 are sums of squares (positive, any size: their log inverts
+  // exactly); H5 and H6 carry a sign and stay below 1 in magnitude.
+  const bool positive = i <= 3;
+  const double value = std::log10(1 + std::pow(10.0, positive ? -log_h : -std::abs(log_h)) / floor);
+  return positive || log_h > 0 ? value : -value;
+}
+}  // namespace
+
 double huDistance(const BodyModel& body, const HuArray& log_hu) {
+  const auto floors = huFloors(std::pow(10.0, -body.log_hu[0]));
   double d = 0;
   // Not the 7th invariant: the only one a mirror changes (its sign), and on
   // a nearly mirror-symmetric part so small that lighting and resampling
   // set its sign. Which hand a region shows is decided on its boundary
   // (showsMirrorImage).
   for (size_t i = 0; i + 1 < log_hu.size(); ++i) {
-    if (body.hu_used[i]) d += std::abs(body.log_hu[i] - log_hu[i]);
+    if (body.hu_used[i])
+      d += std::abs(flooredLog(body.log_hu[i], i, floors[i]) - flooredLog(log_hu[i], i, floors[i]));
   }
   return d;
 }

@@ -147,7 +147,8 @@ bool showsMirrorImage(const PartModel& model, const ImagePose& direct, const Ima
 Result<void> validateModel(const PartModel& model);
 
 // Sum |H_i(a) - H_i(b)| over the invariants the model uses, the 7th (the
-// mirror's sign) left out.
+// mirror's sign) left out; H2..H6 compared above a floor set by the model's
+// H1 (part_model.cpp), below which a part counts as round.
 double huDistance(const BodyModel& body, const HuArray& log_hu);
 
 }  // namespace picksight::vision
