@@ -197,20 +197,19 @@ bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOp
   *out = logHu(huInvariants(regions.front().moments));
   return true;
 }
-}  // namespace
 
-namespace {
 // Invariants 2 to 6 are powers of how far a part departs from a disc: its
 // ellipticity squared (H2), its skew squared (H3, H4), higher products of
 // the two (H5, H6). Compared as plain logs, a near-round part's tiny values
-// weigh as much as a long part's large ones, so two real pieces of one
-// round part (a washer 3 % out of round, a coin, a cap; the trained one 5 %
-// out of round) lie 2-3 apart from where only one's pixels changed, while
-// both are discs to anyone. Below a floor, a deviation of kHuFloorShare of
-// the part's own second moment (H1) in each moment it is made of, an
-// invariant is taken for "round enough": log10(1 + |h| / floor) is 0 there
-// and log10|h| less a constant above it, where the distance is the plain
-// one. Both sides of a comparison take the model's floors.
+// weigh as much as a long part's large ones: in a photograph of sweets
+// taught from one, the other lone sweets lay 1.8-3.6 apart (tolerance 1.35),
+// and a washer taught 1 % out of round lost 4 of 5 pieces 0-4.5 % out of
+// round, while all are discs to anyone. Below a floor (a deviation of
+// kHuFloorShare of the part's own second moment, H1, in each moment the
+// invariant is made of) an invariant is taken for "round enough":
+// log10(1 + |h| / floor) is 0 there and log10|h| less a constant above it,
+// where the distance is the plain one. Both sides of a comparison take the
+// model's floors.
 constexpr double kHuFloorShare = 0.1;
 // Degree of each invariant in the second-order (a) and third-order (b)
 // normalized moments, which scale as H1 and H1^1.5.
