@@ -211,20 +211,21 @@ bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOp
 // where the distance is the plain one. Both sides of a comparison take the
 // model's floors.
 constexpr double kHuFloorShare = 0.1;
-// Degree of each invariant in the second-order (a) and third-order (b)
-// normalized moments, which scale as H1 and H1^1.5.
-constexpr std::array<std::pair<int, int>, 6> kHuDegrees = {
-    {{1, 0}, {2, 0}, {0, 2}, {0, 2}, {0, 4}, {1, 2}}};
+// Degree of H2..H6 in the second-order (a) and third-order (b) normalized
+// moments, which scale as H1 and H1^1.5 (H1 itself is compared as it is).
+constexpr std::array<std::pair<int, int>, 5> kHuDegrees = {
+    {{2, 0}, {0, 2}, {0, 2}, {0, 4}, {1, 2}}};
 
-// The floors of H2..H6 for a part whose H1 is `h1`.
+// The floors of H2..H6 (at 1..5) for a part whose H1 is `h1`.
 std::array<double, 6> huFloors(double h1) {
   const double second = kHuFloorShare * h1;                 // a second-order moment's
   const double third = kHuFloorShare * h1 * std::sqrt(h1);  // a third-order one's
   std::array<double, 6> floors{};
   for (size_t i = 1; i < floors.size(); ++i) {
     floors[i] = 1;
-    for (int k = 0; k < kHuDegrees[i].first; ++k) floors[i] *= second;
-    for (int k = 0; k < kHuDegrees[i].second; ++k) floors[i] *= third;
+    const auto [a, b] = kHuDegrees[i - 1];
+    for (int k = 0; k < a; ++k) floors[i] *= second;
+    for (int k = 0; k < b; ++k) floors[i] *= third;
   }
   return floors;
 }
