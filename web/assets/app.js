@@ -32,7 +32,10 @@
   // Every request resolves (never rejects): {ok, status, body} with body the
   // parsed JSON or {error: text}, so a panel shows the server's message.
   ps.request = async function (method, url, body) {
-    const init = { method, headers: {} };
+    const init = { method, headers: {}, credentials: "same-origin" };
+    // The server refuses changes without this header: a cross-site page
+    // cannot add it, nor post JSON, without a preflight it never grants.
+    if (method !== "GET") init.headers["X-PickSight"] = "1";
     if (body !== undefined) {
       init.headers["Content-Type"] = "application/json";
       init.body = JSON.stringify(body);

@@ -17,6 +17,7 @@ struct RawOptions {
   std::vector<std::string> video_servers;
   std::vector<std::string> vision_apps;
   std::string allow;
+  std::vector<std::string> allow_hosts;
   std::string config_file;
 };
 
@@ -76,6 +77,11 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
         auto list = AllowList::parse(v);
         return list ? std::string() : list.error().message;
       }));
+  app.add_option("--allow-host", raw.allow_hosts,
+                 "names and addresses this server answers to, as a request's Host and a "
+                 "browser's Origin give them (repeatable, or comma-separated; '*': any; default: "
+                 "localhost, loopback, this machine's names and addresses)")
+      ->take_all();
   app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of the streams")
       ->check(CLI::Range(10, 100))
       ->capture_default_str();
@@ -118,6 +124,9 @@ Result<WebOptions> parseWords(const std::vector<std::string>& args, bool* help,
                        "--vision-app: name '" + o.vision_apps.back().name + "' given twice");
   }
   if (!raw.allow.empty()) o.allow = *AllowList::parse(raw.allow);
+  for (const auto& v : raw.allow_hosts)
+    for (const auto& name : splitFields(v, ","))
+      if (!name.empty()) o.allow_hosts.emplace_back(name);
   return o;
 }
 

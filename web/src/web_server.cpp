@@ -25,6 +25,8 @@
 #include "picksight/web/event_hub.hpp"
 #include "picksight/web/metrics_text.hpp"
 #include "picksight/web/proto_json.hpp"
+#include "picksight/web/refusal_log.hpp"
+#include "picksight/web/request_guard.hpp"
 #include "picksight/web/result_feed.hpp"
 #include "picksight/web/web_errors.hpp"
 
@@ -35,6 +37,12 @@ using namespace std::chrono_literals;
 constexpr size_t kMaxBodyBytes = 64 * 1024;
 constexpr auto kKeepalive = 15s;
 constexpr const char* kBoundary = "picksightframe";
+// The page's own scripts, styles, images, streams and requests only; no
+// inline script, no frames, no plugins, no form posting elsewhere.
+constexpr const char* kContentSecurityPolicy =
+    "default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
+    "connect-src 'self'; font-src 'self'; form-action 'self'; frame-ancestors 'none'; "
+    "base-uri 'none'";
 
 // The one table from errors to HTTP statuses.
 int httpStatus(const Error& error) {
@@ -110,7 +118,10 @@ void setFrameHeaders(httplib::Response& res, uint64_t sequence, uint64_t timesta
 
 class WebServer::Impl {
  public:
-  explicit Impl(WebOptions options) : options_(std::move(options)) {
+  explicit Impl(WebOptions options)
+      : options_(std::move(options)),
+        hosts_(options_.allow_hosts.empty() ? HostNames::defaults(options_.listen_host)
+                                            : options_.allow_hosts) {
     if (options_.assets_dir.empty()) options_.assets_dir = defaultAssetsDir();
   }
   ~Impl() { stop(); }
@@ -119,6 +130,8 @@ class WebServer::Impl {
   void stop();
 
   WebOptions options_;
+  const HostNames hosts_;
+  RefusalLog refusals_{"HTTP"};
   zmq::context_t context_;
   EventHub events_;
   std::unique_ptr<CameraMonitor> cameras_;
@@ -159,14 +172,32 @@ Result<void> WebServer::Impl::start() {
   http_.set_write_timeout(5s);
   http_.set_read_timeout(10s);
   http_.set_keep_alive_timeout(5);
+  // On every response, refusals and errors too: no page may frame this one
+  // (clickjacking) nor run anything but the page's own files.
+  http_.set_default_headers({{"X-Frame-Options", "DENY"},
+                             {"Content-Security-Policy", kContentSecurityPolicy},
+                             {"X-Content-Type-Options", "nosniff"},
+                             {"Referrer-Policy", "no-referrer"},
+                             {"Cross-Origin-Opener-Policy", "same-origin"},
+                             {"Cross-Origin-Resource-Policy", "same-origin"}});
   http_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    if (peerAllowed(options_.allow, req.remote_addr))
-      return httplib::Server::HandlerResponse::Unhandled;
-    logWarning("refused HTTP request from ", req.remote_addr, " (not in --allow)");
-    sendError(res, makeError(WebErrc::kBadRequest,
-                             "forbidden: " + req.remote_addr + " is not in the allow-list"));
-    res.status = 403;
-    return httplib::Server::HandlerResponse::Handled;
+    const auto refuse = [&](int status, const std::string& message) {
+      refusals_.refused(req.remote_addr, req.method + " " + req.path + ": " + message);
+      sendJson(res, {{"error", message}}, status);
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    if (!peerAllowed(options_.allow, req.remote_addr))
+      return refuse(403, "forbidden: " + req.remote_addr + " is not in the allow-list");
+    RequestFacts facts;
+    facts.method = req.method;
+    facts.host = req.get_header_value("Host");
+    facts.has_origin = req.has_header("Origin");
+    facts.origin = req.get_header_value("Origin");
+    facts.content_type = req.get_header_value("Content-Type");
+    facts.request_header = req.get_header_value(kRequestHeader);
+    if (auto refusal = checkRequest(hosts_, facts))
+      return refuse(refusal->status, refusal->message);
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   routes();
   port_ =
@@ -178,6 +209,7 @@ Result<void> WebServer::Impl::start() {
     return makeError(WebErrc::kBadConfig, "cannot listen on " + options_.listen_host + ":" +
                                               std::to_string(options_.listen_port));
   }
+  logInfo("requests must name one of these hosts (--allow-host): ", hosts_.describe());
   thread_ = std::thread([this] { http_.listen_after_bind(); });
   return {};
 }

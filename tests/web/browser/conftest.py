@@ -97,8 +97,9 @@ class Cell:
     # HTTP, as the page uses it.
     def http(self, method, path, body=None):
         data = None if body is None else json.dumps(body).encode()
-        req = urllib.request.Request(self.url + path, data=data, method=method,
-                                     headers={"Content-Type": "application/json"} if data else {})
+        # What the page sends: a change needs JSON and the X-PickSight header.
+        headers = {"Content-Type": "application/json", "X-PickSight": "1"} if data else {}
+        req = urllib.request.Request(self.url + path, data=data, method=method, headers=headers)
         try:
             with urllib.request.urlopen(req, timeout=10) as r:
                 return r.status, r.read()

@@ -32,6 +32,9 @@ struct WebOptions {
   std::vector<VisionAppEndpoint> vision_apps;
   std::string assets_dir;  // empty: the build tree's or the installed page
   AllowList allow;         // checked on every request
+  // The names and addresses a request's Host and Origin may give (any case;
+  // "*": any); empty: HostNames::defaults (request_guard.hpp).
+  std::vector<std::string> allow_hosts;
   int jpeg_quality = 80;
   // Concurrent MJPEG and event streams; beyond it a 503, so that streams
   // never take every HTTP thread and starve the page.

@@ -1,0 +1,154 @@
+// picksight-web refusing what a hostile page or network could send: a
+// cross-site form post, a rebinding page's foreign Host, requests that a
+// form could make; written as raw HTTP against a real cell, and checked by
+// what did not change (the model is still there, the camera still open).
+#include <nlohmann/json.hpp>
+
+#include "raw_http.hpp"
+#include "web_fixture.hpp"
+
+namespace picksight::webtest {
+namespace {
+using namespace std::chrono_literals;
+using e2e::VideoServerProcess;
+using e2e::VisionProcess;
+using nlohmann::json;
+
+// A POST as raw bytes: `headers` are whole lines, each ending in CRLF.
+std::string rawPost(int port, const std::string& path, const std::string& headers,
+                    const std::string& body) {
+  return rawRequest(port, "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+                              "\r\n" + headers + "Content-Length: " + std::to_string(body.size()) +
+                              "\r\nConnection: close\r\n\r\n" + body);
+}
+
+std::string rawGet(int port, const std::string& path, const std::string& host) {
+  return rawRequest(port,
+                    "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+}
+
+std::string cameraState(const WebProcess& web) {
+  auto res = web.client().Get("/api/cameras");
+  REQUIRE(res);
+  const json cameras = json::parse(res->body);
+  REQUIRE(cameras.is_array());
+  REQUIRE(!cameras.empty());
+  return cameras[0].value("state", "");
+}
+
+}  // namespace
+
+TEST_CASE("a cross-site form post neither forgets a model nor closes the camera",
+          "[web][security]") {
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=1", "--fps", "10"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  auto learned = robot.request("LEARN 4", 10s);
+  REQUIRE(learned);
+  REQUIRE(learned->rfind("OK 4 ", 0) == 0);
+  WebProcess web({"--video-server", server.frames + "," + server.control, "--vision-app",
+                  "cam0,none,127.0.0.1:" + std::to_string(vision.robot_port)});
+  REQUIRE(pollUntil([&] { return cameraState(web) == "streaming"; }));
+  const int port = web.port;
+  const std::string forget = R"({"line":"FORGET 4","x":"="})";
+  const std::string command = "/api/apps/cam0/command";
+  const std::string self = "Origin: http://127.0.0.1:" + std::to_string(port) + "\r\n";
+
+  // The issue's exact attack: a form's text/plain body, a foreign Origin.
+  std::string res = rawPost(
+      port, command, "Origin: http://attacker.example\r\nContent-Type: text/plain\r\n", forget);
+  CHECK(statusOf(res) == 403);
+  CHECK(json::parse(bodyOf(res))["error"].get<std::string>().find("Origin") != std::string::npos);
+  // Each defence alone refuses it: a form's type from the page's own origin,
+  // JSON without the header a form cannot add, a foreign Origin with both.
+  res = rawPost(port, command, self + "Content-Type: text/plain\r\nX-PickSight: 1\r\n", forget);
+  CHECK(statusOf(res) == 415);
+  res =
+      rawPost(port, command, self + "Content-Type: application/x-www-form-urlencoded\r\n", forget);
+  CHECK(statusOf(res) == 415);
+  res = rawPost(port, command, self + "Content-Type: application/json\r\n", forget);
+  CHECK(statusOf(res) == 403);
+  res = rawPost(port, command,
+                "Origin: null\r\nContent-Type: application/json\r\nX-PickSight: 1\r\n", forget);
+  CHECK(statusOf(res) == 403);
+  res = rawPost(port, command,
+                "Origin: http://127.0.0.1.attacker.example:" + std::to_string(port) +
+                    "\r\nContent-Type: application/json\r\nX-PickSight: 1\r\n",
+                forget);
+  CHECK(statusOf(res) == 403);
+  // The camera close, likewise.
+  res = rawPost(port, "/api/cameras/cam0/close",
+                "Origin: http://attacker.example\r\nContent-Type: text/plain\r\n", "{}");
+  CHECK(statusOf(res) == 403);
+  res = rawPost(port, "/api/cameras/cam0/close", "Content-Type: text/plain\r\n", "{}");
+  CHECK(statusOf(res) == 415);
+
+  // Nothing changed: the model is still there, the camera still streams.
+  auto models = robot.request("MODELS", 5s);
+  REQUIRE(models);
+  CHECK(models->rfind("OK 1", 0) == 0);
+  CHECK(cameraState(web) == "streaming");
+
+  // The page's own request does it (so the checks above could see a change).
+  res =
+      rawPost(port, command,
+              self + "Content-Type: application/json; charset=utf-8\r\nX-PickSight: 1\r\n", forget);
+  CHECK(statusOf(res) == 200);
+  CHECK(json::parse(bodyOf(res))["reply"] == "OK");
+  CHECK(*robot.request("MODELS", 5s) == "OK 0");
+  res = rawPost(port, "/api/cameras/cam0/close",
+                "Content-Type: application/json\r\nX-PickSight: 1\r\n", "{}");
+  CHECK(statusOf(res) == 200);
+  CHECK(pollUntil([&] { return cameraState(web) == "closed"; }));
+}
+
+TEST_CASE("a foreign Host is refused, reads too (DNS rebinding)", "[web][security]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
+  WebProcess web(videoServerArgs(server));
+  const int port = web.port;
+  const std::string p = ":" + std::to_string(port);
+  for (const char* path : {"/", "/api/cameras", "/snapshot/cam0.png", "/frame/cam0.jpg", "/events",
+                           "/metrics", "/static/app.js"}) {
+    CAPTURE(path);
+    const std::string res = rawGet(port, path, "rebind.attacker.example" + p);
+    CHECK(statusOf(res) == 403);
+    CHECK(bodyOf(res).find("Host") != std::string::npos);
+  }
+  CHECK(statusOf(rawRequest(port, "GET /api/cameras HTTP/1.0\r\n\r\n")) == 400);
+  // The machine's own names, in any case, with or without the port.
+  for (const std::string& host : std::vector<std::string>{
+           "127.0.0.1" + p, "localhost" + p, "LOCALHOST", "[::1]" + p, "localhost." + p}) {
+    CAPTURE(host);
+    CHECK(statusOf(rawGet(port, "/api/cameras", host)) == 200);
+  }
+}
+
+TEST_CASE("the hosts the server answers to are those of --allow-host", "[web][security]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
+  auto args = videoServerArgs(server);
+  args.insert(args.end(), {"--allow-host", "cell7.example,127.0.0.1"});
+  WebProcess web(args);
+  CHECK(statusOf(rawGet(web.port, "/api/cameras", "Cell7.Example:8443")) == 200);
+  CHECK(statusOf(rawGet(web.port, "/api/cameras", "127.0.0.1")) == 200);
+  CHECK(statusOf(rawGet(web.port, "/api/cameras", "localhost")) == 403);
+}
+
+TEST_CASE("every response forbids framing, foreign scripts and type sniffing", "[web][security]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
+  WebProcess web(videoServerArgs(server));
+  const std::string host = "127.0.0.1:" + std::to_string(web.port);
+  for (const std::string& res :
+       std::vector<std::string>{rawGet(web.port, "/", host), rawGet(web.port, "/nothing", host),
+                                rawGet(web.port, "/api/cameras", "attacker.example")}) {
+    CHECK(headerOf(res, "X-Frame-Options") == "DENY");
+    CHECK(headerOf(res, "X-Content-Type-Options") == "nosniff");
+    const std::string csp = headerOf(res, "Content-Security-Policy");
+    CHECK(csp.find("default-src 'none'") != std::string::npos);
+    CHECK(csp.find("script-src 'self'") != std::string::npos);
+    CHECK(csp.find("frame-ancestors 'none'") != std::string::npos);
+    CHECK(csp.find("unsafe") == std::string::npos);
+  }
+}
+
+}  // namespace picksight::webtest
