@@ -151,4 +151,40 @@ TEST_CASE("every response forbids framing, foreign scripts and type sniffing", "
   }
 }
 
+TEST_CASE("malformed input gets a 4xx with a plain message, never a 500 with internals",
+          "[web][security]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
+  WebProcess web({"--video-server", server.frames + "," + server.control, "--vision-app",
+                  "cam0,none,127.0.0.1:1"});
+  const int port = web.port;
+  const std::string json_post = "Content-Type: application/json\r\nX-PickSight: 1\r\n";
+  struct Case {
+    std::string response;
+    int status;
+  };
+  const std::vector<Case> cases = {
+      {rawPost(port, "/api/apps/cam0/command", json_post, R"({"line": 1e999})"), 400},
+      {rawPost(port, "/api/cameras/cam0/roi", json_post, R"({"x": -1e999})"), 400},
+      {rawPost(port, "/api/cameras/cam0/feature", json_post, "{\"name\": \"\xff\"}"), 400},
+      {rawGet(port, "/static/%ff", "127.0.0.1"), 404},
+      {rawGet(port, "/static/%ff%fe.js", "127.0.0.1"), 404},
+      {rawGet(port, "/snapshot/%ff.png", "127.0.0.1"), 404},
+      {rawGet(port, "/no/such/route", "127.0.0.1"), 404},
+      {rawRequest(port, "BREW / HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n"), 400},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.response.substr(0, 300));
+    CHECK(statusOf(c.response) == c.status);
+    CHECK(headerOf(c.response, "EXCEPTION_WHAT").empty());
+    const json body = json::parse(bodyOf(c.response), nullptr, false);
+    REQUIRE(body.is_object());
+    const std::string error = body.value("error", "");
+    CHECK(!error.empty());
+    CHECK(error.find("json.exception") == std::string::npos);
+  }
+  // The overflowing number is named as such.
+  CHECK_THAT(json::parse(bodyOf(cases[0].response))["error"].get<std::string>(),
+             Catch::Contains("1e999"));
+}
+
 }  // namespace picksight::webtest

@@ -54,14 +54,26 @@ Result<std::string> text(const nlohmann::json& body, const std::string& field, b
 
 }  // namespace
 
+std::string plainJsonMessage(const nlohmann::json::exception& e) {
+  std::string message = e.what();
+  // "[json.exception.out_of_range.406] number overflow ...": the tag names
+  // the library's internals, the rest the problem.
+  if (message.rfind("[json.exception.", 0) == 0) {
+    const size_t end = message.find("] ");
+    if (end != std::string::npos) message.erase(0, end + 2);
+  }
+  return message;
+}
+
 Result<nlohmann::json> parseJsonBody(const std::string& body) {
   if (body.find_first_not_of(" \t\r\n") == std::string::npos) return nlohmann::json::object();
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(body);
-  } catch (const nlohmann::json::parse_error& e) {
-    // The message says where and what ("syntax error while parsing ...").
-    return makeError(WebErrc::kBadRequest, std::string("bad JSON: ") + e.what());
+  } catch (const nlohmann::json::exception& e) {
+    // Syntax errors and numbers out of range ({"line": 1e999}) alike: the
+    // parser's words say where and what, without its exception's tag.
+    return makeError(WebErrc::kBadRequest, "bad JSON: " + plainJsonMessage(e));
   }
   if (!j.is_object()) return makeError(WebErrc::kBadRequest, "the body must be a JSON object");
   return j;

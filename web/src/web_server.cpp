@@ -63,7 +63,30 @@ int httpStatus(const Error& error) {
 void sendJson(httplib::Response& res, const nlohmann::json& body, int status = 200) {
   res.status = status;
   res.set_header("Cache-Control", "no-store");
-  res.set_content(body.dump(), "application/json");
+  // Messages may quote what a client sent: bytes that are not UTF-8 are
+  // replaced, never a reason to fail the response.
+  res.set_content(body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                  "application/json");
+}
+
+// The words of the statuses httplib answers by itself.
+std::string statusText(int status) {
+  switch (status) {
+    case 400:
+      return "bad request";
+    case 404:
+      return "not found";
+    case 405:
+      return "method not allowed";
+    case 413:
+      return "request body too large";
+    case 414:
+      return "request URI too long";
+    case 416:
+      return "range not satisfiable";
+    default:
+      return "HTTP " + std::to_string(status);
+  }
 }
 
 void sendError(httplib::Response& res, const Error& error) {
@@ -180,6 +203,28 @@ Result<void> WebServer::Impl::start() {
                              {"Referrer-Policy", "no-referrer"},
                              {"Cross-Origin-Opener-Policy", "same-origin"},
                              {"Cross-Origin-Resource-Policy", "same-origin"}});
+  // A handler's exception is a bug: logged here, and the client gets a
+  // plain 500 (httplib's default would quote the exception in a header).
+  http_.set_exception_handler(
+      [](const httplib::Request& req, httplib::Response& res, std::exception_ptr error) {
+        std::string what = "unknown exception";
+        try {
+          if (error) std::rethrow_exception(error);
+        } catch (const std::exception& e) {
+          what = e.what();
+        } catch (...) {
+        }
+        logError("HTTP ", req.method, " ", req.path.substr(0, 120), ": ", what);
+        sendJson(res, {{"error", "internal error (logged by picksight-web)"}}, 500);
+      });
+  // Errors httplib answers itself (no route, a malformed request line, a
+  // body over the limit) get a message too, in the API's form.
+  http_.set_error_handler(
+      httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+        sendJson(res, {{"error", statusText(res.status)}}, res.status);
+        return httplib::Server::HandlerResponse::Handled;
+      }));
   http_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     const auto refuse = [&](int status, const std::string& message) {
       refusals_.refused(req.remote_addr, req.method + " " + req.path + ": " + message);
@@ -230,7 +275,7 @@ void WebServer::Impl::serveFile(const std::string& relative, httplib::Response& 
   }
   std::ifstream in(options_.assets_dir + "/" + relative, std::ios::binary);
   if (!in) {
-    sendError(res, WebErrc::kNotFound, "no file '" + relative + "' in " + options_.assets_dir);
+    sendError(res, WebErrc::kNotFound, "no file '" + relative + "'");
     return;
   }
   std::ostringstream bytes;

@@ -12,6 +12,10 @@
 
 namespace picksight::web {
 
+// A JSON library exception's message without its "[json.exception.X.N] "
+// tag: what a client may read.
+std::string plainJsonMessage(const nlohmann::json::exception& e);
+
 // The JSON object of a request body (an empty body is {}); kBadRequest names
 // the problem (bad JSON, not an object).
 Result<nlohmann::json> parseJsonBody(const std::string& body);
