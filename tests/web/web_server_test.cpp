@@ -444,6 +444,32 @@ TEST_CASE("a command line goes to the vision app and its reply comes back", "[we
   CHECK(json::parse(res->body).contains("error"));
 }
 
+TEST_CASE("the first command after the app's idle timeout is executed, not answered ERROR 16",
+          "[web]") {
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=1", "--mode", "trigger"});
+  VisionProcess vision(server, "cam0", "", {"--robot-idle-timeout", "1"});
+  WebProcess web({"--video-server", server.frames + "," + server.control, "--vision-app",
+                  "cam0,none,127.0.0.1:" + std::to_string(vision.robot_port)});
+  const auto reply = [&](const std::string& line) {
+    auto res = postJson(web, "/api/apps/cam0/command", json{{"line", line}}.dump());
+    REQUIRE(res);
+    REQUIRE(res->status == 200);
+    return json::parse(res->body)["reply"].get<std::string>();
+  };
+  CHECK(reply("STATUS").rfind("OK", 0) == 0);
+  for (int round = 0; round < 2; ++round) {
+    // Past the app's idle timeout: it has sent ERROR 16 on the kept
+    // connection and closed it.
+    std::this_thread::sleep_for(1800ms);
+    const std::string learned = reply("LEARN 4");
+    CAPTURE(learned);
+    CHECK(learned.rfind("OK 4 ", 0) == 0);
+  }
+  auto robot = vision.connect();
+  CHECK(robot.request("MODELS", 5s)->rfind("OK 1", 0) == 0);
+}
+
 TEST_CASE("peers outside the allow-list get 403", "[web]") {
   VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
   auto args = videoServerArgs(server);

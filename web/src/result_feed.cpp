@@ -31,6 +31,10 @@ class ConnectionMonitor : public zmq::monitor_t {
   std::atomic<bool>& connected_;
 };
 
+// The line a vision app sends when it closes a connection for idleness
+// (docs/PROTOCOL.md, error 16): never the reply to a request.
+bool isIdleClose(const std::string& reply) { return reply.rfind("ERROR 16 ", 0) == 0; }
+
 }  // namespace
 
 ResultFeed::ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events)
@@ -204,8 +208,11 @@ Result<std::string> ResultFeed::command(const std::string& line) {
     return makeError(WebErrc::kBadRequest, "command line contains CR or LF");
   std::lock_guard<std::mutex> lock(line_mutex_);
   // A kept connection the app has closed meanwhile (restart, idle timeout)
-  // fails at once: then once more on a fresh one. A reply that timed out is
-  // never sent again (the app may have acted on it).
+  // fails at once, or answers with the line the app sent as it closed it
+  // (ERROR 16 after its idle timeout, waiting unread in our socket): then
+  // once more on a fresh one. The app executes nothing on a connection it
+  // closes for idleness, so the resend cannot run a command twice. A reply
+  // that timed out is never sent again (the app may have acted on it).
   Error last;
   for (int attempt = 0; attempt < 2; ++attempt) {
     const bool reused = line_.isOpen();
@@ -220,8 +227,8 @@ Result<std::string> ResultFeed::command(const std::string& line) {
     }
     const auto start = std::chrono::steady_clock::now();
     auto reply = line_.request(line, kReplyTimeout);
-    if (reply) return reply;
-    last = reply.error();
+    if (reply && !(reused && isIdleClose(*reply))) return reply;
+    last = reply ? makeError(WebErrc::kUnreachable, *reply) : reply.error();
     line_.close();
     if (!reused || std::chrono::steady_clock::now() - start > 1s) break;
   }
