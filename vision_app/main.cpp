@@ -87,10 +87,10 @@ int main(int argc, char** argv) {
     if (results) std::cout << "results " << results->endpoint() << "\n";
     std::cout << "ready" << std::endl;
     logInfo("camera ", options->camera, " from ", options->frames_endpoint, ", robots on ",
-            options->robot.bind_address, ":", robots.port(), read_only ? " (read-only)" : "",
-            ", allowed: ", options->robot.allow.describe());
+            options->robot.listen.bind_address, ":", robots.port(), read_only ? " (read-only)" : "",
+            ", allowed: ", options->robot.listen.allow.describe());
     if (setup) {
-      logInfo("set-up port on ", options->setup->bind_address, ":", setup->port());
+      logInfo("set-up port on ", options->setup->listen.bind_address, ":", setup->port());
     }
     if (results) {
       logInfo("results ", results->endpoint(), " (topic ",
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       logInfo("PLCs on Modbus port ", plc->port(), " (unit ",
               static_cast<int>(options->plc.device.unit_id), ", word order ",
               plc::wordOrderName(options->plc.device.word_order), ", allowed ",
-              options->plc.server.allow.describe(), ")");
+              options->plc.server.listen.allow.describe(), ")");
     }
     // The robot port is listening: a robot program started after us connects.
     notifier.ready("camera " + options->camera + ", robot port " + std::to_string(robots.port()));

@@ -60,8 +60,8 @@ struct Port {
     device = std::make_unique<PlcDevice>(
         device_options, cell.locator(), [] { return kFrameVisionMm; },
         [](const Error& e) { return e.code == std::errc::timed_out ? 20 : 99; });
-    server_options.bind_address = "127.0.0.1";
-    server_options.port = 0;
+    server_options.listen.bind_address = "127.0.0.1";
+    server_options.listen.port = 0;
     server = std::make_unique<ModbusServer>(server_options, *device);
     device->start();
     server->start();
@@ -280,7 +280,7 @@ TEST_CASE("peers outside the allow-list and beyond the connection cap are closed
           "[plc][server]") {
   {
     ModbusServerOptions options;
-    options.allow = *AllowList::parse("10.1.2.0/24");
+    options.listen.allow = *AllowList::parse("10.1.2.0/24");
     Port port({}, options);
     modbus_t* ctx = modbus_new_tcp("127.0.0.1", port.server->port());
     modbus_set_response_timeout(ctx, 5, 0);
@@ -291,7 +291,7 @@ TEST_CASE("peers outside the allow-list and beyond the connection cap are closed
     modbus_free(ctx);
   }
   ModbusServerOptions options;
-  options.max_connections = 2;
+  options.listen.max_connections = 2;
   Port port({}, options);
   ModbusClient a(port.server->port());
   ModbusClient b(port.server->port());
@@ -309,7 +309,7 @@ TEST_CASE("peers outside the allow-list and beyond the connection cap are closed
 
 TEST_CASE("a silent connection is closed after the idle timeout", "[plc][server]") {
   ModbusServerOptions options;
-  options.idle_timeout = std::chrono::milliseconds(200);
+  options.listen.idle_timeout = std::chrono::milliseconds(200);
   Port port({}, options);
   ModbusClient plc(port.server->port());
   CHECK(plc.status() == kStatusReady);

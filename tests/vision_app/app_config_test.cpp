@@ -48,8 +48,8 @@ TEST_CASE("Config file keys are the options without dashes", "[vision_app][confi
   CHECK(o->frames_endpoint == "tcp://10.0.0.2:5555");
   CHECK(o->control_endpoint == "tcp://10.0.0.2:5556");
   CHECK(o->camera == "line1");
-  CHECK(o->robot.port == 7000);
-  CHECK(o->robot.bind_address == "127.0.0.1");
+  CHECK(o->robot.listen.port == 7000);
+  CHECK(o->robot.listen.bind_address == "127.0.0.1");
   CHECK(o->data_dir == "/srv/cell");
   CHECK(o->vision.binarize.method == vision::ThresholdMethod::kFixed);
   CHECK(o->vision.binarize.fixed_threshold == 100);
@@ -64,11 +64,11 @@ TEST_CASE("Command line options override the config file", "[vision_app][config]
   // Before or after --config: the command line wins either way.
   auto before = parse({"--robot-port", "7001", "--config", path});
   REQUIRE(before);
-  CHECK(before->robot.port == 7001);
+  CHECK(before->robot.listen.port == 7001);
   CHECK(before->camera == "line1");
   auto after = parse({"--config", path, "--robot-port", "0"});
   REQUIRE(after);
-  CHECK(after->robot.port == 0);
+  CHECK(after->robot.listen.port == 0);
 }
 
 TEST_CASE("An empty config file changes nothing", "[vision_app][config]") {
@@ -76,7 +76,7 @@ TEST_CASE("An empty config file changes nothing", "[vision_app][config]") {
   auto o = parse({"--config", dir.write("cell.yaml", "# nothing yet\n")});
   REQUIRE(o);
   CHECK(o->camera == app::AppOptions().camera);
-  CHECK(o->robot.port == app::AppOptions().robot.port);
+  CHECK(o->robot.listen.port == app::AppOptions().robot.listen.port);
 }
 
 TEST_CASE("The packaged example config parses", "[vision_app][config]") {
@@ -85,7 +85,7 @@ TEST_CASE("The packaged example config parses", "[vision_app][config]") {
   auto o = parse({"--config", path});
   REQUIRE(o);
   CHECK(o->camera == "cam0");
-  CHECK(o->robot.port == 5600);
+  CHECK(o->robot.listen.port == 5600);
   CHECK(o->frames_endpoint == "tcp://127.0.0.1:5555");
 }
 

@@ -24,15 +24,15 @@ std::string echo(std::string_view line) {
 
 app::RobotServerOptions loopback() {
   app::RobotServerOptions o;
-  o.bind_address = "127.0.0.1";
-  o.port = 0;
+  o.listen.bind_address = "127.0.0.1";
+  o.listen.port = 0;
   return o;
 }
 
 struct Server {
   explicit Server(size_t max_connections = 64) {
     app::RobotServerOptions o = loopback();
-    o.max_connections = max_connections;
+    o.listen.max_connections = max_connections;
     start(o);
   }
   explicit Server(const app::RobotServerOptions& o) { start(o); }
@@ -144,7 +144,7 @@ TEST_CASE("a peer outside the allow-list gets ERROR 15 and is closed",
   app::RobotServerOptions o = loopback();
   auto list = AllowList::parse("10.0.0.0/8");
   REQUIRE(list);
-  o.allow = *list;
+  o.listen.allow = *list;
   Server refusing(o);
   for (int i = 0; i < 3; ++i) {  // every time, logged once
     auto c = refusing.connect();
@@ -153,7 +153,7 @@ TEST_CASE("a peer outside the allow-list gets ERROR 15 and is closed",
     CHECK(reply->rfind("ERROR 15 address 127.0.0.1 is not allowed", 0) == 0);
     CHECK_FALSE(c.readLine(2s));  // closed
   }
-  o.allow = *AllowList::parse("10.0.0.0/8 127.0.0.0/8");
+  o.listen.allow = *AllowList::parse("10.0.0.0/8 127.0.0.0/8");
   Server allowing(o);
   auto c = allowing.connect();
   CHECK(*c.request("PING", 2s) == "OK 4 PING");
@@ -162,7 +162,7 @@ TEST_CASE("a peer outside the allow-list gets ERROR 15 and is closed",
 TEST_CASE("connections beyond the per-address limit are told why and closed",
           "[vision_app][robot_server]") {
   app::RobotServerOptions o = loopback();
-  o.max_per_address = 2;
+  o.listen.max_per_address = 2;
   Server s(o);
   std::vector<LineClient> held;
   CHECK(beyondTwo(s, held).rfind(
@@ -173,7 +173,7 @@ TEST_CASE("connections beyond the per-address limit are told why and closed",
 TEST_CASE("an idle or trickling connection gets ERROR 16 and is closed",
           "[vision_app][robot_server]") {
   app::RobotServerOptions o = loopback();
-  o.idle_timeout = 300ms;
+  o.listen.idle_timeout = 300ms;
   Server s(o);
   auto idle = s.connect();
   auto trickling = s.connect();
@@ -191,8 +191,8 @@ TEST_CASE("an idle or trickling connection gets ERROR 16 and is closed",
 TEST_CASE("64 idle connections lock robots out only until the idle timeout",
           "[vision_app][robot_server]") {
   app::RobotServerOptions o = loopback();
-  o.idle_timeout = 1s;
-  o.max_per_address = 0;  // all from loopback: the total is what is tested
+  o.listen.idle_timeout = 1s;
+  o.listen.max_per_address = 0;  // all from loopback: the total is what is tested
   Server s(o);
   std::vector<LineClient> idle;
   for (int i = 0; i < 64; ++i) {

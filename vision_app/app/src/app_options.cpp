@@ -86,7 +86,7 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
                  "TCP port for robot controllers (default 5600, 0 = any free)")
       ->type_name("PORT")
       ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
-  app.add_option("--bind", o.robot.bind_address,
+  app.add_option("--bind", o.robot.listen.bind_address,
                  "address the robot port listens on (robots are other hosts: all interfaces)")
       ->type_name("ADDRESS")
       ->capture_default_str();
@@ -147,7 +147,8 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
                  "TCP port of the PLC (Modbus TCP) server; absent = no PLC port, 0 = any free")
       ->type_name("PORT")
       ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
-  app.add_option("--modbus-bind", o.plc.server.bind_address, "address the Modbus port listens on")
+  app.add_option("--modbus-bind", o.plc.server.listen.bind_address,
+                 "address the Modbus port listens on")
       ->type_name("ADDRESS")
       ->capture_default_str();
   app.add_option("--modbus-unit", raw.modbus_unit, "Modbus unit id answered (default 1)")
@@ -207,16 +208,17 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
     extras->given = givenOptions(app);
   }
   // The validators accepted these: the conversions cannot fail.
-  if (!raw.robot_port.empty()) o.robot.port = static_cast<uint16_t>(*parseInt(raw.robot_port));
-  if (!raw.robot_allow.empty()) o.robot.allow = *AllowList::parse(raw.robot_allow);
+  if (!raw.robot_port.empty())
+    o.robot.listen.port = static_cast<uint16_t>(*parseInt(raw.robot_port));
+  if (!raw.robot_allow.empty()) o.robot.listen.allow = *AllowList::parse(raw.robot_allow);
   if (!raw.robot_idle_timeout.empty())
-    o.robot.idle_timeout = std::chrono::seconds(*parseInt(raw.robot_idle_timeout));
+    o.robot.listen.idle_timeout = std::chrono::seconds(*parseInt(raw.robot_idle_timeout));
   if (!raw.robot_per_address.empty())
-    o.robot.max_per_address = static_cast<size_t>(*parseInt(raw.robot_per_address));
+    o.robot.listen.max_per_address = static_cast<size_t>(*parseInt(raw.robot_per_address));
   if (!raw.setup_port.empty()) {
     o.setup = o.robot;
-    o.setup->port = static_cast<uint16_t>(*parseInt(raw.setup_port));
-    o.setup->bind_address = raw.setup_bind;
+    o.setup->listen.port = static_cast<uint16_t>(*parseInt(raw.setup_port));
+    o.setup->listen.bind_address = raw.setup_bind;
     o.setup->label = "setup";
   }
   if (raw.threshold == "adaptive") {
@@ -236,10 +238,10 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
   if (!raw.min_area.empty()) o.vision.regions.min_area = *parseDouble(raw.min_area);
   if (!raw.min_hole_area.empty()) o.vision.regions.min_hole_area = *parseDouble(raw.min_hole_area);
   o.plc.enabled = !raw.modbus_port.empty();
-  if (o.plc.enabled) o.plc.server.port = static_cast<uint16_t>(*parseInt(raw.modbus_port));
+  if (o.plc.enabled) o.plc.server.listen.port = static_cast<uint16_t>(*parseInt(raw.modbus_port));
   if (!raw.modbus_unit.empty())
     o.plc.device.unit_id = static_cast<uint8_t>(*parseInt(raw.modbus_unit));
-  if (!raw.modbus_allow.empty()) o.plc.server.allow = *AllowList::parse(raw.modbus_allow);
+  if (!raw.modbus_allow.empty()) o.plc.server.listen.allow = *AllowList::parse(raw.modbus_allow);
   if (!raw.modbus_word_order.empty())
     o.plc.device.word_order = *plc::parseWordOrder(raw.modbus_word_order);
   if (!raw.curve_server_key.empty()) {

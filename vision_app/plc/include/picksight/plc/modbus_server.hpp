@@ -1,5 +1,5 @@
-// The Modbus TCP server PLCs connect to: listens, refuses peers the
-// allow-list does not name, frames each connection's requests and hands
+// The Modbus TCP server PLCs connect to: admits peers as TcpListener does
+// on every PickSight port, frames each connection's requests and hands
 // them to a PlcDevice (which replies with libmodbus). One socket thread
 // serves every connection (a request costs microseconds: a LOCATE runs on
 // the device's worker), so the robot port, which has threads of its own,
@@ -10,22 +10,23 @@
 #pragma once
 
 #include <atomic>
-#include <chrono>
-#include <cstdint>
-#include <string>
 #include <thread>
 
-#include "picksight/common/allow_list.hpp"
+#include "picksight/common/tcp_listener.hpp"
 #include "picksight/plc/plc_device.hpp"
 
 namespace picksight::plc {
 
 struct ModbusServerOptions {
-  std::string bind_address = "0.0.0.0";
-  uint16_t port = 502;                            // 0 = any free port (read it back with port())
-  AllowList allow;                                // empty: every peer
-  size_t max_connections = 16;                    // more are closed at once
-  std::chrono::milliseconds idle_timeout{60000};  // a silent connection is closed
+  // Where and whom: the admission policy every PickSight port shares (a
+  // silent connection is closed after idle_timeout).
+  TcpListenerOptions listen = [] {
+    TcpListenerOptions o;
+    o.port = 502;
+    o.max_connections = 16;
+    o.max_per_address = 8;
+    return o;
+  }();
 };
 
 class ModbusServer {
@@ -36,10 +37,10 @@ class ModbusServer {
   ModbusServer(const ModbusServer&) = delete;
   ModbusServer& operator=(const ModbusServer&) = delete;
 
-  uint16_t port() const { return port_; }
+  uint16_t port() const { return listener_.port(); }
   void start();
   void stop();
-  size_t connections() const { return connections_.load(); }
+  size_t connections() const { return listener_.connections(); }
 
  private:
   void loop();
@@ -47,11 +48,9 @@ class ModbusServer {
   const ModbusServerOptions options_;
   PlcDevice& device_;
   modbus_t* replier_ = nullptr;  // a context for replies, pointed at each connection in turn
-  int listen_fd_ = -1;
-  uint16_t port_ = 0;
+  TcpListener listener_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
-  std::atomic<size_t> connections_{0};
 };
 
 }  // namespace picksight::plc
