@@ -191,3 +191,35 @@ TEST_CASE("picksight-calib reads a known tilted camera from a CSV with every fit
     CHECK(picksight::angleDiffDeg(row.rz, -179.0) < 0.1);
   std::remove(path.c_str());
 }
+
+TEST_CASE("picksight-calib on the paper's Table 2 reads its origin and rotation",
+          "[calibration][cli]") {
+  // The 17 point pairs the paper publishes (tests/data/calibration/
+  // paper_table2/README.md): a least-squares rigid fit places the vision
+  // frame at (328.4, -614.4) mm turned 181.0 degrees; the similarity and the
+  // homography are printed beside it, so a reader sees what a scale or a
+  // tilt would change.
+  const std::string path =
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/calibration/paper_table2/points.csv";
+  const Run r = calib({"--csv", path});
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("inliers 17 of 17") != std::string::npos);
+  const auto lsq = fitRow(r.out, "lsq");
+  REQUIRE(lsq);
+  CHECK(lsq->model == "rigid");
+  CHECK(lsq->dx == Approx(328.4).margin(0.1));
+  CHECK(lsq->dy == Approx(-614.4).margin(0.1));
+  CHECK(picksight::angleDiffDeg(lsq->rz, 181.0) < 0.05);
+  CHECK(lsq->inliers == 17);
+  const auto similarity = fitRow(r.out, "similarity"), homography = fitRow(r.out, "homography");
+  REQUIRE(similarity);
+  REQUIRE(homography);
+  CHECK(similarity->model == "similarity");
+  CHECK(homography->model == "homography");
+  // Whole-millimetre vision coordinates: every fit is about a millimetre off.
+  for (const auto& row : {*lsq, *similarity, *homography}) {
+    CHECK(row.rms > 0.5);
+    CHECK(row.rms < 2.0);
+  }
+}
