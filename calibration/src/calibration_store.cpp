@@ -198,15 +198,10 @@ Result<void> CalibrationStore::load() {
     if (const auto l = root["lens"]) {
       LensModel lens;
       lens.image_size = cv::Size(l["image_width"].as<int>(), l["image_height"].as<int>());
-      const auto k = l["camera_matrix"].as<std::vector<double>>();
-      if (k.size() != 9) throw std::runtime_error("lens camera_matrix must have 9 values");
-      for (int i = 0; i < 9; ++i) lens.camera_matrix(i / 3, i % 3) = k[static_cast<size_t>(i)];
+      lens.camera_matrix = matrix(l, "camera_matrix", "lens.");
       lens.distortion = l["distortion"].as<std::vector<double>>();
       if (lens.distortion.size() < 4)
         throw std::runtime_error("lens distortion needs at least 4 values");
-      for (double v : k) {
-        if (!std::isfinite(v)) throw std::runtime_error("lens.camera_matrix is not all finite");
-      }
       for (double v : lens.distortion) {
         if (!std::isfinite(v)) throw std::runtime_error("lens.distortion is not all finite");
       }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <utility>
@@ -113,6 +114,64 @@ void printKeyValues(std::ostream& out, const std::vector<std::pair<std::string, 
   }
 }
 
+// One field of a reply, listed once for both outputs: its JSON key ("" =
+// text only) and its text label or column header ("" = JSON only), with
+// its value for each. Without a text function the text is the JSON value's
+// own (a string as it is, a number in decimal).
+template <typename T>
+struct Field {
+  const char* key;
+  const char* label;
+  std::function<Json(const T&)> json;
+  std::function<std::string(const T&)> text = {};
+  bool right_aligned = false;
+  int table = 0;  // which of the reply's text tables shows it
+
+  std::string textOf(const T& item) const {
+    if (text) return text(item);
+    const Json value = json(item);
+    return value.is_string() ? value.template get<std::string>() : value.dump();
+  }
+};
+
+template <typename T>
+using Fields = std::vector<Field<T>>;
+
+// The item's JSON object: its fields that have a key, in their order.
+template <typename T>
+Json fieldsJson(const Fields<T>& fields, const T& item) {
+  Json json = Json::object();
+  for (const auto& f : fields)
+    if (*f.key) json[f.key] = f.json(item);
+  return json;
+}
+
+// A table of the items: a column per field of `table` that has a label.
+template <typename T, typename Items>
+void printFieldTable(std::ostream& out, const Fields<T>& fields, const Items& items,
+                     int table = 0) {
+  std::vector<Column> columns;
+  for (const auto& f : fields)
+    if (*f.label && f.table == table) columns.push_back({f.label, f.right_aligned});
+  std::vector<std::vector<std::string>> rows;
+  for (const T& item : items) {
+    rows.emplace_back();
+    for (const auto& f : fields)
+      if (*f.label && f.table == table) rows.back().push_back(f.textOf(item));
+  }
+  printTable(out, columns, rows);
+}
+
+// "label: value" lines of the item's fields that have a label.
+template <typename T>
+std::vector<std::pair<std::string, std::string>> fieldLines(const Fields<T>& fields,
+                                                            const T& item) {
+  std::vector<std::pair<std::string, std::string>> lines;
+  for (const auto& f : fields)
+    if (*f.label) lines.emplace_back(f.label, f.textOf(item));
+  return lines;
+}
+
 std::string roiText(const proto::Roi& roi) {
   if (roi.x() == 0 && roi.y() == 0 && roi.width() == 0 && roi.height() == 0) return "full sensor";
   auto dim = [](std::uint32_t v) { return v == 0 ? std::string("full") : std::to_string(v); };
@@ -136,19 +195,30 @@ std::string rangeText(const proto::Feature& f) {
 }
 
 // The feature as on the wire: scripts get the same fields whatever the type.
-Json featureJson(const proto::Feature& f) {
-  return {{"name", f.name()},
-          {"type", featureTypeName(f.type())},
-          {"value", f.value()},
-          {"has_range", f.has_range()},
-          {"min", f.min()},
-          {"max", f.max()},
-          {"increment", f.increment()},
-          {"choices", std::vector<std::string>(f.choices().begin(), f.choices().end())},
-          {"unit", f.unit()},
-          {"description", f.description()},
-          {"writable", f.writable()}};
+const Fields<proto::Feature>& featureFields() {
+  using F = proto::Feature;
+  static const Fields<F> fields = {
+      {"name", "NAME", [](const F& f) { return Json(f.name()); }},
+      {"type", "TYPE", [](const F& f) { return Json(featureTypeName(f.type())); }},
+      {"value", "VALUE", [](const F& f) { return Json(f.value()); }},
+      {"", "RANGE", {}, rangeText},
+      {"has_range", "", [](const F& f) { return Json(f.has_range()); }},
+      {"min", "", [](const F& f) { return Json(f.min()); }},
+      {"max", "", [](const F& f) { return Json(f.max()); }},
+      {"increment", "", [](const F& f) { return Json(f.increment()); }},
+      {"choices", "",
+       [](const F& f) {
+         return Json(std::vector<std::string>(f.choices().begin(), f.choices().end()));
+       }},
+      {"unit", "UNIT", [](const F& f) { return Json(f.unit()); }},
+      {"description", "", [](const F& f) { return Json(f.description()); }},
+      {"writable", "WRITABLE", [](const F& f) { return Json(f.writable()); },
+       [](const F& f) { return std::string(f.writable() ? "yes" : "no"); }},
+  };
+  return fields;
 }
+
+Json featureJson(const proto::Feature& f) { return fieldsJson(featureFields(), f); }
 
 void printFeatures(const std::string& camera, const proto::ListFeaturesReply& reply, bool as_json,
                    std::ostream& out) {
@@ -162,19 +232,7 @@ void printFeatures(const std::string& camera, const proto::ListFeaturesReply& re
     out << camera << ": no features\n";
     return;
   }
-  std::vector<std::vector<std::string>> rows;
-  for (const auto& f : reply.features()) {
-    rows.push_back({f.name(), featureTypeName(f.type()), f.value(), rangeText(f), f.unit(),
-                    f.writable() ? "yes" : "no"});
-  }
-  printTable(out,
-             {{"NAME", false},
-              {"TYPE", false},
-              {"VALUE", false},
-              {"RANGE", false},
-              {"UNIT", false},
-              {"WRITABLE", false}},
-             rows);
+  printFieldTable(out, featureFields(), reply.features());
 }
 
 // The reply to get (the bare value, for $(...) in shell scripts) or to set
@@ -202,15 +260,22 @@ void printFeature(const proto::ControlRequest& request, const proto::Feature& f,
   out << '\n';
 }
 
+const Fields<proto::CameraSummary>& cameraFields() {
+  using C = proto::CameraSummary;
+  static const Fields<C> fields = {
+      {"name", "NAME", [](const C& c) { return Json(c.name()); }},
+      {"source", "SOURCE", [](const C& c) { return Json(c.source()); }},
+      {"state", "STATE", [](const C& c) { return Json(c.state()); }},
+      {"mode", "MODE", [](const C& c) { return Json(modeName(c.mode())); }},
+  };
+  return fields;
+}
+
 void printList(const proto::ListCamerasReply& reply, bool as_json, std::ostream& out) {
   if (as_json) {
     Json cameras = Json::array();
-    for (const auto& camera : reply.cameras()) {
-      cameras.push_back({{"name", camera.name()},
-                         {"source", camera.source()},
-                         {"state", camera.state()},
-                         {"mode", modeName(camera.mode())}});
-    }
+    for (const auto& camera : reply.cameras())
+      cameras.push_back(fieldsJson(cameraFields(), camera));
     out << toJson({{"cameras", std::move(cameras)}}) << '\n';
     return;
   }
@@ -218,11 +283,7 @@ void printList(const proto::ListCamerasReply& reply, bool as_json, std::ostream&
     out << "no cameras\n";
     return;
   }
-  std::vector<std::vector<std::string>> rows;
-  for (const auto& camera : reply.cameras()) {
-    rows.push_back({camera.name(), camera.source(), camera.state(), modeName(camera.mode())});
-  }
-  printTable(out, {{"NAME", false}, {"SOURCE", false}, {"STATE", false}, {"MODE", false}}, rows);
+  printFieldTable(out, cameraFields(), reply.cameras());
 }
 
 // Where the robot's target centre lies on the sensor, through the hidden
@@ -298,26 +359,52 @@ void printTarget(const std::string& camera, const proto::SimulatedRobot& r, bool
   out << camera << ": target " << targetText(r) << '\n';
 }
 
+std::string sizeText(uint32_t width, uint32_t height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+const Fields<proto::DescribeCameraReply>& describeFields() {
+  using D = proto::DescribeCameraReply;
+  static const Fields<D> fields = {
+      {"name", "camera", [](const D& d) { return Json(d.summary().name()); }},
+      {"source", "source", [](const D& d) { return Json(d.summary().source()); }},
+      {"state", "state", [](const D& d) { return Json(d.summary().state()); }},
+      {"mode", "mode", [](const D& d) { return Json(modeName(d.summary().mode())); }},
+      {"vendor", "vendor", [](const D& d) { return Json(d.vendor()); }},
+      {"model", "model", [](const D& d) { return Json(d.model()); }},
+      {"serial", "serial", [](const D& d) { return Json(d.serial()); }},
+      {"sensor_width", "", [](const D& d) { return Json(d.sensor_width()); }},
+      {"sensor_height", "", [](const D& d) { return Json(d.sensor_height()); }},
+      {"", "sensor", {}, [](const D& d) { return sizeText(d.sensor_width(), d.sensor_height()); }},
+      {"roi", "roi", [](const D& d) { return roiJson(d.roi()); },
+       [](const D& d) { return roiText(d.roi()); }},
+      {"output_width", "", [](const D& d) { return Json(d.output_width()); }},
+      {"output_height", "", [](const D& d) { return Json(d.output_height()); }},
+      {"", "output", {}, [](const D& d) { return sizeText(d.output_width(), d.output_height()); }},
+      {"pixel_format", "pixel format",
+       [](const D& d) { return Json(formatName(d.pixel_format())); }},
+      {"fps", "fps", [](const D& d) { return Json(d.fps()); },
+       [](const D& d) { return formatFixed(d.fps(), 1); }},
+      {"source_formats", "source formats",
+       [](const D& d) {
+         return Json(
+             std::vector<std::string>(d.source_formats().begin(), d.source_formats().end()));
+       },
+       [](const D& d) {
+         std::string formats;
+         for (const auto& format : d.source_formats())
+           formats += (formats.empty() ? "" : ", ") + format;
+         return formats;
+       }},
+  };
+  return fields;
+}
+
 void printInfo(const proto::DescribeCameraReply& d, bool as_json, std::ostream& out) {
-  const proto::CameraSummary& s = d.summary();
+  const bool hardware = d.summary().mode() == proto::HARDWARE_TRIGGER;
   if (as_json) {
-    Json json = {{"name", s.name()},
-                 {"source", s.source()},
-                 {"state", s.state()},
-                 {"mode", modeName(s.mode())},
-                 {"vendor", d.vendor()},
-                 {"model", d.model()},
-                 {"serial", d.serial()},
-                 {"sensor_width", d.sensor_width()},
-                 {"sensor_height", d.sensor_height()},
-                 {"roi", roiJson(d.roi())},
-                 {"output_width", d.output_width()},
-                 {"output_height", d.output_height()},
-                 {"pixel_format", formatName(d.pixel_format())},
-                 {"fps", d.fps()},
-                 {"source_formats",
-                  std::vector<std::string>(d.source_formats().begin(), d.source_formats().end())}};
-    if (s.mode() == proto::HARDWARE_TRIGGER) {
+    Json json = fieldsJson(describeFields(), d);
+    if (hardware) {
       json["trigger_line"] = d.trigger_line();
       json["trigger_activation"] = d.trigger_activation();
       json["trigger_timeout_ms"] = d.trigger_timeout_ms();
@@ -326,23 +413,8 @@ void printInfo(const proto::DescribeCameraReply& d, bool as_json, std::ostream& 
     out << toJson(json) << '\n';
     return;
   }
-  std::string formats;
-  for (const auto& format : d.source_formats()) formats += (formats.empty() ? "" : ", ") + format;
-  std::vector<std::pair<std::string, std::string>> lines = {
-      {"camera", s.name()},
-      {"source", s.source()},
-      {"state", s.state()},
-      {"mode", modeName(s.mode())},
-      {"vendor", d.vendor()},
-      {"model", d.model()},
-      {"serial", d.serial()},
-      {"sensor", std::to_string(d.sensor_width()) + "x" + std::to_string(d.sensor_height())},
-      {"roi", roiText(d.roi())},
-      {"output", std::to_string(d.output_width()) + "x" + std::to_string(d.output_height())},
-      {"pixel format", formatName(d.pixel_format())},
-      {"fps", formatFixed(d.fps(), 1)},
-      {"source formats", formats}};
-  if (s.mode() == proto::HARDWARE_TRIGGER) {
+  auto lines = fieldLines(describeFields(), d);
+  if (hardware) {
     lines.emplace_back("trigger",
                        d.trigger_line() + " " +
                            (d.trigger_activation().empty() ? std::string("(camera's edge)")
@@ -373,64 +445,47 @@ void printTrigger(const std::string& camera, const proto::TriggerReply& t, bool 
   }
 }
 
+// A camera's counters: the server's (table 0) and its driver's, where
+// frames were lost below the server (table 1); the camera names both.
+const Fields<proto::CameraStatistics>& statisticsFields() {
+  using C = proto::CameraStatistics;
+  using Getter = uint64_t (C::*)() const;
+  const auto counter = [](const char* key, const char* header, Getter get, int table) {
+    return Field<C>{key, header, [get](const C& c) { return Json((c.*get)()); }, {}, true, table};
+  };
+  static const Fields<C> fields = {
+      {"camera", "CAMERA", [](const C& c) { return Json(c.camera()); }},
+      counter("frames_acquired", "ACQUIRED", &C::frames_acquired, 0),
+      counter("frames_published", "PUBLISHED", &C::frames_published, 0),
+      counter("frames_dropped", "DROPPED", &C::frames_dropped, 0),
+      counter("acquisition_errors", "ERRORS", &C::acquisition_errors, 0),
+      counter("reconnects", "RECONNECTS", &C::reconnects, 0),
+      {"fps", "FPS", [](const C& c) { return Json(c.fps()); },
+       [](const C& c) { return formatFixed(c.fps(), 1); }, true},
+      counter("last_sequence", "LAST SEQ", &C::last_sequence, 0),
+      counter("driver_incomplete_buffers", "INCOMPLETE", &C::driver_incomplete_buffers, 1),
+      counter("driver_missing_packets", "MISSING PKTS", &C::driver_missing_packets, 1),
+      counter("driver_resent_packets", "RESENT PKTS", &C::driver_resent_packets, 1),
+      counter("driver_underruns", "UNDERRUNS", &C::driver_underruns, 1),
+      counter("driver_sequence_gaps", "SEQ GAPS", &C::driver_sequence_gaps, 1),
+      counter("frames_skipped_stale", "SKIPPED OLD", &C::frames_skipped_stale, 1),
+  };
+  return fields;
+}
+
 void printStats(const proto::StatisticsReply& reply, bool as_json, std::ostream& out) {
   if (as_json) {
     Json cameras = Json::array();
-    for (const auto& c : reply.cameras()) {
-      cameras.push_back({{"camera", c.camera()},
-                         {"frames_acquired", c.frames_acquired()},
-                         {"frames_published", c.frames_published()},
-                         {"frames_dropped", c.frames_dropped()},
-                         {"acquisition_errors", c.acquisition_errors()},
-                         {"reconnects", c.reconnects()},
-                         {"fps", c.fps()},
-                         {"last_sequence", c.last_sequence()},
-                         {"driver_incomplete_buffers", c.driver_incomplete_buffers()},
-                         {"driver_missing_packets", c.driver_missing_packets()},
-                         {"driver_resent_packets", c.driver_resent_packets()},
-                         {"driver_underruns", c.driver_underruns()},
-                         {"driver_sequence_gaps", c.driver_sequence_gaps()},
-                         {"frames_skipped_stale", c.frames_skipped_stale()}});
-    }
+    for (const auto& c : reply.cameras()) cameras.push_back(fieldsJson(statisticsFields(), c));
     out << toJson({{"subscribers", reply.subscribers()}, {"cameras", std::move(cameras)}}) << '\n';
     return;
   }
-  std::vector<std::vector<std::string>> rows;
-  for (const auto& c : reply.cameras()) {
-    rows.push_back({c.camera(), std::to_string(c.frames_acquired()),
-                    std::to_string(c.frames_published()), std::to_string(c.frames_dropped()),
-                    std::to_string(c.acquisition_errors()), std::to_string(c.reconnects()),
-                    formatFixed(c.fps(), 1), std::to_string(c.last_sequence())});
-  }
-  printTable(out,
-             {{"CAMERA", false},
-              {"ACQUIRED", true},
-              {"PUBLISHED", true},
-              {"DROPPED", true},
-              {"ERRORS", true},
-              {"RECONNECTS", true},
-              {"FPS", true},
-              {"LAST SEQ", true}},
-             rows);
-  // The driver's own counters: where frames were lost below the server.
-  std::vector<std::vector<std::string>> driver_rows;
-  for (const auto& c : reply.cameras()) {
-    driver_rows.push_back(
-        {c.camera(), std::to_string(c.driver_incomplete_buffers()),
-         std::to_string(c.driver_missing_packets()), std::to_string(c.driver_resent_packets()),
-         std::to_string(c.driver_underruns()), std::to_string(c.driver_sequence_gaps()),
-         std::to_string(c.frames_skipped_stale())});
-  }
+  // The camera's column heads both tables.
+  Fields<proto::CameraStatistics> driver = statisticsFields();
+  driver.front().table = 1;
+  printFieldTable(out, statisticsFields(), reply.cameras(), 0);
   out << '\n';
-  printTable(out,
-             {{"CAMERA", false},
-              {"INCOMPLETE", true},
-              {"MISSING PKTS", true},
-              {"RESENT PKTS", true},
-              {"UNDERRUNS", true},
-              {"SEQ GAPS", true},
-              {"SKIPPED OLD", true}},
-             driver_rows);
+  printFieldTable(out, driver, reply.cameras(), 1);
   out << "subscribers: " << reply.subscribers() << '\n';
 }
 

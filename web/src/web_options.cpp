@@ -100,17 +100,7 @@ CLI::App webApp() {
       "picksight-web");
 }
 
-Result<WebOptions> parseWords(const std::vector<std::string>& args, bool* help,
-                              ConfigParseExtras* extras) {
-  CLI::App app = webApp();
-  WebOptions o;
-  RawOptions raw;
-  defineOptions(app, o, raw);
-  if (auto ok = parseArgs(app, args, help); !ok) return ok.error();
-  if (extras) {
-    extras->config_file = raw.config_file;
-    extras->given = givenOptions(app);
-  }
+Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
   // The validators accepted these: the conversions cannot fail.
   auto listen = parseHostPort(raw.listen);
   o.listen_host = listen->first;
@@ -161,11 +151,7 @@ std::string webUsage() {
 }
 
 Result<WebOptions> parseWebArgs(const std::vector<std::string>& args, bool* help) {
-  CLI::App app = webApp();
-  WebOptions unused;
-  RawOptions raw;
-  defineOptions(app, unused, raw);
-  return parseWithConfigFile<WebOptions>(args, help, app, parseWords);
+  return parseToolOptions<WebOptions, RawOptions>(args, help, webApp, defineOptions, finishOptions);
 }
 
 }  // namespace picksight::web

@@ -196,17 +196,7 @@ std::string appUsage() {
 
 namespace {
 
-Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
-                              ConfigParseExtras* extras) {
-  CLI::App app = visionApp();
-  AppOptions o;
-  RawOptions raw;
-  defineAppOptions(app, o, raw);
-  if (auto ok = parseArgs(app, args, help); !ok) return ok.error();
-  if (extras) {
-    extras->config_file = raw.config_file;
-    extras->given = givenOptions(app);
-  }
+Result<AppOptions> finishOptions(AppOptions o, RawOptions& raw) {
   // The validators accepted these: the conversions cannot fail.
   if (!raw.robot_port.empty())
     o.robot.listen.port = static_cast<uint16_t>(*parseInt(raw.robot_port));
@@ -255,11 +245,8 @@ Result<AppOptions> parseWords(const std::vector<std::string>& args, bool* help,
 }  // namespace
 
 Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help) {
-  CLI::App app = visionApp();
-  AppOptions unused;
-  RawOptions raw;
-  defineAppOptions(app, unused, raw);
-  return parseWithConfigFile<AppOptions>(args, help, app, parseWords);
+  return parseToolOptions<AppOptions, RawOptions>(args, help, visionApp, defineAppOptions,
+                                                  finishOptions);
 }
 
 }  // namespace picksight::app

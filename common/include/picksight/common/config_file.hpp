@@ -112,4 +112,34 @@ Result<T> parseWithConfigFile(const std::vector<std::string>& args, bool* help, 
   return parse(*words, nullptr, nullptr);
 }
 
+// A tool's whole option parse, --config included: `make` builds the app,
+// `define` declares every option into the tool's options and the raw
+// strings its validators check (Raw has a config_file member for
+// --config), and `finish` turns the raw strings into the options once the
+// validators passed them. The command line parsed once per source of words
+// (the file, then the file and the line), each time into fresh options.
+template <typename Options, typename Raw>
+Result<Options> parseToolOptions(const std::vector<std::string>& args, bool* help,
+                                 CLI::App (*make)(), void (*define)(CLI::App&, Options&, Raw&),
+                                 Result<Options> (*finish)(Options, Raw&)) {
+  const auto parseWords = [&](const std::vector<std::string>& words, bool* asked_help,
+                              ConfigParseExtras* extras) -> Result<Options> {
+    CLI::App app = make();
+    Options options;
+    Raw raw;
+    define(app, options, raw);
+    if (auto ok = parseArgs(app, words, asked_help); !ok) return ok.error();
+    if (extras) {
+      extras->config_file = raw.config_file;
+      extras->given = givenOptions(app);
+    }
+    return finish(std::move(options), raw);
+  };
+  CLI::App app = make();
+  Options unused;
+  Raw raw;
+  define(app, unused, raw);
+  return parseWithConfigFile<Options>(args, help, app, parseWords);
+}
+
 }  // namespace picksight
