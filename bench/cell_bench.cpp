@@ -74,7 +74,19 @@ double median(std::vector<double> v) {
 struct Breakdown {
   double recognition_ms = 0;
   double grasps_ms = 0;
+  uint64_t poses_digest = 0;  // of every reply over 5 scenes x 9 types, in process
+  size_t poses = 0;
 };
+
+// FNV-1a over the reply lines: equal digests, equal replies, so that a
+// change meant to keep the poses shows that it did.
+void digest(uint64_t& hash, const std::string& text) {
+  if (hash == 0) hash = 1469598103934665603ull;
+  for (const char c : text + "\n") {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ull;
+  }
+}
 
 // Where a request's vision time goes, in process on the camera's scene: the
 // other engineer's recognition, and this cell's grasp selection.
@@ -96,7 +108,18 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
     grasps.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     if (pick.poses.size() > outcome.parts.size()) return {};
   }
-  return {median(recognition), median(grasps)};
+  Breakdown b{median(recognition), median(grasps)};
+  for (uint64_t seed = 5; seed < 10; ++seed) {
+    const picksight::synthetic::SceneRenderer scenes(scene(width, height, parts, seed, kTypes));
+    const picksight::Frame shot = picksight::frameFromImage(scenes.render(1), "cam0", 1);
+    for (int type = 1; type <= static_cast<int>(kTypes.size()); ++type) {
+      const auto outcome = picksight::app::locateInFrame(shot, {}, library.snapshot(), type);
+      const auto pick = picksight::app::pickPoses(outcome, *library.grasps(), geometry);
+      b.poses += pick.poses.size();
+      digest(b.poses_digest, picksight::app::locateReply(pick));
+    }
+  }
+  return b;
 }
 }  // namespace
 
@@ -118,12 +141,14 @@ int main(int argc, char** argv) {
   std::vector<double> ms;
   int failures = 0;
   size_t offered = 0;
+  uint64_t replies_digest = 0;
   for (int i = 0; i < requests; ++i) {
     const std::string request = "LOCATE " + std::to_string(1 + i % static_cast<int>(kTypes.size()));
     const auto t0 = Clock::now();
     auto reply = robot->request(request, 10s);
     ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     const std::string text = reply ? *reply : std::string();
+    digest(replies_digest, text);
     const auto words = picksight::splitFields(text, " ");
     if (words.size() < 2 || words[0] != "OK") {
       ++failures;
@@ -157,6 +182,11 @@ int main(int argc, char** argv) {
       "  in process, same scene, median ms: recognition of %zu types %.2f, grasp selection and\n"
       "  robot frame %.3f\n",
       kTypes.size(), inside.recognition_ms, inside.grasps_ms);
+  std::printf(
+      "  replies digest %016llx (robot port, %d requests); in process %zu poses over 5\n"
+      "  scenes x %zu types, digest %016llx\n",
+      static_cast<unsigned long long>(replies_digest), requests, inside.poses, kTypes.size(),
+      static_cast<unsigned long long>(inside.poses_digest));
   std::printf("  %s\n", status ? status->c_str() : "STATUS failed");
   return failures == 0 ? 0 : 1;
 }
