@@ -381,10 +381,19 @@ std::optional<RobustFit> robustFit(const std::vector<PointPair>& pts, TransformM
   // tighter than that.
   const double cut2 = std::pow(std::max(2.5 * scale, 0.1), 2);
   // Refit on the core and decide inliers against the refit, not the
-  // minimal-sample hypothesis. A homography from 4 noisy points (or a tilt from 3)
-  // extrapolates poorly: its core takes every point within 3 cuts, so that
-  // a genuine point far from the sample is not judged by a fit made without
-  // it (the mis-touched points it must reject are millimetres off).
+  // minimal-sample hypothesis. A homography from 4 noisy points (or a tilt
+  // from 3) extrapolates poorly: its core takes every point within 3 cuts,
+  // so that a genuine point far from the sample is not judged by a fit made
+  // without it (the mis-touched points it must reject are millimetres off).
+  // Measured on 300 tilted cells of 7 points spread over the work area:
+  // 4 genuine points cut, 24 with the tilt's core at one cut. What no core
+  // can do is judge a point that lies far beyond all the others (250 mm
+  // out from eleven in a 100 mm square): only it fixes the perspective out
+  // there, so a fit without it cannot predict it and a fit with it bends to
+  // it. The tilt cuts such a genuine point in 63 of 300 layouts and keeps
+  // one touched 1 mm off in 148 (the homography 73 and 153; least squares,
+  // with no perspective to bend, 1 and none): spread the points over the
+  // work area, to its corners when the camera may be tilted (docs/PROTOCOL.md).
   const double core2 =
       model == TransformModel::kHomography || model == TransformModel::kTilt ? 9 * cut2 : cut2;
   RobustFit fit;

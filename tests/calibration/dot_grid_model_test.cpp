@@ -3,6 +3,7 @@
 // the plane, everywhere, not only at the dots; and they survive the file.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -116,10 +117,43 @@ TEST_CASE("a grid in part of the sensor fits the tilt but no lens", "[calibratio
   CHECK_FALSE(model->lens);
   REQUIRE(model->scale.rectify);
   CHECK(fieldError(cam, VisionFrame(model->scale)) < 0.01);
-  // Without the sensor's size (a cropped or resized camera): no lens either.
-  auto cropped = fitDotGrid(g.centres, g.indices, 25, std::nullopt, std::nullopt);
+  // Without the sensor's size (a cropped or resized camera) no lens, even
+  // from dots over the whole sensor (which fit one when its size is given).
+  const Grid wide = imageGrid(cam, 17, 9, 25, 0.02);
+  auto sized = fitDotGrid(wide.centres, wide.indices, 25, std::nullopt, cam.sensor);
+  REQUIRE(sized);
+  CHECK(sized->lens);
+  auto cropped = fitDotGrid(wide.centres, wide.indices, 25, std::nullopt, std::nullopt);
   REQUIRE(cropped);
   CHECK_FALSE(cropped->lens);
+}
+
+TEST_CASE("a lens is fitted from dots reaching 60 % of the way to the sensor's corners",
+          "[calibration]") {
+  // The grid's pitch is about 100 px: 11 x 5 dots reach 0.49 of the
+  // half-diagonal (1101 px), 15 x 7 reach 0.69. The reach, not the
+  // distortion seen, decides.
+  Camera cam;
+  cam.k1 = -0.08;
+  const auto reachOf = [&](const Grid& g) {
+    const cv::Point2d middle((cam.sensor.width - 1) / 2.0, (cam.sensor.height - 1) / 2.0);
+    double reach = 0;
+    for (const auto& c : g.centres) reach = std::max(reach, cv::norm(c - middle));
+    return reach / (std::hypot(cam.sensor.width, cam.sensor.height) / 2);
+  };
+  const Grid inner = imageGrid(cam, 11, 5, 25, 0.02);
+  const Grid outer = imageGrid(cam, 15, 7, 25, 0.02);
+  INFO("reach " << reachOf(inner) << " and " << reachOf(outer) << " of the half-diagonal");
+  REQUIRE(reachOf(inner) < 0.52);
+  REQUIRE(reachOf(outer) > 0.66);
+  auto short_reach = fitDotGrid(inner.centres, inner.indices, 25, std::nullopt, cam.sensor);
+  REQUIRE(short_reach);
+  CHECK_FALSE(short_reach->lens);
+  auto long_reach = fitDotGrid(outer.centres, outer.indices, 25, std::nullopt, cam.sensor);
+  REQUIRE(long_reach);
+  REQUIRE(long_reach->lens);
+  CHECK(long_reach->rms_px < 0.05);
+  CHECK(long_reach->lens->distortion[0] < 0);  // barrel, as drawn
 }
 
 TEST_CASE("a camera looking straight down gets an identity rectification and the orientation kept",

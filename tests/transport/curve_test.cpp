@@ -1,9 +1,14 @@
 // CURVE keys and the ZAP handler: key files and their checks, and real
 // sockets of one process (listed, unlisted and plain clients of a CURVE PUB).
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "picksight/transport/control_client.hpp"
@@ -254,4 +259,77 @@ TEST_CASE("A control client refused by CURVE gets no reply and never blocks",
   dealer.send(zmq::str_buffer("hello"), zmq::send_flags::none);
   zmq::pollitem_t item{router.handle(), 0, ZMQ_POLLIN, 0};
   CHECK(zmq::poll(&item, 1, 10s) == 1);
+}
+
+TEST_CASE("The refused keys counted for the log are bounded: after 1024 the count starts over",
+          "[transport][curve]") {
+  // An attacker cycling keys cannot grow the handler's memory: once 1024
+  // distinct keys were refused it forgets them all, so a key seen before
+  // is logged again as refused once. Spoken to the handler as ZeroMQ does
+  // (ZAP over inproc), with the log (stderr) read back.
+  test::TempDir dir;
+  writePair(dir, "server");
+  const CurveKeyPair listed = writePair(dir, "listed");
+  zmq::context_t context;
+  auto curve = CurveServer::start(context, dir.file("server.key_secret"), dir.file("listed.key"));
+  REQUIRE(curve);
+  zmq::socket_t zap(context, zmq::socket_type::req);
+  zap.set(zmq::sockopt::linger, 0);
+  zap.set(zmq::sockopt::rcvtimeo, 10000);
+  zap.connect("inproc://zeromq.zap.01");
+  const auto ask = [&](const std::string& key) {
+    const std::vector<std::string> request = {"1.0", "7",     "picksight", "192.0.2.9",
+                                              "",    "CURVE", key};
+    for (size_t i = 0; i < request.size(); ++i) {
+      zap.send(zmq::buffer(request[i]),
+               i + 1 < request.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+    }
+    std::vector<std::string> reply;
+    zmq::message_t part;
+    do {
+      REQUIRE(zap.recv(part));
+      reply.push_back(part.to_string());
+    } while (part.more());
+    REQUIRE(reply.size() >= 3);
+    return reply[2];
+  };
+  // A 32-byte key numbered `i` (never the listed one: it is random).
+  const auto key = [](uint32_t i) {
+    std::string k(32, '\x5a');
+    for (int b = 0; b < 4; ++b) k[static_cast<size_t>(b)] = static_cast<char>(i >> (8 * b));
+    return k;
+  };
+  char first_text[kZ85KeyLength + 1];
+  const std::string first = key(0);
+  zmq_z85_encode(first_text, reinterpret_cast<const uint8_t*>(first.data()), 32);
+
+  const std::string log = dir.file("stderr.log");
+  std::fflush(stderr);
+  const int saved = ::dup(STDERR_FILENO);
+  const int file = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  REQUIRE(saved >= 0);
+  REQUIRE(file >= 0);
+  ::dup2(file, STDERR_FILENO);
+  ::close(file);
+  std::vector<std::string> statuses;
+  statuses.push_back(ask(first));
+  for (uint32_t i = 1; i <= 1024; ++i) statuses.push_back(ask(key(i)));
+  statuses.push_back(ask(first));  // the 1025th distinct key emptied the memory
+  std::string listed_binary(32, '\0');
+  REQUIRE(zmq_z85_decode(reinterpret_cast<uint8_t*>(listed_binary.data()),
+                         listed.public_key.c_str()) != nullptr);
+  const std::string admitted = ask(listed_binary);
+  ::dup2(saved, STDERR_FILENO);
+  ::close(saved);
+
+  CHECK(std::count(statuses.begin(), statuses.end(), "400") == 1026);
+  CHECK(admitted == "200");
+  CHECK((*curve)->refused() == 1026);
+  std::ifstream in(log);
+  int first_logged_once = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.find(first_text) != std::string::npos && line.find("(1 time)") != std::string::npos)
+      ++first_logged_once;
+  }
+  CHECK(first_logged_once == 2);
 }
