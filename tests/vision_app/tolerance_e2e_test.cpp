@@ -1,6 +1,7 @@
 // TOLERANCE against a real video server and vision app: a model's
 // tolerances read back, changed, in force at the next LOCATE, kept across a
-// restart, and bad requests refused naming the key without changing anything.
+// restart with the model's grasp styles, and bad requests refused naming the
+// key without changing anything.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -77,6 +78,9 @@ TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next
                                       "mirror_symmetric=1"));
   cell.scene.show(scene(kPlate, 30));
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+  // A grasp style, stored in the model's file: every TOLERANCE that
+  // rewrites the file must keep it.
+  REQUIRE(cell.ask("GRASP 1 ADD 5 0 90") == "OK 1");
 
   // The larger plate with a tight edge tolerance: the next LOCATE leaves it
   // out, and WHY says the boundary failed.
@@ -91,6 +95,7 @@ TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next
   // any case, let the larger plate through.
   cell.restart();
   CHECK_THAT(cell.ask("TOLERANCE 1"), Catch::Contains(" edge_tolerance_px=1.000 "));
+  CHECK(cell.ask("GRASP 1 LIST") == "OK 1 5.000 0.000 90.000");
   CHECK(cell.ask("LOCATE 1") == "OK 0");
   const std::string relaxed = cell.ask(
       "TOLERANCE 1 EDGE_TOLERANCE_PX 6 area_tolerance 0.25 "
