@@ -5,7 +5,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <map>
 #include <optional>
 
@@ -13,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
 
+#include "picksight/common/angles.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "results.pb.h"
 #include "temp_dir.hpp"
@@ -427,17 +430,33 @@ TEST_CASE("a command line goes to the vision app and its reply comes back", "[we
   res = postJson(web, "/api/apps/cam0/command", R"({"line":"LOCATE 1"})");
   REQUIRE(res);
   CHECK(res->status == 200);
-  CHECK(!json::parse(res->body)["reply"].get<std::string>().empty());
+  // The vision app's LOCATE, as it answers its own robot port: the same
+  // parts at the same poses (another frame: within noise, in any order).
+  const auto relayed = e2e::parseLocateReply(json::parse(res->body)["reply"].get<std::string>());
+  auto direct = vision.connect().request("LOCATE 1", 10s);
+  REQUIRE(direct);
+  const auto own = e2e::parseLocateReply(*direct);
+  REQUIRE(!own.empty());
+  REQUIRE(relayed.size() == own.size());
+  for (const auto& p : relayed) {
+    INFO("relayed " << p.x << " " << p.y << " " << p.rz << "; own: " << *direct);
+    CHECK(std::any_of(own.begin(), own.end(), [&](const e2e::Pose& q) {
+      return std::hypot(p.x - q.x, p.y - q.y) < 0.5 && angleDiffDeg(p.rz, q.rz) < 1;
+    }));
+  }
 
   res = postJson(web, "/api/apps/cam0/command", R"({"line":"STATUS\nLEARN 1"})");
   REQUIRE(res);
   CHECK(res->status == 400);
+  CHECK_THAT(json::parse(res->body).value("error", ""), Catch::Contains("CR or LF"));
   res = postJson(web, "/api/apps/cam0/command", json{{"line", std::string(300, 'A')}}.dump());
   REQUIRE(res);
   CHECK(res->status == 400);
+  CHECK_THAT(json::parse(res->body).value("error", ""), Catch::Contains("longer than"));
   res = postJson(web, "/api/apps/nobody/command", R"({"line":"STATUS"})");
   REQUIRE(res);
   CHECK(res->status == 404);
+  CHECK_THAT(json::parse(res->body).value("error", ""), Catch::Contains("'nobody'"));
   res = postJson(web, "/api/apps/gone/command", R"({"line":"STATUS"})");
   REQUIRE(res);
   CHECK(res->status == 502);
