@@ -21,7 +21,8 @@ rest. `git worktree remove` it when done for good.
 
 import argparse
 import fnmatch
-import os
+import html
+import re
 import shlex
 import subprocess
 import sys
@@ -124,24 +125,41 @@ def run(cmd, cwd=None, log=None, timeout=None):
 
 def test_command(entry, build):
     """`ctest:REGEX` runs CTest's entries matching REGEX; `binary[:spec]` runs
-    build/tests/binary with that Catch test spec (all its cases without one)."""
+    build/tests/binary with that Catch test spec (all its cases without one),
+    reporting in XML so that the failing cases can be named."""
     if entry.startswith("ctest:"):
         return ["ctest", "--test-dir", str(build), "--no-tests=error", "--output-on-failure",
                 "-R", entry[len("ctest:"):]]
     binary, _, spec = entry.partition(":")
-    cmd = [str(build / "tests" / binary)]
+    cmd = [str(build / "tests" / binary), "-r", "xml"]
     if spec:
         cmd.append(spec)
     return cmd
 
 
+def failed_cases(entry, output):
+    """The test cases an entry's output says failed (or crashed in), best effort."""
+    if entry.startswith("ctest:"):
+        return re.findall(r"^\s*\d+ - (.+?) \(", output, re.M)
+    binary = entry.partition(":")[0]
+    names = []
+    # Catch's XML: each <TestCase name="..."> closes with an OverallResult;
+    # a case without one is where the binary died.
+    for match in re.finditer(r'<TestCase name="([^"]*)"(.*?)(?=<TestCase name=|\Z)', output, re.S):
+        body = match.group(2)
+        if 'OverallResult success="false"' in body or "OverallResult" not in body:
+            names.append(html.unescape(match.group(1)))
+    return [f"{binary}: {n}" for n in names]
+
+
 def run_tests(entries, build, log, timeout, stop_at_first=True):
-    """Returns the entries that failed (stops at the first when asked)."""
+    """Returns the failing entries, each with the cases that failed (stops at
+    the first failing entry when asked)."""
     failed = []
     for entry in entries:
-        code, _ = run(test_command(entry, build), cwd=build, log=log, timeout=timeout)
+        code, out = run(test_command(entry, build), cwd=build, log=log, timeout=timeout)
         if code != 0:
-            failed.append(entry)
+            failed.append((entry, failed_cases(entry, out) or [entry]))
             if stop_at_first:
                 break
     return failed
@@ -210,7 +228,8 @@ def main():
         entries = list(dict.fromkeys(e for m in mutants for e in m.tests))
         failing = run_tests(entries, build, log, args.timeout, stop_at_first=False)
         if failing:
-            sys.exit("the unmutated code fails: " + ", ".join(failing) + f" (see {log})")
+            sys.exit("the unmutated code fails: " + "; ".join(c for _, cases in failing for c in cases)
+                     + f" (see {log})")
 
         for i, m in enumerate(mutants, 1):
             start = time.monotonic()
@@ -226,7 +245,9 @@ def main():
                 else:
                     failed = run_tests(m.tests, build, log, args.timeout)
                     m.result = "killed" if failed else "SURVIVED"
-                    m.killed_by = failed[0] if failed else ""
+                    if failed:
+                        cases = failed[0][1]
+                        m.killed_by = cases[0] + (f" (and {len(cases) - 1} more)" if len(cases) > 1 else "")
             finally:
                 path.write_text(original, encoding="utf-8")
             m.seconds = time.monotonic() - start
