@@ -19,6 +19,7 @@
 #include "picksight/vision/part_model.hpp"
 #include "picksight/vision/recognizer.hpp"
 #include "picksight/vision/regions.hpp"
+#include "picksight/vision/rejection.hpp"
 
 using namespace picksight::vision;
 namespace pt = picksight::test;
@@ -309,6 +310,21 @@ TEST_CASE("round parts a few percent out of round are one type, a clearly oval o
   for (const uint64_t seed : {3, 4}) {
     INFO("seed " << seed);
     checkReported(recognizeDrawn(parts, {&model}, seed), parts, expected);
+  }
+  // The shape test (Hu) refuses the oval itself, not the boundary check
+  // after it; the washers pass it.
+  const cv::Mat grey = pt::drawParts(1000, 640, parts, 3);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  for (const auto& part : parts) {
+    const auto region = std::find_if(regions.begin(), regions.end(), [&](const Region& r) {
+      return std::hypot(r.centroid.x - part.x, r.centroid.y - part.y) < 5;
+    });
+    REQUIRE(region != regions.end());
+    const bool oval = part.y > 300;
+    INFO((oval ? "oval" : "washer") << " at " << part.x << ", " << part.y);
+    const RegionExplanation why = explainRegion(*region, {&model});
+    CHECK(regionTestName(why.test) ==
+          std::string(regionTestName(oval ? RegionTest::kHu : RegionTest::kPasses)));
   }
 }
 

@@ -133,3 +133,34 @@ TEST_CASE("a scaled copy is judged scale with its scale and a mirror image mirro
   CHECK(m.test == RegionTest::kMirror);
   CHECK(std::string(regionTestName(RegionTest::kScale)) == "scale");
 }
+
+TEST_CASE("copies from 0.6x to 1.6x the model are judged scale and one beyond area",
+          "[vision][why]") {
+  // The scaled-copy search spans 0.6x to 1.6x: a copy at 1.5x (or 0.65x)
+  // is the whole part drawn larger (smaller), one at 1.75x is only a region
+  // of another area.
+  const PartModel model = trained(lShape());
+  const cv::Mat scene = pt::drawParts(1280, 720,
+                                      {{pt::scaled(lShape(), 1.5), 230, 360, 40},
+                                       {pt::scaled(lShape(), 0.65), 600, 360, 150},
+                                       {pt::scaled(lShape(), 1.75), 980, 360, 250}},
+                                      5);
+  const auto regions = regionsOf(scene);
+  REQUIRE(regions.size() == 3);
+  const std::vector<const PartModel*> models{&model};
+  struct Copy {
+    double x, scale;
+    RegionTest test;
+  };
+  for (const auto& [x, scale, test] :
+       {Copy{230, 1.5, RegionTest::kScale}, Copy{600, 0.65, RegionTest::kScale},
+        Copy{980, 1.75, RegionTest::kArea}}) {
+    INFO("scale " << scale);
+    const Region* region = near(regions, x, 360);
+    REQUIRE(region);
+    const RegionExplanation e = explainRegion(*region, models);
+    CHECK(regionTestName(e.test) == std::string(regionTestName(test)));
+    if (test == RegionTest::kScale) CHECK(e.measured == Approx(scale).epsilon(0.01));
+  }
+  CHECK(recognize(regions, models).empty());
+}
