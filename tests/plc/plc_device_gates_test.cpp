@@ -117,7 +117,7 @@ TEST_CASE("a trigger before the results are acknowledged is missed and runs no L
   CHECK(plc.calls() == 2);
 }
 
-TEST_CASE("part types 0 to 9999 and all types are accepted, 10000 and above refused",
+TEST_CASE("part types 0 to 9999 and all types are accepted and 10000 and above refused",
           "[plc][exceptions]") {
   DeviceOnPair plc;
   for (uint16_t type : {uint16_t{0}, uint16_t{9999}, kAllTypes}) {

@@ -41,7 +41,7 @@ TEST_CASE("a ROI's four fields reach the request as whole pixels up to 65535", "
   checkRefused("roi", json{{"height", "tall"}}, "height");
 }
 
-TEST_CASE("an output size is a scale in (0, 16] or a width and height", "[web]") {
+TEST_CASE("an output size is a scale up to 16 or a width and height", "[web]") {
   auto request = web::cameraAction("cam0", "size", json{{"scale", 16}});
   REQUIRE(request);
   REQUIRE(request->has_set_size());
@@ -116,7 +116,8 @@ TEST_CASE("the target overlay is a point in mm or hidden", "[web]") {
   checkRefused("target", json{{"hide", false}}, "x_mm");
 }
 
-TEST_CASE("open, close and trigger name their camera and an unknown action is not found", "[web]") {
+TEST_CASE("open and close and trigger name their camera and an unknown action is not found",
+          "[web]") {
   auto request = web::cameraAction("cam2", "open", json::object());
   REQUIRE(request);
   REQUIRE(request->has_open_stream());
