@@ -14,8 +14,9 @@
 
 #include "bench_cell.hpp"
 #include "locate_args.hpp"
-#include "picksight/cell/grasp_planner.hpp"
+#include "picksight/cell/cell_locate.hpp"
 #include "picksight/common/text.hpp"
+#include "picksight/protocol/cell_commands.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
 #include "picksight/synthetic/scene.hpp"
@@ -113,10 +114,14 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
     const picksight::synthetic::SceneRenderer scenes(scene(width, height, parts, seed, kTypes));
     const picksight::Frame shot = picksight::frameFromImage(scenes.render(1), "cam0", 1);
     for (int type = 1; type <= static_cast<int>(kTypes.size()); ++type) {
-      const auto outcome = picksight::app::locateInFrame(shot, {}, library.snapshot(), type);
-      const auto pick = picksight::app::pickPoses(outcome, *library.grasps(), geometry);
-      b.poses += pick.poses.size();
-      digest(b.poses_digest, picksight::app::locateReply(pick));
+      // The cell's one LOCATE path, as the offline CLI runs it on an image.
+      const auto located = picksight::app::locateAndPick(
+          calibration, &library, [&]() -> picksight::Result<picksight::app::LocateOutcome> {
+            return picksight::app::locateInFrame(shot, {}, library.snapshot(), type);
+          });
+      if (!located) return {};
+      b.poses += located->pick.poses.size();
+      digest(b.poses_digest, picksight::app::locateReply(located->pick));
     }
   }
   return b;

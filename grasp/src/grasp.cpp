@@ -39,8 +39,12 @@ std::vector<std::vector<cv::Point2d>> fingerPolygons(const Pose& gripper, const 
 
 bool fingersClear(const Pose& gripper, const Gripper& fingers,
                   const calibration::VisionFrame& frame, const Obstacles& obstacles) {
+  return polygonsClear(fingerPolygons(gripper, fingers, frame), obstacles);
+}
+
+bool polygonsClear(const FingerPolygons& polygons, const Obstacles& obstacles) {
   const cv::Rect image(0, 0, obstacles.mask.cols, obstacles.mask.rows);
-  for (const auto& poly : fingerPolygons(gripper, fingers, frame)) {
+  for (const auto& poly : polygons) {
     std::vector<cv::Point> fixed;
     std::vector<cv::Point2d> in_mask;
     for (const auto& p : poly) {
@@ -67,13 +71,21 @@ bool fingersClear(const Pose& gripper, const Gripper& fingers,
   return true;
 }
 
+std::optional<size_t> firstClearGrasp(const std::vector<FingerPolygons>& grasps,
+                                      const Obstacles& obstacles) {
+  for (size_t i = 0; i < grasps.size(); ++i) {
+    if (polygonsClear(grasps[i], obstacles)) return i;
+  }
+  return std::nullopt;
+}
+
 std::optional<size_t> firstClearGrasp(const Pose& part, const std::vector<GraspStyle>& styles,
                                       const Gripper& fingers, const calibration::VisionFrame& frame,
                                       const Obstacles& obstacles) {
-  for (size_t i = 0; i < styles.size(); ++i) {
-    if (fingersClear(gripperPose(part, styles[i]), fingers, frame, obstacles)) return i;
-  }
-  return std::nullopt;
+  std::vector<FingerPolygons> grasps;
+  for (const auto& style : styles)
+    grasps.push_back(fingerPolygons(gripperPose(part, style), fingers, frame));
+  return firstClearGrasp(grasps, obstacles);
 }
 
 }  // namespace picksight::grasp

@@ -80,19 +80,24 @@ struct Cell {
     camera->setImage(scene.image);
     return cell->handle(request);
   }
+  // A bar trained as type 1 with two styles, across it and from its ends
+  // (units are pixels until CALCAM), and two fingers `reach` px either side.
+  void barWithGripper(int reach) {
+    REQUIRE(ask(Scene().bar({320, 240}), "LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);
+    CHECK(cell->handle("GRASP 1 ADD 0 0 0") == "OK 1");
+    CHECK(cell->handle("GRASP 1 ADD 0 0 90") == "OK 2");
+    CHECK(cell->handle("GRIPPER 1 FINGER 0 " + std::to_string(reach) + " 10 8") == "OK 1");
+    CHECK(cell->handle("GRIPPER 1 FINGER 0 -" + std::to_string(reach) + " 10 8") == "OK 2");
+  }
 };
 }  // namespace
 
 TEST_CASE("the first grasp whose fingers are clear wins and a blocked part is not offered",
           "[cell][grasp]") {
   Cell cell;
-  REQUIRE(cell.ask(Scene().bar({320, 240}), "LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);
   // Style 1 grips across the bar (fingers above and below it), style 2 from
-  // its ends; units are pixels until CALCAM.
-  CHECK(cell.cell->handle("GRASP 1 ADD 0 0 0") == "OK 1");
-  CHECK(cell.cell->handle("GRASP 1 ADD 0 0 90") == "OK 2");
-  CHECK(cell.cell->handle("GRIPPER 1 FINGER 0 55 10 8") == "OK 1");
-  CHECK(cell.cell->handle("GRIPPER 1 FINGER 0 -55 10 8") == "OK 2");
+  // its ends.
+  cell.barWithGripper(55);
   CHECK(cell.cell->handle("GRASP 1 LIST") == "OK 2 0.000 0.000 0.000 0.000 0.000 90.000");
   CHECK(cell.cell->handle("GRIPPER 1 LIST") ==
         "OK 2 0.000 55.000 10.000 8.000 0.000 -55.000 10.000 8.000");
@@ -121,6 +126,22 @@ TEST_CASE("the first grasp whose fingers are clear wins and a blocked part is no
   CHECK(posesAre(cell.ask(blocked, "LOCATE 1"), {{200.0, -240.0, 0.0}}));
   CHECK(cell.cell->handle("GRASP 1 CLEAR") == "OK 0");
   CHECK(cell.cell->handle("GRASP 7 LIST").rfind("ERROR 32 ", 0) == 0);
+}
+
+TEST_CASE("a part found touching another owns only its placed footprint", "[cell][grasp]") {
+  Cell cell;
+  cell.barWithGripper(30);
+  // Alone: style 1 (its fingers 11 px off the bar's long sides).
+  CHECK(posesAre(cell.ask(Scene().bar({200, 240}), "LOCATE 1"), {{200.0, -240.0, 0.0}}));
+  // A small disc fused to the bar's lower side, under style 1's lower finger
+  // (image y 266..274): one region, a fifth larger than the bar, within
+  // what an area test alone would take for the bar itself. Vision finds the
+  // bar touching the disc, so the disc is another thing under the finger:
+  // style 2, the fingers on the bar's own footprint (90 or 270 degrees: the
+  // bar is symmetric under a half turn).
+  const std::string reply = cell.ask(Scene().bar({200, 240}).disc({200, 266}, 13), "LOCATE 1");
+  INFO(reply);
+  CHECK((posesAre(reply, {{200.0, -240.0, 90.0}}) || posesAre(reply, {{200.0, -240.0, 270.0}})));
 }
 
 TEST_CASE("a grasp whose fingers leave the image is not offered", "[cell][grasp]") {

@@ -7,9 +7,10 @@
 #include <ostream>
 
 #include "picksight/calibration/camera_calibration.hpp"
-#include "picksight/cell/grasp_planner.hpp"
+#include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/text.hpp"
+#include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/cell_calibration.hpp"
@@ -190,15 +191,17 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       }
       out << learnReply(*learned) << "\n";
     } else if (command == "locate") {
-      // The robot's LOCATE: same frame (calibration of the data dir), same grasps.
-      const LocateOutcome outcome =
-          locateInFrame(frameFromImage(grey, path, 1), options->vision, library.snapshot(), type);
-      const auto geometry = calibration.geometry();
-      if (!geometry) {
-        out << errorReply(geometry.error()) << "\n";
+      // The robot's LOCATE path on the image: same frame (calibration of
+      // the data dir), same grasps.
+      const auto located = locateAndPick(calibration, &library, [&]() -> Result<LocateOutcome> {
+        return locateInFrame(frameFromImage(grey, path, 1), options->vision, library.snapshot(),
+                             type);
+      });
+      if (!located) {
+        out << errorReply(located.error()) << "\n";
         return 1;
       }
-      out << locateReply(pickPoses(outcome, *library.grasps(), *geometry)) << "\n";
+      out << locateReply(located->pick) << "\n";
     } else {
       const auto blobs = blobsInImage(grey, options->vision);
       std::string line = "OK " + std::to_string(blobs.size());

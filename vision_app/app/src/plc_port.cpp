@@ -1,12 +1,12 @@
 // PLC port wiring.
 #include "picksight/vision_app/plc_port.hpp"
 
-#include "picksight/plc/cell_locator.hpp"
+#include "picksight/plc/cell_picker.hpp"
 
 namespace picksight::app {
 
 PlcPort::PlcPort(const PlcPortOptions& options, VisionCell& cell)
-    : device_(options.device, plc::cellLocator(cell.context()),
+    : device_(options.device, plc::cellPicker(cell.context(), cell.results()),
               plc::cellFrameState(cell.calibration()), plc::robotErrorCodeOf),
       server_(options.server, device_) {}
 

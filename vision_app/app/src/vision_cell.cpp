@@ -7,13 +7,6 @@
 #include "picksight/protocol/model_commands.hpp"
 
 namespace picksight::app {
-namespace {
-// Requests that work on a fresh frame and publish it with its regions
-// (LOCATE publishes its own, richer record).
-bool publishesFrame(const std::string& command) {
-  return command == "LEARN" || command == "BLOBS" || command == "STORE" || command == "CALCAM";
-}
-}  // namespace
 
 VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera,
                        VisionOptions options)
@@ -22,6 +15,7 @@ VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> 
       vision_(std::move(camera), std::move(options), &models_),
       protocol_(vision_),
       context_(vision_, calibration_) {
+  // What each command publishes is in its table entry (Publishes).
   addModelCommands(protocol_.table(), vision_);
   addCalibrationCommands(protocol_.table(), vision_, calibration_);
   addCellCommands(protocol_.table(), context_);
@@ -45,21 +39,21 @@ std::string VisionCell::handle(std::string_view line, bool read_only, Session* s
   Session local;
   Session& s = session ? *session : local;
   if (!session) s.received = std::chrono::steady_clock::now();
-  const auto frame_before = context_.results ? vision_.lastFramePixels() : nullptr;
+  const auto frame_before = results_ ? vision_.lastFramePixels() : nullptr;
   std::string reply = protocol_.handle(line, read_only, &s);
-  if (!s.after_reply && context_.results) {
-    const auto request = parseRequest(line);
-    if (request && publishesFrame(request->command)) {
-      auto record = std::make_shared<RequestRecord>();
-      record->request = request->command;
-      record->request_line = std::string(line);
-      record->client = s.client;
-      record->options = vision_.options();
-      // A request refused before it took a frame has none of its own.
-      auto frame = vision_.lastFramePixels();
-      if (frame != frame_before) record->frame = std::move(frame);
-      s.after_reply = publishWhenSent(std::move(record), s.received, context_.results);
-    }
+  if (s.publishes == Publishes::kRecord && s.record) {
+    // Filled in (reply, time) even with no results stream: WHY keeps it.
+    s.after_reply = publishWhenSent(std::move(s.record), s.received, results_);
+  } else if (s.publishes == Publishes::kFrame && results_) {
+    auto record = std::make_shared<RequestRecord>();
+    record->request = s.command;
+    record->request_line = std::string(line);
+    record->client = s.client;
+    record->options = vision_.options();
+    // A request refused before it took a frame has none of its own.
+    auto frame = vision_.lastFramePixels();
+    if (frame != frame_before) record->frame = std::move(frame);
+    s.after_reply = publishWhenSent(std::move(record), s.received, results_);
   }
   if (!session && s.after_reply) {
     s.after_reply(reply);

@@ -8,7 +8,6 @@
 #include <cmath>
 
 #include "picksight/common/angles.hpp"
-#include "picksight/common/text.hpp"
 
 namespace picksight::app {
 namespace {
@@ -50,11 +49,12 @@ std::vector<std::vector<cv::Point>> placedFootprint(const vision::PartModel& mod
 // Obstacles around one part: the mask over the box the fingers can reach,
 // without the part's own pixels.
 grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
-                              const std::vector<std::vector<cv::Point2d>>& finger_polys) {
+                              const std::vector<grasp::FingerPolygons>& grasps) {
   const cv::Matx23d to_frame = scene.mapping.sensorToFrame();
   std::vector<cv::Point2f> corners;
-  for (const auto& poly : finger_polys)
-    for (const auto& p : poly) corners.emplace_back(apply(to_frame, p));
+  for (const auto& polygons : grasps)
+    for (const auto& poly : polygons)
+      for (const auto& p : poly) corners.emplace_back(apply(to_frame, p));
   const cv::Rect image(0, 0, scene.mask.cols, scene.mask.rows);
   cv::Rect box = cv::boundingRect(corners);
   box = cv::Rect(box.x - 2, box.y - 2, box.width + 4, box.height + 4) & image;
@@ -72,12 +72,11 @@ grasp::Obstacles obstaclesFor(const LocatedPart& part, const LocateScene& scene,
   const std::vector<std::vector<cv::Point>> outer{region.outer};
   cv::drawContours(own, outer, 0, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
                    -box.tl());
-  // A region of one part's area is that part alone; a larger one holds
-  // touching parts, and only this part's placed footprint is its own.
+  // A part recognized in a region of its own is that region; one found in a
+  // blob shared with other parts (vision decided: LocatedPart::touching)
+  // owns only its placed footprint.
   const vision::PartModel* model = modelOf(scene, part.type);
-  const double frame_area = scene.mapping.areaToFrame(part.area);
-  if (model && region.area > model->body.area * (1 + 2 * model->body.area_tolerance) &&
-      frame_area > 0) {
+  if (model && part.touching) {
     const cv::Point2d centre = apply(to_frame, {part.x, part.y});
     const auto polys = placedFootprint(*model, centre, part.angle_deg, box.tl());
     cv::Mat footprint(box.size(), CV_8UC1, cv::Scalar(0));
@@ -124,15 +123,15 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
       pick.styles.push_back(&styles == &kOwnPose ? -1 : 0);
       continue;
     }
-    const grasp::Gripper& gripper = setup->second.gripper;
-    std::vector<std::vector<cv::Point2d>> reach;
+    // Each style's fingers, once: they size the obstacle mask and are
+    // tested against it.
+    std::vector<grasp::FingerPolygons> reach;
     for (const auto& style : styles) {
-      for (auto& poly :
-           grasp::fingerPolygons(grasp::gripperPose(pose, style), gripper, geometry.vision))
-        reach.push_back(std::move(poly));
+      reach.push_back(grasp::fingerPolygons(grasp::gripperPose(pose, style), setup->second.gripper,
+                                            geometry.vision));
     }
     const grasp::Obstacles obstacles = obstaclesFor(part, outcome.scene, reach);
-    const auto chosen = grasp::firstClearGrasp(pose, styles, gripper, geometry.vision, obstacles);
+    const auto chosen = grasp::firstClearGrasp(reach, obstacles);
     if (!chosen) {
       ++pick.skipped;
       continue;
@@ -142,13 +141,6 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
     pick.styles.push_back(&styles == &kOwnPose ? -1 : static_cast<int>(*chosen));
   }
   return pick;
-}
-
-std::string locateReply(const CellPick& pick) {
-  std::string out = "OK " + std::to_string(pick.poses.size());
-  for (const auto& p : pick.poses)
-    out += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
-  return out;
 }
 
 }  // namespace picksight::app

@@ -151,10 +151,13 @@ std::optional<calibration::Method> parseMethod(const std::vector<std::string>& a
 
 void addCalibrationCommands(CommandTable& table, VisionService& vision,
                             CellCalibration& calibration) {
-  table.add("CALCAM", "CALCAM <radius_mm> or CALCAM GRID <pitch_mm>",
-            [&](const Request& r) { return calcam(r, vision, calibration); });
-  table.add("STORE", "STORE <x> <y>",
-            [&](const Request& r) { return store(r, vision, calibration); });
+  table.add(
+      "CALCAM", "CALCAM <radius_mm> or CALCAM GRID <pitch_mm>",
+      [&](const Request& r) { return calcam(r, vision, calibration); }, alwaysChanges,
+      Publishes::kFrame);
+  table.add(
+      "STORE", "STORE <x> <y>", [&](const Request& r) { return store(r, vision, calibration); },
+      alwaysChanges, Publishes::kFrame);
   table.add("DELETE", "DELETE <id>", [&](const Request& r) {
     const auto id = r.args.size() == 1 ? parseInt(r.args[0]) : std::nullopt;
     if (!id || *id < 0 || *id > 1000000000)

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cctype>
 
-#include "picksight/cell/grasp_planner.hpp"
 #include "picksight/common/text.hpp"
+#include "picksight/results/request_record.hpp"
 
 namespace picksight::app {
 namespace {
@@ -41,7 +41,7 @@ std::string locate(const Request& r, CellContext& cell) {
   record->request_line = r.line;
   record->client = r.session->client;
   r.session->last_locate = record;
-  r.session->after_reply = publishWhenSent(record, r.session->received, cell.results);
+  r.session->record = std::move(record);
   return out;
 }
 
@@ -289,27 +289,11 @@ std::string cameraMode(const Request& r, CellContext& cell) {
 }
 }  // namespace
 
-Result<CellLocate> locateAndPick(CellContext& cell, int type) {
-  // A damaged calibration file is an error, never a silent change of frame;
-  // checked before the frame is taken.
-  if (auto geometry = cell.calibration.geometry(); !geometry) return geometry.error();
-  auto outcome = cell.vision.locate(type);
-  if (!outcome) return outcome.error();
-  // Taken again: a CLEARCAL or a COMPUTE may have come meanwhile.
-  const auto geometry = cell.calibration.geometry();
-  if (!geometry) return geometry.error();
-  const auto grasps =
-      cell.vision.models() ? cell.vision.models()->grasps() : std::make_shared<const GraspMap>();
-  CellLocate located;
-  located.pick = pickPoses(*outcome, *grasps, *geometry);
-  located.outcome = std::move(*outcome);
-  located.grasps = grasps;
-  located.geometry = *geometry;
-  ++cell.locates;
-  cell.last_offered = located.pick.poses.size();
-  cell.last_skipped = located.pick.skipped;
-  cell.skipped_total += located.pick.skipped;
-  return located;
+std::string locateReply(const CellPick& pick) {
+  std::string out = "OK " + std::to_string(pick.poses.size());
+  for (const auto& p : pick.poses)
+    out += " " + formatFixed(p.x) + " " + formatFixed(p.y) + " " + formatFixed(p.rz_deg);
+  return out;
 }
 
 std::string locateAllReply(const CellLocate& located) {
@@ -323,24 +307,6 @@ std::string locateAllReply(const CellLocate& located) {
   return out;
 }
 
-std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
-                                            const VisionOptions& options) {
-  auto record = std::make_shared<RequestRecord>();
-  record->request = "LOCATE";
-  record->asked_type = type;
-  record->options = options;
-  if (located) {
-    record->locate = std::move(located->outcome);
-    // Nothing published or explained reads the mask: a connection's last
-    // LOCATE (kept for WHY) holds no frame-sized buffer.
-    record->locate->scene.mask.release();
-    record->pick = std::move(located->pick);
-    record->grasps = std::move(located->grasps);
-    record->geometry = std::move(located->geometry);
-  }
-  return record;
-}
-
 const std::vector<std::string>& exposureFeatureNames() {
   static const std::vector<std::string> names{"ExposureTime", "ExposureTimeAbs",
                                               "exposure_time_absolute"};
@@ -350,7 +316,7 @@ const std::vector<std::string>& exposureFeatureNames() {
 void addCellCommands(CommandTable& table, CellContext& cell) {
   table.add(
       "LOCATE", "LOCATE <type> | LOCATE ALL", [&cell](const Request& r) { return locate(r, cell); },
-      neverChanges);
+      neverChanges, Publishes::kRecord);
   table.add("WHY", "WHY", why, neverChanges);
   table.add(
       "GRASP", "GRASP <type> ADD <x> <y> <rz> | CLEAR | LIST",

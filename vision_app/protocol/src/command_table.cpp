@@ -76,17 +76,26 @@ bool changesUnlessList(const Request& r) {
 }
 
 void CommandTable::add(const std::string& word, const std::string& usage, Handler handler,
-                       ChangesCell changes) {
-  commands_[toUpper(word)] = Entry{usage, std::move(handler), std::move(changes)};
+                       ChangesCell changes, Publishes publishes) {
+  commands_[toUpper(word)] = Entry{usage, std::move(handler), std::move(changes), publishes};
 }
 
 std::string CommandTable::dispatch(std::string_view line, bool read_only, Session* session) const {
+  if (session) {
+    session->command.clear();
+    session->publishes = Publishes::kNothing;
+    session->record = nullptr;
+  }
   auto request = parseRequest(line);
   if (!request) return errorReply(ProtocolErrc::kEmptyRequest, "empty request");
   const auto it = commands_.find(request->command);
   if (it == commands_.end()) {
     return errorReply(ProtocolErrc::kUnknownCommand,
                       "unknown command '" + printable(request->command) + "' (try HELP)");
+  }
+  if (session) {
+    session->command = request->command;
+    session->publishes = it->second.publishes;
   }
   if (read_only && it->second.changes(*request)) {
     return errorReply(ProtocolErrc::kReadOnly,

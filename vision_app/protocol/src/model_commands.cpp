@@ -201,42 +201,46 @@ std::string tolerance(VisionService& vision, const Request& r) {
 }  // namespace
 
 void addModelCommands(CommandTable& table, VisionService& vision) {
-  table.add("LEARN", "LEARN <type> [name] [AT <x> <y> <w> <h>]", [&vision](const Request& r) {
-    constexpr const char* kUsage = "usage: LEARN <type> [name] [AT <x> <y> <w> <h>]";
-    // "AT" and its four numbers close the line; a name comes before them.
-    std::vector<std::string> args = r.args;
-    std::optional<cv::Rect> at;
-    const auto keyword = std::find(args.begin(), args.end(), "AT");
-    if (keyword != args.end()) {
-      if (args.end() - keyword != 5) {
-        return errorReply(ProtocolErrc::kBadArguments, "LEARN: AT needs <x> <y> <w> <h>");
-      }
-      const auto rect = parseRect(args, static_cast<size_t>(keyword - args.begin()) + 1);
-      if (!rect) {
-        return errorReply(ProtocolErrc::kBadArguments,
-                          "LEARN: AT x y in [0, " + std::to_string(kMaxSensorPx) +
-                              "], w h in [1, " + std::to_string(kMaxSensorPx) + "] sensor pixels");
-      }
-      at = rect;
-      args.erase(keyword, args.end());
-    }
-    if (args.empty() || args.size() > 2) return errorReply(ProtocolErrc::kBadArguments, kUsage);
-    const auto type = parseType(args[0]);
-    if (!type) {
-      return errorReply(
-          ProtocolErrc::kBadArguments,
-          "LEARN: type must be an integer in [0, 9999], got '" + printable(args[0]) + "'");
-    }
-    const std::string name = args.size() > 1 ? args[1] : "type" + std::to_string(*type);
-    if (!validModelName(name)) {
-      return errorReply(
-          ProtocolErrc::kBadArguments,
-          "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" + printable(name) + "'");
-    }
-    auto learned = vision.learn(*type, name, at);
-    if (!learned) return errorReply(learned.error());
-    return learnReply(*learned);
-  });
+  table.add(
+      "LEARN", "LEARN <type> [name] [AT <x> <y> <w> <h>]",
+      [&vision](const Request& r) {
+        constexpr const char* kUsage = "usage: LEARN <type> [name] [AT <x> <y> <w> <h>]";
+        // "AT" and its four numbers close the line; a name comes before them.
+        std::vector<std::string> args = r.args;
+        std::optional<cv::Rect> at;
+        const auto keyword = std::find(args.begin(), args.end(), "AT");
+        if (keyword != args.end()) {
+          if (args.end() - keyword != 5) {
+            return errorReply(ProtocolErrc::kBadArguments, "LEARN: AT needs <x> <y> <w> <h>");
+          }
+          const auto rect = parseRect(args, static_cast<size_t>(keyword - args.begin()) + 1);
+          if (!rect) {
+            return errorReply(ProtocolErrc::kBadArguments,
+                              "LEARN: AT x y in [0, " + std::to_string(kMaxSensorPx) +
+                                  "], w h in [1, " + std::to_string(kMaxSensorPx) +
+                                  "] sensor pixels");
+          }
+          at = rect;
+          args.erase(keyword, args.end());
+        }
+        if (args.empty() || args.size() > 2) return errorReply(ProtocolErrc::kBadArguments, kUsage);
+        const auto type = parseType(args[0]);
+        if (!type) {
+          return errorReply(
+              ProtocolErrc::kBadArguments,
+              "LEARN: type must be an integer in [0, 9999], got '" + printable(args[0]) + "'");
+        }
+        const std::string name = args.size() > 1 ? args[1] : "type" + std::to_string(*type);
+        if (!validModelName(name)) {
+          return errorReply(
+              ProtocolErrc::kBadArguments,
+              "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" + printable(name) + "'");
+        }
+        auto learned = vision.learn(*type, name, at);
+        if (!learned) return errorReply(learned.error());
+        return learnReply(*learned);
+      },
+      alwaysChanges, Publishes::kFrame);
   table.add(
       "MODELS", "MODELS",
       [&vision](const Request& r) {
@@ -283,7 +287,7 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         for (const auto& b : *blobs) reply += " " + blobSummary(b);
         return reply;
       },
-      neverChanges);
+      neverChanges, Publishes::kFrame);
 }
 
 }  // namespace picksight::app

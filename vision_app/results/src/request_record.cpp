@@ -153,4 +153,22 @@ void RequestRecord::explain() const {
   }
 }
 
+std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
+                                            const VisionOptions& options) {
+  auto record = std::make_shared<RequestRecord>();
+  record->request = "LOCATE";
+  record->asked_type = type;
+  record->options = options;
+  if (located) {
+    record->locate = std::move(located->outcome);
+    // Nothing published or explained reads the mask: a connection's last
+    // LOCATE (kept for WHY) holds no frame-sized buffer.
+    record->locate->scene.mask.release();
+    record->pick = std::move(located->pick);
+    record->grasps = std::move(located->grasps);
+    record->geometry = std::move(located->geometry);
+  }
+  return record;
+}
+
 }  // namespace picksight::app

@@ -64,6 +64,19 @@ struct Obstacles {
 bool fingersClear(const Pose& gripper, const Gripper& fingers,
                   const calibration::VisionFrame& frame, const Obstacles& obstacles);
 
+// The fingers' corners of one grasp (fingerPolygons), in sensor pixels.
+using FingerPolygons = std::vector<std::vector<cv::Point2d>>;
+
+// True when none of the polygons covers an obstacle pixel (fingersClear
+// for polygons already computed).
+bool polygonsClear(const FingerPolygons& polygons, const Obstacles& obstacles);
+
+// Index of the first grasp whose fingers' polygons are clear; nullopt when
+// none is. For a caller that needs the polygons itself (to size the
+// obstacle mask), so that they are computed once per grasp.
+std::optional<size_t> firstClearGrasp(const std::vector<FingerPolygons>& grasps,
+                                      const Obstacles& obstacles);
+
 // Index of the first style whose grasp is clear; nullopt when none is (or
 // when there are no styles). With no fingers every grasp is clear.
 std::optional<size_t> firstClearGrasp(const Pose& part, const std::vector<GraspStyle>& styles,

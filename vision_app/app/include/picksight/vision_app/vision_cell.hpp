@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "picksight/camera_link/camera_link.hpp"
+#include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"
@@ -47,7 +48,9 @@ class VisionCell {
 
   // Every vision request publishes its result there from now on (null:
   // none); `results` outlives the cell. Call before serving starts.
-  void publishResultsTo(ResultsPublisher* results) { context_.results = results; }
+  void publishResultsTo(ResultsPublisher* results) { results_ = results; }
+  // Where requests publish (null: nowhere); read at each request.
+  ResultsPublisher* const& results() const { return results_; }
 
   VisionService& vision() { return vision_; }
   ModelLibrary& models() { return models_; }
@@ -61,6 +64,7 @@ class VisionCell {
   VisionService vision_;
   RobotProtocol protocol_;
   CellContext context_;
+  ResultsPublisher* results_ = nullptr;
 };
 
 }  // namespace picksight::app

@@ -30,13 +30,10 @@ const vision::PartModel* modelOf(const LocateScene& scene, int type);
 grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision);
 
 // The grasp poses of the parts of `outcome`. Obstacles are the scene's
-// mask without the part's own pixels (for a region holding more than one
-// part, without the placed model's footprint). A part of a type with no
+// mask without the part's own pixels (for a part found touching others,
+// without its placed model's footprint). A part of a type with no
 // grasp styles is grasped at its own pose, checked against the fingers.
 CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
                    const CellGeometry& geometry);
-
-// The LOCATE reply a robot reads: "OK <n>" then x y rz of each pose.
-std::string locateReply(const CellPick& pick);
 
 }  // namespace picksight::app

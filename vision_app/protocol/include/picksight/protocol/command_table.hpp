@@ -77,11 +77,13 @@ class CommandTable {
 
   // Registers (or replaces) a command word, upper case. A command changes
   // the cell unless it says otherwise, so that a new command is refused on
-  // a read-only port until someone decides it only reads.
+  // a read-only port until someone decides it only reads. `publishes`:
+  // what its requests publish (see Session).
   void add(const std::string& word, const std::string& usage, Handler handler,
-           ChangesCell changes = alwaysChanges);
+           ChangesCell changes = alwaysChanges, Publishes publishes = Publishes::kNothing);
   // Parses and runs one request line. On a read-only port a request that
-  // changes the cell gets ProtocolErrc::kReadOnly and does nothing. With
+  // changes the cell gets ProtocolErrc::kReadOnly and does nothing. The
+  // session's command and publishes are its entry's, refused or not. With
   // `session` (a connection's), its after_reply is left for the caller to
   // run once the reply is sent; without, it runs before this returns.
   // Thread-safe once set up.
@@ -95,6 +97,7 @@ class CommandTable {
     std::string usage;
     Handler handler;
     ChangesCell changes;
+    Publishes publishes = Publishes::kNothing;
   };
   std::map<std::string, Entry> commands_;
 };

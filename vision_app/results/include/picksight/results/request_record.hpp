@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/grasp_planner.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/frame.hpp"
@@ -81,5 +82,11 @@ class RequestRecord {
   mutable std::vector<RegionRejection> rejections_;
   mutable std::string why_;
 };
+
+// A LOCATE's record (robot port or PLC trigger), the outcome moved in
+// (`located` may be an error); the caller fills in the request line and
+// the client, the reply and the time once they are known.
+std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
+                                            const VisionOptions& options);
 
 }  // namespace picksight::app

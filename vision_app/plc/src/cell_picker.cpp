@@ -1,9 +1,11 @@
-// PLC triggers through the cell's one LOCATE path.
-#include "picksight/plc/cell_locator.hpp"
+// PLC triggers picked through the cell's one LOCATE path.
+#include "picksight/plc/cell_picker.hpp"
 
 #include <chrono>
 
+#include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_errors.hpp"
+#include "picksight/results/request_record.hpp"
 
 namespace picksight::plc {
 
@@ -32,13 +34,13 @@ PlcResult plcResult(const app::CellLocate& located) {
   return result;
 }
 
-PlcDevice::Locator cellLocator(app::CellContext& cell) {
-  return [&cell](int type) -> Result<PlcResult> {
+PlcDevice::Locator cellPicker(app::CellContext& cell, app::ResultsPublisher* const& results) {
+  return [&cell, &results](int type) -> Result<PlcResult> {
     const auto started = std::chrono::steady_clock::now();
     auto located = app::locateAndPick(cell, type);
     Result<PlcResult> result =
         located ? Result<PlcResult>(plcResult(*located)) : Result<PlcResult>(located.error());
-    if (cell.results) {
+    if (results) {
       // Queued only: the publisher builds and sends it on its own thread.
       const std::string reply =
           located ? app::locateReply(located->pick) : app::errorReply(located.error());
@@ -49,7 +51,7 @@ PlcDevice::Locator cellLocator(app::CellContext& cell) {
       record->elapsed_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
               .count();
-      cell.results->publish(std::move(record));
+      results->publish(std::move(record));
     }
     return result;
   };

@@ -1,0 +1,34 @@
+// The cell's LOCATE: parts, grasps, reply frame, and the STATUS figures.
+#include "picksight/cell/cell_locate.hpp"
+
+namespace picksight::app {
+
+Result<CellLocate> locateAndPick(const CellCalibration& calibration, const ModelLibrary* models,
+                                 const std::function<Result<LocateOutcome>()>& locate) {
+  if (auto geometry = calibration.geometry(); !geometry) return geometry.error();
+  auto outcome = locate();
+  if (!outcome) return outcome.error();
+  // Taken again: a CLEARCAL or a COMPUTE may have come meanwhile.
+  const auto geometry = calibration.geometry();
+  if (!geometry) return geometry.error();
+  const auto grasps = models ? models->grasps() : std::make_shared<const GraspMap>();
+  CellLocate located;
+  located.pick = pickPoses(*outcome, *grasps, *geometry);
+  located.outcome = std::move(*outcome);
+  located.grasps = grasps;
+  located.geometry = *geometry;
+  return located;
+}
+
+Result<CellLocate> locateAndPick(CellContext& cell, int type) {
+  auto located = locateAndPick(cell.calibration, cell.vision.models(),
+                               [&] { return cell.vision.locate(type); });
+  if (!located) return located;
+  ++cell.locates;
+  cell.last_offered = located->pick.poses.size();
+  cell.last_skipped = located->pick.skipped;
+  cell.skipped_total += located->pick.skipped;
+  return located;
+}
+
+}  // namespace picksight::app

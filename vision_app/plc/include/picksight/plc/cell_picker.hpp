@@ -1,0 +1,26 @@
+// The PLC device's view of a cell: its trigger picks through the cell's one
+// LOCATE path (cell/cell_locate, as the robot port's LOCATE), its error
+// codes are the robot protocol's, its calibration state is the cell's reply
+// frame.
+#pragma once
+
+#include "picksight/cell/cell_locate.hpp"
+#include "picksight/plc/plc_device.hpp"
+#include "picksight/results/results_publisher.hpp"
+
+namespace picksight::plc {
+
+uint16_t frameCode(app::CoordinateFrame frame);  // kFrame*
+
+// A LOCATE's poses as the PLC registers hold them: each pose with its
+// part's type and score.
+PlcResult plcResult(const app::CellLocate& located);
+
+// The three callbacks of a PlcDevice over `cell` (borrowed; outlives the
+// device). The picker publishes each trigger's record on `results` when it
+// is set (read at each trigger; the pointer outlives the device).
+PlcDevice::Locator cellPicker(app::CellContext& cell, app::ResultsPublisher* const& results);
+PlcDevice::FrameState cellFrameState(const app::CellCalibration& calibration);
+int robotErrorCodeOf(const Error& error);
+
+}  // namespace picksight::plc
