@@ -18,6 +18,7 @@ struct RawOptions {
   std::vector<std::string> vision_apps;
   std::string allow;
   std::vector<std::string> allow_hosts;
+  int header_timeout_s = 10;
   std::string config_file;
 };
 
@@ -88,6 +89,15 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
   app.add_option("--max-streams", o.max_streams, "concurrent MJPEG and event streams")
       ->check(CLI::Range(1, 200))
       ->capture_default_str();
+  app.add_option("--header-timeout", raw.header_timeout_s,
+                 "seconds a connection has to deliver its whole request (header and body); "
+                 "no byte restarts it")
+      ->check(CLI::Range(1, 300))
+      ->capture_default_str();
+  app.add_option("--per-address", o.per_address,
+                 "connections open at once from one address (streams included)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   app.add_option("--config", raw.config_file,
                  "YAML file of options, each named as its flag without dashes "
                  "(lists for the repeatable ones); the command line overrides it");
@@ -114,6 +124,7 @@ Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
                        "--vision-app: name '" + o.vision_apps.back().name + "' given twice");
   }
   if (!raw.allow.empty()) o.allow = *AllowList::parse(raw.allow);
+  o.header_timeout = std::chrono::seconds(raw.header_timeout_s);
   for (const auto& v : raw.allow_hosts)
     for (const auto& name : splitFields(v, ","))
       if (!name.empty()) o.allow_hosts.emplace_back(name);

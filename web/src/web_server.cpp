@@ -23,6 +23,7 @@
 #include "picksight/web/camera_actions.hpp"
 #include "picksight/web/camera_monitor.hpp"
 #include "picksight/web/event_hub.hpp"
+#include "picksight/web/http_gate.hpp"
 #include "picksight/web/metrics_text.hpp"
 #include "picksight/web/proto_json.hpp"
 #include "picksight/web/refusal_log.hpp"
@@ -131,6 +132,26 @@ bool peerAllowed(const AllowList& allow, const std::string& address) {
   return false;
 }
 
+// Debian's cpp-httplib (0.11.4) serves only the sockets it accepts itself,
+// and restarts its read timeout at every byte; HttpGate accepts instead and
+// hands over complete requests. Serving a given socket is httplib's
+// private virtual process_and_close_socket, and keep-alive loops look at its
+// protected listening socket: named here through explicit instantiation,
+// which the language exempts from access checks (the only way to reach
+// them without patching the library). On an SSLServer the virtual call
+// does the TLS handshake.
+using ProcessSocket = bool (httplib::Server::*)(::socket_t);
+using ListenSocket = std::atomic<::socket_t> httplib::Server::*;
+ProcessSocket processSocketOf();
+ListenSocket listenSocketOf();
+template <ProcessSocket Process, ListenSocket Listen>
+struct HttplibInternals {
+  friend ProcessSocket processSocketOf() { return Process; }
+  friend ListenSocket listenSocketOf() { return Listen; }
+};
+template struct HttplibInternals<&httplib::Server::process_and_close_socket,
+                                 &httplib::Server::svr_sock_>;
+
 void setFrameHeaders(httplib::Response& res, uint64_t sequence, uint64_t timestamp_ns) {
   res.set_header("X-Frame-Sequence", std::to_string(sequence));
   res.set_header("X-Frame-Timestamp-Ns", std::to_string(timestamp_ns));
@@ -154,13 +175,13 @@ class WebServer::Impl {
 
   WebOptions options_;
   const HostNames hosts_;
-  RefusalLog refusals_{"HTTP"};
   zmq::context_t context_;
   EventHub events_;
   std::unique_ptr<CameraMonitor> cameras_;
   std::map<std::string, std::unique_ptr<ResultFeed>> apps_;
-  httplib::Server http_;
-  std::thread thread_;
+  RefusalLog refusals_{"HTTP"};
+  std::unique_ptr<httplib::Server> http_ = std::make_unique<httplib::Server>();
+  std::unique_ptr<HttpGate> gate_;
   int port_ = 0;
   std::atomic<bool> stopping_{false};
   std::atomic<int> streams_{0};
@@ -186,26 +207,23 @@ Result<void> WebServer::Impl::start() {
                                              options_.jpeg_quality);
   for (const auto& app : options_.vision_apps)
     apps_[app.name] = std::make_unique<ResultFeed>(context_, app, events_);
-  // Every stream holds a thread; the rest serve the page and the API.
-  const size_t threads = static_cast<size_t>(options_.max_streams) + 16;
-  http_.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  http_.set_payload_max_length(kMaxBodyBytes);
+  http_->set_payload_max_length(kMaxBodyBytes);
   // A viewer whose socket takes no bytes for this long is dropped: it held
   // one HTTP thread, never a camera or another viewer.
-  http_.set_write_timeout(5s);
-  http_.set_read_timeout(10s);
-  http_.set_keep_alive_timeout(5);
+  http_->set_write_timeout(5s);
+  http_->set_read_timeout(10s);
+  http_->set_keep_alive_timeout(5);
   // On every response, refusals and errors too: no page may frame this one
   // (clickjacking) nor run anything but the page's own files.
-  http_.set_default_headers({{"X-Frame-Options", "DENY"},
-                             {"Content-Security-Policy", kContentSecurityPolicy},
-                             {"X-Content-Type-Options", "nosniff"},
-                             {"Referrer-Policy", "no-referrer"},
-                             {"Cross-Origin-Opener-Policy", "same-origin"},
-                             {"Cross-Origin-Resource-Policy", "same-origin"}});
+  http_->set_default_headers({{"X-Frame-Options", "DENY"},
+                              {"Content-Security-Policy", kContentSecurityPolicy},
+                              {"X-Content-Type-Options", "nosniff"},
+                              {"Referrer-Policy", "no-referrer"},
+                              {"Cross-Origin-Opener-Policy", "same-origin"},
+                              {"Cross-Origin-Resource-Policy", "same-origin"}});
   // A handler's exception is a bug: logged here, and the client gets a
   // plain 500 (httplib's default would quote the exception in a header).
-  http_.set_exception_handler(
+  http_->set_exception_handler(
       [](const httplib::Request& req, httplib::Response& res, std::exception_ptr error) {
         std::string what = "unknown exception";
         try {
@@ -219,13 +237,13 @@ Result<void> WebServer::Impl::start() {
       });
   // Errors httplib answers itself (no route, a malformed request line, a
   // body over the limit) get a message too, in the API's form.
-  http_.set_error_handler(
+  http_->set_error_handler(
       httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
         if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
         sendJson(res, {{"error", statusText(res.status)}}, res.status);
         return httplib::Server::HandlerResponse::Handled;
       }));
-  http_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+  http_->set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     const auto refuse = [&](int status, const std::string& message) {
       refusals_.refused(req.remote_addr, req.method + " " + req.path + ": " + message);
       sendJson(res, {{"error", message}}, status);
@@ -245,26 +263,34 @@ Result<void> WebServer::Impl::start() {
     return httplib::Server::HandlerResponse::Unhandled;
   });
   routes();
-  port_ =
-      options_.listen_port == 0
-          ? http_.bind_to_any_port(options_.listen_host)
-          : (http_.bind_to_port(options_.listen_host, options_.listen_port) ? options_.listen_port
-                                                                            : -1);
-  if (port_ <= 0) {
-    return makeError(WebErrc::kBadConfig, "cannot listen on " + options_.listen_host + ":" +
-                                              std::to_string(options_.listen_port));
-  }
+  GateOptions gate;
+  gate.header_timeout = options_.header_timeout;
+  gate.per_address = options_.per_address;
+  gate.max_body_bytes = kMaxBodyBytes;
+  // Every stream holds a thread; the rest serve the page and the API.
+  gate.threads = static_cast<size_t>(options_.max_streams) + 16;
+  gate_ = std::make_unique<HttpGate>(gate, refusals_);
+  auto port = gate_->listen(options_.listen_host, options_.listen_port);
+  if (!port) return port.error();
+  port_ = *port;
+  // httplib serves the requests the gate found complete, one per
+  // connection: a kept-alive connection's next request would be read by
+  // httplib's per-byte timeouts, past the gate.
+  http_->set_keep_alive_max_count(1);
+  http_.get()->*listenSocketOf() = gate_->listeningSocket();
   logInfo("requests must name one of these hosts (--allow-host): ", hosts_.describe());
-  thread_ = std::thread([this] { http_.listen_after_bind(); });
+  gate_->start([this](int fd) { (http_.get()->*processSocketOf())(fd); });
   return {};
 }
 
 void WebServer::Impl::stop() {
   if (stopping_.exchange(true)) return;
   events_.closeAll();
-  http_.stop();
+  if (gate_) gate_->stop();
+  // httplib's keep-alive loops end when its listening socket is invalid.
+  if (http_) http_.get()->*listenSocketOf() = INVALID_SOCKET;
   if (cameras_) cameras_->stop();  // wakes the streams waiting on frames
-  if (thread_.joinable()) thread_.join();
+  if (gate_) gate_->join();
   for (auto& [name, app] : apps_) app->stop();
 }
 
@@ -464,32 +490,32 @@ std::string WebServer::Impl::metrics() {
 }
 
 void WebServer::Impl::routes() {
-  http_.Get("/", [this](const httplib::Request&, httplib::Response& res) {
+  http_->Get("/", [this](const httplib::Request&, httplib::Response& res) {
     serveFile("index.html", res);
   });
-  http_.Get(R"(/static/(.+))", [this](const httplib::Request& req, httplib::Response& res) {
+  http_->Get(R"(/static/(.+))", [this](const httplib::Request& req, httplib::Response& res) {
     serveFile(req.matches[1], res);
   });
-  http_.Get("/api/cameras", [this](const httplib::Request&, httplib::Response& res) {
+  http_->Get("/api/cameras", [this](const httplib::Request&, httplib::Response& res) {
     sendJson(res, cameras_->cameras());
   });
-  http_.Get("/api/apps", [this](const httplib::Request&, httplib::Response& res) { apps(res); });
-  http_.Get(R"(/snapshot/([^/]+)\.png)",
-            [this](const httplib::Request& req, httplib::Response& res) {
-              snapshot(req.matches[1], res);
-            });
-  http_.Get(R"(/frame/([^/]+)\.jpg)", [this](const httplib::Request& req, httplib::Response& res) {
+  http_->Get("/api/apps", [this](const httplib::Request&, httplib::Response& res) { apps(res); });
+  http_->Get(R"(/snapshot/([^/]+)\.png)",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               snapshot(req.matches[1], res);
+             });
+  http_->Get(R"(/frame/([^/]+)\.jpg)", [this](const httplib::Request& req, httplib::Response& res) {
     frameJpeg(req.matches[1], res);
   });
-  http_.Get(
+  http_->Get(
       R"(/stream/([^/]+)\.mjpg)",
       [this](const httplib::Request& req, httplib::Response& res) { stream(req.matches[1], res); });
-  http_.Get(R"(/binary/([^/]+)\.png)", [this](const httplib::Request& req, httplib::Response& res) {
-    binary(req.matches[1], res);
-  });
-  http_.Get("/events", [this](const httplib::Request&, httplib::Response& res) { events(res); });
-  http_.Get(R"(/api/results/([^/]+)/latest)", [this](const httplib::Request& req,
-                                                     httplib::Response& res) {
+  http_->Get(
+      R"(/binary/([^/]+)\.png)",
+      [this](const httplib::Request& req, httplib::Response& res) { binary(req.matches[1], res); });
+  http_->Get("/events", [this](const httplib::Request&, httplib::Response& res) { events(res); });
+  http_->Get(R"(/api/results/([^/]+)/latest)", [this](const httplib::Request& req,
+                                                      httplib::Response& res) {
     ResultFeed* app = appOr404(req.matches[1], res);
     if (!app) return;
     const std::string json = app->latestJson();
@@ -498,46 +524,46 @@ void WebServer::Impl::routes() {
     res.set_header("Cache-Control", "no-store");
     res.set_content(json, "application/json");
   });
-  http_.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
+  http_->Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics(), "text/plain; version=0.0.4; charset=utf-8");
   });
-  http_.Post(R"(/api/apps/([^/]+)/command)",
+  http_->Post(R"(/api/apps/([^/]+)/command)",
+              [this](const httplib::Request& req, httplib::Response& res) {
+                ResultFeed* app = appOr404(req.matches[1], res);
+                if (!app) return;
+                auto body = parseJsonBody(req.body);
+                if (!body) return sendError(res, body.error());
+                auto line = body->find("line");
+                if (line == body->end() || !line->is_string())
+                  return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
+                auto reply = app->command(line->get<std::string>());
+                if (!reply) return sendError(res, reply.error());
+                sendJson(res, {{"reply", *reply}});
+              });
+  http_->Get(R"(/api/cameras/([^/]+)/features)",
              [this](const httplib::Request& req, httplib::Response& res) {
-               ResultFeed* app = appOr404(req.matches[1], res);
-               if (!app) return;
-               auto body = parseJsonBody(req.body);
-               if (!body) return sendError(res, body.error());
-               auto line = body->find("line");
-               if (line == body->end() || !line->is_string())
-                 return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
-               auto reply = app->command(line->get<std::string>());
+               proto::ControlRequest request;
+               request.mutable_list_features()->set_camera(req.matches[1]);
+               auto reply = cameras_->control(req.matches[1], request);
                if (!reply) return sendError(res, reply.error());
-               sendJson(res, {{"reply", *reply}});
+               nlohmann::json list = nlohmann::json::array();
+               for (const auto& f : reply->list_features().features())
+                 list.push_back(protoJson(f, true));
+               sendJson(res, list);
              });
-  http_.Get(R"(/api/cameras/([^/]+)/features)",
-            [this](const httplib::Request& req, httplib::Response& res) {
-              proto::ControlRequest request;
-              request.mutable_list_features()->set_camera(req.matches[1]);
-              auto reply = cameras_->control(req.matches[1], request);
-              if (!reply) return sendError(res, reply.error());
-              nlohmann::json list = nlohmann::json::array();
-              for (const auto& f : reply->list_features().features())
-                list.push_back(protoJson(f, true));
-              sendJson(res, list);
-            });
-  http_.Post(R"(/api/cameras/([^/]+)/([a-z]+))",
-             [this](const httplib::Request& req, httplib::Response& res) {
-               const std::string camera = req.matches[1];
-               if (!cameras_->feed(camera))
-                 return sendError(res, WebErrc::kNotFound, "no camera '" + camera + "'");
-               auto body = parseJsonBody(req.body);
-               if (!body) return sendError(res, body.error());
-               auto request = cameraAction(camera, req.matches[2], *body);
-               if (!request) return sendError(res, request.error());
-               auto reply = cameras_->control(camera, *request);
-               if (!reply) return sendError(res, reply.error());
-               sendJson(res, actionReplyJson(*reply));
-             });
+  http_->Post(R"(/api/cameras/([^/]+)/([a-z]+))",
+              [this](const httplib::Request& req, httplib::Response& res) {
+                const std::string camera = req.matches[1];
+                if (!cameras_->feed(camera))
+                  return sendError(res, WebErrc::kNotFound, "no camera '" + camera + "'");
+                auto body = parseJsonBody(req.body);
+                if (!body) return sendError(res, body.error());
+                auto request = cameraAction(camera, req.matches[2], *body);
+                if (!request) return sendError(res, request.error());
+                auto reply = cameras_->control(camera, *request);
+                if (!reply) return sendError(res, reply.error());
+                sendJson(res, actionReplyJson(*reply));
+              });
 }
 
 WebServer::WebServer(WebOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}

@@ -1,6 +1,7 @@
 // Command-line options and YAML configuration of picksight-web.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -39,6 +40,10 @@ struct WebOptions {
   // Concurrent MJPEG and event streams; beyond it a 503, so that streams
   // never take every HTTP thread and starve the page.
   int max_streams = 48;
+  // A connection must deliver its whole request within this (no byte
+  // restarts it), and one address may hold per_address connections.
+  std::chrono::milliseconds header_timeout{10000};
+  int per_address = 32;
 };
 
 // Parses argv without the program name; errors name the option. With
