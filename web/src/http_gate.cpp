@@ -53,8 +53,8 @@ void raiseDescriptorLimit() {
   ::setrlimit(RLIMIT_NOFILE, &limit);
 }
 
-// A short answer to a connection refused here, then closed.
-void refuseConnection(int fd, int status, const char* reason, const std::string& message) {
+// A short answer to a connection refused here; the caller closes it.
+void answerRefusal(int fd, int status, const char* reason, const std::string& message) {
   const std::string body = "{\"error\":\"" + message + "\"}";
   const std::string response =
       "HTTP/1.1 " + std::to_string(status) + " " + reason +
@@ -62,8 +62,16 @@ void refuseConnection(int fd, int status, const char* reason, const std::string&
       "\r\nConnection: close\r\nX-Frame-Options: DENY\r\n\r\n" + body;
   (void)::send(fd, response.data(), response.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
   ::shutdown(fd, SHUT_WR);
-  ::close(fd);
 }
+
+// A refused connection's client may still be sending (a body over the
+// limit): what it sends is read and dropped for a while before the socket
+// is closed, since closing with unread bytes resets the connection, and a
+// reset makes the client lose the answer (or, unless it ignores SIGPIPE,
+// its life).
+constexpr auto kLinger = std::chrono::seconds(2);
+constexpr size_t kLingerBytes = 1 << 20;
+constexpr size_t kMaxLingering = 1024;
 
 // What the bytes received so far say about a request.
 enum class Progress { kWaiting, kComplete, kHeaderTooLarge, kBodyTooLarge, kChunked };
@@ -139,6 +147,9 @@ class HttpGate::Impl {
   void release(const std::string& address);
   void refuse(int fd, const std::string& address, int status, const char* reason,
               const std::string& message);
+  // Keeps a refused connection open (reading and dropping) for kLinger.
+  void linger(int fd);
+  void drain(int fd);
 
   const GateOptions options_;
   RefusalLog& refusals_;
@@ -157,6 +168,13 @@ class HttpGate::Impl {
   std::unordered_map<int, Waiting> waiting_;
   std::deque<std::pair<Clock::time_point, std::pair<int, uint64_t>>> deadlines_;  // in order
   uint64_t next_serial_ = 0;
+
+  struct Lingering {
+    Clock::time_point deadline;
+    size_t budget = 0;
+  };
+  std::unordered_map<int, Lingering> lingering_;
+  std::deque<std::pair<Clock::time_point, int>> linger_deadlines_;  // in order
 
   std::mutex per_address_mutex_;
   std::map<std::string, int> per_address_;  // under per_address_mutex_
@@ -233,12 +251,13 @@ void HttpGate::Impl::run() {
   while (!stopping_) {
     int timeout_ms = 1000;
     const auto now = Clock::now();
-    if (!deadlines_.empty())
-      timeout_ms = static_cast<int>(std::clamp<int64_t>(
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadlines_.front().first - now)
-                  .count() +
-              1,
-          0, 1000));
+    const auto until = [&](Clock::time_point t) {
+      return static_cast<int>(std::clamp<int64_t>(
+          std::chrono::duration_cast<std::chrono::milliseconds>(t - now).count() + 1, 0, 1000));
+    };
+    if (!deadlines_.empty()) timeout_ms = until(deadlines_.front().first);
+    if (!linger_deadlines_.empty())
+      timeout_ms = std::min(timeout_ms, until(linger_deadlines_.front().first));
     if (accept_paused_) timeout_ms = std::min(timeout_ms, 100);
     const int n = ::epoll_wait(epoll_fd_, events, 64, timeout_ms);
     if (stopping_) break;
@@ -247,6 +266,8 @@ void HttpGate::Impl::run() {
       if (fd == wake_fd_) continue;
       if (fd == listen_fd_)
         acceptAll();
+      else if (lingering_.count(fd) > 0)
+        drain(fd);
       else
         check(fd);
     }
@@ -263,6 +284,8 @@ void HttpGate::Impl::run() {
     ::close(fd);
     release(w.address);
   }
+  for (auto& [fd, l] : lingering_) ::close(fd);
+  lingering_.clear();
   waiting_.clear();
   waiting_count_ = 0;
 }
@@ -293,8 +316,9 @@ void HttpGate::Impl::acceptAll() {
       if (count >= options_.per_address) {
         refusals_.refused(address, "more than " + std::to_string(options_.per_address) +
                                        " connections from one address (--per-address)");
-        refuseConnection(fd, 503, "Service Unavailable",
-                         "too many connections from " + address + " (--per-address)");
+        answerRefusal(fd, 503, "Service Unavailable",
+                      "too many connections from " + address + " (--per-address)");
+        linger(fd);
         continue;
       }
       ++count;
@@ -390,6 +414,15 @@ void HttpGate::Impl::expire(Clock::time_point now) {
                formatFixed(static_cast<double>(options_.header_timeout.count()) / 1000.0, 1) +
                " s of connecting (--header-timeout)");
   }
+  while (!linger_deadlines_.empty() && linger_deadlines_.front().first <= now) {
+    const int fd = linger_deadlines_.front().second;
+    linger_deadlines_.pop_front();
+    auto it = lingering_.find(fd);
+    if (it == lingering_.end() || it->second.deadline > now) continue;  // closed, or reused
+    ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
+    ::close(fd);
+    lingering_.erase(it);
+  }
   // Served and closed connections leave their entries behind: dropped
   // from the front as they come due, so the queue holds at most one entry
   // per connection accepted within the last header_timeout.
@@ -404,8 +437,43 @@ void HttpGate::Impl::release(const std::string& address) {
 void HttpGate::Impl::refuse(int fd, const std::string& address, int status, const char* reason,
                             const std::string& message) {
   refusals_.refused(address, message);
-  refuseConnection(fd, status, reason, message);
+  answerRefusal(fd, status, reason, message);
   release(address);
+  linger(fd);
+}
+
+void HttpGate::Impl::linger(int fd) {
+  if (lingering_.size() >= kMaxLingering) {
+    ::close(fd);
+    return;
+  }
+  const auto deadline = Clock::now() + kLinger;
+  lingering_[fd] = Lingering{deadline, kLingerBytes};
+  linger_deadlines_.push_back({deadline, fd});
+  epoll_event e{};
+  e.events = EPOLLIN | EPOLLRDHUP;
+  e.data.fd = fd;
+  ::epoll_ctl(epoll_fd_, EPOLL_CTL_ADD, fd, &e);
+  drain(fd);
+}
+
+void HttpGate::Impl::drain(int fd) {
+  auto it = lingering_.find(fd);
+  if (it == lingering_.end()) return;
+  char chunk[16384];
+  while (true) {
+    const ssize_t n = ::recv(fd, chunk, sizeof(chunk), MSG_DONTWAIT);
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return;  // more may come
+    if (n < 0 && errno == EINTR) continue;
+    if (n > 0 && static_cast<size_t>(n) < it->second.budget) {
+      it->second.budget -= static_cast<size_t>(n);
+      continue;
+    }
+    break;  // closed by the client, failed or over budget
+  }
+  ::epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
+  ::close(fd);
+  lingering_.erase(it);
 }
 
 HttpGate::HttpGate(GateOptions options, RefusalLog& refusals)
