@@ -24,6 +24,7 @@
 #include "picksight/web/camera_monitor.hpp"
 #include "picksight/web/event_hub.hpp"
 #include "picksight/web/http_gate.hpp"
+#include "picksight/web/idle_worker.hpp"
 #include "picksight/web/metrics_text.hpp"
 #include "picksight/web/proto_json.hpp"
 #include "picksight/web/refusal_log.hpp"
@@ -182,6 +183,8 @@ class WebServer::Impl {
   RefusalLog refusals_{"HTTP"};
   std::unique_ptr<httplib::Server> http_ = std::make_unique<httplib::Server>();
   std::unique_ptr<HttpGate> gate_;
+  // Snapshots' PNGs and binarized images, made on request at SCHED_IDLE.
+  IdleWorker images_{"snapshot and binarized images"};
   int port_ = 0;
   std::atomic<bool> stopping_{false};
   std::atomic<int> streams_{0};
@@ -192,6 +195,8 @@ class WebServer::Impl {
   std::shared_ptr<CameraFeed> feedOr404(const std::string& camera, httplib::Response& res);
   ResultFeed* appOr404(const std::string& name, httplib::Response& res);
   void snapshot(const std::string& camera, httplib::Response& res);
+  // Runs `job` on images_; false (and a 503) when it was refused.
+  bool onIdle(const std::function<void()>& job, httplib::Response& res);
   void frameJpeg(const std::string& camera, httplib::Response& res);
   void stream(const std::string& camera, httplib::Response& res);
   void binary(const std::string& app, httplib::Response& res);
@@ -330,12 +335,29 @@ void WebServer::Impl::snapshot(const std::string& camera, httplib::Response& res
   auto frame = feed->latest();
   if (!frame) return sendError(res, WebErrc::kNotFound, "no frame from '" + camera + "' yet");
   std::vector<unsigned char> png;
+  bool encoded = false;
   // Fast compression: lossless all the same, and a 1920x1080 frame takes
   // tens of milliseconds instead of hundreds.
-  if (!cv::imencode(".png", frame->image, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
-    return sendError(res, WebErrc::kEncode, "PNG encoding failed");
+  if (!onIdle(
+          [&] {
+            encoded = cv::imencode(".png", frame->image, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+          },
+          res))
+    return;
+  if (!encoded) return sendError(res, WebErrc::kEncode, "PNG encoding failed");
   setFrameHeaders(res, frame->info.sequence, frame->info.host_timestamp_ns);
   res.set_content(std::string(png.begin(), png.end()), "image/png");
+}
+
+bool WebServer::Impl::onIdle(const std::function<void()>& job, httplib::Response& res) {
+  if (images_.run(job) != IdleWorker::Outcome::kRefused) return true;
+  sendJson(res,
+           {{"error",
+             "busy: images are made only on cores the vision leaves free, and all are "
+             "taken; try again"}},
+           503);
+  res.set_header("Retry-After", "1");
+  return false;
 }
 
 void WebServer::Impl::frameJpeg(const std::string& camera, httplib::Response& res) {
@@ -420,12 +442,18 @@ void WebServer::Impl::binary(const std::string& name, httplib::Response& res) {
         b.dark_parts() ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
     options.adaptive_window = static_cast<int>(b.window());
   }
-  cv::Mat grey = frame->image;
-  if (grey.channels() == 3) cv::cvtColor(frame->image, grey, cv::COLOR_BGR2GRAY);
-  const cv::Mat mask = vision::binarize(grey, options);
   std::vector<unsigned char> png;
-  if (!cv::imencode(".png", mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
-    return sendError(res, WebErrc::kEncode, "PNG encoding failed");
+  bool encoded = false;
+  if (!onIdle(
+          [&] {
+            cv::Mat grey = frame->image;
+            if (grey.channels() == 3) cv::cvtColor(frame->image, grey, cv::COLOR_BGR2GRAY);
+            const cv::Mat mask = vision::binarize(grey, options);
+            encoded = cv::imencode(".png", mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+          },
+          res))
+    return;
+  if (!encoded) return sendError(res, WebErrc::kEncode, "PNG encoding failed");
   setFrameHeaders(res, frame->info.sequence, frame->info.host_timestamp_ns);
   res.set_content(std::string(png.begin(), png.end()), "image/png");
 }
