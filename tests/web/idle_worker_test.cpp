@@ -20,7 +20,7 @@ TEST_CASE("an on-demand image job runs at idle priority", "[web]") {
   CHECK(policy == SCHED_IDLE);
 }
 
-TEST_CASE("a starved image job runs on its caller, one caller at a time", "[web]") {
+TEST_CASE("a starved image job runs on its caller and one caller at a time", "[web]") {
   IdleWorker worker("test images", 16, 100ms);
   std::promise<void> release_worker;
   std::shared_future<void> worker_released = release_worker.get_future().share();

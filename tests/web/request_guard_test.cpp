@@ -21,7 +21,7 @@ RequestFacts post(const std::string& origin, const std::string& type, const std:
 
 }  // namespace
 
-TEST_CASE("Host headers are matched by name, any case, any port", "[web][security]") {
+TEST_CASE("Host headers are matched by name in any case and with any port", "[web][security]") {
   const HostNames names({"Cell.Example", "10.1.2.3", "fd00::7"});
   CHECK(names.allowsHost("cell.example"));
   CHECK(names.allowsHost("CELL.example:8080"));
@@ -53,7 +53,7 @@ TEST_CASE("the default host names hold loopback and this machine", "[web][securi
   CHECK(HostNames(HostNames::defaults("cell.example")).allowsHost("cell.example"));
 }
 
-TEST_CASE("a change needs a matching Origin, a JSON type and the X-PickSight header",
+TEST_CASE("a change needs a matching Origin and a JSON type and the X-PickSight header",
           "[web][security]") {
   const HostNames names({"cell.example"});
   CHECK_FALSE(checkRequest(names, post("http://cell.example:8080", "application/json", "1")));

@@ -103,7 +103,7 @@ TEST_CASE("a cross-site form post neither forgets a model nor closes the camera"
   CHECK(pollUntil([&] { return cameraState(web) == "closed"; }));
 }
 
-TEST_CASE("a foreign Host is refused, reads too (DNS rebinding)", "[web][security]") {
+TEST_CASE("a foreign Host is refused for reads too against DNS rebinding", "[web][security]") {
   VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
   WebProcess web(videoServerArgs(server));
   const int port = web.port;
@@ -134,7 +134,8 @@ TEST_CASE("the hosts the server answers to are those of --allow-host", "[web][se
   CHECK(statusOf(rawGet(web.port, "/api/cameras", "localhost")) == 403);
 }
 
-TEST_CASE("every response forbids framing, foreign scripts and type sniffing", "[web][security]") {
+TEST_CASE("every response forbids framing and foreign scripts and type sniffing",
+          "[web][security]") {
   VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
   WebProcess web(videoServerArgs(server));
   const std::string host = "127.0.0.1:" + std::to_string(web.port);
@@ -151,7 +152,7 @@ TEST_CASE("every response forbids framing, foreign scripts and type sniffing", "
   }
 }
 
-TEST_CASE("malformed input gets a 4xx with a plain message, never a 500 with internals",
+TEST_CASE("malformed input gets a 4xx with a plain message and never a 500 with internals",
           "[web][security]") {
   VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "10"});
   WebProcess web({"--video-server", server.frames + "," + server.control, "--vision-app",

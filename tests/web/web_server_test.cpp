@@ -463,7 +463,7 @@ TEST_CASE("a command line goes to the vision app and its reply comes back", "[we
   CHECK(json::parse(res->body).contains("error"));
 }
 
-TEST_CASE("the first command after the app's idle timeout is executed, not answered ERROR 16",
+TEST_CASE("the first command after the app's idle timeout is executed and not answered ERROR 16",
           "[web]") {
   VideoServerProcess server(
       {"--source", "cam0=synthetic:width=640,height=480,parts=1", "--mode", "trigger"});
