@@ -22,7 +22,8 @@
 #include "picksight/synthetic/scene.hpp"
 #include "picksight/tool_support/line_client.hpp"
 #include "picksight/tool_support/subprocess.hpp"
-#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 namespace {
 using namespace std::chrono_literals;

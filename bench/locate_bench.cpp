@@ -33,8 +33,8 @@
 #include "picksight/tool_support/subprocess.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/transport/frame_message.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 
 namespace {
 using namespace std::chrono_literals;

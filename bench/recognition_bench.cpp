@@ -22,10 +22,11 @@
 #include "picksight/common/angles.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/synthetic/scene.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 namespace {
 namespace ps = picksight::synthetic;

@@ -24,11 +24,12 @@
 #include "picksight/common/angles.hpp"
 #include "picksight/common/command_line.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/regions.hpp"
-#include "picksight/vision/touching_parts.hpp"
+#include "picksight/vision/blob_search/touching_parts.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 #include "silhouette_types.hpp"
 
 namespace {

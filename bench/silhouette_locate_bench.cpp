@@ -25,7 +25,8 @@
 #include "picksight/common/command_line.hpp"
 #include "picksight/store/model_library.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
-#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/training/part_training.hpp"
 #include "silhouette_types.hpp"
 
 namespace {

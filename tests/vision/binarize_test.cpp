@@ -4,8 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 
 using namespace picksight::vision;
 

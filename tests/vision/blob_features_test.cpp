@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/common/angles.hpp"
-#include "picksight/vision/blob_features.hpp"
+#include "picksight/vision/segmentation/blob_features.hpp"
 
 using namespace picksight::vision;
 using picksight::angleDiffDeg;

@@ -12,8 +12,9 @@
 
 #include "picksight/common/angles.hpp"
 #include "picksight/synthetic/scene.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 using namespace picksight::vision;
 namespace ps = picksight::synthetic;

@@ -10,10 +10,11 @@
 #include <vector>
 
 #include "picksight/synthetic/scene.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 namespace picksight::test {
 

@@ -14,12 +14,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "drawn_parts.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/blob_features.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/regions.hpp"
-#include "picksight/vision/rejection.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/blob_features.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 using namespace picksight::vision;
 namespace pt = picksight::test;

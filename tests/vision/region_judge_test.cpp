@@ -9,12 +9,13 @@
 #include <vector>
 
 #include "drawn_parts.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/region_judge.hpp"
-#include "picksight/vision/regions.hpp"
-#include "picksight/vision/rejection.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
+#include "picksight/vision/recognition/region_judge.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 using namespace picksight::vision;
 namespace pt = picksight::test;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "picksight/common/angles.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 
 using picksight::angleDiffDeg;
 using picksight::vision::findRegions;

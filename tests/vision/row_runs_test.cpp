@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "picksight/vision/row_runs.hpp"
+#include "picksight/vision/segmentation/row_runs.hpp"
 
 using picksight::vision::RowRuns;
 

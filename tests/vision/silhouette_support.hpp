@@ -13,10 +13,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "picksight/synthetic/silhouette_scene.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 namespace picksight::test {
 

@@ -12,8 +12,8 @@
 #include "picksight/common/angles.hpp"
 #include "picksight/synthetic/scene.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
-#include "picksight/vision/region_judge.hpp"
-#include "picksight/vision/touching_parts.hpp"
+#include "picksight/vision/blob_search/touching_parts.hpp"
+#include "picksight/vision/recognition/region_judge.hpp"
 
 using namespace picksight::vision;
 namespace ps = picksight::synthetic;

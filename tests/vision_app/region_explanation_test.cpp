@@ -21,8 +21,9 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/results/request_record.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/rejection.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 using namespace picksight;
 namespace ps = picksight::synthetic;

@@ -10,7 +10,7 @@
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_file.hpp"
 #include "picksight/transport/control_client.hpp"
-#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/models/part_model.hpp"
 
 using namespace picksight;
 using namespace picksight::app;

@@ -19,7 +19,7 @@
 #include "picksight/common/log.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/transport/control_client.hpp"
-#include "picksight/vision/binarize.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/web/camera_actions.hpp"
 #include "picksight/web/camera_monitor.hpp"
 #include "picksight/web/event_hub.hpp"

@@ -7,8 +7,8 @@
 #include <map>
 #include <optional>
 
-#include "picksight/vision/blob_features.hpp"
-#include "picksight/vision/region_judge.hpp"
+#include "picksight/vision/recognition/region_judge.hpp"
+#include "picksight/vision/segmentation/blob_features.hpp"
 
 namespace picksight::app {
 namespace {

@@ -10,7 +10,8 @@
 #include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/common/text.hpp"
-#include "picksight/vision/recognizer.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 namespace picksight::app {
 

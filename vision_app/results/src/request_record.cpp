@@ -7,7 +7,7 @@
 #include <set>
 
 #include "picksight/common/text.hpp"
-#include "picksight/vision/rejection.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
 
 namespace picksight::app {
 namespace {

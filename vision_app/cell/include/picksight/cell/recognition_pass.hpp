@@ -9,9 +9,9 @@
 
 #include <vector>
 
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/recognizer.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 
 namespace picksight::app {
 

@@ -18,10 +18,10 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/store/model_library.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/blob_features.hpp"
-#include "picksight/vision/part_model.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/blob_features.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 
 namespace picksight::app {
 

@@ -8,7 +8,8 @@
 
 #include "picksight/common/result.hpp"
 #include "picksight/grasp/grasp.hpp"
-#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/training/part_training.hpp"
 
 namespace picksight::app {
 

@@ -14,7 +14,7 @@
 
 #include "picksight/common/result.hpp"
 #include "picksight/store/model_file.hpp"
-#include "picksight/vision/part_model.hpp"
+#include "picksight/vision/models/part_model.hpp"
 
 namespace picksight::app {
 

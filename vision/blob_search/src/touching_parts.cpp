@@ -1,0 +1,592 @@
+// Parts inside merged blobs: the hypotheses of every model (see
+// touching_parts_hypotheses.cpp) refined on the grey-level edges
+// (touching_parts_edge_fit.cpp), each checked against its mirror image, then
+// accepted best first where they fit the blob (their boundary on its edges
+// or its body, not on the background) and not each other, two hypotheses
+// of the same pixels settled by which lies on more of its edges. A quick
+// search from each model's most telling anchors comes first; the full one
+// goes on, model by model, only while the parts found leave some of the
+// blob unexplained.
+#include "picksight/vision/blob_search/touching_parts.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <optional>
+
+#include "picksight/common/angles.hpp"
+#include "touching_parts_internal.hpp"
+
+namespace picksight::vision {
+namespace {
+using namespace touching;
+using picksight::angleDiffDeg;
+using picksight::wrapDeg;
+
+constexpr int kMaxRefinedPerModel = 8;
+// Poses refined per blob, for each part the blob can hold: the best
+// screened hypotheses of all models, so that a blob costs about the same
+// whatever the number of trained types.
+constexpr int kRefinedPerPart = 12;
+constexpr int kMaxRefinedPerBlob = 48;
+// A mirror-image candidate that verifies within this of the direct one
+// makes the handedness a question: where the two hands differ decides it
+// (showsMirrorImage), and a part shown mirrored is not reported.
+constexpr double kMirrorMargin = 0.03;
+// A screened pose this close to one already refined is not refined again.
+constexpr double kRefinedNearPx = 3.0;
+constexpr double kRefinedNearDeg = 4.0;
+// The edge fit of a screened pose: how far it looks for the edges at first,
+// its passes.
+constexpr double kEdgeSearchPx = 4.0;
+constexpr int kEdgeIterations = 6;
+// A fit whose coarse passes settle this close to a pose already refined
+// ends there (the dense passes move a pose by hundredths of a pixel; two
+// refined poses within a pixel and a degree are one).
+constexpr double kConvergedPx = 0.5;
+constexpr double kConvergedDeg = 0.5;
+// The mirror image placed on a part is refined on the edges when it
+// verifies within this of the margin before (a hypothesis a few pixels and
+// degrees off loses that much at the rim, kCoarseSlack).
+constexpr double kMirrorScreenSlack = 0.25;
+// Parts that touch share at most their contact pixels; a part lying on
+// another, up to a quarter of its outline hidden, shares up to a third of
+// its area with it (0.31 at most of 193 parts taken in 12 overlapping
+// bench scenes, sharp and blurred); two readings of the same pixels (a
+// look-alike on a part, a pose twice) share most of them. A part lies in
+// its blob.
+constexpr double kMaxOverlap = 0.4;
+constexpr double kMaxOutside = 0.06;
+
+// A part lying partly under another shows less of its boundary: what is
+// not on an edge lies on the other part's body. It then needs this much of
+// its boundary on edges.
+constexpr double kMinVisible = 0.7;
+// The verified fraction the dense passes of the edge fit may still add.
+constexpr double kUnsettledSlack = 0.1;
+// The search of a blob ends once the parts found explain it whole: each
+// fits its edges within this (pixels, rms; a part fits within a few tenths,
+// a look-alike of another size or shape does not), and together they cover
+// every pixel of the blob but a seam this wide (pixels) where the drawn
+// outlines and the thresholded pixels disagree.
+constexpr double kWholeFitRmsPx = 0.6;
+constexpr int kSeamPx = 2;
+// A corner or arc of the blob within this of what the parts found leave
+// unexplained may belong to a part still to find (pixels).
+constexpr int kRestAnchorPx = 6;
+// A part's boundary is on the blob's edges or hidden under another part's
+// body, never on the background, but where the model's primitives cut a
+// sharp tip or notch by more than the edge tolerance: at most 1 % of the
+// boundary on the benchmark's parts (a hand's fingertips, 0.98 %), blurred
+// or not. A look-alike of another type placed on a part crosses it with
+// 2.8 to 15 % (the hands of Kimia-99), however much of the rest lies on the
+// part's edges, and may verify above the verify fraction there (0.83 to
+// 0.85 on a hidden hand). Asked of every candidate but one that is its blob
+// whole (the blob in it and it in the blob, kMaxOutside): a lone part the
+// region tests failed on the pose its moments skewed, which the verify
+// fraction alone judges, as the region tests do; a model that also accepts
+// a similar type (a bar on a notched bar, 5 % across the notch) is left to
+// the recognizer's screen across types.
+constexpr double kMaxOnBackground = 0.02;
+
+// Whether more of the boundary at the pose than a part can show lies off
+// the edges on the background.
+bool crossesBackground(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
+                       const Coverage& coverage) {
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  const double flip = pose.mirrored ? -1.0 : 1.0;
+  double total = 0;
+  double background = 0;
+  for (const auto& sample : m.samples) {
+    total += sample.weight;
+    const cv::Point2d p = pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s);
+    if (edges.at(p) > m.edge_tolerance && coverage.at(p) < 0.5) background += sample.weight;
+  }
+  return background > kMaxOnBackground * total;
+}
+
+bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double px, double deg) {
+  if (a.mirrored != b.mirrored) return false;
+  if (std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) > px) return false;
+  // A period of 0 (any turn looks the same): the angles always agree.
+  return angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
+}
+
+// The mirror image of a chiral model placed where it best covers the part
+// at `direct`: turned by one of the angles where its complex moment lines
+// up with the model's (2 phase / k + j 360 / k, as in training), the best
+// verified of them refined on the grey-level edges. The hand of every part
+// reported is decided against this one: the hypothesis search looks for
+// each model's own hand only (searching the mirror image from the blob's
+// corners and arcs as well cost a tenth of the search and changed no
+// decision on the benchmark's type sets). Like any hypothesis it is refined
+// only when it screens at `screen` (a fraction verified), and only to the
+// end while it may still verify at `needed` (what the part's mirror image
+// must reach): nullopt otherwise.
+std::optional<Candidate> alignedMirror(const PartModel& m, const Region& region,
+                                       const ImagePose& direct, const EdgeDistance& edges,
+                                       double screen, double needed) {
+  const int k = m.orientation_order;
+  if (k <= 0 || m.body.mirror_symmetric) return std::nullopt;
+  Candidate best;
+  best.model = &m;
+  best.score = -1;
+  for (int j = 0; j < k; ++j) {
+    const double angle = direct.angle_deg + 2 * m.orientation_phase_deg / k + j * 360.0 / k;
+    const double score =
+        verifyScore(m.samples, direct.centre, angle, edges, m.edge_tolerance, true);
+    if (score > best.score) best = {&m, {direct.centre, angle, true}, score, 0, 0};
+  }
+  if (best.score < screen) return std::nullopt;
+  // Settled where it verifies too little for the dense passes to lift it to
+  // `needed`, and short of it unrefined too, it cannot be as good as the
+  // part either way: no mirror image, and no dense passes.
+  bool given_up = false;
+  const auto worth = [&](const ImagePose& pose) {
+    given_up = best.score < needed &&
+               verifyScore(m.samples, pose.centre, pose.angle_deg, edges, m.edge_tolerance, true) <
+                   needed - kUnsettledSlack;
+    return !given_up;
+  };
+  const EdgeFit fit =
+      refinePoseOnEdges(m, region, best.pose, kEdgeSearchPx, kEdgeIterations, worth);
+  if (given_up) return std::nullopt;
+  if (!fit.ok) return best;
+  const double score =
+      verifyScore(m.samples, fit.pose.centre, fit.pose.angle_deg, edges, m.edge_tolerance, true);
+  if (score < best.score) return best;
+  return Candidate{&m, fit.pose, score, fit.rms_px, fit.precise_length};
+}
+
+// The model's loops placed at a pose, as polygons in image coordinates:
+// filled together, the holes stay empty.
+std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose) {
+  std::vector<std::vector<cv::Point>> polys;
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  const double flip = pose.mirrored ? -1.0 : 1.0;
+  for (const auto& loop : m.loops) {
+    std::vector<cv::Point> poly;
+    for (const auto& p : loop.primitives) {
+      const int n = std::max(1, static_cast<int>(p.length() / 2.0));
+      for (int i = 0; i < n; ++i) {
+        const cv::Point2d q = p.pointAt(static_cast<double>(i) / n);
+        const cv::Point2d r = pose.centre + rotate({q.x, flip * q.y}, c, s);
+        poly.emplace_back(static_cast<int>(std::lround(r.x)), static_cast<int>(std::lround(r.y)));
+      }
+    }
+    polys.push_back(std::move(poly));
+  }
+  return polys;
+}
+
+// A candidate that fits the blob on its own, drawn over its box.
+struct Placed {
+  const Candidate* candidate = nullptr;
+  cv::Rect box;   // image coordinates
+  cv::Mat drawn;  // 255 on the part, over `box`
+  int area = 0;
+};
+
+// Pixels two placed candidates share.
+int sharedPixels(const Placed& a, const Placed& b) {
+  const cv::Rect both = a.box & b.box;
+  if (both.empty()) return 0;
+  cv::Mat shared;
+  cv::bitwise_and(a.drawn(both - a.box.tl()), b.drawn(both - b.box.tl()), shared);
+  return cv::countNonZero(shared);
+}
+
+// Which of the placed candidates (best score first) are the blob's parts:
+// best first, each where it does not overlap those already taken by more
+// than parts can (kMaxOverlap). Two candidates that cannot both be parts
+// explain the same pixels two ways: the one whose boundary lies on more
+// of the blob's edges (EdgeFit::precise_length) is the part, whatever
+// their scores, and the other waits for it to be refused. A similar
+// outline of another type verifies within the edge tolerance on a part
+// whose rest another hides, and is then first by its score; it lies on
+// the part's edges for only short stretches.
+// `mirrored(candidate)`: whether the part there shows the mirror image of
+// the candidate's model; asked only of a candidate about to be taken.
+template <typename MirrorTest>
+std::vector<size_t> chooseParts(const std::vector<Placed>& placed, MirrorTest&& mirrored) {
+  const size_t n = placed.size();
+  // Rivals: pairs that cannot both be parts, whichever is taken first.
+  std::vector<std::vector<size_t>> better(n);  // the rivals that explain more, per candidate
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j) {
+      if (i == j || placed[j].candidate->precise <= placed[i].candidate->precise) continue;
+      const int shared = sharedPixels(placed[i], placed[j]);
+      if (shared > kMaxOverlap * std::max(placed[i].area, placed[j].area)) better[i].push_back(j);
+    }
+  }
+  enum class State { kOpen, kTaken, kRefused };
+  std::vector<State> state(n, State::kOpen);
+  // The pixels taken, over the boxes of all.
+  cv::Rect all;
+  for (const auto& p : placed) all |= p.box;
+  cv::Mat claimed(all.size(), CV_8UC1, cv::Scalar(0));
+  const auto tryTake = [&](size_t i) {
+    const Placed& p = placed[i];
+    cv::Mat shared;
+    cv::bitwise_and(p.drawn, claimed(p.box - all.tl()), shared);
+    if (cv::countNonZero(shared) > kMaxOverlap * p.area || mirrored(*p.candidate)) {
+      state[i] = State::kRefused;
+      return;
+    }
+    state[i] = State::kTaken;
+    cv::Mat claimed_here = claimed(p.box - all.tl());
+    cv::bitwise_or(claimed_here, p.drawn, claimed_here);
+  };
+  // Whether a rival that explains more of candidate i's pixels is still
+  // open or taken.
+  const auto rivalIn = [&](size_t i) {
+    return std::any_of(better[i].begin(), better[i].end(),
+                       [&](size_t j) { return state[j] != State::kRefused; });
+  };
+  // Best score first; a candidate with an open rival that explains more
+  // waits.
+  std::vector<size_t> waiting;
+  for (size_t i = 0; i < n; ++i) {
+    if (rivalIn(i)) {
+      waiting.push_back(i);
+    } else {
+      tryTake(i);
+    }
+  }
+  // Then those that waited, the one explaining most first, each once every
+  // rival that explains more has been refused.
+  std::stable_sort(waiting.begin(), waiting.end(), [&](size_t a, size_t b) {
+    return placed[a].candidate->precise > placed[b].candidate->precise;
+  });
+  for (const size_t i : waiting) {
+    if (rivalIn(i)) {
+      state[i] = State::kRefused;
+    } else {
+      tryTake(i);
+    }
+  }
+  std::vector<size_t> taken;
+  for (size_t i = 0; i < n; ++i) {
+    if (state[i] == State::kTaken) taken.push_back(i);
+  }
+  return taken;
+}
+
+}  // namespace
+
+std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
+                                const std::vector<const PartModel*>& models,
+                                const EdgeDistance* built_edges) {
+  std::vector<Match> found;
+  const Region& region = regions[index];
+  double tolerance = 0;
+  double conformity = 1e9;
+  std::vector<const PartModel*> fitting;
+  for (const PartModel* m : models) {
+    // A part in the blob is no larger than the blob.
+    if (m->loops.empty() || m->body.area * (1 - m->body.area_tolerance) > region.area) continue;
+    fitting.push_back(m);
+    tolerance = std::max(tolerance, m->edge_tolerance);
+    conformity = std::min(conformity, m->conformity);
+  }
+  if (fitting.empty()) return found;
+
+  std::vector<std::vector<cv::Point>> contours{region.outer};
+  contours.insert(contours.end(), region.hole_boundaries.begin(), region.hole_boundaries.end());
+  // Read at no more than the loose screening tolerance (and clipped there).
+  std::optional<EdgeDistance> own_edges;
+  if (!built_edges) {
+    const double screen_reach = kLooseScreenFactor * tolerance;
+    const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
+    own_edges.emplace(contours,
+                      cv::Rect(region.bbox.x - margin, region.bbox.y - margin,
+                               region.bbox.width + 2 * margin, region.bbox.height + 2 * margin),
+                      screen_reach);
+  }
+  const EdgeDistance& edges = built_edges ? *built_edges : *own_edges;
+  std::vector<std::vector<cv::Point2d>> loops2d;
+  for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
+  std::vector<CornerAnchor> image_corners;
+  std::vector<ArcAnchor> image_arcs;
+  anchorsOf(fitLoops(loops2d, conformity), &image_corners, &image_arcs);
+
+  // The blob's pixels (over its box, image coordinates), which placed parts
+  // are compared with.
+  double smallest = region.area;
+  for (const PartModel* m : fitting) smallest = std::min(smallest, m->body.area);
+  const cv::Rect blob_box(region.coverage_origin, region.coverage.size());
+  cv::Mat blob;
+  cv::compare(region.coverage, 0.5, blob, cv::CMP_GE);
+  const Coverage coverage(region);
+  const int blob_pixels = cv::countNonZero(blob);
+  // The blob's pixels in `box` that `drawn` (over `box`) covers.
+  const auto coveredIn = [&](const cv::Mat& drawn, const cv::Rect& box) {
+    const cv::Rect both = box & blob_box;
+    if (both.empty()) return 0;
+    cv::Mat covered;
+    cv::bitwise_and(drawn(both - box.tl()), blob(both - blob_box.tl()), covered);
+    return cv::countNonZero(covered);
+  };
+  const int parts = std::max(1, static_cast<int>(region.area / std::max(smallest, 1.0)));
+  const auto budget =
+      static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
+
+  // Refined poses (a deque: the placed ones point into it), and those that
+  // fit the blob on their own, each drawn on its box of the canvas.
+  std::deque<Candidate> refined;
+  std::vector<Placed> placed;
+  size_t refinements = 0;
+  // Whether a choice made now could differ from the last one.
+  bool changed = false;
+
+  // The best screened poses of one model (its own hand: see
+  // alignedMirror), best first, no two alike.
+  // The blob's anchors the search starts from (all, or those near what the
+  // parts found leave unexplained).
+  const BlobCorners all_corners(std::move(image_corners));
+  const BlobCorners* corners = &all_corners;
+  const std::vector<ArcAnchor>* arcs = &image_arcs;
+  const auto screen = [&](const PartModel* m, bool quick) {
+    std::vector<Candidate> proposed;
+    propose(*m, *searchOf(*m), quick, *corners, *arcs, edges, &proposed);
+    std::stable_sort(proposed.begin(), proposed.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+    std::vector<Candidate> screened;
+    for (const auto& p : proposed) {
+      if (static_cast<int>(screened.size()) >= kMaxRefinedPerModel) break;
+      const auto near = [&](const Candidate& q) { return samePose(*m, p.pose, q.pose, 2.0, 3.0); };
+      if (std::any_of(screened.begin(), screened.end(), near)) continue;
+      screened.push_back(p);
+    }
+    return screened;
+  };
+
+  // Places a refined candidate that fits the blob on its own.
+  const auto place = [&](const Candidate& c) {
+    const PartModel& m = *c.model;
+    // Below the verify fraction, a part may be partly hidden (kMinVisible).
+    const bool verified = c.score * 100 >= m.verify_percent;
+    if (!verified && c.score < kMinVisible) return;
+    const bool crosses = crossesBackground(m, c.pose, edges, coverage);
+    if (!verified && crosses) return;
+    const auto outline = placedOutline(m, c.pose);
+    cv::Rect box;
+    for (const auto& poly : outline) box |= cv::boundingRect(poly);
+    box += cv::Size(1, 1);
+    Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
+    cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
+    p.area = cv::countNonZero(p.drawn);
+    if (p.area <= 0) return;
+    // The outline drawn whole covers its boundary's pixels (about half a
+    // pixel all round more than the part's area): that seam lies off the
+    // blob without the part lying off it. Counted in, it put a good pose of
+    // a part 90 px long 6.8 % off its blob.
+    const int seam = std::max(0, p.area - static_cast<int>(std::lround(m.body.area)));
+    const int off_blob = p.area - coveredIn(p.drawn, box);
+    if (off_blob - seam > kMaxOutside * p.area) return;
+    // Crossing the background, only a candidate that is its blob whole
+    // stays (kMaxOnBackground).
+    if (crosses && blob_pixels - (p.area - off_blob) > kMaxOutside * p.area) return;
+    placed.push_back(std::move(p));
+    changed = true;
+  };
+
+  // Refines screened poses, best first, and places those that fit.
+  const auto refine = [&](const std::vector<Candidate>& screened) {
+    for (const auto& p : screened) {
+      const PartModel* m = p.model;
+      // A screened pose next to one already refined converges to it: the
+      // edge fit is the costliest step here.
+      const auto refined_near = [&](const Candidate& q) {
+        return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
+      };
+      if (std::any_of(refined.begin(), refined.end(), refined_near)) continue;
+      if (refinements >= budget) return;
+      ++refinements;
+      // Settled on a pose already refined (it would end as the same pose), or
+      // on one too little of whose boundary lies on edges for a part, even a
+      // partly hidden one: not worth the dense passes.
+      const auto worth = [&](const ImagePose& pose) {
+        const auto converged = [&](const Candidate& q) {
+          return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
+        };
+        if (std::any_of(refined.begin(), refined.end(), converged)) return false;
+        return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
+                           false) >= kMinVisible - kUnsettledSlack;
+      };
+      const EdgeFit fit =
+          refinePoseOnEdges(*m, region, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
+      if (!fit.ok) continue;
+      const auto same = [&](const Candidate& q) {
+        return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
+      };
+      if (std::any_of(refined.begin(), refined.end(), same)) continue;
+      const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
+                                       m->edge_tolerance, false);
+      refined.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
+      place(refined.back());
+    }
+  };
+
+  // A part shown mirrored is not reported: the mirror image verifies about
+  // as well and where the hands differ fits better. Only asked of a
+  // candidate about to be taken (placing the mirror image costs an edge
+  // fit, made once per candidate).
+  std::map<const Candidate*, std::optional<Candidate>> aligned_mirrors;
+  const auto mirrored = [&](const Candidate& c) {
+    const PartModel& m = *c.model;
+    const auto as_good = [&](const Candidate& q) {
+      return q.model == c.model &&
+             std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
+                 0.5 * m.radius &&
+             q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
+    };
+    auto aligned = aligned_mirrors.find(&c);
+    if (aligned == aligned_mirrors.end()) {
+      aligned = aligned_mirrors
+                    .emplace(&c, alignedMirror(m, region, c.pose, edges,
+                                               c.score - kMirrorMargin - kMirrorScreenSlack,
+                                               c.score - kMirrorMargin))
+                    .first;
+    }
+    return aligned->second && as_good(*aligned->second);
+  };
+
+  // The parts among those placed: best first; among equal scores the
+  // closer fit to the grey-level edges.
+  std::vector<size_t> taken;
+  const auto choose = [&] {
+    changed = false;
+    std::stable_sort(placed.begin(), placed.end(), [](const Placed& a, const Placed& b) {
+      const Candidate& u = *a.candidate;
+      const Candidate& v = *b.candidate;
+      return u.score > v.score + 1e-9 || (std::abs(u.score - v.score) <= 1e-9 && u.rms < v.rms);
+    });
+    taken = chooseParts(placed, mirrored);
+  };
+  // What erodes a seam away.
+  const cv::Mat seam =
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1));
+  // The blob's pixels the parts taken leave unexplained.
+  const auto unexplained = [&] {
+    cv::Mat rest = blob.clone();
+    for (const size_t i : taken) {
+      const Placed& p = placed[i];
+      const cv::Rect both = p.box & blob_box;
+      if (!both.empty()) rest(both - blob_box.tl()).setTo(0, p.drawn(both - p.box.tl()));
+    }
+    return rest;
+  };
+  // Whether the parts taken are the whole blob: each fits its edges closely,
+  // and together they cover every pixel of it but a thin seam.
+  const auto explainsWhole = [&] {
+    if (taken.empty()) return false;
+    for (const size_t i : taken) {
+      if (placed[i].candidate->rms > kWholeFitRmsPx) return false;
+    }
+    cv::Mat rest = unexplained();
+    // A seam runs along the blob's outline or a part's: more pixels than
+    // fit in seams that long, and some piece is wider.
+    double seam_length = static_cast<double>(region.outer.size());
+    for (const auto& h : region.hole_boundaries) seam_length += static_cast<double>(h.size());
+    for (const size_t i : taken) {
+      seam_length += static_cast<double>(searchOf(*placed[i].candidate->model)->edges.size());
+    }
+    const int left = cv::countNonZero(rest);
+    if (left == 0) return true;
+    if (left > (2 * kSeamPx + 1) * (seam_length + 2 * kSeamPx + 1)) return false;
+    cv::erode(rest, rest, seam);
+    return cv::countNonZero(rest) == 0;
+  };
+
+  // First a quick search of every model, from its most telling corners and
+  // arc: the parts that show whole are mostly found there. Then, while the
+  // parts found do not explain the blob whole, the full search of each model,
+  // those the quick search found something of first.
+  std::vector<std::pair<double, size_t>> order;
+  for (size_t k = 0; k < fitting.size(); ++k) {
+    const auto screened = screen(fitting[k], true);
+    order.emplace_back(screened.empty() ? -1.0 : screened.front().score, k);
+    refine(screened);
+  }
+  choose();
+  if (!explainsWhole()) {
+    // With parts found, the rest of the blob is most likely one part more:
+    // the models closest to its area first. Otherwise those the quick
+    // search saw most of.
+    std::optional<BlobCorners> rest_corners;
+    std::vector<ArcAnchor> rest_arcs;
+    if (!taken.empty()) {
+      cv::Mat rest = unexplained();
+      const double rest_area = std::max(1, cv::countNonZero(rest));
+      // The parts to find lie in the rest, and their corners and arcs on its
+      // rim (or where it meets the parts found): the full search starts from
+      // those, not from the outlines of the parts found.
+      cv::erode(rest, rest, seam);
+      if (cv::countNonZero(rest) > 0) {
+        // Whether any pixel of the rest lies in the square of `reach`
+        // about p (the dilation of the rest by it, read at p): a sum over the
+        // integral image.
+        cv::Mat sums;
+        cv::integral(rest, sums, CV_32S);
+        const int reach = kSeamPx + kRestAnchorPx;
+        const auto inRest = [&](cv::Point2d p) {
+          const int x = static_cast<int>(std::lround(p.x)) - blob_box.x;
+          const int y = static_cast<int>(std::lround(p.y)) - blob_box.y;
+          const int x0 = std::clamp(x - reach, 0, rest.cols);
+          const int x1 = std::clamp(x + reach + 1, 0, rest.cols);
+          const int y0 = std::clamp(y - reach, 0, rest.rows);
+          const int y1 = std::clamp(y + reach + 1, 0, rest.rows);
+          if (x0 >= x1 || y0 >= y1) return false;
+          return sums.at<int>(y1, x1) - sums.at<int>(y0, x1) - sums.at<int>(y1, x0) +
+                     sums.at<int>(y0, x0) >
+                 0;
+        };
+        std::vector<CornerAnchor> near_rest;
+        for (const auto& c : all_corners.corners) {
+          if (inRest(c.at)) near_rest.push_back(c);
+        }
+        rest_corners.emplace(std::move(near_rest));
+        for (const auto& a : image_arcs) {
+          const double mid = a.mid_deg * kRadPerDeg;
+          if (inRest(a.centre + a.radius * cv::Point2d(std::cos(mid), std::sin(mid))))
+            rest_arcs.push_back(a);
+        }
+        corners = &*rest_corners;
+        arcs = &rest_arcs;
+      }
+      for (auto& entry : order) {
+        entry.first = -std::abs(fitting[entry.second]->body.area - rest_area) / rest_area;
+      }
+    }
+    std::stable_sort(order.begin(), order.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (const auto& entry : order) {
+      refine(screen(fitting[entry.second], false));
+      if (!changed) continue;
+      choose();
+      if (explainsWhole()) break;
+    }
+  }
+  if (changed) choose();
+  for (const size_t i : taken) {
+    const Candidate& c = *placed[i].candidate;
+    Match match;
+    match.model = c.model;
+    match.region = index;
+    match.score = c.score;
+    match.centroid = c.pose.centre;
+    match.symmetry_deg = c.model->symmetryDeg();
+    match.angle_deg = wrapDeg(c.pose.angle_deg, match.symmetry_deg);
+    match.touching = true;
+    found.push_back(match);
+  }
+  return found;
+}
+
+}  // namespace picksight::vision

@@ -1,0 +1,135 @@
+// What the touching-parts files share: boundary anchors (corners, arcs), the
+// model's search data, screened candidates and the coverage reader. Not
+// installed: only touching_parts*.cpp include it.
+#pragma once
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/common/angles.hpp"
+#include "picksight/vision/models/boundary_model.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+
+namespace picksight::vision {
+namespace touching {
+
+using picksight::kRadPerDeg;
+
+inline double angleOf(cv::Point2d v) { return std::atan2(v.y, v.x) / kRadPerDeg; }
+
+inline cv::Point2d rotate(cv::Point2d p, double c, double s) {
+  return {c * p.x - s * p.y, s * p.x + c * p.y};
+}
+
+// Twice the signed area of a loop: > 0 when its interior lies on the side of
+// the left normal (-t.y, t.x) of the walking direction t.
+double loopOrientation(const BoundaryLoop& loop);
+
+// A corner as an unordered pair of edges leaving a point, so that it reads
+// the same on a mirrored model: the bisector of the two edges, the opening
+// angle between them, and whether the body fills the opening.
+struct CornerAnchor {
+  cv::Point2d at;
+  double bisector_deg = 0;
+  cv::Point2d bisector;  // the unit vector: turns between corners without a sine
+  double opening_deg = 0;
+  bool convex = true;
+};
+
+struct ArcAnchor {
+  cv::Point2d centre;
+  double radius = 0;
+  double length = 0;
+  double mid_deg = 0;    // direction of the arc's middle from its centre
+  double sweep_deg = 0;  // signed, in the loop's walking direction
+};
+
+// The corners and arcs of fitted loops (model frame or image).
+void anchorsOf(const std::vector<BoundaryLoop>& loops, std::vector<CornerAnchor>* corners,
+               std::vector<ArcAnchor>* arcs);
+
+// A boundary point of the model with its normal pointing away from the body.
+struct EdgeSample {
+  cv::Point2d point;
+  cv::Point2d normal;
+  double weight = 0;
+};
+
+// The model's edge samples every `step` pixels, away from primitive ends.
+std::vector<EdgeSample> edgeSamples(const PartModel& model, double step);
+
+// Bilinear reading of a region's coverage (0 outside its box).
+class Coverage {
+ public:
+  explicit Coverage(const Region& r)
+      : c_(r.coverage), origin_(r.coverage_origin), last_(c_.cols - 1, c_.rows - 1) {}
+  float at(cv::Point2d p) const {
+    return bilinearAt(c_, p.x - origin_.x, p.y - origin_.y, last_, 0.f);
+  }
+
+ private:
+  const cv::Mat& c_;
+  cv::Point origin_;
+  cv::Point2d last_;  // the last column and row
+};
+
+struct Candidate {
+  const PartModel* model = nullptr;
+  ImagePose pose;
+  double score = 0;
+  double rms = 0;
+  double precise = 0;  // EdgeFit::precise_length, once refined
+};
+
+// A corner's first look counts boundary samples within this many edge
+// tolerances: the blob's distance map must reach that far.
+constexpr double kLooseScreenFactor = 2.0;
+
+}  // namespace touching
+
+struct BlobSearchModel {
+  std::vector<touching::CornerAnchor> corners;  // the most telling (keepTelling)
+  std::vector<touching::ArcAnchor> arcs;        // likewise
+  // The few most telling corners and arcs (indices into the above), which
+  // a first, quick search of a blob starts from.
+  std::vector<size_t> quick_corners;
+  std::vector<size_t> quick_arcs;
+  std::vector<BoundarySample> sparse;  // hypotheses are screened on these
+  std::vector<BoundarySample> glance;  // after a first look at these
+  // The glance samples farthest first from each corner (by index in
+  // `corners`) and each arc's centre (`arcs`): a pose put on a wrong anchor
+  // matches near it and fails far from it, so the first look ends sooner.
+  std::vector<std::vector<BoundarySample>> corner_glance;
+  std::vector<std::vector<BoundarySample>> arc_glance;
+  std::vector<touching::EdgeSample> edges;  // poses are refined on these, 1 px apart
+  double glance_weight = 0;                 // the glance samples' total
+};
+
+namespace touching {
+
+// The model's side of the search: derived by prepareModel, or built here
+// for a model put together without it.
+std::shared_ptr<const BlobSearchModel> searchOf(const PartModel& m);
+
+// The corners of a blob the search starts from, with their indices in
+// order of opening angle (each model corner visits only those it may be).
+struct BlobCorners {
+  explicit BlobCorners(std::vector<CornerAnchor> corners);
+  std::vector<CornerAnchor> corners;
+  std::vector<size_t> by_opening;
+};
+
+// Screens the poses proposed for one model (its own hand; the mirror image
+// is asked of each part about to be taken, in touching_parts.cpp) in a
+// blob: appends those that verify well enough on `edges` to `out`. `quick`:
+// from the model's quick corners and arcs only.
+void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
+             const BlobCorners& image_corners, const std::vector<ArcAnchor>& image_arcs,
+             const EdgeDistance& edges, std::vector<Candidate>* out);
+
+}  // namespace touching
+}  // namespace picksight::vision

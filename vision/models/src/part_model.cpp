@@ -1,0 +1,220 @@
+// Part models: the Hu distance with its floors, which hand a region shows
+// (the boundary where the two hands lie apart), how far a model is from its
+// mirror image, and the check of a model's values.
+#include "picksight/vision/models/part_model.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "picksight/common/angles.hpp"
+
+namespace picksight::vision {
+namespace {
+// How much a model sample at `separation` pixels from the other hand's
+// boundary tells the two apart: nothing within the edge tolerance (both
+// would verify there), fully from twice the tolerance.
+double handednessWeight(double separation, double tolerance) {
+  return std::clamp((separation - tolerance) / tolerance, 0.0, 1.0);
+}
+
+// What one hand (the model, or its mirror image) placed at `pose` shows on
+// the region's edges where the other hand, placed at `other`, lies apart
+// from it.
+struct HandEvidence {
+  double weight = 0;    // of the samples that tell the hands apart
+  double on = 0;        // of those, within the tolerance of an edge
+  double distance = 0;  // weighted sum of their clipped edge distances
+};
+
+HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const ImagePose& other,
+                          const EdgeDistance& edges) {
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  const double oc = std::cos(other.angle_deg * kRadPerDeg);
+  const double os = std::sin(other.angle_deg * kRadPerDeg);
+  const double clip = 2 * m.edge_tolerance;
+  // A map built for a smaller tolerance than the model's now cannot say.
+  const BoundaryDistanceMap* map =
+      m.boundary_map && m.boundary_map->reach() >= clip ? m.boundary_map.get() : nullptr;
+  HandEvidence e;
+  for (const auto& sample : m.samples) {
+    const double py = pose.mirrored ? -sample.point.y : sample.point.y;
+    const cv::Point2d x =
+        pose.centre + cv::Point2d(c * sample.point.x - s * py, s * sample.point.x + c * py);
+    // The same image point in the other hand's model frame.
+    const cv::Point2d d = x - other.centre;
+    cv::Point2d u(oc * d.x + os * d.y, -os * d.x + oc * d.y);
+    if (other.mirrored) u.y = -u.y;
+    const double separation = map ? map->at(u) : boundaryDistance(m.loops, u);
+    const double w = sample.weight * handednessWeight(separation, m.edge_tolerance);
+    if (w <= 0) continue;
+    const double at = edges.at(x);
+    e.weight += w;
+    if (at <= m.edge_tolerance) e.on += w;
+    e.distance += w * std::min<double>(at, clip);
+  }
+  return e;
+}
+
+// Invariants 2 to 6 are powers of how far a part departs from a disc: its
+// ellipticity squared (H2), its skew squared (H3, H4), higher products of
+// the two (H5, H6). Compared as plain logs, a near-round part's tiny values
+// weigh as much as a long part's large ones: in a photograph of sweets
+// taught from one, the other lone sweets lay 1.8-3.6 apart (tolerance 1.35),
+// and a washer taught 1 % out of round lost 4 of 5 pieces 0-4.5 % out of
+// round, while all are discs to anyone. Below a floor (a deviation of
+// kHuFloorShare of the part's own second moment, H1, in each moment the
+// invariant is made of) an invariant is taken for "round enough":
+// log10(1 + |h| / floor) is 0 there and log10|h| less a constant above it,
+// where the distance is the plain one. Both sides of a comparison take the
+// model's floors.
+constexpr double kHuFloorShare = 0.1;
+// Degree of H2..H6 in the second-order (a) and third-order (b) normalized
+// moments, which scale as H1 and H1^1.5 (H1 itself is compared as it is).
+constexpr std::array<std::pair<int, int>, 5> kHuDegrees = {
+    {{2, 0}, {0, 2}, {0, 2}, {0, 4}, {1, 2}}};
+
+// The floors of H2..H6 (at 1..5) for a part whose H1 is `h1`.
+std::array<double, 6> huFloors(double h1) {
+  const double second = kHuFloorShare * h1;                 // a second-order moment's
+  const double third = kHuFloorShare * h1 * std::sqrt(h1);  // a third-order one's
+  std::array<double, 6> floors{};
+  for (size_t i = 1; i < floors.size(); ++i) {
+    floors[i] = 1;
+    const auto [a, b] = kHuDegrees[i - 1];
+    for (int k = 0; k < a; ++k) floors[i] *= second;
+    for (int k = 0; k < b; ++k) floors[i] *= third;
+  }
+  return floors;
+}
+
+double flooredLog(double log_h, size_t i, double floor) {
+  if (i == 0) return log_h;
+  // logHu writes 0 for an invariant that is exactly 0 (a square's H2).
+  if (log_h == 0) return 0;
+  // H2..H4 are sums of squares (positive, any size: their log inverts
+  // exactly); H5 and H6 carry a sign and stay below 1 in magnitude.
+  const bool positive = i <= 3;
+  const double value = std::log10(1 + std::pow(10.0, positive ? -log_h : -std::abs(log_h)) / floor);
+  return positive || log_h > 0 ? value : -value;
+}
+}  // namespace
+
+// The weighted boundary length of the model that lies apart from its
+// mirror image turned by `turn_deg`: sample p against the set R(t) M P, i.e.
+// M R(-t) p against P (M: y -> -y).
+double chiralLength(const PartModel& m, double turn_deg) {
+  const double c = std::cos(turn_deg * kRadPerDeg);
+  const double s = std::sin(turn_deg * kRadPerDeg);
+  double length = 0;
+  for (const auto& sample : m.samples) {
+    const cv::Point2d p = sample.point;
+    const cv::Point2d u(c * p.x + s * p.y, -(-s * p.x + c * p.y));
+    length += sample.weight * handednessWeight(boundaryDistance(m.loops, u), m.edge_tolerance);
+  }
+  return length;
+}
+
+double huDistance(const BodyModel& body, const HuArray& log_hu) {
+  const auto floors = huFloors(std::pow(10.0, -body.log_hu[0]));
+  double d = 0;
+  // Not the 7th invariant: the only one a mirror changes (its sign), and on
+  // a nearly mirror-symmetric part so small that lighting and resampling
+  // set its sign. Which hand a region shows is decided on its boundary
+  // (showsMirrorImage).
+  for (size_t i = 0; i + 1 < log_hu.size(); ++i) {
+    if (body.hu_used[i])
+      d += std::abs(flooredLog(body.log_hu[i], i, floors[i]) - flooredLog(log_hu[i], i, floors[i]));
+  }
+  return d;
+}
+
+const char* errorName(PartModelErrc e) {
+  switch (e) {
+    case PartModelErrc::kNotGrey:
+      return "not grey";
+    case PartModelErrc::kNoPart:
+      return "no part";
+    case PartModelErrc::kSeveralParts:
+      return "several parts";
+    case PartModelErrc::kInvalid:
+      return "invalid";
+  }
+  return "unknown";
+}
+
+namespace {
+// What is wrong with a model; empty when nothing is.
+std::string modelProblem(const PartModel& m) {
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (m.type < 0 || m.type > 9999) return "type must be in [0, 9999]";
+  if (!finite(m.body.area) || m.body.area <= 0) return "body area must be a positive number";
+  if (!finite(m.body.area_tolerance) || m.body.area_tolerance <= 0 || m.body.area_tolerance >= 1) {
+    return "area tolerance must be in (0, 1)";
+  }
+  if (m.body.holes < 0 || m.body.holes > 10000) return "hole count out of range";
+  if (!finite(m.min_region_area) || m.min_region_area < 0 || !finite(m.min_hole_area) ||
+      m.min_hole_area < 0) {
+    return "minimum region and hole areas must be numbers >= 0";
+  }
+  for (double h : m.body.log_hu) {
+    if (!finite(h)) return "log Hu invariants must be finite";
+  }
+  if (!finite(m.body.hu_tolerance) || m.body.hu_tolerance <= 0)
+    return "Hu tolerance must be positive";
+  if (m.orientation_order < 0 || m.orientation_order > kMaxModelOrder)
+    return "orientation order out of range";
+  if (!finite(m.orientation_phase_deg)) return "orientation phase must be finite";
+  if (m.symmetry_order < 0 || m.symmetry_order > kMaxModelOrder)
+    return "symmetry order out of range";
+  if (!finite(m.conformity) || m.conformity <= 0 || m.conformity > 50)
+    return "conformity must be in (0, 50] px";
+  if (!finite(m.edge_tolerance) || m.edge_tolerance <= 0 || m.edge_tolerance > 50) {
+    return "edge tolerance must be in (0, 50] px";
+  }
+  if (!finite(m.verify_percent) || m.verify_percent <= 0 || m.verify_percent > 100) {
+    return "verify percent must be in (0, 100]";
+  }
+  if (m.loops.empty() || m.loops[0].hole) return "the boundary needs an outer loop first";
+  for (const auto& loop : m.loops) {
+    if (loop.primitives.empty()) return "a boundary loop has no primitives";
+    if (!finite(loop.weight) || loop.weight < 0) return "loop weights must be >= 0";
+    for (const auto& p : loop.primitives) {
+      if (!finite(p.start.x) || !finite(p.start.y) || !finite(p.end.x) || !finite(p.end.y) ||
+          !finite(p.weight) || p.weight < 0) {
+        return "a primitive has a bad point or weight";
+      }
+      if (p.kind == PrimitiveKind::kArc &&
+          (!finite(p.radius) || p.radius <= 0 || !finite(p.sweep_deg) ||
+           std::abs(p.sweep_deg) > 360 || !finite(p.centre.x) || !finite(p.centre.y))) {
+        return "an arc has a bad centre, radius or sweep";
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+bool showsMirrorImage(const PartModel& model, const ImagePose& direct, const ImagePose& mirror,
+                      const EdgeDistance& edges) {
+  const HandEvidence d = handEvidence(model, direct, mirror, edges);
+  const HandEvidence m = handEvidence(model, mirror, direct, edges);
+  // Placed this way the two hands coincide: nothing shows it is the model.
+  if (d.weight <= 0 || m.weight <= 0) return true;
+  const double on_direct = d.on / d.weight;
+  const double on_mirror = m.on / m.weight;
+  if (std::abs(on_direct - on_mirror) > 1e-9) return on_mirror > on_direct;
+  return m.distance / m.weight <= d.distance / d.weight;
+}
+
+Result<void> validateModel(const PartModel& model) {
+  const std::string problem = modelProblem(model);
+  if (problem.empty()) return {};
+  return makeError(PartModelErrc::kInvalid, problem);
+}
+
+}  // namespace picksight::vision

@@ -1,0 +1,28 @@
+// Recognition: which trained parts are in a set of regions, where and how
+// turned; body features propose, the boundary model verifies.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/vision/models/match.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+
+namespace picksight::vision {
+
+// Every part of the given models among the regions, best score first. A
+// region that passes every test of a model (judgeRegion) holds one part,
+// of the model that verifies best; a region that is the whole of a part
+// drawn other than trained (judgeRegion's kScale or kMirror for some model)
+// holds none; any other is searched for parts that touch (one merged blob)
+// with the boundary models (see locateInBlob). Holes are counted as the
+// regions hold them: give the regions as the models see them
+// (withHolesAtLeast with their min_hole_area).
+// Regions are searched on OpenCV's worker threads (cv::setNumThreads); the
+// result does not depend on their number.
+std::vector<Match> recognize(const std::vector<Region>& regions,
+                             const std::vector<const PartModel*>& models);
+
+}  // namespace picksight::vision

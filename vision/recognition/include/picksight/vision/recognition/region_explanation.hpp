@@ -1,0 +1,38 @@
+// Why a region is not a part of a model: the first of recognize()'s tests
+// it fails for the model it comes nearest to, with the measured value and
+// the tolerance, for the results stream and the robot's WHY.
+//
+// Pure functions on the same regions and models recognize() sees (frame
+// pixels); the verdicts are judgeRegion's, the recognizer's own, so an
+// explanation never disagrees with the recognizer about a separated region.
+#pragma once
+
+#include <vector>
+
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/recognition/region_judge.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+
+namespace picksight::vision {
+
+struct RegionExplanation {
+  const PartModel* nearest = nullptr;  // borrowed from the list; null: no models
+  // The first test the region fails for `nearest` (kEdge: the frame border
+  // cuts it, which findRegions leaves out of recognition); kPasses: it
+  // passes every test of that model (it is that part, or a touching blob
+  // searched further).
+  RegionTest test = RegionTest::kPasses;
+  // The value measured and its tolerance, as in Verdict.
+  double measured = 0;
+  double low = 0;
+  double high = 0;
+};
+
+// The model of `models` the region comes nearest to (the one whose tests it
+// passes furthest; among those passing every test the best verified, as
+// recognize() picks; else the closest in area) and the first test it
+// fails. `region` is as findRegions found it with the smallest minimum hole
+// area of the models: each model judges it with its own min_hole_area.
+RegionExplanation explainRegion(const Region& region, const std::vector<const PartModel*>& models);
+
+}  // namespace picksight::vision

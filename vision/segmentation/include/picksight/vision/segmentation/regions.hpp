@@ -1,0 +1,71 @@
+// Connected regions of a binary image with their holes, and the features the
+// locator needs from each: area, sub-pixel centroid, orientation.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "picksight/vision/segmentation/row_runs.hpp"
+
+namespace picksight::vision {
+
+struct Region {
+  double area = 0;       // pixels (covered fraction summed, with a grey image)
+  cv::Point2d centroid;  // sub-pixel, pixel centres at integer coordinates
+  // Axis of least second moment, pointing along the longer path through the
+  // region from its centroid; degrees in [0, 360), image axes (x right, y down).
+  double angle_deg = 0;
+  // 1 - (minor/major inertia): 0 for a disc or a square, where no axis exists.
+  double elongation = 0;
+  int holes = 0;
+  cv::Rect bbox;
+  bool touches_border = false;
+  // Moments (grey-weighted with a grey image, else binary). Raw moments
+  // (m00..m03) are about an origin near bbox.tl(); central and normalized
+  // moments do not depend on the origin.
+  cv::Moments moments;
+  std::vector<cv::Point> outer;  // outer boundary, image coordinates
+  std::vector<std::vector<cv::Point>> hole_boundaries;
+  // The weight of every pixel in the moments (CV_32F, 0..1: grey-level
+  // coverage, or 1 inside the mask without a grey image), over a box whose
+  // top-left pixel is `coverage_origin`. Kept so that higher-order features
+  // (complex moments for the rotation of symmetric parts) need no second pass.
+  cv::Mat coverage;
+  cv::Point coverage_origin;
+  // The runs of `coverage` outside which it is 0 (same box; a superset of
+  // its non-zero pixels), so that a pass over the coverage skips the rest
+  // of the box: outside a curved or slender part, and its holes, that is
+  // most of it. Empty (height 0) when not known: the whole box is read.
+  RowRuns covered;
+};
+
+struct RegionOptions {
+  double min_area = 50;  // smaller regions are noise
+  // Holes whose area (pixels, inside their boundary trace) is below this are
+  // not counted: sensor noise or dust, never a feature a model may rely on
+  // (the hole count must match exactly).
+  double min_hole_area = 0;
+  bool keep_border_regions = false;  // a part cut by the image edge cannot be located
+};
+
+// Regions of a CV_8UC1 mask (non-zero = part), 8-connected, largest first.
+//
+// With the grey image the mask came from, area, centroid, moments and angle
+// are measured to sub-pixel accuracy from the grey levels: each pixel counts
+// for the fraction of it the part covers, read from its grey level between
+// the part's own level and the background's around it. A binary mask alone
+// quantizes every edge pixel to 0 or 1, which biases the centroid by tenths
+// of a pixel when edges run along a pixel diagonal.
+//
+// Regions are measured on OpenCV's worker threads (cv::setNumThreads); the
+// result does not depend on their number.
+std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& options = {},
+                                const cv::Mat& grey = cv::Mat());
+
+// Orientation of a region from its moments and outer boundary (see Region).
+double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
+                      const std::vector<cv::Point>& outer);
+
+}  // namespace picksight::vision

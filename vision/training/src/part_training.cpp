@@ -1,0 +1,311 @@
+// Part model training: body features, stability of the Hu invariants under
+// rotation, boundary primitives snapped to the edges, orientation order and
+// symmetries; and the preparation of a model's derived data.
+#include "picksight/vision/training/part_training.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <utility>
+
+#include "picksight/common/angles.hpp"
+#include "picksight/vision/blob_search/touching_parts.hpp"
+
+namespace picksight::vision {
+namespace {
+constexpr int kMaxOrder = kMaxModelOrder;
+// Relative strength |c_k| / sum w |z|^k an orientation order needs. Below it
+// the phase of c_k is mostly pixel noise.
+constexpr double kMinOrderStrength = 0.05;
+constexpr double kWeakOrderStrength = 0.01;
+// Higher orders weigh the rim ever more, where noise and small defects sit.
+constexpr int kMaxPreferredOrder = 6;
+// Fraction of the boundary that must coincide with itself turned (or
+// mirrored) for the part to count as symmetric.
+constexpr double kSymmetryScore = 0.97;
+// Boundary length (pixels, weighted as in handednessWeight) by which a part
+// must differ from its mirror image, however it is turned, to count as
+// chiral: a 5 x 5 px notch differs by ~8 px, a symmetric part's fitted
+// primitives from their mirror images by well under one.
+constexpr double kMinChiralLength = 3.0;
+// Turns of the training image that measure how stable each Hu invariant is.
+constexpr double kProbeTurnsDeg[] = {23, 67, 141, 212, 299};
+// An invariant whose log changes by more than this under a turn is noise.
+constexpr double kMaxHuSpread = 1.0;
+constexpr double kMinHuTolerance = 0.5;
+// Invariants below 1e-7 (H above 7) are what a symmetry makes 0: what is
+// measured is pixel noise, of random sign (a 100 px part resolves normalized
+// moments to ~1e-4, their products to ~1e-8).
+constexpr double kMaxLogHu = 7.0;
+
+// |c_k| / sum w |z|^k for k = 0..kMaxOrder, and arg c_k (degrees).
+void complexMoments(const Region& r, std::vector<double>* strength,
+                    std::vector<double>* phase_deg) {
+  std::vector<std::complex<double>> c(kMaxOrder + 1, {0, 0});
+  std::vector<double> a(kMaxOrder + 1, 0);
+  const double scale = 1.0 / std::sqrt(std::max(r.area, 1.0));
+  for (int y = 0; y < r.coverage.rows; ++y) {
+    const float* row = r.coverage.ptr<float>(y);
+    for (int x = 0; x < r.coverage.cols; ++x) {
+      if (row[x] <= 0) continue;
+      const std::complex<double> z((r.coverage_origin.x + x - r.centroid.x) * scale,
+                                   (r.coverage_origin.y + y - r.centroid.y) * scale);
+      const double m = std::abs(z);
+      std::complex<double> p(1, 0);
+      double pm = 1;
+      for (int k = 0; k <= kMaxOrder; ++k) {
+        c[k] += static_cast<double>(row[x]) * p;
+        a[k] += row[x] * pm;
+        p *= z;
+        pm *= m;
+      }
+    }
+  }
+  strength->assign(kMaxOrder + 1, 0);
+  phase_deg->assign(kMaxOrder + 1, 0);
+  for (int k = 0; k <= kMaxOrder; ++k) {
+    (*strength)[k] = a[k] > 0 ? std::abs(c[k]) / a[k] : 0;
+    (*phase_deg)[k] = std::arg(c[k]) * 180.0 / M_PI;
+  }
+}
+
+// A boundary fitted to the edges puts the part's centroid a few tenths of a
+// pixel off where the snap to the edges could not move a primitive (short
+// edges, thin stems): every pose found from the edges (parts that touch)
+// would inherit it. The boundary is moved, once, so that the fit to the
+// training edges puts the model's origin on the trained centroid.
+constexpr double kMaxCentringPx = 1.0;
+constexpr double kMaxCentringDeg = 1.0;
+
+void centreOnEdges(PartModel& m, const Region& r) {
+  const EdgeFit fit = refinePoseOnEdges(m, r, {r.centroid, 0.0, false});
+  if (!fit.ok) return;
+  // Model point p lies on the edges at centroid + delta + R(e) p: in the
+  // model frame, at delta + R(e) p.
+  const cv::Point2d delta = fit.pose.centre - r.centroid;
+  const double e = signedDeg(fit.pose.angle_deg);
+  if (std::hypot(delta.x, delta.y) > kMaxCentringPx || std::abs(e) > kMaxCentringDeg) return;
+  const double c = std::cos(e * kRadPerDeg);
+  const double s = std::sin(e * kRadPerDeg);
+  const auto move = [&](cv::Point2d p) {
+    return cv::Point2d(c * p.x - s * p.y, s * p.x + c * p.y) + delta;
+  };
+  for (auto& loop : m.loops) {
+    for (auto& p : loop.primitives) {
+      p.start = move(p.start);
+      p.end = move(p.end);
+      p.centre = move(p.centre);
+    }
+  }
+  m.corners = findCorners(m.loops, m.conformity);
+  prepareModel(m);
+}
+
+std::vector<std::vector<cv::Point>> contoursOf(const Region& r) {
+  std::vector<std::vector<cv::Point>> all{r.outer};
+  all.insert(all.end(), r.hole_boundaries.begin(), r.hole_boundaries.end());
+  return all;
+}
+
+// Log Hu invariants of the part turned by `deg` about its centroid.
+bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOptions& options,
+                 HuArray* out) {
+  double reach = 0;
+  for (const auto& p : r.outer)
+    reach = std::max(reach, std::hypot(p.x - r.centroid.x, p.y - r.centroid.y));
+  const int half = static_cast<int>(std::ceil(reach)) + 12;
+  const cv::Point c(static_cast<int>(std::lround(r.centroid.x)),
+                    static_cast<int>(std::lround(r.centroid.y)));
+  cv::Mat padded;
+  cv::copyMakeBorder(grey, padded, half, half, half, half, cv::BORDER_REPLICATE);
+  const cv::Mat window = padded(cv::Rect(c.x, c.y, 2 * half + 1, 2 * half + 1));
+  const cv::Point2f centre(static_cast<float>(r.centroid.x - c.x + half),
+                           static_cast<float>(r.centroid.y - c.y + half));
+  cv::Mat turned;
+  cv::warpAffine(window, turned, cv::getRotationMatrix2D(centre, -deg, 1.0), window.size(),
+                 cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  BinarizeOptions b = options.binarize;
+  b.method = ThresholdMethod::kOtsu;
+  RegionOptions ro = options.regions;
+  ro.keep_border_regions = true;
+  const auto regions = findRegions(binarize(turned, b), ro, turned);
+  if (regions.empty()) return false;
+  *out = logHu(huInvariants(regions.front().moments));
+  return true;
+}
+
+}  // namespace
+
+void prepareModel(PartModel& model) {
+  model.samples = sampleBoundary(model.loops, 1.0);
+  model.radius = 0;
+  for (const auto& s : model.samples)
+    model.radius = std::max(model.radius, std::hypot(s.point.x, s.point.y));
+  // Farther than twice the tolerance, every distance weighs the same
+  // (handednessWeight).
+  model.boundary_map =
+      std::make_shared<const BoundaryDistanceMap>(model.loops, 2 * model.edge_tolerance + 1.0);
+  model.blob_search = makeBlobSearchModel(model);
+}
+
+Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& name,
+                             const TrainOptions& options) {
+  if (grey.empty() || grey.type() != CV_8UC1) {
+    return makeError(PartModelErrc::kNotGrey, "the training image must be 8-bit grey");
+  }
+  const auto regions = findRegions(binarize(grey, options.binarize), options.regions, grey);
+  if (regions.empty()) return makeError(PartModelErrc::kNoPart, "no part in the image");
+  if (regions.size() > 1) {
+    return makeError(
+        PartModelErrc::kSeveralParts,
+        std::to_string(regions.size()) + " parts in the image, training needs exactly one");
+  }
+  return trainModelFromRegion(grey, regions.front(), type, name, options);
+}
+
+Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int type,
+                                       const std::string& name, const TrainOptions& options) {
+  if (grey.empty() || grey.type() != CV_8UC1) {
+    return makeError(PartModelErrc::kNotGrey, "the training image must be 8-bit grey");
+  }
+  PartModel m;
+  m.type = type;
+  m.name = name;
+  m.trained_centroid = r.centroid;
+  m.trained_angle_deg = r.angle_deg;
+  m.min_region_area = options.regions.min_area;
+  m.min_hole_area = options.regions.min_hole_area;
+  m.conformity = options.conformity;
+  m.verify_percent = options.verify_percent;
+  m.edge_tolerance = options.conformity + 1.0;
+  m.body.area = r.area;
+  m.body.area_tolerance = options.area_tolerance;
+  m.body.holes = r.holes;
+  m.body.log_hu = logHu(huInvariants(r.moments));
+
+  // Boundary in the model frame: the trained pose, centroid at the origin.
+  std::vector<std::vector<cv::Point2d>> contours;
+  for (const auto& c : contoursOf(r)) {
+    std::vector<cv::Point2d> loop;
+    loop.reserve(c.size());
+    for (const auto& p : c) loop.emplace_back(p.x - r.centroid.x, p.y - r.centroid.y);
+    contours.push_back(std::move(loop));
+  }
+  m.loops = fitLoops(contours, m.conformity);
+  snapToEdges(m.loops, r, r.centroid);
+  m.corners = findCorners(m.loops, m.conformity);
+  prepareModel(m);
+  centreOnEdges(m, r);
+
+  // Orientation order: the lowest whose complex moment has a direction.
+  std::vector<double> strength;
+  std::vector<double> phase;
+  complexMoments(r, &strength, &phase);
+  // Among the orders with a clear direction, the one whose phase gives the
+  // finest rotation: an error e in arg c_k turns the estimate by e / k, and e
+  // shrinks as |c_k| grows.
+  m.orientation_order = 0;
+  int strongest = 0;
+  double finest = 0;
+  for (int k = 2; k <= kMaxOrder; ++k) {
+    if (strength[k] >= kMinOrderStrength && k <= kMaxPreferredOrder && k * strength[k] > finest) {
+      m.orientation_order = k;
+      finest = k * strength[k];
+    }
+    if (strength[k] > strength[strongest]) strongest = k;
+  }
+  for (int k = kMaxPreferredOrder + 1; k <= kMaxOrder && m.orientation_order == 0; ++k) {
+    if (strength[k] >= kMinOrderStrength) m.orientation_order = k;
+  }
+  if (m.orientation_order == 0 && strongest >= 2 && strength[strongest] >= kWeakOrderStrength) {
+    m.orientation_order = strongest;
+  }
+  m.orientation_phase_deg = m.orientation_order > 0 ? phase[m.orientation_order] : 0;
+
+  // Symmetries, by verifying the model against its own training edges.
+  const int margin = static_cast<int>(std::ceil(m.edge_tolerance)) + 4;
+  const cv::Rect roi = cv::Rect(r.bbox.x - margin, r.bbox.y - margin, r.bbox.width + 2 * margin,
+                                r.bbox.height + 2 * margin);
+  const EdgeDistance edges(contoursOf(r), roi);
+  m.symmetry_order = 1;
+  int passed = 0;
+  for (int s = 2; s <= kMaxOrder; ++s) {
+    if (verifyScore(m.samples, r.centroid, 360.0 / s, edges, m.edge_tolerance) >= kSymmetryScore) {
+      m.symmetry_order = s;
+      ++passed;
+    }
+  }
+  if (m.orientation_order == 0 && passed == kMaxOrder - 1) m.symmetry_order = 0;
+  if (m.orientation_order == 0) {
+    m.body.mirror_symmetric = true;
+  } else {
+    // The mirror image lines up with the part at one of the turns where its
+    // complex moment does (as in recognition); a hair either side absorbs
+    // the phase's pixel noise.
+    const int k = m.orientation_order;
+    double least = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < k; ++j) {
+      for (double nudge : {-0.5, -0.25, 0.0, 0.25, 0.5}) {
+        least = std::min(least,
+                         chiralLength(m, 2 * m.orientation_phase_deg / k + j * 360.0 / k + nudge));
+      }
+    }
+    m.body.mirror_symmetric = least < kMinChiralLength;
+  }
+
+  // Which Hu invariants survive turning, and how far they move.
+  const HuArray& h0 = m.body.log_hu;
+  std::array<double, 7> spread{};
+  std::array<bool, 7> same_sign;
+  same_sign.fill(true);
+  std::vector<HuArray> probes;
+  for (double deg : kProbeTurnsDeg) {
+    HuArray h;
+    if (!turnedLogHu(grey, r, deg, options, &h)) continue;
+    probes.push_back(h);
+    for (size_t i = 0; i < h.size(); ++i) {
+      spread[i] = std::max(spread[i], std::abs(h[i] - h0[i]));
+      same_sign[i] = same_sign[i] && (h[i] >= 0) == (h0[i] >= 0);
+    }
+  }
+  for (size_t i = 0; i < h0.size(); ++i) {
+    m.body.hu_used[i] = !probes.empty() && same_sign[i] && spread[i] <= kMaxHuSpread &&
+                        std::abs(h0[i]) <= kMaxLogHu;
+  }
+  double worst = 0;
+  for (const auto& h : probes) worst = std::max(worst, huDistance(m.body, h));
+  m.body.hu_tolerance = std::max(kMinHuTolerance, 3 * worst);
+  return m;
+}
+
+PartModel scaledModel(const PartModel& model, double scale) {
+  PartModel m = model;
+  const double area = scale * scale;
+  m.body.area *= area;
+  m.min_region_area *= area;
+  m.min_hole_area *= area;
+  for (auto& loop : m.loops) {
+    for (auto& p : loop.primitives) {
+      p.start *= scale;
+      p.end *= scale;
+      p.centre *= scale;
+      p.radius *= scale;
+    }
+  }
+  const auto scaled = [scale](Range r) { return Range{r.min * scale, r.max * scale}; };
+  for (auto& c : m.corners) {
+    c.at *= scale;
+    c.length_in = scaled(c.length_in);
+    c.length_out = scaled(c.length_out);
+    c.radius_in = scaled(c.radius_in);
+    c.radius_out = scaled(c.radius_out);
+  }
+  prepareModel(m);
+  return m;
+}
+
+}  // namespace picksight::vision
