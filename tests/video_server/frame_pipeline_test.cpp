@@ -366,3 +366,25 @@ TEST_CASE("validateOutputSettings rejects half sizes and negative values", "[vid
   huge_scale.scale = 17;
   CHECK_FALSE(validateOutputSettings(huge_scale, sensor));
 }
+
+TEST_CASE("output sizes are bounded at 16384 a side and 64 Mi pixels in all", "[video_server]") {
+  // What one frame may allocate, however the size was asked for: as a size,
+  // or as a scale of the sensor (or its ROI).
+  const cv::Size sensor(2048, 2048);
+  OutputSettings s;
+  s.size = cv::Size(16384, 4096);  // 64 Mi exactly
+  CHECK(validateOutputSettings(s, sensor));
+  s.size = cv::Size(16384, 4097);
+  auto r = validateOutputSettings(s, sensor);
+  REQUIRE_FALSE(r);
+  CHECK_THAT(r.error().message, Catch::Contains("pixels in all"));
+  s.size = cv::Size(16385, 8);
+  CHECK_FALSE(validateOutputSettings(s, sensor));
+  OutputSettings scaled;
+  scaled.scale = 4;  // 8192 x 8192: 64 Mi
+  CHECK(validateOutputSettings(scaled, sensor));
+  scaled.scale = 4.01;
+  r = validateOutputSettings(scaled, sensor);
+  REQUIRE_FALSE(r);
+  CHECK_THAT(r.error().message, Catch::Contains("scaled size"));
+}
