@@ -13,15 +13,18 @@ ccache, the compilers; no network.
     tests/mutants/run_mutants.py --markdown        # the table for tests/README.md
 
 The list's format is described atop mutants.tsv. The scratch worktree (git worktree
-add of HEAD) and its build directory live under --work (default
-$TMPDIR/picksight-mutants) and are kept between runs: the next run moves the
-worktree to HEAD in place and rebuilds only what changed; ccache serves the
-rest. `git worktree remove` it when done for good.
+add of HEAD, under --work, default $TMPDIR/picksight-mutants) and its build
+directory (build/ in it) are kept between runs: the next run moves the
+worktree to HEAD in place and rebuilds only what changed. ccache's base_dir
+is set to the worktree, so the first build takes the libraries from the
+cache a developer's build filled. `git worktree remove` it when done for
+good.
 """
 
 import argparse
 import fnmatch
 import html
+import os
 import re
 import shlex
 import subprocess
@@ -199,7 +202,12 @@ def main():
     if args.check:
         return
     work = args.work.resolve()
-    src, build = work / "src", work / "build"
+    # The build directory inside the worktree, as a developer's (build/):
+    # with ccache's base_dir set to the worktree its compilations read as
+    # a developer tree's do, so the libraries come from the cache.
+    src = work / "src"
+    build = src / "build"
+    os.environ["CCACHE_BASEDIR"] = str(src)
     work.mkdir(parents=True, exist_ok=True)
     # The worktree is kept between runs and moved to HEAD in place: files
     # that did not change keep their times, so the build dir stays current.
