@@ -277,9 +277,9 @@ TEST_CASE("The refused keys counted for the log are bounded: after 1024 the coun
   zap.set(zmq::sockopt::linger, 0);
   zap.set(zmq::sockopt::rcvtimeo, 10000);
   zap.connect("inproc://zeromq.zap.01");
-  const auto ask = [&](const std::string& key) {
-    const std::vector<std::string> request = {"1.0", "7",     "picksight", "192.0.2.9",
-                                              "",    "CURVE", key};
+  const auto ask = [&](const std::string& key, const std::string& version = "1.0") {
+    const std::vector<std::string> request = {version, "7",     "picksight", "192.0.2.9",
+                                              "",      "CURVE", key};
     for (size_t i = 0; i < request.size(); ++i) {
       zap.send(zmq::buffer(request[i]),
                i + 1 < request.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
@@ -319,11 +319,14 @@ TEST_CASE("The refused keys counted for the log are bounded: after 1024 the coun
   REQUIRE(zmq_z85_decode(reinterpret_cast<uint8_t*>(listed_binary.data()),
                          listed.public_key.c_str()) != nullptr);
   const std::string admitted = ask(listed_binary);
+  // A request of another ZAP version is malformed, even for a listed key.
+  const std::string other_version = ask(listed_binary, "2.0");
   ::dup2(saved, STDERR_FILENO);
   ::close(saved);
 
   CHECK(std::count(statuses.begin(), statuses.end(), "400") == 1026);
   CHECK(admitted == "200");
+  CHECK(other_version == "500");
   CHECK((*curve)->refused() == 1026);
   std::ifstream in(log);
   int first_logged_once = 0;
