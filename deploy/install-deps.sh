@@ -34,8 +34,8 @@ PACKAGES=(
   dpkg-dev file systemd
   # PLC port: Modbus TCP server (libmodbus), and the independent client of its tests
   libmodbus-dev python3-pymodbus
-  # web HMI (picksight-web): HTTP server, JPEG encoding
-  libcpp-httplib-dev
+  # web HMI (picksight-web): HTTP server, JPEG encoding, argon2id password hashes
+  libcpp-httplib-dev libsodium-dev
   libturbojpeg0-dev
   # pymodbus imports its serial client with every client (a Recommends of python3-pymodbus)
   python3-serial-asyncio

@@ -1,0 +1,53 @@
+// The roles of the web HMI's requests (access_policy.hpp).
+#include "picksight/web/access_policy.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+#include <vector>
+
+namespace picksight::web {
+namespace {
+
+std::vector<std::string> words(std::string_view line) {
+  std::vector<std::string> out;
+  std::string word;
+  for (char c : line) {
+    // The robot protocol splits on spaces, tabs and commas.
+    if (c == ' ' || c == '\t' || c == ',') {
+      if (!word.empty()) out.push_back(word);
+      word.clear();
+    } else {
+      word += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    }
+  }
+  if (!word.empty()) out.push_back(word);
+  return out;
+}
+
+}  // namespace
+
+Role roleForCommand(std::string_view line) {
+  static const std::set<std::string> reads = {"LOCATE",  "WHY",       "STATUS", "PING",
+                                              "VERSION", "HELP",      "MODELS", "BLOBS",
+                                              "LIST",    "RESIDUALS", "FRAME"};
+  const auto w = words(line);
+  if (w.empty()) return Role::kOperator;  // refused by the app anyway
+  const std::string& command = w[0];
+  if (reads.count(command) > 0) return Role::kOperator;
+  // Reads with these arguments, changes with more.
+  if ((command == "EXPOSURE" || command == "ROI" || command == "CAMMODE") && w.size() == 1)
+    return Role::kOperator;
+  if (command == "TOLERANCE" && w.size() <= 2) return Role::kOperator;
+  if ((command == "GRASP" || command == "GRIPPER") && w.size() == 3 && w[2] == "LIST")
+    return Role::kOperator;
+  return Role::kEngineer;
+}
+
+Role roleForCameraAction(std::string_view action) {
+  // A software trigger takes a frame, as LOCATE does; everything else
+  // changes how the camera works.
+  return action == "trigger" ? Role::kOperator : Role::kEngineer;
+}
+
+}  // namespace picksight::web
