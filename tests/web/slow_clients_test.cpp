@@ -93,14 +93,15 @@ TEST_CASE("one address holds at most --per-address connections", "[web][security
   // Another address is served; and this one again once its sockets close.
   RawSocket other(web.port, "127.0.0.41");
   REQUIRE(other.valid());
-  REQUIRE(other.send("GET /api/cameras HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n"));
+  REQUIRE(other.send("GET /api/cameras HTTP/1.1\r\nHost: 127.0.0.1\r\n" + web.cookieLine() +
+                     "Connection: close\r\n\r\n"));
   CHECK(statusOf(other.readAll()) == 200);
   held.clear();
   CHECK(pollUntil([&] {
     RawSocket again(web.port, "127.0.0.40");
     return again.valid() &&
-           again.send(
-               "GET /api/cameras HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n") &&
+           again.send("GET /api/cameras HTTP/1.1\r\nHost: 127.0.0.1\r\n" + web.cookieLine() +
+                      "Connection: close\r\n\r\n") &&
            statusOf(again.readAll(5s)) == 200;
   }));
 }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -24,20 +25,48 @@ struct WebProcess {
     std::vector<std::string> argv = {e2e::binPath("picksight-web"), "--listen", "127.0.0.1:0"};
     argv.insert(argv.end(), args.begin(), args.end());
     process = std::make_unique<Subprocess>(argv);
-    auto url = process->waitForLine("web http://127.0.0.1:", std::chrono::seconds(10));
-    REQUIRE(url);
-    auto p = parseInt(*url);
+    // With no users yet the server makes 'admin' and prints its password
+    // once, before its URL; the tests log in with it.
+    const std::string url_prefix = "web http://127.0.0.1:";
+    std::optional<std::string> line;
+    while ((line = process->readLine(std::chrono::seconds(10)))) {
+      if (line->rfind("admin-password ", 0) == 0) admin_password = line->substr(15);
+      if (line->rfind(url_prefix, 0) == 0) break;
+    }
+    REQUIRE(line);
+    auto p = parseInt(line->substr(url_prefix.size()));
     REQUIRE(p);
     port = static_cast<int>(*p);
+    if (!admin_password.empty()) cookie = login("admin", admin_password);
   }
+  // A client logged in as the admin (when the server printed its password).
   httplib::Client client() const {
+    httplib::Client c = anonymousClient();
+    if (!cookie.empty()) c.set_default_headers({{"Cookie", cookie}});
+    return c;
+  }
+  httplib::Client anonymousClient() const {
     httplib::Client c("127.0.0.1", port);
     c.set_connection_timeout(std::chrono::seconds(5));
     c.set_read_timeout(std::chrono::seconds(10));
     return c;
   }
+  // POST /api/login; the session's "name=value" for a Cookie header, empty
+  // when refused.
+  std::string login(const std::string& user, const std::string& password) const {
+    auto res = anonymousClient().Post(
+        "/api/login", {{"X-PickSight", "1"}},
+        "{\"user\":\"" + user + "\",\"password\":\"" + password + "\"}", "application/json");
+    if (!res || res->status != 200) return "";
+    const std::string set = res->get_header_value("Set-Cookie");
+    return set.substr(0, set.find(';'));
+  }
+  // "Cookie: ...\r\n" for a raw request, logged in as the admin.
+  std::string cookieLine() const { return cookie.empty() ? "" : "Cookie: " + cookie + "\r\n"; }
   std::unique_ptr<Subprocess> process;
   int port = 0;
+  std::string admin_password;
+  std::string cookie;
 };
 
 // Calls `done` until it returns true or `timeout` passes; its last answer.

@@ -51,8 +51,8 @@ TEST_CASE("with --max-streams 1 a second event stream gets 503", "[web]") {
   args.insert(args.end(), {"--max-streams", "1"});
   WebProcess web(args);
   const std::string request =
-      "GET /events HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(web.port) +
-      "\r\nConnection: close\r\n\r\n";
+      "GET /events HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(web.port) + "\r\n" +
+      web.cookieLine() + "Connection: close\r\n\r\n";
   RawSocket first(web.port);
   REQUIRE(first.valid());
   REQUIRE(first.send(request));

@@ -15,16 +15,18 @@ using e2e::VisionProcess;
 using nlohmann::json;
 
 // A POST as raw bytes: `headers` are whole lines, each ending in CRLF.
-std::string rawPost(int port, const std::string& path, const std::string& headers,
+std::string rawPost(const WebProcess& web, const std::string& path, const std::string& headers,
                     const std::string& body) {
-  return rawRequest(port, "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
-                              "\r\n" + headers + "Content-Length: " + std::to_string(body.size()) +
-                              "\r\nConnection: close\r\n\r\n" + body);
+  return rawRequest(web.port, "POST " + path + " HTTP/1.1\r\nHost: 127.0.0.1:" +
+                                  std::to_string(web.port) + "\r\n" + web.cookieLine() + headers +
+                                  "Content-Length: " + std::to_string(body.size()) +
+                                  "\r\nConnection: close\r\n\r\n" + body);
 }
 
-std::string rawGet(int port, const std::string& path, const std::string& host) {
-  return rawRequest(port,
-                    "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+// A GET as the logged-in admin, naming `host`.
+std::string rawGet(const WebProcess& web, const std::string& path, const std::string& host) {
+  return rawRequest(web.port, "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\n" +
+                                  web.cookieLine() + "Connection: close\r\n\r\n");
 }
 
 std::string cameraState(const WebProcess& web) {
@@ -57,31 +59,30 @@ TEST_CASE("a cross-site form post neither forgets a model nor closes the camera"
 
   // The issue's exact attack: a form's text/plain body, a foreign Origin.
   std::string res = rawPost(
-      port, command, "Origin: http://attacker.example\r\nContent-Type: text/plain\r\n", forget);
+      web, command, "Origin: http://attacker.example\r\nContent-Type: text/plain\r\n", forget);
   CHECK(statusOf(res) == 403);
   CHECK(json::parse(bodyOf(res))["error"].get<std::string>().find("Origin") != std::string::npos);
   // Each defence alone refuses it: a form's type from the page's own origin,
   // JSON without the header a form cannot add, a foreign Origin with both.
-  res = rawPost(port, command, self + "Content-Type: text/plain\r\nX-PickSight: 1\r\n", forget);
+  res = rawPost(web, command, self + "Content-Type: text/plain\r\nX-PickSight: 1\r\n", forget);
   CHECK(statusOf(res) == 415);
-  res =
-      rawPost(port, command, self + "Content-Type: application/x-www-form-urlencoded\r\n", forget);
+  res = rawPost(web, command, self + "Content-Type: application/x-www-form-urlencoded\r\n", forget);
   CHECK(statusOf(res) == 415);
-  res = rawPost(port, command, self + "Content-Type: application/json\r\n", forget);
+  res = rawPost(web, command, self + "Content-Type: application/json\r\n", forget);
   CHECK(statusOf(res) == 403);
-  res = rawPost(port, command,
+  res = rawPost(web, command,
                 "Origin: null\r\nContent-Type: application/json\r\nX-PickSight: 1\r\n", forget);
   CHECK(statusOf(res) == 403);
-  res = rawPost(port, command,
+  res = rawPost(web, command,
                 "Origin: http://127.0.0.1.attacker.example:" + std::to_string(port) +
                     "\r\nContent-Type: application/json\r\nX-PickSight: 1\r\n",
                 forget);
   CHECK(statusOf(res) == 403);
   // The camera close, likewise.
-  res = rawPost(port, "/api/cameras/cam0/close",
+  res = rawPost(web, "/api/cameras/cam0/close",
                 "Origin: http://attacker.example\r\nContent-Type: text/plain\r\n", "{}");
   CHECK(statusOf(res) == 403);
-  res = rawPost(port, "/api/cameras/cam0/close", "Content-Type: text/plain\r\n", "{}");
+  res = rawPost(web, "/api/cameras/cam0/close", "Content-Type: text/plain\r\n", "{}");
   CHECK(statusOf(res) == 415);
 
   // Nothing changed: the model is still there, the camera still streams.
@@ -92,12 +93,12 @@ TEST_CASE("a cross-site form post neither forgets a model nor closes the camera"
 
   // The page's own request does it (so the checks above could see a change).
   res =
-      rawPost(port, command,
+      rawPost(web, command,
               self + "Content-Type: application/json; charset=utf-8\r\nX-PickSight: 1\r\n", forget);
   CHECK(statusOf(res) == 200);
   CHECK(json::parse(bodyOf(res))["reply"] == "OK");
   CHECK(*robot.request("MODELS", 5s) == "OK 0");
-  res = rawPost(port, "/api/cameras/cam0/close",
+  res = rawPost(web, "/api/cameras/cam0/close",
                 "Content-Type: application/json\r\nX-PickSight: 1\r\n", "{}");
   CHECK(statusOf(res) == 200);
   CHECK(pollUntil([&] { return cameraState(web) == "closed"; }));
@@ -111,7 +112,7 @@ TEST_CASE("a foreign Host is refused for reads too against DNS rebinding", "[web
   for (const char* path : {"/", "/api/cameras", "/snapshot/cam0.png", "/frame/cam0.jpg", "/events",
                            "/metrics", "/static/app.js"}) {
     CAPTURE(path);
-    const std::string res = rawGet(port, path, "rebind.attacker.example" + p);
+    const std::string res = rawGet(web, path, "rebind.attacker.example" + p);
     CHECK(statusOf(res) == 403);
     CHECK(bodyOf(res).find("Host") != std::string::npos);
   }
@@ -120,7 +121,7 @@ TEST_CASE("a foreign Host is refused for reads too against DNS rebinding", "[web
   for (const std::string& host : std::vector<std::string>{
            "127.0.0.1" + p, "localhost" + p, "LOCALHOST", "[::1]" + p, "localhost." + p}) {
     CAPTURE(host);
-    CHECK(statusOf(rawGet(port, "/api/cameras", host)) == 200);
+    CHECK(statusOf(rawGet(web, "/api/cameras", host)) == 200);
   }
 }
 
@@ -129,9 +130,9 @@ TEST_CASE("the hosts the server answers to are those of --allow-host", "[web][se
   auto args = videoServerArgs(server);
   args.insert(args.end(), {"--allow-host", "cell7.example,127.0.0.1"});
   WebProcess web(args);
-  CHECK(statusOf(rawGet(web.port, "/api/cameras", "Cell7.Example:8443")) == 200);
-  CHECK(statusOf(rawGet(web.port, "/api/cameras", "127.0.0.1")) == 200);
-  CHECK(statusOf(rawGet(web.port, "/api/cameras", "localhost")) == 403);
+  CHECK(statusOf(rawGet(web, "/api/cameras", "Cell7.Example:8443")) == 200);
+  CHECK(statusOf(rawGet(web, "/api/cameras", "127.0.0.1")) == 200);
+  CHECK(statusOf(rawGet(web, "/api/cameras", "localhost")) == 403);
 }
 
 TEST_CASE("every response forbids framing and foreign scripts and type sniffing",
@@ -140,8 +141,8 @@ TEST_CASE("every response forbids framing and foreign scripts and type sniffing"
   WebProcess web(videoServerArgs(server));
   const std::string host = "127.0.0.1:" + std::to_string(web.port);
   for (const std::string& res :
-       std::vector<std::string>{rawGet(web.port, "/", host), rawGet(web.port, "/nothing", host),
-                                rawGet(web.port, "/api/cameras", "attacker.example")}) {
+       std::vector<std::string>{rawGet(web, "/", host), rawGet(web, "/nothing", host),
+                                rawGet(web, "/api/cameras", "attacker.example")}) {
     CHECK(headerOf(res, "X-Frame-Options") == "DENY");
     CHECK(headerOf(res, "X-Content-Type-Options") == "nosniff");
     const std::string csp = headerOf(res, "Content-Security-Policy");
@@ -164,13 +165,13 @@ TEST_CASE("malformed input gets a 4xx with a plain message and never a 500 with 
     int status;
   };
   const std::vector<Case> cases = {
-      {rawPost(port, "/api/apps/cam0/command", json_post, R"({"line": 1e999})"), 400},
-      {rawPost(port, "/api/cameras/cam0/roi", json_post, R"({"x": -1e999})"), 400},
-      {rawPost(port, "/api/cameras/cam0/feature", json_post, "{\"name\": \"\xff\"}"), 400},
-      {rawGet(port, "/static/%ff", "127.0.0.1"), 404},
-      {rawGet(port, "/static/%ff%fe.js", "127.0.0.1"), 404},
-      {rawGet(port, "/snapshot/%ff.png", "127.0.0.1"), 404},
-      {rawGet(port, "/no/such/route", "127.0.0.1"), 404},
+      {rawPost(web, "/api/apps/cam0/command", json_post, R"({"line": 1e999})"), 400},
+      {rawPost(web, "/api/cameras/cam0/roi", json_post, R"({"x": -1e999})"), 400},
+      {rawPost(web, "/api/cameras/cam0/feature", json_post, "{\"name\": \"\xff\"}"), 400},
+      {rawGet(web, "/static/%ff", "127.0.0.1"), 404},
+      {rawGet(web, "/static/%ff%fe.js", "127.0.0.1"), 404},
+      {rawGet(web, "/snapshot/%ff.png", "127.0.0.1"), 404},
+      {rawGet(web, "/no/such/route", "127.0.0.1"), 404},
       {rawRequest(port, "BREW / HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n"), 400},
   };
   for (const auto& c : cases) {

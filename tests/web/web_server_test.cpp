@@ -215,7 +215,8 @@ TEST_CASE("a stalled MJPEG reader delays neither another viewer nor snapshots", 
   address.sin_port = htons(static_cast<uint16_t>(web.port));
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   REQUIRE(::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0);
-  const std::string request = "GET /stream/cam0.mjpg HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  const std::string request =
+      "GET /stream/cam0.mjpg HTTP/1.1\r\nHost: 127.0.0.1\r\n" + web.cookieLine() + "\r\n";
   REQUIRE(::send(fd, request.data(), request.size(), 0) == static_cast<ssize_t>(request.size()));
   // The stalled stream is counted as a viewer once the server serves it.
   REQUIRE(pollUntil([&] {

@@ -262,12 +262,18 @@ int serveWeb(const picksight::StopSignals& stop, Cell& cell, const std::string& 
                              frames + "," + control, "--vision-app",
                              "cam0," + (results.empty() ? "none" : results) +
                                  ",127.0.0.1:" + std::to_string(robot_port)});
-  auto url = web.waitForLine("web ", 10s);
-  if (!url) {
+  // Its users live in memory: it prints the one admin's random password
+  // before its URL.
+  std::string password;
+  std::optional<std::string> line;
+  while ((line = web.readLine(10s)) && line->rfind("web ", 0) != 0)
+    if (line->rfind("admin-password ", 0) == 0) password = line->substr(15);
+  if (!line) {
     std::cerr << "demo: picksight-web did not start\n";
     return 1;
   }
-  std::cout << "\nThe cell's HMI: " << *url << "  (Ctrl-C stops the cell)" << std::endl;
+  std::cout << "\nThe cell's HMI: " << line->substr(4) << "  (Ctrl-C stops the cell)\n"
+            << "log in as admin, password " << password << std::endl;
   stop.wait();
   std::cout << "stopping" << std::endl;
   return WEXITSTATUS(web.terminate());

@@ -46,6 +46,8 @@
       let parsed;
       try { parsed = text ? JSON.parse(text) : {}; } catch (e) { parsed = { error: text }; }
       if (!r.ok && !parsed.error) parsed.error = "HTTP " + r.status;
+      // A session that ended (logout elsewhere, expiry): log in again.
+      if (r.status === 401 && url !== "/api/login" && ps.user) showLogin("session ended: log in again");
       return { ok: r.ok, status: r.status, body: parsed };
     } catch (e) {
       return { ok: false, status: 0, body: { error: String(e) } };
@@ -467,8 +469,49 @@
   }
   ps.drawTool = drawRects;
 
+  // ---- users -------------------------------------------------------------------
+  // The session is an HttpOnly cookie the script never sees: /api/session
+  // says who is logged in, and the page starts its feeds only then.
+  ps.user = null;  // {user, role} once logged in
+  function showLogin(message) {
+    ps.user = null;
+    $("login-error").textContent = message || "";
+    $("login").hidden = false;
+    $("login-user").focus();
+  }
+  function showUser() {
+    $("login").hidden = true;
+    $("user-name").textContent = ps.user.user + " (" + ps.user.role + ")";
+    document.body.dataset.role = ps.user.role;
+  }
+  let started = false;
+  function startLive() {
+    if (started) return;
+    started = true;
+    refreshCameras().then(refreshApps);
+    setInterval(refreshApps, 5000);
+    connectEvents();
+  }
+  async function login() {
+    const r = await ps.request("POST", "/api/login",
+                               { user: $("login-user").value, password: $("login-password").value });
+    $("login-password").value = "";
+    if (!r.ok) { $("login-error").textContent = r.body.error; return; }
+    const again = started;
+    ps.user = r.body;
+    showUser();
+    // The event stream gave up on the ended session: start it afresh.
+    if (again) location.reload(); else startLive();
+  }
+  ps.login = login;
+
   // ---- start -------------------------------------------------------------------
   document.addEventListener("DOMContentLoaded", () => {
+    $("login-form").addEventListener("submit", (e) => { e.preventDefault(); login(); });
+    $("logout").addEventListener("click", async () => {
+      await ps.post("/api/logout");
+      location.reload();
+    });
     for (const b of document.querySelectorAll("#tabs button")) b.addEventListener("click", () => selectTab(b.dataset.tab));
     $("camera-select").addEventListener("change", (e) => selectCamera(e.target.value));
     $("app-select").addEventListener("change", (e) => {
@@ -484,8 +527,11 @@
     ps.on("frame", drawRects);
     watchFrameSize();
     rectTool();
-    refreshCameras().then(refreshApps);
-    setInterval(refreshApps, 5000);
-    connectEvents();
+    ps.get("/api/session").then((r) => {
+      if (!r.ok || !r.body.user) return showLogin();
+      ps.user = r.body;
+      showUser();
+      startLive();
+    });
   });
 })();

@@ -19,6 +19,7 @@ struct RawOptions {
   std::string allow;
   std::vector<std::string> allow_hosts;
   int header_timeout_s = 10;
+  int session_timeout_s = 3600;
   std::string config_file;
 };
 
@@ -98,6 +99,13 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
                  "connections open at once from one address (streams included)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
+  app.add_option("--users", o.users_file,
+                 "the users file (argon2id hashes, written by the page's Users panel); with no "
+                 "users, an 'admin' with a random password printed once (default: in memory)");
+  app.add_option("--session-timeout", raw.session_timeout_s,
+                 "seconds without a request after which a login ends")
+      ->check(CLI::Range(1, 86400))
+      ->capture_default_str();
   app.add_option("--config", raw.config_file,
                  "YAML file of options, each named as its flag without dashes "
                  "(lists for the repeatable ones); the command line overrides it");
@@ -125,6 +133,7 @@ Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
   }
   if (!raw.allow.empty()) o.allow = *AllowList::parse(raw.allow);
   o.header_timeout = std::chrono::seconds(raw.header_timeout_s);
+  o.session_timeout = std::chrono::seconds(raw.session_timeout_s);
   for (const auto& v : raw.allow_hosts)
     for (const auto& name : splitFields(v, ","))
       if (!name.empty()) o.allow_hosts.emplace_back(name);

@@ -5,8 +5,12 @@
 #include <netinet/in.h>
 
 #include <atomic>
+#include <cstring>
 #include <fstream>
+#include <iostream>
 #include <map>
+#include <optional>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -20,6 +24,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/web/access_policy.hpp"
 #include "picksight/web/camera_actions.hpp"
 #include "picksight/web/camera_monitor.hpp"
 #include "picksight/web/event_hub.hpp"
@@ -30,6 +35,8 @@
 #include "picksight/web/refusal_log.hpp"
 #include "picksight/web/request_guard.hpp"
 #include "picksight/web/result_feed.hpp"
+#include "picksight/web/sessions.hpp"
+#include "picksight/web/user_store.hpp"
 #include "picksight/web/web_errors.hpp"
 
 namespace picksight::web {
@@ -37,6 +44,9 @@ namespace {
 using namespace std::chrono_literals;
 
 constexpr size_t kMaxBodyBytes = 64 * 1024;
+// A login lasts a working day at most, however busy.
+constexpr std::chrono::seconds kSessionMaxAge{12 * 3600};
+constexpr const char* kSessionCookie = "picksight_session";
 constexpr auto kKeepalive = 15s;
 constexpr const char* kBoundary = "picksightframe";
 // The page's own scripts, styles, images, streams and requests only; no
@@ -183,6 +193,9 @@ class WebServer::Impl {
   RefusalLog refusals_{"HTTP"};
   std::unique_ptr<httplib::Server> http_ = std::make_unique<httplib::Server>();
   std::unique_ptr<HttpGate> gate_;
+  std::optional<UserStore> users_;
+  std::unique_ptr<Sessions> sessions_;
+  LoginLimiter logins_;
   // Snapshots' PNGs and binarized images, made on request at SCHED_IDLE.
   IdleWorker images_{"snapshot and binarized images"};
   int port_ = 0;
@@ -191,6 +204,11 @@ class WebServer::Impl {
 
  private:
   void routes();
+  void userRoutes();
+  // The session of the request's cookie, if any is valid.
+  std::optional<Session> sessionOf(const httplib::Request& req);
+  // The role a request needs; nullopt: none (the page, login).
+  std::optional<Role> roleNeeded(const httplib::Request& req);
   void serveFile(const std::string& relative, httplib::Response& res);
   std::shared_ptr<CameraFeed> feedOr404(const std::string& camera, httplib::Response& res);
   ResultFeed* appOr404(const std::string& name, httplib::Response& res);
@@ -208,6 +226,18 @@ class WebServer::Impl {
 };
 
 Result<void> WebServer::Impl::start() {
+  auto users = UserStore::open(options_.users_file);
+  if (!users) return users.error();
+  users_.emplace(std::move(*users));
+  sessions_ = std::make_unique<Sessions>(options_.session_timeout, kSessionMaxAge);
+  if (users_->empty()) {
+    // Never a fixed default: a random password, said once.
+    const std::string password = UserStore::randomPassword();
+    if (auto set = users_->set("admin", Role::kAdmin, password); !set) return set.error();
+    std::cout << "admin-password " << password << std::endl;
+    logInfo("no users yet", options_.users_file.empty() ? " (no --users file: kept in memory)" : "",
+            ": made 'admin' with the password printed on stdout (change it under Users)");
+  }
   cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
                                              options_.jpeg_quality);
   for (const auto& app : options_.vision_apps)
@@ -265,9 +295,24 @@ Result<void> WebServer::Impl::start() {
     facts.request_header = req.get_header_value(kRequestHeader);
     if (auto refusal = checkRequest(hosts_, facts))
       return refuse(refusal->status, refusal->message);
+    const auto needed = roleNeeded(req);
+    if (!needed) return httplib::Server::HandlerResponse::Unhandled;
+    const auto session = sessionOf(req);
+    if (!session) {
+      sendJson(res, {{"error", "log in first (POST /api/login)"}}, 401);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (session->role < *needed) {
+      sendJson(res,
+               {{"error", std::string("this needs the ") + roleName(*needed) + " role; " +
+                              session->user + " is " + roleName(session->role)}},
+               403);
+      return httplib::Server::HandlerResponse::Handled;
+    }
     return httplib::Server::HandlerResponse::Unhandled;
   });
   routes();
+  userRoutes();
   GateOptions gate;
   gate.header_timeout = options_.header_timeout;
   gate.per_address = options_.per_address;
@@ -517,6 +562,113 @@ std::string WebServer::Impl::metrics() {
   return metricsText(cameras_->figures(), apps);
 }
 
+std::optional<Session> WebServer::Impl::sessionOf(const httplib::Request& req) {
+  const std::string cookies = req.get_header_value("Cookie");
+  const std::string key = std::string(kSessionCookie) + "=";
+  size_t at = 0;
+  while ((at = cookies.find(key, at)) != std::string::npos) {
+    if (at == 0 || cookies[at - 1] == ' ' || cookies[at - 1] == ';') {
+      const size_t start = at + key.size();
+      const size_t end = cookies.find(';', start);
+      return sessions_->find(cookies.substr(start, end == std::string::npos ? end : end - start));
+    }
+    at += key.size();
+  }
+  return std::nullopt;
+}
+
+std::optional<Role> WebServer::Impl::roleNeeded(const httplib::Request& req) {
+  const std::string& path = req.path;
+  if (path == "/" || path.rfind("/static/", 0) == 0 || path == "/api/login" ||
+      path == "/api/session")
+    return std::nullopt;
+  if (path.rfind("/api/users", 0) == 0) return Role::kAdmin;
+  if (!changesState(req.method)) return Role::kOperator;
+  // POST /api/apps/<app>/command: a session here; the role its line needs
+  // is checked by the route, since httplib reads the body after this.
+  static const std::regex camera(R"(/api/cameras/[^/]+/([a-z]+))");
+  std::smatch match;
+  if (std::regex_match(path, match, camera)) return roleForCameraAction(match[1].str());
+  return Role::kOperator;  // logout
+}
+
+void WebServer::Impl::userRoutes() {
+  http_->Post("/api/login", [this](const httplib::Request& req, httplib::Response& res) {
+    if (auto wait = logins_.blocked(req.remote_addr)) {
+      res.set_header("Retry-After", std::to_string(wait->count()));
+      return sendJson(
+          res, {{"error", "too many failed logins: wait " + std::to_string(wait->count()) + " s"}},
+          429);
+    }
+    auto body = parseJsonBody(req.body);
+    if (!body) return sendError(res, body.error());
+    const auto user = body->find("user");
+    const auto password = body->find("password");
+    if (user == body->end() || !user->is_string() || password == body->end() ||
+        !password->is_string())
+      return sendError(res, WebErrc::kBadRequest, "\"user\" and \"password\": strings");
+    const std::string name = user->get<std::string>();
+    const auto role = users_->verify(name, password->get<std::string>());
+    if (!role) {
+      logins_.failed(req.remote_addr);
+      refusals_.refused(req.remote_addr, "failed login as '" + name.substr(0, 32) + "'");
+      return sendJson(res, {{"error", "wrong user or password"}}, 401);
+    }
+    logins_.succeeded(req.remote_addr);
+    const std::string token = sessions_->create({name, *role});
+    // HttpOnly: no script reads it; SameSite=Strict: no other site's page
+    // sends it. Secure once the server speaks TLS (plain HTTP is for
+    // loopback and SSH tunnels, where a Secure cookie would not be sent).
+    res.set_header("Set-Cookie", std::string(kSessionCookie) + "=" + token +
+                                     "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
+                                     std::to_string(sessions_->maxAge().count()));
+    logInfo("login: ", name, " (", roleName(*role), ") from ", req.remote_addr);
+    sendJson(res, {{"user", name}, {"role", roleName(*role)}});
+  });
+  http_->Post("/api/logout", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string cookies = req.get_header_value("Cookie");
+    const size_t at = cookies.find(std::string(kSessionCookie) + "=");
+    if (at != std::string::npos)
+      sessions_->remove(cookies.substr(at + std::strlen(kSessionCookie) + 1, 64));
+    res.set_header("Set-Cookie",
+                   std::string(kSessionCookie) + "=; Path=/; HttpOnly; SameSite=Strict; Max-Age=0");
+    sendJson(res, {{"ok", true}});
+  });
+  http_->Get("/api/session", [this](const httplib::Request& req, httplib::Response& res) {
+    const auto session = sessionOf(req);
+    // Not an error: the page asks before it shows its login form.
+    if (!session) return sendJson(res, {{"user", nullptr}});
+    sendJson(res, {{"user", session->user}, {"role", roleName(session->role)}});
+  });
+  http_->Get("/api/users", [this](const httplib::Request&, httplib::Response& res) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& u : users_->list())
+      list.push_back({{"name", u.name}, {"role", roleName(u.role)}});
+    sendJson(res, list);
+  });
+  http_->Post("/api/users", [this](const httplib::Request& req, httplib::Response& res) {
+    auto body = parseJsonBody(req.body);
+    if (!body) return sendError(res, body.error());
+    const auto name = body->value("name", nlohmann::json());
+    const auto role = parseRole(body->value("role", std::string()));
+    const auto password = body->value("password", nlohmann::json());
+    if (!name.is_string() || !role || !password.is_string())
+      return sendError(res, WebErrc::kBadRequest,
+                       "\"name\", \"password\" and \"role\" (operator, engineer, admin)");
+    if (auto set = users_->set(name.get<std::string>(), *role, password.get<std::string>()); !set)
+      return sendError(res, set.error());
+    sessions_->removeUser(name.get<std::string>());  // the old password or role ends here
+    sendJson(res, {{"ok", true}});
+  });
+  http_->Post(R"(/api/users/([^/]+)/delete)",
+              [this](const httplib::Request& req, httplib::Response& res) {
+                if (auto removed = users_->remove(req.matches[1]); !removed)
+                  return sendError(res, removed.error());
+                sessions_->removeUser(req.matches[1]);
+                sendJson(res, {{"ok", true}});
+              });
+}
+
 void WebServer::Impl::routes() {
   http_->Get("/", [this](const httplib::Request&, httplib::Response& res) {
     serveFile("index.html", res);
@@ -555,19 +707,24 @@ void WebServer::Impl::routes() {
   http_->Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics(), "text/plain; version=0.0.4; charset=utf-8");
   });
-  http_->Post(R"(/api/apps/([^/]+)/command)",
-              [this](const httplib::Request& req, httplib::Response& res) {
-                ResultFeed* app = appOr404(req.matches[1], res);
-                if (!app) return;
-                auto body = parseJsonBody(req.body);
-                if (!body) return sendError(res, body.error());
-                auto line = body->find("line");
-                if (line == body->end() || !line->is_string())
-                  return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
-                auto reply = app->command(line->get<std::string>());
-                if (!reply) return sendError(res, reply.error());
-                sendJson(res, {{"reply", *reply}});
-              });
+  http_->Post(R"(/api/apps/([^/]+)/command)", [this](const httplib::Request& req,
+                                                     httplib::Response& res) {
+    ResultFeed* app = appOr404(req.matches[1], res);
+    if (!app) return;
+    auto body = parseJsonBody(req.body);
+    if (!body) return sendError(res, body.error());
+    auto line = body->find("line");
+    if (line == body->end() || !line->is_string())
+      return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
+    const auto session = sessionOf(req);
+    const Role needed = roleForCommand(line->get<std::string>());
+    if (!session || session->role < needed)
+      return sendJson(
+          res, {{"error", std::string("this line needs the ") + roleName(needed) + " role"}}, 403);
+    auto reply = app->command(line->get<std::string>());
+    if (!reply) return sendError(res, reply.error());
+    sendJson(res, {{"reply", *reply}});
+  });
   http_->Get(R"(/api/cameras/([^/]+)/features)",
              [this](const httplib::Request& req, httplib::Response& res) {
                proto::ControlRequest request;

@@ -83,7 +83,14 @@ class Cell:
         web = self._start([bin_path("picksight-web"), "--listen", "127.0.0.1:0", "--assets", ASSETS,
                            "--video-server", f"{self.frames},{self.control}",
                            "--vision-app", f"{APP},{self.results},127.0.0.1:{self.robot_port}"])
-        self.url = web.wait_line("web ", 20.0).strip()
+        # With no users yet, picksight-web makes 'admin' and prints its
+        # password once, before its URL.
+        lines = stdout_lines(web)
+        self.url = lines["web"].strip()
+        self.admin_password = lines["admin-password"].strip()
+        self.opener = urllib.request.build_opener(urllib.request.HTTPCookieProcessor())
+        status, body = self.http("POST", "/api/login", {"user": "admin", "password": self.admin_password})
+        assert status == 200, body
 
     def _start(self, argv):
         p = Process(argv)
@@ -101,7 +108,7 @@ class Cell:
         headers = {"Content-Type": "application/json", "X-PickSight": "1"} if data else {}
         req = urllib.request.Request(self.url + path, data=data, method=method, headers=headers)
         try:
-            with urllib.request.urlopen(req, timeout=10) as r:
+            with self.opener.open(req, timeout=10) as r:
                 return r.status, r.read()
         except urllib.error.HTTPError as e:
             return e.code, e.read()
@@ -148,6 +155,16 @@ class Browser:
         self.console = []
         self.driver.get(url)
 
+    def login(self, user, password):
+        """Logs in through the page's form; waits until the form is gone."""
+        wait_until(lambda: self.js("return !document.getElementById('login').hidden"), what="the login form")
+        self.js("document.getElementById('login-user').value = arguments[0];"
+                "document.getElementById('login-password').value = arguments[1];"
+                "document.getElementById('login-submit').click();", user, password)
+
+    def logged_in(self):
+        return self.js("return document.getElementById('login').hidden && !!window.picksight.user")
+
     def js(self, script, *args):
         return self.driver.execute_script(script, *args)
 
@@ -171,5 +188,7 @@ class Browser:
 @pytest.fixture(scope="module")
 def browser(cell, tmp_path_factory):
     b = Browser(cell.url + "/", tmp_path_factory.mktemp("chromium"))
+    b.login("admin", cell.admin_password)
+    wait_until(b.logged_in, what="the login")
     yield b
     b.quit()

@@ -44,6 +44,11 @@ struct WebOptions {
   // restarts it), and one address may hold per_address connections.
   std::chrono::milliseconds header_timeout{10000};
   int per_address = 32;
+  // The users file (user_store.hpp); empty: users in memory only. With no
+  // users, an admin with a random password printed once is made.
+  std::string users_file;
+  // A login ends after this long without a request (and after 12 h).
+  std::chrono::seconds session_timeout{3600};
 };
 
 // Parses argv without the program name; errors name the option. With

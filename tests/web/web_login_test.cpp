@@ -1,0 +1,173 @@
+// picksight-web's users over HTTP: nothing but the page and its login
+// without a session, an operator who can locate but not teach or close the
+// camera, logout and expiry, the login limit, the users file kept across
+// restarts.
+#include <nlohmann/json.hpp>
+
+#include "picksight/common/atomic_file.hpp"
+#include "raw_http.hpp"
+#include "temp_dir.hpp"
+#include "web_fixture.hpp"
+
+namespace picksight::webtest {
+namespace {
+using namespace std::chrono_literals;
+using e2e::VideoServerProcess;
+using e2e::VisionProcess;
+using nlohmann::json;
+
+httplib::Result post(httplib::Client& client, const std::string& path, const json& body) {
+  return client.Post(path.c_str(), {{"X-PickSight", "1"}}, body.dump(), "application/json");
+}
+
+httplib::Client as(const WebProcess& web, const std::string& cookie) {
+  auto c = web.anonymousClient();
+  c.set_default_headers({{"Cookie", cookie}});
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("without a session only the page and the login answer", "[web][users]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  WebProcess web(videoServerArgs(server));
+  REQUIRE(web.admin_password.size() == 16);
+  auto anonymous = web.anonymousClient();
+  for (const char* path : {"/", "/static/app.js"}) {
+    auto res = anonymous.Get(path);
+    REQUIRE(res);
+    CHECK(res->status == 200);
+  }
+  for (const char* path : {"/api/cameras", "/api/apps", "/snapshot/cam0.png", "/frame/cam0.jpg",
+                           "/events", "/metrics", "/api/users"}) {
+    CAPTURE(path);
+    auto res = anonymous.Get(path);
+    REQUIRE(res);
+    CHECK(res->status == 401);
+  }
+  auto who = anonymous.Get("/api/session");
+  REQUIRE(who);
+  CHECK(who->status == 200);
+  CHECK(json::parse(who->body)["user"].is_null());
+  auto res = post(anonymous, "/api/cameras/cam0/close", json::object());
+  REQUIRE(res);
+  CHECK(res->status == 401);
+  // The admin's session, from the printed password.
+  res = as(web, web.cookie).Get("/api/session");
+  REQUIRE(res);
+  CHECK(res->status == 200);
+  CHECK(json::parse(res->body)["role"] == "admin");
+}
+
+TEST_CASE("the session cookie is HttpOnly and SameSite=Strict and ends at logout", "[web][users]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  WebProcess web(videoServerArgs(server));
+  auto anonymous = web.anonymousClient();
+  auto res = post(anonymous, "/api/login", {{"user", "admin"}, {"password", web.admin_password}});
+  REQUIRE(res);
+  REQUIRE(res->status == 200);
+  const std::string set = res->get_header_value("Set-Cookie");
+  CHECK(set.find("HttpOnly") != std::string::npos);
+  CHECK(set.find("SameSite=Strict") != std::string::npos);
+  CHECK(set.find("Max-Age=") != std::string::npos);
+  auto session = as(web, set.substr(0, set.find(';')));
+  CHECK(session.Get("/api/cameras")->status == 200);
+  CHECK(post(session, "/api/logout", json::object())->status == 200);
+  CHECK(session.Get("/api/cameras")->status == 401);
+  // The other session (the fixture's) is untouched.
+  CHECK(web.client().Get("/api/cameras")->status == 200);
+  res = post(anonymous, "/api/login", {{"user", "admin"}, {"password", "not the password"}});
+  REQUIRE(res);
+  CHECK(res->status == 401);
+}
+
+TEST_CASE("an operator locates but cannot teach nor close the camera nor manage users",
+          "[web][users]") {
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=1", "--fps", "10"});
+  VisionProcess vision(server);
+  WebProcess web({"--video-server", server.frames + "," + server.control, "--vision-app",
+                  "cam0,none,127.0.0.1:" + std::to_string(vision.robot_port)});
+  auto admin = web.client();
+  REQUIRE(post(admin, "/api/users",
+               {{"name", "olga"}, {"role", "operator"}, {"password", "operator-olga"}})
+              ->status == 200);
+  REQUIRE(post(admin, "/api/users",
+               {{"name", "emil"}, {"role", "engineer"}, {"password", "engineer-emil"}})
+              ->status == 200);
+  auto olga = as(web, web.login("olga", "operator-olga"));
+  auto res = post(olga, "/api/apps/cam0/command", {{"line", "LOCATE 1"}});
+  REQUIRE(res);
+  CHECK(res->status == 200);
+  for (const char* line : {"LEARN 4", "FORGET 4", "TOLERANCE 4 area_tolerance 0.2", "CALCAM 5",
+                           "STORE 1 2", "COMPUTE", "CLEARCAL", "GRASP 4 ADD 0 0 0"}) {
+    CAPTURE(line);
+    res = post(olga, "/api/apps/cam0/command", {{"line", line}});
+    REQUIRE(res);
+    CHECK(res->status == 403);
+    CHECK_THAT(json::parse(res->body)["error"].get<std::string>(), Catch::Contains("engineer"));
+  }
+  res = post(olga, "/api/cameras/cam0/close", json::object());
+  REQUIRE(res);
+  CHECK(res->status == 403);
+  CHECK(olga.Get("/api/users")->status == 403);
+  CHECK(post(olga, "/api/users", {{"name", "olga"}, {"role", "admin"}, {"password", "x12345678"}})
+            ->status == 403);
+  // Nothing changed; the engineer teaches.
+  auto robot = vision.connect();
+  CHECK(*robot.request("MODELS", 5s) == "OK 0");
+  auto emil = as(web, web.login("emil", "engineer-emil"));
+  res = post(emil, "/api/apps/cam0/command", {{"line", "LEARN 4"}});
+  REQUIRE(res);
+  CHECK(res->status == 200);
+  CHECK(json::parse(res->body)["reply"].get<std::string>().rfind("OK 4 ", 0) == 0);
+  CHECK(emil.Get("/api/users")->status == 403);
+}
+
+TEST_CASE("a session ends after --session-timeout without a request", "[web][users]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  auto args = videoServerArgs(server);
+  args.insert(args.end(), {"--session-timeout", "1"});
+  WebProcess web(args);
+  auto admin = web.client();
+  CHECK(admin.Get("/api/cameras")->status == 200);
+  std::this_thread::sleep_for(1500ms);
+  CHECK(admin.Get("/api/cameras")->status == 401);
+}
+
+TEST_CASE("five failed logins from an address hold its next ones for a minute", "[web][users]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  WebProcess web(videoServerArgs(server));
+  auto anonymous = web.anonymousClient();
+  for (int i = 0; i < 5; ++i)
+    CHECK(post(anonymous, "/api/login",
+               {{"user", "admin"}, {"password", "guess" + std::to_string(i)}})
+              ->status == 401);
+  auto res = post(anonymous, "/api/login", {{"user", "admin"}, {"password", web.admin_password}});
+  REQUIRE(res);
+  CHECK(res->status == 429);
+  CHECK(!res->get_header_value("Retry-After").empty());
+}
+
+TEST_CASE("the users file keeps the users and no new password is printed", "[web][users]") {
+  test::TempDir dir;
+  const std::string users = (dir.path() / "users.json").string();
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  auto args = videoServerArgs(server);
+  args.insert(args.end(), {"--users", users});
+  std::string password;
+  {
+    WebProcess first(args);
+    password = first.admin_password;
+    REQUIRE(password.size() == 16);
+  }
+  const auto text = readFile(users);
+  REQUIRE(text);
+  CHECK(text->find("$argon2id$") != std::string::npos);
+  CHECK(text->find(password) == std::string::npos);
+  WebProcess second(args);
+  CHECK(second.admin_password.empty());
+  CHECK(!second.login("admin", password).empty());
+}
+
+}  // namespace picksight::webtest
