@@ -17,6 +17,7 @@
 #include <map>
 #include <optional>
 
+#include "blob_search.hpp"
 #include "picksight/common/angles.hpp"
 #include "touching_parts_internal.hpp"
 
@@ -184,14 +185,6 @@ std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Imag
   return polys;
 }
 
-// A candidate that fits the blob on its own, drawn over its box.
-struct Placed {
-  const Candidate* candidate = nullptr;
-  cv::Rect box;   // image coordinates
-  cv::Mat drawn;  // 255 on the part, over `box`
-  int area = 0;
-};
-
 // Pixels two placed candidates share.
 int sharedPixels(const Placed& a, const Placed& b) {
   const cv::Rect both = a.box & b.box;
@@ -279,306 +272,297 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, MirrorTest&& 
 
 }  // namespace
 
-std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
-                                const std::vector<const PartModel*>& models,
-                                const EdgeDistance* built_edges) {
-  std::vector<Match> found;
-  const Region& region = regions[index];
-  double tolerance = 0;
-  double conformity = 1e9;
-  std::vector<const PartModel*> fitting;
+namespace touching {
+
+BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
+                       const std::vector<const PartModel*>& models, const EdgeDistance* built_edges)
+    : region_(regions[index]), index_(index) {
   for (const PartModel* m : models) {
     // A part in the blob is no larger than the blob.
-    if (m->loops.empty() || m->body.area * (1 - m->body.area_tolerance) > region.area) continue;
-    fitting.push_back(m);
-    tolerance = std::max(tolerance, m->edge_tolerance);
-    conformity = std::min(conformity, m->conformity);
+    if (m->loops.empty() || m->body.area * (1 - m->body.area_tolerance) > region_.area) continue;
+    fitting_.push_back(m);
+    tolerance_ = std::max(tolerance_, m->edge_tolerance);
+    conformity_ = std::min(conformity_, m->conformity);
   }
-  if (fitting.empty()) return found;
+  if (fitting_.empty()) return;
 
-  std::vector<std::vector<cv::Point>> contours{region.outer};
-  contours.insert(contours.end(), region.hole_boundaries.begin(), region.hole_boundaries.end());
+  std::vector<std::vector<cv::Point>> contours{region_.outer};
+  contours.insert(contours.end(), region_.hole_boundaries.begin(), region_.hole_boundaries.end());
   // Read at no more than the loose screening tolerance (and clipped there).
-  std::optional<EdgeDistance> own_edges;
   if (!built_edges) {
-    const double screen_reach = kLooseScreenFactor * tolerance;
+    const double screen_reach = kLooseScreenFactor * tolerance_;
     const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
-    own_edges.emplace(contours,
-                      cv::Rect(region.bbox.x - margin, region.bbox.y - margin,
-                               region.bbox.width + 2 * margin, region.bbox.height + 2 * margin),
-                      screen_reach);
+    own_edges_.emplace(contours,
+                       cv::Rect(region_.bbox.x - margin, region_.bbox.y - margin,
+                                region_.bbox.width + 2 * margin, region_.bbox.height + 2 * margin),
+                       screen_reach);
   }
-  const EdgeDistance& edges = built_edges ? *built_edges : *own_edges;
+  edges_ = built_edges ? built_edges : &*own_edges_;
   std::vector<std::vector<cv::Point2d>> loops2d;
   for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
   std::vector<CornerAnchor> image_corners;
-  std::vector<ArcAnchor> image_arcs;
-  anchorsOf(fitLoops(loops2d, conformity), &image_corners, &image_arcs);
+  anchorsOf(fitLoops(loops2d, conformity_), &image_corners, &image_arcs_);
+  // The search starts from all of the blob's anchors (narrowToRest turns it
+  // to those near what the parts found leave unexplained).
+  all_corners_.emplace(std::move(image_corners));
+  corners_ = &*all_corners_;
+  arcs_ = &image_arcs_;
 
   // The blob's pixels (over its box, image coordinates), which placed parts
   // are compared with.
-  double smallest = region.area;
-  for (const PartModel* m : fitting) smallest = std::min(smallest, m->body.area);
-  const cv::Rect blob_box(region.coverage_origin, region.coverage.size());
-  cv::Mat blob;
-  cv::compare(region.coverage, 0.5, blob, cv::CMP_GE);
-  const Coverage coverage(region);
-  const int blob_pixels = cv::countNonZero(blob);
-  // The blob's pixels in `box` that `drawn` (over `box`) covers.
-  const auto coveredIn = [&](const cv::Mat& drawn, const cv::Rect& box) {
-    const cv::Rect both = box & blob_box;
-    if (both.empty()) return 0;
-    cv::Mat covered;
-    cv::bitwise_and(drawn(both - box.tl()), blob(both - blob_box.tl()), covered);
-    return cv::countNonZero(covered);
-  };
-  const int parts = std::max(1, static_cast<int>(region.area / std::max(smallest, 1.0)));
-  const auto budget =
-      static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
+  double smallest = region_.area;
+  for (const PartModel* m : fitting_) smallest = std::min(smallest, m->body.area);
+  blob_box_ = cv::Rect(region_.coverage_origin, region_.coverage.size());
+  cv::compare(region_.coverage, 0.5, blob_, cv::CMP_GE);
+  coverage_.emplace(region_);
+  blob_pixels_ = cv::countNonZero(blob_);
+  const int parts = std::max(1, static_cast<int>(region_.area / std::max(smallest, 1.0)));
+  budget_ = static_cast<size_t>(std::min(kMaxRefinedPerBlob, kRefinedPerPart * (parts + 1)));
+  seam_ = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1));
+}
 
-  // Refined poses (a deque: the placed ones point into it), and those that
-  // fit the blob on their own, each drawn on its box of the canvas.
-  std::deque<Candidate> refined;
-  std::vector<Placed> placed;
-  size_t refinements = 0;
-  // Whether a choice made now could differ from the last one.
-  bool changed = false;
+int BlobSearch::coveredIn(const cv::Mat& drawn, const cv::Rect& box) const {
+  const cv::Rect both = box & blob_box_;
+  if (both.empty()) return 0;
+  cv::Mat covered;
+  cv::bitwise_and(drawn(both - box.tl()), blob_(both - blob_box_.tl()), covered);
+  return cv::countNonZero(covered);
+}
 
-  // The best screened poses of one model (its own hand: see
-  // alignedMirror), best first, no two alike.
-  // The blob's anchors the search starts from (all, or those near what the
-  // parts found leave unexplained).
-  const BlobCorners all_corners(std::move(image_corners));
-  const BlobCorners* corners = &all_corners;
-  const std::vector<ArcAnchor>* arcs = &image_arcs;
-  const auto screen = [&](const PartModel* m, bool quick) {
-    std::vector<Candidate> proposed;
-    propose(*m, *searchOf(*m), quick, *corners, *arcs, edges, &proposed);
-    std::stable_sort(proposed.begin(), proposed.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-    std::vector<Candidate> screened;
-    for (const auto& p : proposed) {
-      if (static_cast<int>(screened.size()) >= kMaxRefinedPerModel) break;
-      const auto near = [&](const Candidate& q) { return samePose(*m, p.pose, q.pose, 2.0, 3.0); };
-      if (std::any_of(screened.begin(), screened.end(), near)) continue;
-      screened.push_back(p);
-    }
-    return screened;
-  };
+std::vector<Candidate> BlobSearch::screen(const PartModel& model, bool quick) const {
+  std::vector<Candidate> proposed;
+  propose(model, *searchOf(model), quick, *corners_, *arcs_, *edges_, &proposed);
+  std::stable_sort(proposed.begin(), proposed.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::vector<Candidate> screened;
+  for (const auto& p : proposed) {
+    if (static_cast<int>(screened.size()) >= kMaxRefinedPerModel) break;
+    const auto near = [&](const Candidate& q) { return samePose(model, p.pose, q.pose, 2.0, 3.0); };
+    if (std::any_of(screened.begin(), screened.end(), near)) continue;
+    screened.push_back(p);
+  }
+  return screened;
+}
 
-  // Places a refined candidate that fits the blob on its own.
-  const auto place = [&](const Candidate& c) {
-    const PartModel& m = *c.model;
-    // Below the verify fraction, a part may be partly hidden (kMinVisible).
-    const bool verified = c.score * 100 >= m.verify_percent;
-    if (!verified && c.score < kMinVisible) return;
-    const bool crosses = crossesBackground(m, c.pose, edges, coverage);
-    if (!verified && crosses) return;
-    const auto outline = placedOutline(m, c.pose);
-    cv::Rect box;
-    for (const auto& poly : outline) box |= cv::boundingRect(poly);
-    box += cv::Size(1, 1);
-    Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
-    cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
-    p.area = cv::countNonZero(p.drawn);
-    if (p.area <= 0) return;
-    // The outline drawn whole covers its boundary's pixels (about half a
-    // pixel all round more than the part's area): that seam lies off the
-    // blob without the part lying off it. Counted in, it put a good pose of
-    // a part 90 px long 6.8 % off its blob.
-    const int seam = std::max(0, p.area - static_cast<int>(std::lround(m.body.area)));
-    const int off_blob = p.area - coveredIn(p.drawn, box);
-    if (off_blob - seam > kMaxOutside * p.area) return;
-    // Crossing the background, only a candidate that is its blob whole
-    // stays (kMaxOnBackground).
-    if (crosses && blob_pixels - (p.area - off_blob) > kMaxOutside * p.area) return;
-    placed.push_back(std::move(p));
-    changed = true;
-  };
+bool BlobSearch::place(const Candidate& c) {
+  const PartModel& m = *c.model;
+  // Below the verify fraction, a part may be partly hidden (kMinVisible).
+  const bool verified = c.score * 100 >= m.verify_percent;
+  if (!verified && c.score < kMinVisible) return false;
+  const bool crosses = crossesBackground(m, c.pose, *edges_, *coverage_);
+  if (!verified && crosses) return false;
+  const auto outline = placedOutline(m, c.pose);
+  cv::Rect box;
+  for (const auto& poly : outline) box |= cv::boundingRect(poly);
+  box += cv::Size(1, 1);
+  Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
+  cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
+  p.area = cv::countNonZero(p.drawn);
+  if (p.area <= 0) return false;
+  // The outline drawn whole covers its boundary's pixels (about half a
+  // pixel all round more than the part's area): that seam lies off the
+  // blob without the part lying off it. Counted in, it put a good pose of
+  // a part 90 px long 6.8 % off its blob.
+  const int seam = std::max(0, p.area - static_cast<int>(std::lround(m.body.area)));
+  const int off_blob = p.area - coveredIn(p.drawn, box);
+  if (off_blob - seam > kMaxOutside * p.area) return false;
+  // Crossing the background, only a candidate that is its blob whole
+  // stays (kMaxOnBackground).
+  if (crosses && blob_pixels_ - (p.area - off_blob) > kMaxOutside * p.area) return false;
+  placed_.push_back(std::move(p));
+  changed_ = true;
+  return true;
+}
 
-  // Refines screened poses, best first, and places those that fit.
-  const auto refine = [&](const std::vector<Candidate>& screened) {
-    for (const auto& p : screened) {
-      const PartModel* m = p.model;
-      // A screened pose next to one already refined converges to it: the
-      // edge fit is the costliest step here.
-      const auto refined_near = [&](const Candidate& q) {
-        return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
-      };
-      if (std::any_of(refined.begin(), refined.end(), refined_near)) continue;
-      if (refinements >= budget) return;
-      ++refinements;
-      // Settled on a pose already refined (it would end as the same pose), or
-      // on one too little of whose boundary lies on edges for a part, even a
-      // partly hidden one: not worth the dense passes.
-      const auto worth = [&](const ImagePose& pose) {
-        const auto converged = [&](const Candidate& q) {
-          return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
-        };
-        if (std::any_of(refined.begin(), refined.end(), converged)) return false;
-        return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
-                           false) >= kMinVisible - kUnsettledSlack;
-      };
-      const EdgeFit fit =
-          refinePoseOnEdges(*m, region, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
-      if (!fit.ok) continue;
-      const auto same = [&](const Candidate& q) {
-        return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
-      };
-      if (std::any_of(refined.begin(), refined.end(), same)) continue;
-      const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
-                                       m->edge_tolerance, false);
-      refined.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
-      place(refined.back());
-    }
-  };
-
-  // A part shown mirrored is not reported: the mirror image verifies about
-  // as well and where the hands differ fits better. Only asked of a
-  // candidate about to be taken (placing the mirror image costs an edge
-  // fit, made once per candidate).
-  std::map<const Candidate*, std::optional<Candidate>> aligned_mirrors;
-  const auto mirrored = [&](const Candidate& c) {
-    const PartModel& m = *c.model;
-    const auto as_good = [&](const Candidate& q) {
-      return q.model == c.model &&
-             std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
-                 0.5 * m.radius &&
-             q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, edges);
+void BlobSearch::refine(const std::vector<Candidate>& screened) {
+  const EdgeDistance& edges = *edges_;
+  for (const auto& p : screened) {
+    const PartModel* m = p.model;
+    // A screened pose next to one already refined converges to it: the
+    // edge fit is the costliest step here.
+    const auto refined_near = [&](const Candidate& q) {
+      return q.model == m && samePose(*m, p.pose, q.pose, kRefinedNearPx, kRefinedNearDeg);
     };
-    auto aligned = aligned_mirrors.find(&c);
-    if (aligned == aligned_mirrors.end()) {
-      aligned = aligned_mirrors
-                    .emplace(&c, alignedMirror(m, region, c.pose, edges,
-                                               c.score - kMirrorMargin - kMirrorScreenSlack,
-                                               c.score - kMirrorMargin))
-                    .first;
-    }
-    return aligned->second && as_good(*aligned->second);
-  };
+    if (std::any_of(refined_.begin(), refined_.end(), refined_near)) continue;
+    if (refinements_ >= budget_) return;
+    ++refinements_;
+    // Settled on a pose already refined (it would end as the same pose), or
+    // on one too little of whose boundary lies on edges for a part, even a
+    // partly hidden one: not worth the dense passes.
+    const auto worth = [&](const ImagePose& pose) {
+      const auto converged = [&](const Candidate& q) {
+        return q.model == m && samePose(*m, pose, q.pose, kConvergedPx, kConvergedDeg);
+      };
+      if (std::any_of(refined_.begin(), refined_.end(), converged)) return false;
+      return verifyScore(m->samples, pose.centre, pose.angle_deg, edges, m->edge_tolerance,
+                         false) >= kMinVisible - kUnsettledSlack;
+    };
+    const EdgeFit fit =
+        refinePoseOnEdges(*m, region_, p.pose, kEdgeSearchPx, kEdgeIterations, worth);
+    if (!fit.ok) continue;
+    const auto same = [&](const Candidate& q) {
+      return q.model == m && samePose(*m, fit.pose, q.pose, 1.0, 1.0);
+    };
+    if (std::any_of(refined_.begin(), refined_.end(), same)) continue;
+    const double score = verifyScore(m->samples, fit.pose.centre, fit.pose.angle_deg, edges,
+                                     m->edge_tolerance, false);
+    refined_.push_back({m, fit.pose, score, fit.rms_px, fit.precise_length});
+    place(refined_.back());
+  }
+}
 
-  // The parts among those placed: best first; among equal scores the
-  // closer fit to the grey-level edges.
-  std::vector<size_t> taken;
-  const auto choose = [&] {
-    changed = false;
-    std::stable_sort(placed.begin(), placed.end(), [](const Placed& a, const Placed& b) {
-      const Candidate& u = *a.candidate;
-      const Candidate& v = *b.candidate;
-      return u.score > v.score + 1e-9 || (std::abs(u.score - v.score) <= 1e-9 && u.rms < v.rms);
-    });
-    taken = chooseParts(placed, mirrored);
+// A part shown mirrored is not reported: the mirror image verifies about
+// as well and where the hands differ fits better. Only asked of a
+// candidate about to be taken (placing the mirror image costs an edge
+// fit, made once per candidate).
+bool BlobSearch::showsMirror(const Candidate& c) {
+  const PartModel& m = *c.model;
+  const auto as_good = [&](const Candidate& q) {
+    return q.model == c.model &&
+           std::hypot(q.pose.centre.x - c.pose.centre.x, q.pose.centre.y - c.pose.centre.y) <
+               0.5 * m.radius &&
+           q.score >= c.score - kMirrorMargin && showsMirrorImage(m, c.pose, q.pose, *edges_);
   };
-  // What erodes a seam away.
-  const cv::Mat seam =
-      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1));
-  // The blob's pixels the parts taken leave unexplained.
-  const auto unexplained = [&] {
-    cv::Mat rest = blob.clone();
-    for (const size_t i : taken) {
-      const Placed& p = placed[i];
-      const cv::Rect both = p.box & blob_box;
-      if (!both.empty()) rest(both - blob_box.tl()).setTo(0, p.drawn(both - p.box.tl()));
-    }
-    return rest;
-  };
-  // Whether the parts taken are the whole blob: each fits its edges closely,
-  // and together they cover every pixel of it but a thin seam.
-  const auto explainsWhole = [&] {
-    if (taken.empty()) return false;
-    for (const size_t i : taken) {
-      if (placed[i].candidate->rms > kWholeFitRmsPx) return false;
-    }
-    cv::Mat rest = unexplained();
-    // A seam runs along the blob's outline or a part's: more pixels than
-    // fit in seams that long, and some piece is wider.
-    double seam_length = static_cast<double>(region.outer.size());
-    for (const auto& h : region.hole_boundaries) seam_length += static_cast<double>(h.size());
-    for (const size_t i : taken) {
-      seam_length += static_cast<double>(searchOf(*placed[i].candidate->model)->edges.size());
-    }
-    const int left = cv::countNonZero(rest);
-    if (left == 0) return true;
-    if (left > (2 * kSeamPx + 1) * (seam_length + 2 * kSeamPx + 1)) return false;
-    cv::erode(rest, rest, seam);
-    return cv::countNonZero(rest) == 0;
-  };
+  auto aligned = aligned_mirrors_.find(&c);
+  if (aligned == aligned_mirrors_.end()) {
+    aligned = aligned_mirrors_
+                  .emplace(&c, alignedMirror(m, region_, c.pose, *edges_,
+                                             c.score - kMirrorMargin - kMirrorScreenSlack,
+                                             c.score - kMirrorMargin))
+                  .first;
+  }
+  return aligned->second && as_good(*aligned->second);
+}
 
+// The parts among those placed: best first; among equal scores the closer
+// fit to the grey-level edges.
+void BlobSearch::choose() {
+  changed_ = false;
+  std::stable_sort(placed_.begin(), placed_.end(), [](const Placed& a, const Placed& b) {
+    const Candidate& u = *a.candidate;
+    const Candidate& v = *b.candidate;
+    return u.score > v.score + 1e-9 || (std::abs(u.score - v.score) <= 1e-9 && u.rms < v.rms);
+  });
+  taken_ = chooseParts(placed_, [this](const Candidate& c) { return showsMirror(c); });
+}
+
+cv::Mat BlobSearch::unexplained() const {
+  cv::Mat rest = blob_.clone();
+  for (const size_t i : taken_) {
+    const Placed& p = placed_[i];
+    const cv::Rect both = p.box & blob_box_;
+    if (!both.empty()) rest(both - blob_box_.tl()).setTo(0, p.drawn(both - p.box.tl()));
+  }
+  return rest;
+}
+
+bool BlobSearch::explainsWhole() const {
+  if (taken_.empty()) return false;
+  for (const size_t i : taken_) {
+    if (placed_[i].candidate->rms > kWholeFitRmsPx) return false;
+  }
+  cv::Mat rest = unexplained();
+  // A seam runs along the blob's outline or a part's: more pixels than
+  // fit in seams that long, and some piece is wider.
+  double seam_length = static_cast<double>(region_.outer.size());
+  for (const auto& h : region_.hole_boundaries) seam_length += static_cast<double>(h.size());
+  for (const size_t i : taken_) {
+    seam_length += static_cast<double>(searchOf(*placed_[i].candidate->model)->edges.size());
+  }
+  const int left = cv::countNonZero(rest);
+  if (left == 0) return true;
+  if (left > (2 * kSeamPx + 1) * (seam_length + 2 * kSeamPx + 1)) return false;
+  cv::erode(rest, rest, seam_);
+  return cv::countNonZero(rest) == 0;
+}
+
+double BlobSearch::narrowToRest() {
+  cv::Mat rest = unexplained();
+  const double rest_area = std::max(1, cv::countNonZero(rest));
+  // The parts to find lie in the rest, and their corners and arcs on its
+  // rim (or where it meets the parts found): the full search starts from
+  // those, not from the outlines of the parts found.
+  cv::erode(rest, rest, seam_);
+  if (cv::countNonZero(rest) == 0) return rest_area;
+  // Whether any pixel of the rest lies in the square of `reach` about p
+  // (the dilation of the rest by it, read at p): a sum over the integral
+  // image.
+  cv::Mat sums;
+  cv::integral(rest, sums, CV_32S);
+  const int reach = kSeamPx + kRestAnchorPx;
+  const auto inRest = [&](cv::Point2d p) {
+    const int x = static_cast<int>(std::lround(p.x)) - blob_box_.x;
+    const int y = static_cast<int>(std::lround(p.y)) - blob_box_.y;
+    const int x0 = std::clamp(x - reach, 0, rest.cols);
+    const int x1 = std::clamp(x + reach + 1, 0, rest.cols);
+    const int y0 = std::clamp(y - reach, 0, rest.rows);
+    const int y1 = std::clamp(y + reach + 1, 0, rest.rows);
+    if (x0 >= x1 || y0 >= y1) return false;
+    return sums.at<int>(y1, x1) - sums.at<int>(y0, x1) - sums.at<int>(y1, x0) +
+               sums.at<int>(y0, x0) >
+           0;
+  };
+  std::vector<CornerAnchor> near_rest;
+  for (const auto& c : all_corners_->corners) {
+    if (inRest(c.at)) near_rest.push_back(c);
+  }
+  rest_corners_.emplace(std::move(near_rest));
+  rest_arcs_.clear();
+  for (const auto& a : image_arcs_) {
+    const double mid = a.mid_deg * kRadPerDeg;
+    if (inRest(a.centre + a.radius * cv::Point2d(std::cos(mid), std::sin(mid))))
+      rest_arcs_.push_back(a);
+  }
+  corners_ = &*rest_corners_;
+  arcs_ = &rest_arcs_;
+  return rest_area;
+}
+
+void BlobSearch::fullSearch(std::vector<std::pair<double, size_t>> order) {
+  // With parts found, the rest of the blob is most likely one part more:
+  // the models closest to its area first. Otherwise those the quick search
+  // saw most of.
+  if (!taken_.empty()) {
+    const double rest_area = narrowToRest();
+    for (auto& entry : order) {
+      entry.first = -std::abs(fitting_[entry.second]->body.area - rest_area) / rest_area;
+    }
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& entry : order) {
+    refine(screen(*fitting_[entry.second], false));
+    if (!changed_) continue;
+    choose();
+    if (explainsWhole()) break;
+  }
+}
+
+std::vector<Match> BlobSearch::run() {
+  if (fitting_.empty()) return {};
   // First a quick search of every model, from its most telling corners and
   // arc: the parts that show whole are mostly found there. Then, while the
   // parts found do not explain the blob whole, the full search of each model,
   // those the quick search found something of first.
   std::vector<std::pair<double, size_t>> order;
-  for (size_t k = 0; k < fitting.size(); ++k) {
-    const auto screened = screen(fitting[k], true);
+  for (size_t k = 0; k < fitting_.size(); ++k) {
+    const auto screened = screen(*fitting_[k], true);
     order.emplace_back(screened.empty() ? -1.0 : screened.front().score, k);
     refine(screened);
   }
   choose();
-  if (!explainsWhole()) {
-    // With parts found, the rest of the blob is most likely one part more:
-    // the models closest to its area first. Otherwise those the quick
-    // search saw most of.
-    std::optional<BlobCorners> rest_corners;
-    std::vector<ArcAnchor> rest_arcs;
-    if (!taken.empty()) {
-      cv::Mat rest = unexplained();
-      const double rest_area = std::max(1, cv::countNonZero(rest));
-      // The parts to find lie in the rest, and their corners and arcs on its
-      // rim (or where it meets the parts found): the full search starts from
-      // those, not from the outlines of the parts found.
-      cv::erode(rest, rest, seam);
-      if (cv::countNonZero(rest) > 0) {
-        // Whether any pixel of the rest lies in the square of `reach`
-        // about p (the dilation of the rest by it, read at p): a sum over the
-        // integral image.
-        cv::Mat sums;
-        cv::integral(rest, sums, CV_32S);
-        const int reach = kSeamPx + kRestAnchorPx;
-        const auto inRest = [&](cv::Point2d p) {
-          const int x = static_cast<int>(std::lround(p.x)) - blob_box.x;
-          const int y = static_cast<int>(std::lround(p.y)) - blob_box.y;
-          const int x0 = std::clamp(x - reach, 0, rest.cols);
-          const int x1 = std::clamp(x + reach + 1, 0, rest.cols);
-          const int y0 = std::clamp(y - reach, 0, rest.rows);
-          const int y1 = std::clamp(y + reach + 1, 0, rest.rows);
-          if (x0 >= x1 || y0 >= y1) return false;
-          return sums.at<int>(y1, x1) - sums.at<int>(y0, x1) - sums.at<int>(y1, x0) +
-                     sums.at<int>(y0, x0) >
-                 0;
-        };
-        std::vector<CornerAnchor> near_rest;
-        for (const auto& c : all_corners.corners) {
-          if (inRest(c.at)) near_rest.push_back(c);
-        }
-        rest_corners.emplace(std::move(near_rest));
-        for (const auto& a : image_arcs) {
-          const double mid = a.mid_deg * kRadPerDeg;
-          if (inRest(a.centre + a.radius * cv::Point2d(std::cos(mid), std::sin(mid))))
-            rest_arcs.push_back(a);
-        }
-        corners = &*rest_corners;
-        arcs = &rest_arcs;
-      }
-      for (auto& entry : order) {
-        entry.first = -std::abs(fitting[entry.second]->body.area - rest_area) / rest_area;
-      }
-    }
-    std::stable_sort(order.begin(), order.end(),
-                     [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (const auto& entry : order) {
-      refine(screen(fitting[entry.second], false));
-      if (!changed) continue;
-      choose();
-      if (explainsWhole()) break;
-    }
-  }
-  if (changed) choose();
-  for (const size_t i : taken) {
-    const Candidate& c = *placed[i].candidate;
+  if (!explainsWhole()) fullSearch(std::move(order));
+  if (changed_) choose();
+  return matches();
+}
+
+std::vector<Match> BlobSearch::matches() const {
+  std::vector<Match> found;
+  for (const size_t i : taken_) {
+    const Candidate& c = *placed_[i].candidate;
     Match match;
     match.model = c.model;
-    match.region = index;
+    match.region = index_;
     match.score = c.score;
     match.centroid = c.pose.centre;
     match.symmetry_deg = c.model->symmetryDeg();
@@ -587,6 +571,15 @@ std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index
     found.push_back(match);
   }
   return found;
+}
+
+}  // namespace touching
+
+std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
+                                const std::vector<const PartModel*>& models,
+                                const EdgeDistance* built_edges) {
+  touching::BlobSearch search(regions, index, models, built_edges);
+  return search.run();
 }
 
 }  // namespace picksight::vision

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "picksight/common/angles.hpp"
 #include "touching_parts_internal.hpp"
@@ -182,29 +183,57 @@ BlobCorners::BlobCorners(std::vector<CornerAnchor> all)
             [&](size_t a, size_t b) { return corners[a].opening_deg < corners[b].opening_deg; });
 }
 
-// Screens the poses proposed for one model (its own hand) in a blob.
-void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
-             const BlobCorners& blob_corners, const std::vector<ArcAnchor>& image_arcs,
-             const EdgeDistance& edges, std::vector<Candidate>* out) {
-  const std::vector<CornerAnchor>& image_corners = blob_corners.corners;
-  const std::vector<size_t>& by_opening = blob_corners.by_opening;
-  const auto& sparse = search.sparse;
-  const auto& glance = search.glance;
-  const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
-  // The pose putting model point `model_point` on `image_point` turned by
-  // `angle`, scored on `samples`.
-  const auto screen = [&](cv::Point2d model_point, cv::Point2d image_point, double angle,
-                          const std::vector<BoundarySample>& samples) {
-    const double c = std::cos(angle * kRadPerDeg);
-    const double s = std::sin(angle * kRadPerDeg);
-    const cv::Point2d centre = image_point - rotate(model_point, c, s);
-    const double score = verifyScore(samples, centre, angle, edges, model.edge_tolerance, false);
-    return Candidate{&model, ImagePose{centre, normalizeDeg(angle), false}, score, 0};
-  };
-  // A corner's direction is a few degrees off (its edges are short): the
-  // first look forgives that with a wider tolerance, and the turn about the
-  // corner is then searched coarse to fine on the screening samples.
-  const double loose = kLooseScreenFactor * model.edge_tolerance;
+namespace {
+// The poses proposed for one model in one blob (see propose), step by step:
+// every model corner put on the blob's corners it may be (fromCorners), then
+// every model arc on the blob's arcs of its radius (fromArcs). A pose that
+// screens as well as a part verifies settles the anchors it explains.
+class Proposer {
+ public:
+  Proposer(const PartModel& model, const BlobSearchModel& search, bool quick,
+           const BlobCorners& blob_corners, const std::vector<ArcAnchor>& image_arcs,
+           const EdgeDistance& edges, std::vector<Candidate>* out)
+      : model_(model),
+        search_(search),
+        quick_(quick),
+        image_corners_(blob_corners.corners),
+        by_opening_(blob_corners.by_opening),
+        image_arcs_(image_arcs),
+        edges_(edges),
+        out_(out),
+        threshold_(model.verify_percent / 100.0 - kCoarseSlack),
+        // A corner's direction is a few degrees off (its edges are short):
+        // the first look forgives that with a wider tolerance, and the turn
+        // about the corner is then searched coarse to fine on the
+        // screening samples.
+        loose_(kLooseScreenFactor * model.edge_tolerance) {}
+
+  // Each model corner on the image corners of about its opening angle.
+  void fromCorners() {
+    for (size_t mi = 0; mi < search_.corners.size(); ++mi) {
+      if (!visits(mi, search_.quick_corners)) continue;
+      const CornerAnchor& mc = search_.corners[mi];
+      for (const size_t i : cornersLike(mc)) fromCorner(mi, image_corners_[i]);
+    }
+  }
+
+  // An arc fixes where its centre goes; the turn about it lines up the two
+  // arcs (kArcSlideDeg), scanned coarsely at a glance, and around each
+  // promising step finely. The model's arc must turn the way the blob's arc
+  // goes.
+  void fromArcs() {
+    for (size_t mi = 0; mi < search_.arcs.size(); ++mi) {
+      if (!visits(mi, search_.quick_arcs)) continue;
+      const ArcAnchor& ma = search_.arcs[mi];
+      for (const auto& ia : image_arcs_) {
+        if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
+        if ((ia.sweep_deg > 0) != (ma.sweep_deg > 0)) continue;
+        fromArc(mi, ia);
+      }
+    }
+  }
+
+ private:
   // Poses screened as well as a part verifies: a corner or an arc of the
   // blob that one of them already puts its model's corner or arc on has
   // nothing new to propose (every corner of a part that shows leads to the
@@ -214,142 +243,185 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
     double c;
     double s;
   };
-  std::vector<Settled> settled;
-  const auto settle = [&](const Candidate& c) {
-    if (c.score * 100 < model.verify_percent) return;
-    settled.push_back(
+
+  // The pose putting model point `model_point` on `image_point` turned by
+  // `angle`, scored on `samples`.
+  Candidate screen(cv::Point2d model_point, cv::Point2d image_point, double angle,
+                   const std::vector<BoundarySample>& samples) const {
+    const double c = std::cos(angle * kRadPerDeg);
+    const double s = std::sin(angle * kRadPerDeg);
+    const cv::Point2d centre = image_point - rotate(model_point, c, s);
+    const double score = verifyScore(samples, centre, angle, edges_, model_.edge_tolerance, false);
+    return Candidate{&model_, ImagePose{centre, normalizeDeg(angle), false}, score, 0};
+  }
+
+  void settle(const Candidate& c) {
+    if (c.score * 100 < model_.verify_percent) return;
+    settled_.push_back(
         {c.pose, std::cos(c.pose.angle_deg * kRadPerDeg), std::sin(c.pose.angle_deg * kRadPerDeg)});
-  };
-  const auto explained = [&](cv::Point2d model_point, cv::Point2d image_point, double angle) {
-    return std::any_of(settled.begin(), settled.end(), [&](const Settled& q) {
+  }
+
+  bool explained(cv::Point2d model_point, cv::Point2d image_point, double angle) const {
+    return std::any_of(settled_.begin(), settled_.end(), [&](const Settled& q) {
       if (std::abs(signedDeg(q.pose.angle_deg - angle)) > kExplainedDeg) return false;
       const cv::Point2d at = q.pose.centre + rotate(model_point, q.c, q.s);
       return std::hypot(at.x - image_point.x, at.y - image_point.y) <= kExplainedPx;
     });
-  };
-  // Each model corner visits only the image corners it may be (a few in
-  // ten), in the blob's order.
-  std::vector<size_t> visit;
-  const auto visits = [&](size_t mi, const std::vector<size_t>& quick_ones) {
-    return !quick || std::find(quick_ones.begin(), quick_ones.end(), mi) != quick_ones.end();
-  };
-  for (size_t mi = 0; mi < search.corners.size(); ++mi) {
-    if (!visits(mi, search.quick_corners)) continue;
-    const CornerAnchor& mc = search.corners[mi];
+  }
+
+  // Whether anchor `mi` is searched (a quick search: only its quick ones).
+  bool visits(size_t mi, const std::vector<size_t>& quick_ones) const {
+    return !quick_ || std::find(quick_ones.begin(), quick_ones.end(), mi) != quick_ones.end();
+  }
+
+  // The image corners model corner `mc` may be (a few in ten: about its
+  // opening angle, as convex), in the blob's order.
+  const std::vector<size_t>& cornersLike(const CornerAnchor& mc) {
     const auto first = std::lower_bound(
-        by_opening.begin(), by_opening.end(), mc.opening_deg - kCornerAngleSlackDeg,
-        [&](size_t i, double v) { return image_corners[i].opening_deg < v; });
-    visit.clear();
-    for (auto it = first; it != by_opening.end() &&
-                          image_corners[*it].opening_deg <= mc.opening_deg + kCornerAngleSlackDeg;
+        by_opening_.begin(), by_opening_.end(), mc.opening_deg - kCornerAngleSlackDeg,
+        [&](size_t i, double v) { return image_corners_[i].opening_deg < v; });
+    visit_.clear();
+    for (auto it = first; it != by_opening_.end() &&
+                          image_corners_[*it].opening_deg <= mc.opening_deg + kCornerAngleSlackDeg;
          ++it) {
-      if (image_corners[*it].convex == mc.convex) visit.push_back(*it);
+      if (image_corners_[*it].convex == mc.convex) visit_.push_back(*it);
     }
-    std::sort(visit.begin(), visit.end());
-    for (const size_t i : visit) {
-      const CornerAnchor& ic = image_corners[i];
-      const double angle = ic.bisector_deg - mc.bisector_deg;
-      if (explained(mc.at, ic.at, angle)) continue;
-      // cos and sin of the difference of the two bisectors' directions.
-      const double cosine = ic.bisector.x * mc.bisector.x + ic.bisector.y * mc.bisector.y;
-      const double sine = ic.bisector.y * mc.bisector.x - ic.bisector.x * mc.bisector.y;
-      const auto glances = [&](double c, double s, double needed) {
-        return verifiesAtLeast(search.corner_glance[mi], search.glance_weight,
-                               ic.at - rotate(mc.at, c, s), c, s, 1.0, edges, loose, needed);
-      };
-      const double needed = threshold - kGlanceSlack;
-      double start = angle;
-      if (!glances(cosine, sine, needed)) {
-        // Just short of it, the bisector may be a few degrees off (a
-        // corner between short or curved edges): see kGlanceNearMiss.
-        if (!quick || !glances(cosine, sine, needed - kGlanceNearMiss)) continue;
-        bool turned = false;
-        for (const double k : {-1.0, 1.0}) {
-          const double a = (angle + k * kGlanceTurnDeg) * kRadPerDeg;
-          if (glances(std::cos(a), std::sin(a), threshold)) {
-            start = angle + k * kGlanceTurnDeg;
-            turned = true;
-            break;
-          }
-        }
-        if (!turned) continue;
+    std::sort(visit_.begin(), visit_.end());
+    return visit_;
+  }
+
+  // Model corner `mi` on image corner `ic`: a first look at the bisectors'
+  // turn, then the turn searched coarse to fine.
+  void fromCorner(size_t mi, const CornerAnchor& ic) {
+    const CornerAnchor& mc = search_.corners[mi];
+    const double angle = ic.bisector_deg - mc.bisector_deg;
+    if (explained(mc.at, ic.at, angle)) return;
+    const auto start = firstLook(mi, ic, angle);
+    if (!start) return;
+    Candidate c = screen(mc.at, ic.at, *start, search_.sparse);
+    for (double step = kCornerTurnStepDeg; step >= kCornerTurnFinestDeg; step /= 2) {
+      if (step < kCornerTurnStepDeg && c.score < threshold_ - kCornerTurnGiveUp) break;
+      const double at = c.pose.angle_deg;
+      for (int k = -2; k <= 2; ++k) {
+        if (k == 0 || (step < kCornerTurnStepDeg && std::abs(k) > 1)) continue;
+        const Candidate n = screen(mc.at, ic.at, at + k * step, search_.sparse);
+        if (n.score > c.score) c = n;
       }
-      Candidate c = screen(mc.at, ic.at, start, sparse);
-      for (double step = kCornerTurnStepDeg; step >= kCornerTurnFinestDeg; step /= 2) {
-        if (step < kCornerTurnStepDeg && c.score < threshold - kCornerTurnGiveUp) break;
-        const double at = c.pose.angle_deg;
-        for (int k = -2; k <= 2; ++k) {
-          if (k == 0 || (step < kCornerTurnStepDeg && std::abs(k) > 1)) continue;
-          const Candidate n = screen(mc.at, ic.at, at + k * step, sparse);
-          if (n.score > c.score) c = n;
-        }
+    }
+    if (c.score >= threshold_) out_->push_back(c);
+    settle(c);
+  }
+
+  // The turn the search about corner `mi` on `ic` starts from: `angle`
+  // where the first look at the corner's glance samples passes, or (a
+  // quick search, just short of it) a few degrees either side of it; none
+  // where neither passes.
+  std::optional<double> firstLook(size_t mi, const CornerAnchor& ic, double angle) const {
+    const CornerAnchor& mc = search_.corners[mi];
+    // cos and sin of the difference of the two bisectors' directions.
+    const double cosine = ic.bisector.x * mc.bisector.x + ic.bisector.y * mc.bisector.y;
+    const double sine = ic.bisector.y * mc.bisector.x - ic.bisector.x * mc.bisector.y;
+    const auto glances = [&](double c, double s, double needed) {
+      return verifiesAtLeast(search_.corner_glance[mi], search_.glance_weight,
+                             ic.at - rotate(mc.at, c, s), c, s, 1.0, edges_, loose_, needed);
+    };
+    const double needed = threshold_ - kGlanceSlack;
+    if (glances(cosine, sine, needed)) return angle;
+    // Just short of it, the bisector may be a few degrees off (a corner
+    // between short or curved edges): see kGlanceNearMiss.
+    if (!quick_ || !glances(cosine, sine, needed - kGlanceNearMiss)) return std::nullopt;
+    for (const double k : {-1.0, 1.0}) {
+      const double a = (angle + k * kGlanceTurnDeg) * kRadPerDeg;
+      if (glances(std::cos(a), std::sin(a), threshold_)) return angle + k * kGlanceTurnDeg;
+    }
+    return std::nullopt;
+  }
+
+  // Model arc `mi` on image arc `ia`: the coarse scan of the turn, then the
+  // fine one about each of its peaks.
+  void fromArc(size_t mi, const ArcAnchor& ia) {
+    const ArcAnchor& ma = search_.arcs[mi];
+    const double middle = ia.mid_deg - ma.mid_deg;
+    if (explained(ma.centre, ia.centre, middle)) return;
+    // A whole circle's ends are wherever its loop started: any turn.
+    const bool circle = std::max(std::abs(ma.sweep_deg), std::abs(ia.sweep_deg)) >= kCircleDeg;
+    const double half =
+        circle ? 180.0
+               : std::min(180.0, 0.5 * std::abs(std::abs(ma.sweep_deg) - std::abs(ia.sweep_deg)) +
+                                     kArcSlideDeg);
+    const double coarse = kCoarseScanStepPx / std::max(model_.radius, 1.0) / kRadPerDeg;
+    const int steps = static_cast<int>(std::ceil(2 * half / coarse)) + 1;
+    const double step = 2 * half / (steps - 1);
+    scanArc(mi, ia, middle - half, step, steps);
+    const double fine = kScanStepPx / std::max(model_.radius, 1.0) / kRadPerDeg;
+    for (int k = 0; k < steps; ++k) {
+      const double s = scan_[k];
+      if (s < threshold_ - kGlanceSlack || (k > 0 && s < scan_[k - 1]) ||
+          (k + 1 < steps && s <= scan_[k + 1])) {
+        continue;
       }
-      if (c.score >= threshold) out->push_back(c);
-      settle(c);
+      Candidate best;
+      best.score = -1;
+      const double at = middle - half + k * step;
+      for (double a = at - step; a <= at + step; a += fine) {
+        const Candidate c = screen(ma.centre, ia.centre, a, search_.sparse);
+        if (c.score > best.score) best = c;
+      }
+      if (best.score >= threshold_) out_->push_back(best);
+      settle(best);
     }
   }
-  // An arc fixes where its centre goes; the turn about it lines up the two
-  // arcs (kArcSlideDeg), scanned coarsely at a glance, and around each
-  // promising step finely. The model's arc must turn the way the blob's
-  // arc goes.
-  const double fine = kScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
-  const double coarse = kCoarseScanStepPx / std::max(model.radius, 1.0) / kRadPerDeg;
-  std::vector<double> scan;
-  for (size_t mi = 0; mi < search.arcs.size(); ++mi) {
-    if (!visits(mi, search.quick_arcs)) continue;
-    const ArcAnchor& ma = search.arcs[mi];
-    for (const auto& ia : image_arcs) {
-      if (std::abs(ia.radius - ma.radius) > std::max(2.0, 0.12 * ma.radius)) continue;
-      if ((ia.sweep_deg > 0) != (ma.sweep_deg > 0)) continue;
-      const double middle = ia.mid_deg - ma.mid_deg;
-      if (explained(ma.centre, ia.centre, middle)) continue;
-      // A whole circle's ends are wherever its loop started: any turn.
-      const bool circle = std::max(std::abs(ma.sweep_deg), std::abs(ia.sweep_deg)) >= kCircleDeg;
-      const double half =
-          circle ? 180.0
-                 : std::min(180.0, 0.5 * std::abs(std::abs(ma.sweep_deg) - std::abs(ia.sweep_deg)) +
-                                       kArcSlideDeg);
-      const int steps = static_cast<int>(std::ceil(2 * half / coarse)) + 1;
-      const double step = 2 * half / (steps - 1);
-      scan.resize(static_cast<size_t>(steps));
-      // A step whose glance cannot reach the threshold is neither kept nor
-      // a better neighbour of one that is: -1 stands for its score. The
-      // turn advances by a fixed rotation (no sine and cosine per step).
-      const double start = (middle - half) * kRadPerDeg;
-      const double step_cos = std::cos(step * kRadPerDeg);
-      const double step_sin = std::sin(step * kRadPerDeg);
-      double turn_c = std::cos(start);
-      double turn_s = std::sin(start);
-      for (int k = 0; k < steps; ++k) {
-        const double angle = middle - half + k * step;
-        const cv::Point2d centre = ia.centre - rotate(ma.centre, turn_c, turn_s);
-        scan[k] =
-            verifiesAtLeast(search.arc_glance[mi], search.glance_weight, centre, turn_c, turn_s,
-                            1.0, edges, model.edge_tolerance, threshold - kGlanceSlack)
-                ? screen(ma.centre, ia.centre, angle, glance).score
-                : -1.0;
-        const double next_c = turn_c * step_cos - turn_s * step_sin;
-        turn_s = turn_s * step_cos + turn_c * step_sin;
-        turn_c = next_c;
-      }
-      for (int k = 0; k < steps; ++k) {
-        const double s = scan[k];
-        if (s < threshold - kGlanceSlack || (k > 0 && s < scan[k - 1]) ||
-            (k + 1 < steps && s <= scan[k + 1])) {
-          continue;
-        }
-        Candidate best;
-        best.score = -1;
-        const double at = middle - half + k * step;
-        for (double a = at - step; a <= at + step; a += fine) {
-          const Candidate c = screen(ma.centre, ia.centre, a, sparse);
-          if (c.score > best.score) best = c;
-        }
-        if (best.score >= threshold) out->push_back(best);
-        settle(best);
-      }
+
+  // The glance score of model arc `mi` on `ia` at `steps` turns `step`
+  // apart from `from` (degrees), into scan_. A step whose glance cannot
+  // reach the threshold is neither kept nor a better neighbour of one that
+  // is: -1 stands for its score. The turn advances by a fixed rotation (no
+  // sine and cosine per step).
+  void scanArc(size_t mi, const ArcAnchor& ia, double from, double step, int steps) {
+    const ArcAnchor& ma = search_.arcs[mi];
+    scan_.resize(static_cast<size_t>(steps));
+    const double start = from * kRadPerDeg;
+    const double step_cos = std::cos(step * kRadPerDeg);
+    const double step_sin = std::sin(step * kRadPerDeg);
+    double turn_c = std::cos(start);
+    double turn_s = std::sin(start);
+    for (int k = 0; k < steps; ++k) {
+      const double angle = from + k * step;
+      const cv::Point2d centre = ia.centre - rotate(ma.centre, turn_c, turn_s);
+      scan_[k] =
+          verifiesAtLeast(search_.arc_glance[mi], search_.glance_weight, centre, turn_c, turn_s,
+                          1.0, edges_, model_.edge_tolerance, threshold_ - kGlanceSlack)
+              ? screen(ma.centre, ia.centre, angle, search_.glance).score
+              : -1.0;
+      const double next_c = turn_c * step_cos - turn_s * step_sin;
+      turn_s = turn_s * step_cos + turn_c * step_sin;
+      turn_c = next_c;
     }
   }
+
+  const PartModel& model_;
+  const BlobSearchModel& search_;
+  bool quick_;
+  const std::vector<CornerAnchor>& image_corners_;
+  const std::vector<size_t>& by_opening_;
+  const std::vector<ArcAnchor>& image_arcs_;
+  const EdgeDistance& edges_;
+  std::vector<Candidate>* out_;
+  double threshold_;
+  double loose_;
+  std::vector<Settled> settled_;
+  std::vector<size_t> visit_;  // cornersLike's, kept for its capacity
+  std::vector<double> scan_;   // scanArc's, likewise
+};
+}  // namespace
+
+// Screens the poses proposed for one model (its own hand) in a blob.
+void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
+             const BlobCorners& blob_corners, const std::vector<ArcAnchor>& image_arcs,
+             const EdgeDistance& edges, std::vector<Candidate>* out) {
+  Proposer proposer(model, search, quick, blob_corners, image_arcs, edges, out);
+  proposer.fromCorners();
+  proposer.fromArcs();
 }
 }  // namespace touching
 

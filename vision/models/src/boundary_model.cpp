@@ -170,6 +170,62 @@ Primitive makeLine(cv::Point2d a, cv::Point2d b) {
   p.end = b;
   return p;
 }
+// The larger side of the points' bounding box.
+double extentOf(const std::vector<cv::Point2d>& pts) {
+  double x0 = pts[0].x, x1 = x0, y0 = pts[0].y, y1 = y0;
+  for (const auto& p : pts) {
+    x0 = std::min(x0, p.x);
+    x1 = std::max(x1, p.x);
+    y0 = std::min(y0, p.y);
+    y1 = std::max(y1, p.y);
+  }
+  return std::max(x1 - x0, y1 - y0);
+}
+
+// The Douglas-Peucker polygon of a closed contour (`n` >= 4 points),
+// started at its sharpest turn so that no arc runs through the start: its
+// m vertices as unwrapped contour indices, increasing, and the first again
+// plus n at the end (m + 1 in all).
+std::vector<size_t> polygonFromSharpest(const std::vector<cv::Point2d>& pts, double conformity) {
+  const size_t n = pts.size();
+  // Polygon: split at the point farthest from the first, then recursively.
+  size_t far = 0;
+  double far_d = -1;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = std::hypot(pts[i].x - pts[0].x, pts[i].y - pts[0].y);
+    if (d > far_d) {
+      far_d = d;
+      far = i;
+    }
+  }
+  std::vector<size_t> v{0};
+  douglasPeucker(pts, 0, far, conformity, v);
+  v.push_back(far);
+  douglasPeucker(pts, far, n, conformity, v);
+  const size_t m = v.size();
+
+  // Arcs must not run through the start: begin at the sharpest turn.
+  size_t start = 0;
+  double sharpest = -1;
+  for (size_t j = 0; j < m; ++j) {
+    const cv::Point2d in = pts[v[j]] - pts[v[(j + m - 1) % m]];
+    const cv::Point2d out_dir = pts[v[(j + 1) % m]] - pts[v[j]];
+    const double turn = std::abs(signedDeg(angleOf(out_dir) - angleOf(in)));
+    if (turn > sharpest) {
+      sharpest = turn;
+      start = j;
+    }
+  }
+  // Vertex j of the rotated list as an unwrapped contour index.
+  std::vector<size_t> idx(m + 1);
+  for (size_t j = 0; j <= m; ++j) {
+    size_t k = v[(start + j) % m];
+    if (j > 0 && k <= idx[j - 1]) k += n * ((idx[j - 1] - k) / n + 1);
+    idx[j] = k;
+  }
+  idx[m] = idx[0] + n;
+  return idx;
+}
 }  // namespace
 
 double Primitive::length() const {
@@ -217,53 +273,9 @@ std::vector<Primitive> fitPrimitives(const std::vector<cv::Point2d>& pts, double
     for (size_t i = 0; i < n; ++i) out.push_back(makeLine(pts[i], pts[(i + 1) % n]));
     return out;
   }
-  double extent = 0;
-  {
-    double x0 = pts[0].x, x1 = x0, y0 = pts[0].y, y1 = y0;
-    for (const auto& p : pts) {
-      x0 = std::min(x0, p.x);
-      x1 = std::max(x1, p.x);
-      y0 = std::min(y0, p.y);
-      y1 = std::max(y1, p.y);
-    }
-    extent = std::max(x1 - x0, y1 - y0);
-  }
-  // Polygon: split at the point farthest from the first, then recursively.
-  size_t far = 0;
-  double far_d = -1;
-  for (size_t i = 0; i < n; ++i) {
-    const double d = std::hypot(pts[i].x - pts[0].x, pts[i].y - pts[0].y);
-    if (d > far_d) {
-      far_d = d;
-      far = i;
-    }
-  }
-  std::vector<size_t> v{0};
-  douglasPeucker(pts, 0, far, conformity, v);
-  v.push_back(far);
-  douglasPeucker(pts, far, n, conformity, v);
-  const size_t m = v.size();
-
-  // Arcs must not run through the start: begin at the sharpest turn.
-  size_t start = 0;
-  double sharpest = -1;
-  for (size_t j = 0; j < m; ++j) {
-    const cv::Point2d in = pts[v[j]] - pts[v[(j + m - 1) % m]];
-    const cv::Point2d out_dir = pts[v[(j + 1) % m]] - pts[v[j]];
-    const double turn = std::abs(signedDeg(angleOf(out_dir) - angleOf(in)));
-    if (turn > sharpest) {
-      sharpest = turn;
-      start = j;
-    }
-  }
-  // Vertex j of the rotated list as an unwrapped contour index.
-  std::vector<size_t> idx(m + 1);
-  for (size_t j = 0; j <= m; ++j) {
-    size_t k = v[(start + j) % m];
-    if (j > 0 && k <= idx[j - 1]) k += n * ((idx[j - 1] - k) / n + 1);
-    idx[j] = k;
-  }
-  idx[m] = idx[0] + n;
+  const double extent = extentOf(pts);
+  const std::vector<size_t> idx = polygonFromSharpest(pts, conformity);
+  const size_t m = idx.size() - 1;
 
   const ContourSums sums(pts);
   const auto arcFits = [&](size_t first, size_t last, Circle* c) {

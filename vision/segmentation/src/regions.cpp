@@ -311,62 +311,14 @@ void forEachCoverage(const BandReading& reading, const BandPixels& pixels, const
   });
 }
 
-// Reads one region with a band of a given reach (see greyMoments below).
-// Returns false when the grey levels cannot be trusted.
-//
-// Light falls unevenly, so a pixel's grey level is read between the levels
-// the light at that pixel gives the background and the part: planes fitted
-// to a ring of background around the part and to the part's interior give
-// both (see the light below), and a pixel's coverage is (I - background) /
-// (part - background). Constant levels instead would weigh one side of a
-// part more than the other and pull its centroid by a tenth of a pixel under
-// a few percent of light gradient.
-//
-// Pixels deeper inside the binary boundary than the band (`interior`, with
-// the `histogram` of its grey levels) are the part's: their coverage is 1.
-// Only the band, where the edge blur is, carries sub-pixel information;
-// reading the interior from grey levels too would only add its noise, and
-// let a highlight or a printed mark on the part pull its centroid.
-//
-// The ring, the band and the interior are run sets made by square
-// morphology on the region's runs, so the cost follows the boundary's length
-// and not the box's area. `tail` is the mean coverage, not clamped (so that
-// noise averages out), of the band's outermost pixels.
-bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
-              const std::array<int, 256>& histogram, Dilations& dilations, PartLight* part_light,
-              BandReading* reading) {
-  const RowRuns& near = dilations.byRadius(reach);
-  const RowRuns& nearer = dilations.byRadius(reach - 1);
-  const RowRuns& far = dilations.byRadius(reach + 2);
-  // Background from a ring just outside the edge blur, free of other parts.
-  const cv::Mat& set = pixels.set;
-  const auto free = [&](int y, int x, uint8_t) { return set.ptr<uint8_t>(y)[x] == 0; };
-  PlaneFit background;
-  if (!fitPlane(pixels.grey, far.minus(near), free, &background)) return false;
+// The light over the region's box (see readBand): r.plane, the
+// background's level, and r.part, the part's, as planes that follow one
+// light fitted to the background ring and the part's interior. False where
+// it cannot be read.
+bool readLight(const BandPixels& pixels, const RowRuns& interior, const PlaneFit& background,
+               cv::Point2d centre, double part_grey, double contrast, bool lit,
+               double interior_count, PartLight* part_light, BandReading* reading) {
   BandReading& r = *reading;
-
-  // The interior's moments, run by run in closed form.
-  Moments10& sums = r.sums;
-  sums = Moments10{};
-  double interior_count = 0;
-  interior.forEachRun([&](int y, int a, int b) {
-    sums.addRun(a, b, y);
-    interior_count += b - a;
-  });
-  if (interior_count < 8) return false;
-  // The part's level: its median grey (so that a highlight or a printed mark
-  // does not change the level every edge pixel is read against), against
-  // the background's at the interior's centroid; below, where its own light
-  // is read, its plane's level there.
-  const cv::Point2d centre(sums.m10 / sums.m00, sums.m01 / sums.m00);
-  const double centre_background = background.at(centre);
-  const double part_grey = interpolatedMedian(histogram, interior_count);
-  const double contrast = part_grey - centre_background;
-  // A black background carries no light to be relative to: the contrast is
-  // then judged on the grey scale.
-  const bool lit = centre_background >= kMinLitBackground;
-  if (std::abs(contrast) < kMinContrast * (lit ? centre_background : 255)) return false;
-
   // Light falls unevenly, and a part reflects a fixed fraction of the light
   // that reaches it, as the background does: both levels follow the same
   // light, l(p) = 1 + g (p - centre) near the part. A plane fitted to each
@@ -380,7 +332,7 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
   // and low-contrast ones worse than the background's. Interior pixels far
   // from the median (a highlight, a mark, an edge blurred into a thin stem)
   // are left out of the part's plane.
-  const double b0 = centre_background;
+  const double b0 = background.at(centre);
   cv::Matx22d weight = cv::Matx22d::zeros();
   cv::Vec2d weighted(0, 0);
   if (lit) {
@@ -432,10 +384,15 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
   } else {
     return false;
   }
+  return true;
+}
 
-  // The band: pixels near the region, not deep inside it, never a
-  // neighbour's; its moments summed row by row.
-  reading->band = near.minus(interior);
+// The band's coverage read from its grey levels (see readBand), clamped,
+// into reading->band_coverage, and its moments added to reading->sums row
+// by row. False where the band covers nothing.
+bool sumBand(const BandPixels& pixels, BandReading* reading) {
+  BandReading& r = *reading;
+  Moments10& sums = r.sums;
   int row = -1;
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
   std::vector<float>& band_coverage = reading->band_coverage;
@@ -458,15 +415,86 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
     s3 += xxv * x;
   });
   if (row >= 0) sums.addRow(row, s0, s1, s2, s3);
-  if (sums.m00 <= 0) return false;
-  // The band's outermost pixels.
+  return sums.m00 > 0;
+}
+
+// The mean coverage, not clamped (so that noise averages out), of the
+// band's outermost pixels `rim` (see readBand).
+double bandTail(const BandReading& r, const BandPixels& pixels, const RowRuns& rim) {
   double tail_sum = 0;
   int tail_count = 0;
-  forEachCoverage(r, pixels, near.minus(nearer), [&](int, int, float raw) {
+  forEachCoverage(r, pixels, rim, [&](int, int, float raw) {
     tail_sum += raw;
     ++tail_count;
   });
-  reading->tail = tail_count > 0 ? tail_sum / tail_count : 0.0;
+  return tail_count > 0 ? tail_sum / tail_count : 0.0;
+}
+
+// Reads one region with a band of a given reach (see greyMoments below).
+// Returns false when the grey levels cannot be trusted.
+//
+// Light falls unevenly, so a pixel's grey level is read between the levels
+// the light at that pixel gives the background and the part: planes fitted
+// to a ring of background around the part and to the part's interior give
+// both (readLight), and a pixel's coverage is (I - background) /
+// (part - background). Constant levels instead would weigh one side of a
+// part more than the other and pull its centroid by a tenth of a pixel under
+// a few percent of light gradient.
+//
+// Pixels deeper inside the binary boundary than the band (`interior`, with
+// the `histogram` of its grey levels) are the part's: their coverage is 1.
+// Only the band, where the edge blur is, carries sub-pixel information;
+// reading the interior from grey levels too would only add its noise, and
+// let a highlight or a printed mark on the part pull its centroid.
+//
+// The ring, the band and the interior are run sets made by square
+// morphology on the region's runs, so the cost follows the boundary's length
+// and not the box's area. `tail` is the mean coverage, not clamped (so that
+// noise averages out), of the band's outermost pixels.
+bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
+              const std::array<int, 256>& histogram, Dilations& dilations, PartLight* part_light,
+              BandReading* reading) {
+  const RowRuns& near = dilations.byRadius(reach);
+  const RowRuns& nearer = dilations.byRadius(reach - 1);
+  const RowRuns& far = dilations.byRadius(reach + 2);
+  // Background from a ring just outside the edge blur, free of other parts.
+  const cv::Mat& set = pixels.set;
+  const auto free = [&](int y, int x, uint8_t) { return set.ptr<uint8_t>(y)[x] == 0; };
+  PlaneFit background;
+  if (!fitPlane(pixels.grey, far.minus(near), free, &background)) return false;
+  BandReading& r = *reading;
+
+  // The interior's moments, run by run in closed form.
+  Moments10& sums = r.sums;
+  sums = Moments10{};
+  double interior_count = 0;
+  interior.forEachRun([&](int y, int a, int b) {
+    sums.addRun(a, b, y);
+    interior_count += b - a;
+  });
+  if (interior_count < 8) return false;
+  // The part's level: its median grey (so that a highlight or a printed mark
+  // does not change the level every edge pixel is read against), against
+  // the background's at the interior's centroid; below, where its own light
+  // is read, its plane's level there.
+  const cv::Point2d centre(sums.m10 / sums.m00, sums.m01 / sums.m00);
+  const double centre_background = background.at(centre);
+  const double part_grey = interpolatedMedian(histogram, interior_count);
+  const double contrast = part_grey - centre_background;
+  // A black background carries no light to be relative to: the contrast is
+  // then judged on the grey scale.
+  const bool lit = centre_background >= kMinLitBackground;
+  if (std::abs(contrast) < kMinContrast * (lit ? centre_background : 255)) return false;
+
+  if (!readLight(pixels, interior, background, centre, part_grey, contrast, lit, interior_count,
+                 part_light, reading)) {
+    return false;
+  }
+  // The band: pixels near the region, not deep inside it, never a
+  // neighbour's.
+  reading->band = near.minus(interior);
+  if (!sumBand(pixels, reading)) return false;
+  reading->tail = bandTail(r, pixels, near.minus(nearer));
   return true;
 }
 
@@ -580,6 +608,73 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
   return true;
 }
 
+// Measures the region whose outer boundary is contours[i] (see
+// findRegions) into `region`: its pixels over its box (alone in its box, or
+// the set pixels connected to its boundary), holes, moments (grey-level
+// where they can be trusted), orientation and elongation. Moves its
+// contours out. False, nothing written, for a region smaller than
+// options.min_area.
+bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions& options,
+                   std::vector<std::vector<cv::Point>>& contours,
+                   const std::vector<cv::Vec4i>& hierarchy, const std::vector<cv::Rect>& boxes,
+                   int i, Region* region) {
+  const cv::Rect frame(0, 0, mask.cols, mask.rows);
+  const cv::Rect bbox = boxes[static_cast<size_t>(i)];
+  // The box the grey-level moments need: the edge blur and a background
+  // ring around the region.
+  const cv::Rect box =
+      (bbox + cv::Size(2 * kBoxMargin, 2 * kBoxMargin) - cv::Point(kBoxMargin, kBoxMargin)) & frame;
+  bool alone = true;
+  for (size_t j = 0; j < boxes.size() && alone; ++j) {
+    alone = static_cast<int>(j) == i || hierarchy[j][3] >= 0 || (boxes[j] & box).empty();
+  }
+  // The region's pixels over the box: the set pixels 8-connected to its
+  // boundary (islands in its holes and neighbours are other regions).
+  RowRuns own_runs = RowRuns::ofMask(mask(box));
+  cv::Mat own = mask(box);
+  if (!alone) {
+    own_runs = own_runs.connectedTo(contours[i][0] - box.tl());
+    own = own_runs.toMask();
+  }
+  const cv::Mat inner = own(bbox - box.tl());
+  // The region's pixels are all in its bounding box, so its runs over
+  // the wider box count them.
+  if (static_cast<double>(own_runs.count()) < options.min_area) return false;
+
+  Region& r = *region;
+  r.bbox = bbox;
+  r.touches_border =
+      bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+  r.outer = std::move(contours[i]);
+  for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
+    if (options.min_hole_area > 0 && cv::contourArea(contours[h]) < options.min_hole_area) continue;
+    r.hole_boundaries.push_back(std::move(contours[h]));
+  }
+  r.holes = static_cast<int>(r.hole_boundaries.size());
+
+  if (!grey.empty() && greyMoments(grey(box), own, own_runs, mask(box), box, &r.moments,
+                                   &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
+    r.area = r.moments.m00;
+  } else {
+    // Binary moments only where the grey levels cannot be trusted.
+    const cv::Moments m = cv::moments(inner, true);
+    r.moments = m;
+    r.area = m.m00;
+    r.centroid = cv::Point2d(bbox.x + m.m10 / m.m00, bbox.y + m.m01 / m.m00);
+    inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
+    r.coverage_origin = bbox.tl();
+    r.covered = RowRuns::ofMask(inner);
+  }
+  r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
+  const cv::Moments& rm = r.moments;
+  const double common =
+      std::sqrt((rm.mu20 - rm.mu02) * (rm.mu20 - rm.mu02) + 4 * rm.mu11 * rm.mu11);
+  const double major = rm.mu20 + rm.mu02 + common;
+  const double minor = rm.mu20 + rm.mu02 - common;
+  r.elongation = major > 0 ? 1.0 - minor / major : 0;
+  return true;
+}
+
 }  // namespace
 
 std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& options,
@@ -592,7 +687,6 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
   cv::findContours(mask, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
-  const cv::Rect frame(0, 0, mask.cols, mask.rows);
   std::vector<int> outers;
   // Boxes of every region, noise too: a region whose box meets no other
   // region's box owns every set pixel of its box, and needs no labelling.
@@ -617,62 +711,10 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   cv::parallel_for_(cv::Range(0, static_cast<int>(outers.size())), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       const int i = outers[static_cast<size_t>(k)];
-      const cv::Rect bbox = boxes[static_cast<size_t>(i)];
-      // The box the grey-level moments need: the edge blur and a background
-      // ring around the region.
-      const cv::Rect box =
-          (bbox + cv::Size(2 * kBoxMargin, 2 * kBoxMargin) - cv::Point(kBoxMargin, kBoxMargin)) &
-          frame;
-      bool alone = true;
-      for (size_t j = 0; j < boxes.size() && alone; ++j) {
-        alone = static_cast<int>(j) == i || hierarchy[j][3] >= 0 || (boxes[j] & box).empty();
-      }
-      // The region's pixels over the box: the set pixels 8-connected to its
-      // boundary (islands in its holes and neighbours are other regions).
-      RowRuns own_runs = RowRuns::ofMask(mask(box));
-      cv::Mat own = mask(box);
-      if (!alone) {
-        own_runs = own_runs.connectedTo(contours[i][0] - box.tl());
-        own = own_runs.toMask();
-      }
-      const cv::Mat inner = own(bbox - box.tl());
-      // The region's pixels are all in its bounding box, so its runs over
-      // the wider box count them.
-      if (static_cast<double>(own_runs.count()) < options.min_area) continue;
-
-      Region& r = found[static_cast<size_t>(k)];
-      r.bbox = bbox;
-      r.touches_border =
-          bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
-      r.outer = std::move(contours[i]);
-      for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
-        if (options.min_hole_area > 0 && cv::contourArea(contours[h]) < options.min_hole_area)
-          continue;
-        r.hole_boundaries.push_back(std::move(contours[h]));
-      }
-      r.holes = static_cast<int>(r.hole_boundaries.size());
-
-      if (!grey.empty() && greyMoments(grey(box), own, own_runs, mask(box), box, &r.moments,
-                                       &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
-        r.area = r.moments.m00;
-      } else {
-        // Binary moments only where the grey levels cannot be trusted.
-        const cv::Moments m = cv::moments(inner, true);
-        r.moments = m;
-        r.area = m.m00;
-        r.centroid = cv::Point2d(bbox.x + m.m10 / m.m00, bbox.y + m.m01 / m.m00);
-        inner.convertTo(r.coverage, CV_32F, 1.0 / 255.0);
-        r.coverage_origin = bbox.tl();
-        r.covered = RowRuns::ofMask(inner);
-      }
-      r.angle_deg = orientationDeg(r.moments, r.centroid, r.outer);
-      const cv::Moments& rm = r.moments;
-      const double common =
-          std::sqrt((rm.mu20 - rm.mu02) * (rm.mu20 - rm.mu02) + 4 * rm.mu11 * rm.mu11);
-      const double major = rm.mu20 + rm.mu02 + common;
-      const double minor = rm.mu20 + rm.mu02 - common;
-      r.elongation = major > 0 ? 1.0 - minor / major : 0;
-      kept[static_cast<size_t>(k)] = 1;
+      kept[static_cast<size_t>(k)] = measureRegion(mask, grey, options, contours, hierarchy, boxes,
+                                                   i, &found[static_cast<size_t>(k)])
+                                         ? 1
+                                         : 0;
     }
   });
   std::vector<Region> regions;

@@ -138,6 +138,97 @@ bool turnedLogHu(const cv::Mat& grey, const Region& r, double deg, const TrainOp
   return true;
 }
 
+// The orientation order and phase of a model trained on region `r`.
+void setOrientation(PartModel& m, const Region& r) {
+  // Orientation order: the lowest whose complex moment has a direction.
+  std::vector<double> strength;
+  std::vector<double> phase;
+  complexMoments(r, &strength, &phase);
+  // Among the orders with a clear direction, the one whose phase gives the
+  // finest rotation: an error e in arg c_k turns the estimate by e / k, and e
+  // shrinks as |c_k| grows.
+  m.orientation_order = 0;
+  int strongest = 0;
+  double finest = 0;
+  for (int k = 2; k <= kMaxOrder; ++k) {
+    if (strength[k] >= kMinOrderStrength && k <= kMaxPreferredOrder && k * strength[k] > finest) {
+      m.orientation_order = k;
+      finest = k * strength[k];
+    }
+    if (strength[k] > strength[strongest]) strongest = k;
+  }
+  for (int k = kMaxPreferredOrder + 1; k <= kMaxOrder && m.orientation_order == 0; ++k) {
+    if (strength[k] >= kMinOrderStrength) m.orientation_order = k;
+  }
+  if (m.orientation_order == 0 && strongest >= 2 && strength[strongest] >= kWeakOrderStrength) {
+    m.orientation_order = strongest;
+  }
+  m.orientation_phase_deg = m.orientation_order > 0 ? phase[m.orientation_order] : 0;
+}
+
+// The symmetry order of a model trained on region `r` and whether it equals
+// its mirror image.
+void setSymmetries(PartModel& m, const Region& r) {
+  // Symmetries, by verifying the model against its own training edges.
+  const int margin = static_cast<int>(std::ceil(m.edge_tolerance)) + 4;
+  const cv::Rect roi = cv::Rect(r.bbox.x - margin, r.bbox.y - margin, r.bbox.width + 2 * margin,
+                                r.bbox.height + 2 * margin);
+  const EdgeDistance edges(contoursOf(r), roi);
+  m.symmetry_order = 1;
+  int passed = 0;
+  for (int s = 2; s <= kMaxOrder; ++s) {
+    if (verifyScore(m.samples, r.centroid, 360.0 / s, edges, m.edge_tolerance) >= kSymmetryScore) {
+      m.symmetry_order = s;
+      ++passed;
+    }
+  }
+  if (m.orientation_order == 0 && passed == kMaxOrder - 1) m.symmetry_order = 0;
+  if (m.orientation_order == 0) {
+    m.body.mirror_symmetric = true;
+  } else {
+    // The mirror image lines up with the part at one of the turns where its
+    // complex moment does (as in recognition); a hair either side absorbs
+    // the phase's pixel noise.
+    const int k = m.orientation_order;
+    double least = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < k; ++j) {
+      for (double nudge : {-0.5, -0.25, 0.0, 0.25, 0.5}) {
+        least = std::min(least,
+                         chiralLength(m, 2 * m.orientation_phase_deg / k + j * 360.0 / k + nudge));
+      }
+    }
+    m.body.mirror_symmetric = least < kMinChiralLength;
+  }
+}
+
+// Which Hu invariants of a model trained on region `r` of `grey` it uses,
+// and their tolerance.
+void setHuTolerance(PartModel& m, const cv::Mat& grey, const Region& r,
+                    const TrainOptions& options) {
+  // Which Hu invariants survive turning, and how far they move.
+  const HuArray& h0 = m.body.log_hu;
+  std::array<double, 7> spread{};
+  std::array<bool, 7> same_sign;
+  same_sign.fill(true);
+  std::vector<HuArray> probes;
+  for (double deg : kProbeTurnsDeg) {
+    HuArray h;
+    if (!turnedLogHu(grey, r, deg, options, &h)) continue;
+    probes.push_back(h);
+    for (size_t i = 0; i < h.size(); ++i) {
+      spread[i] = std::max(spread[i], std::abs(h[i] - h0[i]));
+      same_sign[i] = same_sign[i] && (h[i] >= 0) == (h0[i] >= 0);
+    }
+  }
+  for (size_t i = 0; i < h0.size(); ++i) {
+    m.body.hu_used[i] = !probes.empty() && same_sign[i] && spread[i] <= kMaxHuSpread &&
+                        std::abs(h0[i]) <= kMaxLogHu;
+  }
+  double worst = 0;
+  for (const auto& h : probes) worst = std::max(worst, huDistance(m.body, h));
+  m.body.hu_tolerance = std::max(kMinHuTolerance, 3 * worst);
+}
+
 }  // namespace
 
 void prepareModel(PartModel& model) {
@@ -201,84 +292,9 @@ Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int
   prepareModel(m);
   centreOnEdges(m, r);
 
-  // Orientation order: the lowest whose complex moment has a direction.
-  std::vector<double> strength;
-  std::vector<double> phase;
-  complexMoments(r, &strength, &phase);
-  // Among the orders with a clear direction, the one whose phase gives the
-  // finest rotation: an error e in arg c_k turns the estimate by e / k, and e
-  // shrinks as |c_k| grows.
-  m.orientation_order = 0;
-  int strongest = 0;
-  double finest = 0;
-  for (int k = 2; k <= kMaxOrder; ++k) {
-    if (strength[k] >= kMinOrderStrength && k <= kMaxPreferredOrder && k * strength[k] > finest) {
-      m.orientation_order = k;
-      finest = k * strength[k];
-    }
-    if (strength[k] > strength[strongest]) strongest = k;
-  }
-  for (int k = kMaxPreferredOrder + 1; k <= kMaxOrder && m.orientation_order == 0; ++k) {
-    if (strength[k] >= kMinOrderStrength) m.orientation_order = k;
-  }
-  if (m.orientation_order == 0 && strongest >= 2 && strength[strongest] >= kWeakOrderStrength) {
-    m.orientation_order = strongest;
-  }
-  m.orientation_phase_deg = m.orientation_order > 0 ? phase[m.orientation_order] : 0;
-
-  // Symmetries, by verifying the model against its own training edges.
-  const int margin = static_cast<int>(std::ceil(m.edge_tolerance)) + 4;
-  const cv::Rect roi = cv::Rect(r.bbox.x - margin, r.bbox.y - margin, r.bbox.width + 2 * margin,
-                                r.bbox.height + 2 * margin);
-  const EdgeDistance edges(contoursOf(r), roi);
-  m.symmetry_order = 1;
-  int passed = 0;
-  for (int s = 2; s <= kMaxOrder; ++s) {
-    if (verifyScore(m.samples, r.centroid, 360.0 / s, edges, m.edge_tolerance) >= kSymmetryScore) {
-      m.symmetry_order = s;
-      ++passed;
-    }
-  }
-  if (m.orientation_order == 0 && passed == kMaxOrder - 1) m.symmetry_order = 0;
-  if (m.orientation_order == 0) {
-    m.body.mirror_symmetric = true;
-  } else {
-    // The mirror image lines up with the part at one of the turns where its
-    // complex moment does (as in recognition); a hair either side absorbs
-    // the phase's pixel noise.
-    const int k = m.orientation_order;
-    double least = std::numeric_limits<double>::infinity();
-    for (int j = 0; j < k; ++j) {
-      for (double nudge : {-0.5, -0.25, 0.0, 0.25, 0.5}) {
-        least = std::min(least,
-                         chiralLength(m, 2 * m.orientation_phase_deg / k + j * 360.0 / k + nudge));
-      }
-    }
-    m.body.mirror_symmetric = least < kMinChiralLength;
-  }
-
-  // Which Hu invariants survive turning, and how far they move.
-  const HuArray& h0 = m.body.log_hu;
-  std::array<double, 7> spread{};
-  std::array<bool, 7> same_sign;
-  same_sign.fill(true);
-  std::vector<HuArray> probes;
-  for (double deg : kProbeTurnsDeg) {
-    HuArray h;
-    if (!turnedLogHu(grey, r, deg, options, &h)) continue;
-    probes.push_back(h);
-    for (size_t i = 0; i < h.size(); ++i) {
-      spread[i] = std::max(spread[i], std::abs(h[i] - h0[i]));
-      same_sign[i] = same_sign[i] && (h[i] >= 0) == (h0[i] >= 0);
-    }
-  }
-  for (size_t i = 0; i < h0.size(); ++i) {
-    m.body.hu_used[i] = !probes.empty() && same_sign[i] && spread[i] <= kMaxHuSpread &&
-                        std::abs(h0[i]) <= kMaxLogHu;
-  }
-  double worst = 0;
-  for (const auto& h : probes) worst = std::max(worst, huDistance(m.body, h));
-  m.body.hu_tolerance = std::max(kMinHuTolerance, 3 * worst);
+  setOrientation(m, r);
+  setSymmetries(m, r);
+  setHuTolerance(m, grey, r, options);
   return m;
 }
 

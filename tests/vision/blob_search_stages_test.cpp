@@ -1,0 +1,237 @@
+// The blob search's stages one at a time (vision/blob_search/src/blob_search.hpp)
+// on one blob of two drawn parts that touch, an L and a bar: which models
+// may lie in it, the screened poses, the edge fit and placement, the choice
+// of parts, whether they explain the blob, the anchors near what is left,
+// and the hand test.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "blob_search.hpp"
+#include "drawn_parts.hpp"
+#include "picksight/common/angles.hpp"
+#include "picksight/vision/blob_search/touching_parts.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
+
+using namespace picksight::vision;
+using picksight::angleDiffDeg;
+using picksight::vision::touching::BlobSearch;
+using picksight::vision::touching::Candidate;
+namespace pt = picksight::test;
+namespace ps = picksight::synthetic;
+
+namespace {
+// An L with arms of different lengths (it differs from its mirror image),
+// and a bar as wide as the L's long arm.
+ps::Shape lDrawing() {
+  return ps::Shape{{{{0, 0}, {100, 0}, {100, 30}, {30, 30}, {30, 70}, {0, 70}}}};
+}
+ps::Shape lShape() { return pt::centred(lDrawing()); }
+ps::Shape bar() { return pt::centred(ps::Shape{{pt::rectLoop(90, 30)}}); }
+
+PartModel trainAlone(const ps::Shape& shape, int type, const std::string& name) {
+  const cv::Mat image = pt::drawParts(400, 300, {{shape, 200, 150, 0}}, 5);
+  auto model = trainModel(image, type, name);
+  REQUIRE(model.ok());
+  return model.value();
+}
+
+struct Models {
+  PartModel l = trainAlone(lShape(), 1, "ell");
+  PartModel b = trainAlone(bar(), 2, "bar");
+  // Larger than the blob: never searched.
+  PartModel big = trainAlone(ps::Shape{{pt::rectLoop(260, 200)}}, 3, "big");
+};
+
+const Models& models() {
+  static const Models m;
+  return m;
+}
+
+// The L at (260, 220) turned by 25 degrees (mirrored when asked), and the
+// bar against the end of its long arm, overlapping it by 2 px so that the
+// two make one blob.
+struct Scene {
+  cv::Mat grey;
+  std::vector<Region> regions;
+  ImagePose l_pose;
+  ImagePose bar_pose;
+};
+
+Scene touchingPair(bool mirrored_l) {
+  const ps::ShapeMoments lm = ps::shapeMoments(lDrawing());
+  const double turn = 25;
+  const double c = std::cos(turn * M_PI / 180);
+  const double s = std::sin(turn * M_PI / 180);
+  // The bar's centre in the L's frame: past the long arm's end, on its axis.
+  const double flip = mirrored_l ? -1.0 : 1.0;
+  const cv::Point2d offset(100 - lm.cx + 45 - 2, flip * (15 - lm.cy));
+  Scene scene;
+  scene.l_pose = {{260, 220}, turn, mirrored_l};
+  scene.bar_pose = {
+      scene.l_pose.centre + cv::Point2d(c * offset.x - s * offset.y, s * offset.x + c * offset.y),
+      turn, false};
+  scene.grey =
+      pt::drawParts(640, 480,
+                    {{lShape(), scene.l_pose.centre.x, scene.l_pose.centre.y, turn, mirrored_l},
+                     {bar(), scene.bar_pose.centre.x, scene.bar_pose.centre.y, turn}},
+                    11);
+  scene.regions = findRegions(binarize(scene.grey, {}), {}, scene.grey);
+  return scene;
+}
+
+std::vector<const PartModel*> all() { return {&models().l, &models().b, &models().big}; }
+
+bool near(const ImagePose& a, const ImagePose& b, const PartModel& m, double px, double deg) {
+  return std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) <= px &&
+         angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
+}
+
+const Candidate* closest(const std::deque<Candidate>& refined, const PartModel& m,
+                         const ImagePose& truth) {
+  const Candidate* best = nullptr;
+  for (const auto& c : refined) {
+    if (c.model != &m) continue;
+    const double d = std::hypot(c.pose.centre.x - truth.centre.x, c.pose.centre.y - truth.centre.y);
+    if (!best || d < std::hypot(best->pose.centre.x - truth.centre.x,
+                                best->pose.centre.y - truth.centre.y)) {
+      best = &c;
+    }
+  }
+  return best;
+}
+}  // namespace
+
+TEST_CASE("blob search: only the models no larger than the blob are searched",
+          "[vision][blob_search]") {
+  const Scene scene = touchingPair(false);
+  REQUIRE(scene.regions.size() == 1);
+  const auto models_list = all();
+  const BlobSearch search(scene.regions, 0, models_list, nullptr);
+  const auto& fitting = search.fitting();
+  REQUIRE(fitting.size() == 2);
+  CHECK(fitting[0] == &models().l);
+  CHECK(fitting[1] == &models().b);
+  // The blob's anchors: the L's corners and the bar's, less those the
+  // contact hides.
+  CHECK(search.corners().corners.size() >= 6);
+}
+
+TEST_CASE("blob search: screening proposes the part's pose, best first, no two alike",
+          "[vision][blob_search]") {
+  const Scene scene = touchingPair(false);
+  REQUIRE(scene.regions.size() == 1);
+  const auto models_list = all();
+  const BlobSearch search(scene.regions, 0, models_list, nullptr);
+  const PartModel& l = models().l;
+  for (const bool quick : {true, false}) {
+    INFO("quick " << quick);
+    const auto screened = search.screen(l, quick);
+    REQUIRE(!screened.empty());
+    CHECK(screened.size() <= 8);
+    for (size_t i = 1; i < screened.size(); ++i) {
+      CHECK(screened[i - 1].score >= screened[i].score);
+      for (size_t j = 0; j < i; ++j) CHECK_FALSE(near(screened[i].pose, screened[j].pose, l, 2, 3));
+    }
+    // A corner's pose is a few degrees and pixels off before the edge fit.
+    CHECK(near(screened.front().pose, scene.l_pose, l, 4, 4));
+  }
+}
+
+TEST_CASE("blob search: the edge fit puts a screened pose on the part, placed in the blob",
+          "[vision][blob_search]") {
+  const Scene scene = touchingPair(false);
+  REQUIRE(scene.regions.size() == 1);
+  const auto models_list = all();
+  BlobSearch search(scene.regions, 0, models_list, nullptr);
+  const PartModel& l = models().l;
+  search.refine(search.screen(l, false));
+  const Candidate* fitted = closest(search.refined(), l, scene.l_pose);
+  REQUIRE(fitted);
+  CHECK(near(fitted->pose, scene.l_pose, l, 0.3, 0.5));
+  CHECK(fitted->score * 100 >= l.verify_percent);
+  const auto& placed = search.placed();
+  CHECK(std::any_of(placed.begin(), placed.end(),
+                    [&](const auto& p) { return p.candidate == fitted; }));
+  // The same part 40 px off lies on the background: not placed.
+  const Candidate off{&l, {fitted->pose.centre + cv::Point2d(0, 40), 25, false}, 0.95, 0.1, 0};
+  CHECK_FALSE(search.place(off));
+}
+
+TEST_CASE("blob search: the parts are chosen and explain the blob whole", "[vision][blob_search]") {
+  const Scene scene = touchingPair(false);
+  REQUIRE(scene.regions.size() == 1);
+  const auto models_list = all();
+  BlobSearch search(scene.regions, 0, models_list, nullptr);
+  // The L alone leaves the bar's pixels unexplained.
+  search.refine(search.screen(models().l, false));
+  search.choose();
+  REQUIRE(search.taken().size() == 1);
+  CHECK_FALSE(search.explainsWhole());
+  // The anchors the full search goes on from lie by the bar, and the rest
+  // is about the bar's area.
+  const size_t corners_before = search.corners().corners.size();
+  const double rest = search.narrowToRest();
+  CHECK(rest == Approx(models().b.body.area).epsilon(0.2));
+  CHECK(search.corners().corners.size() < corners_before);
+  for (const auto& c : search.corners().corners) {
+    INFO("corner at " << c.at.x << ", " << c.at.y);
+    CHECK(std::hypot(c.at.x - scene.bar_pose.centre.x, c.at.y - scene.bar_pose.centre.y) < 70);
+  }
+  // With the bar, the two parts are the blob.
+  search.refine(search.screen(models().b, false));
+  search.choose();
+  const auto matches = search.matches();
+  REQUIRE(matches.size() == 2);
+  CHECK(search.explainsWhole());
+  for (const auto& m : matches) {
+    const ImagePose& truth = m.model == &models().l ? scene.l_pose : scene.bar_pose;
+    CHECK(std::hypot(m.centroid.x - truth.centre.x, m.centroid.y - truth.centre.y) < 0.3);
+    CHECK(angleDiffDeg(m.angle_deg, truth.angle_deg, m.symmetry_deg) < 0.5);
+    CHECK(m.touching);
+  }
+  // run() is the stages in order: the same parts as locateInBlob.
+  BlobSearch whole(scene.regions, 0, models_list, nullptr);
+  const auto run = whole.run();
+  const auto located = locateInBlob(scene.regions, 0, models_list);
+  REQUIRE(run.size() == located.size());
+  for (size_t i = 0; i < run.size(); ++i) {
+    CHECK(run[i].model == located[i].model);
+    CHECK(run[i].centroid == located[i].centroid);
+    CHECK(run[i].angle_deg == located[i].angle_deg);
+  }
+}
+
+TEST_CASE("blob search: a part drawn as the mirror image of its model is not reported",
+          "[vision][blob_search]") {
+  const PartModel& l = models().l;
+  REQUIRE_FALSE(l.body.mirror_symmetric);
+  const auto models_list = all();
+  {
+    // The L as trained: its own hand, not the mirror image.
+    const Scene scene = touchingPair(false);
+    REQUIRE(scene.regions.size() == 1);
+    BlobSearch search(scene.regions, 0, models_list, nullptr);
+    search.refine(search.screen(l, false));
+    const Candidate* fitted = closest(search.refined(), l, scene.l_pose);
+    REQUIRE(fitted);
+    CHECK_FALSE(search.showsMirror(*fitted));
+  }
+  // The L mirrored: the bar is found, the L's model reports nothing there.
+  const Scene scene = touchingPair(true);
+  REQUIRE(scene.regions.size() == 1);
+  BlobSearch search(scene.regions, 0, models_list, nullptr);
+  const auto found = search.run();
+  bool bar_found = false;
+  for (const auto& m : found) {
+    INFO(m.model->name << " at " << m.centroid.x << ", " << m.centroid.y);
+    CHECK(m.model != &l);
+    bar_found = bar_found || (m.model == &models().b &&
+                              std::hypot(m.centroid.x - scene.bar_pose.centre.x,
+                                         m.centroid.y - scene.bar_pose.centre.y) < 0.5);
+  }
+  CHECK(bar_found);
+}

@@ -1,0 +1,134 @@
+// The search of one merged blob for the parts inside it (locateInBlob), as
+// named stages a test can run one at a time. Not installed: only
+// touching_parts.cpp and the blob search's stage tests include it.
+//
+//   BlobSearch(...)     the models that fit in the blob; its edge map,
+//                       corners and arcs, and pixels
+//   screen(model, ...)  a model's poses proposed from the anchors, best
+//                       first, no two alike
+//   refine(screened)    each screened pose fitted on the grey-level edges
+//                       (within the blob's budget of edge fits), and placed
+//                       where it fits the blob on its own (place)
+//   choose()            the parts among those placed (best first, rivals
+//                       for the same pixels settled, mirror images refused)
+//   explainsWhole()     whether the parts taken are the whole blob
+//   narrowToRest()      the anchors the full search starts from: those near
+//                       what the parts taken leave unexplained
+//   run()               the stages in order: a quick search of every model,
+//                       then while the blob is not explained whole the full
+//                       search, model by model
+#pragma once
+
+#include <deque>
+#include <map>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "picksight/vision/models/boundary_verification.hpp"
+#include "picksight/vision/models/match.hpp"
+#include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+#include "touching_parts_internal.hpp"
+
+namespace picksight::vision::touching {
+
+// A refined candidate that fits the blob on its own, drawn over its box.
+struct Placed {
+  const Candidate* candidate = nullptr;
+  cv::Rect box;   // image coordinates
+  cv::Mat drawn;  // 255 on the part, over `box`
+  int area = 0;
+};
+
+class BlobSearch {
+ public:
+  // The search of region `index` of `regions` with `models` (see
+  // locateInBlob; `built_edges` may be null). Selects the models that fit in
+  // the blob and, when any does, reads the blob: its edge map (unless given),
+  // corners and arcs, and pixels. Keeps references to all arguments.
+  BlobSearch(const std::vector<Region>& regions, size_t index,
+             const std::vector<const PartModel*>& models, const EdgeDistance* built_edges);
+  BlobSearch(const BlobSearch&) = delete;
+  BlobSearch& operator=(const BlobSearch&) = delete;
+
+  // The stages in order; the parts found, best score first.
+  std::vector<Match> run();
+
+  // The models no larger than the blob (empty: nothing to search).
+  const std::vector<const PartModel*>& fitting() const { return fitting_; }
+  // The blob's corners and arcs the next screening starts from.
+  const BlobCorners& corners() const { return *corners_; }
+  const std::vector<ArcAnchor>& arcs() const { return *arcs_; }
+
+  // The best screened poses of one model (its own hand: see alignedMirror),
+  // best first, no two alike. `quick`: from its most telling anchors only.
+  std::vector<Candidate> screen(const PartModel& model, bool quick) const;
+  // Refines screened poses, best first, and places those that fit.
+  void refine(const std::vector<Candidate>& screened);
+  // Places a refined candidate (kept by the caller for the search's
+  // lifetime) where it fits the blob on its own; false where it does not.
+  bool place(const Candidate& candidate);
+  // Takes the parts among those placed.
+  void choose();
+  // Whether the parts taken are the whole blob: each fits its edges closely,
+  // and together they cover every pixel of it but a thin seam.
+  bool explainsWhole() const;
+  // Turns the next screenings to the anchors near the blob's pixels that the
+  // parts taken leave unexplained (when any remain past a seam). Returns
+  // the area of those pixels (at least 1).
+  double narrowToRest();
+  // Whether the part at `candidate` shows its model's mirror image (asked
+  // of a candidate about to be taken; the aligned mirror image is fitted
+  // once per candidate).
+  bool showsMirror(const Candidate& candidate);
+
+  const std::deque<Candidate>& refined() const { return refined_; }
+  const std::vector<Placed>& placed() const { return placed_; }
+  // Indices into placed() of the parts taken by the last choose().
+  const std::vector<size_t>& taken() const { return taken_; }
+  // The parts taken, as matches.
+  std::vector<Match> matches() const;
+
+ private:
+  // The blob's pixels the parts taken leave unexplained (over its box).
+  cv::Mat unexplained() const;
+  // The blob's pixels in `box` that `drawn` (over `box`) covers.
+  int coveredIn(const cv::Mat& drawn, const cv::Rect& box) const;
+  // The full search after the quick one: `order` holds per model (index
+  // into fitting()) what the quick search saw of it.
+  void fullSearch(std::vector<std::pair<double, size_t>> order);
+
+  const Region& region_;
+  size_t index_;
+  std::vector<const PartModel*> fitting_;
+  double tolerance_ = 0;     // the largest edge tolerance of the fitting models
+  double conformity_ = 1e9;  // their smallest conformity
+  std::optional<EdgeDistance> own_edges_;
+  const EdgeDistance* edges_ = nullptr;
+  std::optional<BlobCorners> all_corners_;
+  std::vector<ArcAnchor> image_arcs_;
+  std::optional<BlobCorners> rest_corners_;
+  std::vector<ArcAnchor> rest_arcs_;
+  const BlobCorners* corners_ = nullptr;
+  const std::vector<ArcAnchor>* arcs_ = nullptr;
+  cv::Rect blob_box_;
+  cv::Mat blob_;  // 255 on the blob's pixels, over blob_box_
+  std::optional<Coverage> coverage_;
+  int blob_pixels_ = 0;
+  size_t budget_ = 0;  // edge fits the blob may cost
+  cv::Mat seam_;       // what erodes a seam away
+  // Refined poses (a deque: the placed ones point into it), and those that
+  // fit the blob on their own.
+  std::deque<Candidate> refined_;
+  std::vector<Placed> placed_;
+  size_t refinements_ = 0;
+  // Whether a choice made now could differ from the last one.
+  bool changed_ = false;
+  std::map<const Candidate*, std::optional<Candidate>> aligned_mirrors_;
+  std::vector<size_t> taken_;
+};
+
+}  // namespace picksight::vision::touching
