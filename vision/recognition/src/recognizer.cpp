@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/blob_search/touching_parts.hpp"
@@ -19,7 +21,8 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
                                    double max_tolerance) {
   const Region& r = regions[i];
   RegionCache cache(r, max_tolerance);
-  Match best;
+  const PartModel* best = nullptr;
+  Verdict best_verdict;
   // The region is one whole part, though of no model as trained (its
   // mirror image, or a copy of other size): no touching parts to look for.
   bool whole_part = false;
@@ -27,18 +30,21 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
     const Verdict v = judgeRegion(cache, *model, !whole_part);
     if (v.test == RegionTest::kScale || v.test == RegionTest::kMirror) whole_part = true;
     if (v.test != RegionTest::kPasses) continue;
-    const bool better = v.score > best.score + 1e-9 || (std::abs(v.score - best.score) <= 1e-9 &&
-                                                        v.hu_distance < best.body_distance);
-    if (best.model && !better) continue;
-    best.model = model;
-    best.region = i;
-    best.score = v.score;
-    best.centroid = r.centroid;
-    best.symmetry_deg = model->symmetryDeg();
-    best.angle_deg = wrapDeg(v.angle_deg, best.symmetry_deg);
-    best.body_distance = v.hu_distance;
+    if (best && !ranksAbove(v, best_verdict)) continue;
+    best = model;
+    best_verdict = v;
   }
-  if (best.model) return {best};
+  if (best) {
+    Match match;
+    match.model = best;
+    match.region = i;
+    match.score = best_verdict.score;
+    match.centroid = r.centroid;
+    match.symmetry_deg = best->symmetryDeg();
+    match.angle_deg = wrapDeg(best_verdict.angle_deg, match.symmetry_deg);
+    match.body_distance = best_verdict.hu_distance;
+    return {match};
+  }
   if (whole_part) return {};
   // No model explains the blob whole: parts that touch, or none.
   return locateInBlob(regions, i, models, cache.builtEdges());
@@ -63,6 +69,41 @@ std::vector<Match> recognize(const std::vector<Region>& regions,
   for (const auto& found : per_region) matches.insert(matches.end(), found.begin(), found.end());
   std::stable_sort(matches.begin(), matches.end(),
                    [](const Match& a, const Match& b) { return a.score > b.score; });
+  return matches;
+}
+
+std::vector<Match> recognizeEachHoleSetting(const std::vector<Region>& regions,
+                                            const std::vector<const PartModel*>& models) {
+  const auto settings = byMinHoleArea(models);
+  // One recognize() per setting, on the regions as that setting sees them.
+  const auto recognizeSetting = [&](double min_hole_area,
+                                    const std::vector<const PartModel*>& list) {
+    return hasHoleBelow(regions, min_hole_area)
+               ? recognize(withHolesAtLeast(regions, min_hole_area), list)
+               : recognize(regions, list);
+  };
+  if (settings.empty()) return {};
+  if (settings.size() == 1)
+    return recognizeSetting(settings.begin()->first, settings.begin()->second);
+  // Where models of several settings found parts in one region, the
+  // setting whose best part there scores highest keeps the region: as when
+  // every model competes in one recognize().
+  std::vector<std::pair<size_t, Match>> all;
+  size_t setting = 0;
+  for (const auto& [min_hole_area, list] : settings) {
+    for (auto& m : recognizeSetting(min_hole_area, list)) all.emplace_back(setting, std::move(m));
+    ++setting;
+  }
+  std::map<size_t, std::pair<size_t, double>> best;  // region -> (setting, score)
+  for (const auto& [in_setting, m] : all) {
+    auto it = best.find(m.region);
+    if (it == best.end() || m.score > it->second.second) best[m.region] = {in_setting, m.score};
+  }
+  std::vector<Match> matches;
+  for (auto& [in_setting, m] : all)
+    if (best[m.region].first == in_setting) matches.push_back(std::move(m));
+  std::stable_sort(matches.begin(), matches.end(),
+                   [](const Match& u, const Match& v) { return u.score > v.score; });
   return matches;
 }
 

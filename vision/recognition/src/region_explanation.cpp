@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 namespace picksight::vision {
 
@@ -13,22 +12,14 @@ RegionExplanation explainRegion(const Region& region, const std::vector<const Pa
   if (models.empty()) return best;
   double max_tolerance = 0;
   for (const PartModel* m : models) max_tolerance = std::max(max_tolerance, m->edge_tolerance);
-  // The models by their minimum hole area: each setting sees the region as
-  // recognition gives it to those models (its smaller holes left out).
-  std::map<double, std::vector<const PartModel*>> settings;
-  for (const PartModel* m : models) settings[m->min_hole_area].push_back(m);
-
   double best_area_gap = 0;
-  double best_score = -1;
-  double best_distance = 0;
+  Verdict best_verdict;
   const auto consider = [&](const PartModel* model, const Verdict& v) {
     const double gap = std::abs(region.area - model->body.area) / std::max(model->body.area, 1.0);
     bool nearer = !best.nearest || static_cast<int>(v.test) > static_cast<int>(best.test);
     if (best.nearest && v.test == best.test) {
-      // Passing models rank as recognize() ranks them: score, then Hu distance.
-      nearer = v.test != RegionTest::kPasses           ? gap < best_area_gap
-               : std::abs(v.score - best_score) > 1e-9 ? v.score > best_score
-                                                       : v.hu_distance < best_distance;
+      // Passing models rank as recognize() ranks them.
+      nearer = v.test != RegionTest::kPasses ? gap < best_area_gap : ranksAbove(v, best_verdict);
     }
     if (!nearer) return;
     best.nearest = model;
@@ -37,10 +28,11 @@ RegionExplanation explainRegion(const Region& region, const std::vector<const Pa
     best.low = v.low;
     best.high = v.high;
     best_area_gap = gap;
-    best_score = v.score;
-    best_distance = v.hu_distance;
+    best_verdict = v;
   };
-  for (const auto& [min_hole_area, list] : settings) {
+  // Each setting sees the region as recognition gives it to its models
+  // (its smaller holes left out).
+  for (const auto& [min_hole_area, list] : byMinHoleArea(models)) {
     if (region.touches_border) {
       for (const PartModel* m : list) consider(m, Verdict{RegionTest::kEdge});
       continue;

@@ -230,19 +230,12 @@ Verdict failed(RegionTest test, double measured, double low, double high) {
 }
 }  // namespace
 
-Verdict judgeRegion(RegionCache& cache, const PartModel& model, bool check_scale) {
+Verdict judgeBody(RegionCache& cache, const PartModel& model, int holes) {
   const Region& r = cache.region();
   const BodyModel& body = model.body;
-  if (r.holes != body.holes) return failed(RegionTest::kHoles, r.holes, body.holes, body.holes);
+  if (holes != body.holes) return failed(RegionTest::kHoles, holes, body.holes, body.holes);
   const double area_ratio = r.area / body.area;
   if (std::abs(area_ratio - 1) > body.area_tolerance) {
-    if (check_scale && area_ratio >= kMinCopyScale * kMinCopyScale &&
-        area_ratio <= kMaxCopyScale * kMaxCopyScale &&
-        huDistance(body, cache.logHu()) <= body.hu_tolerance &&
-        isScaledCopy(cache, model, std::sqrt(area_ratio))) {
-      return failed(RegionTest::kScale, std::sqrt(area_ratio), std::sqrt(1 - body.area_tolerance),
-                    std::sqrt(1 + body.area_tolerance));
-    }
     return failed(RegionTest::kArea, r.area, body.area * (1 - body.area_tolerance),
                   body.area * (1 + body.area_tolerance));
   }
@@ -250,6 +243,41 @@ Verdict judgeRegion(RegionCache& cache, const PartModel& model, bool check_scale
   if (distance > body.hu_tolerance) {
     return failed(RegionTest::kHu, distance, body.hu_tolerance, body.hu_tolerance);
   }
+  Verdict v;
+  v.hu_distance = distance;
+  return v;
+}
+
+bool ranksAbove(const Verdict& a, const Verdict& b) {
+  return a.score > b.score + 1e-9 ||
+         (std::abs(a.score - b.score) <= 1e-9 && a.hu_distance < b.hu_distance);
+}
+
+std::map<double, std::vector<const PartModel*>> byMinHoleArea(
+    const std::vector<const PartModel*>& models) {
+  std::map<double, std::vector<const PartModel*>> settings;
+  for (const PartModel* m : models) settings[m->min_hole_area].push_back(m);
+  return settings;
+}
+
+Verdict judgeRegion(RegionCache& cache, const PartModel& model, bool check_scale) {
+  const Region& r = cache.region();
+  const BodyModel& body = model.body;
+  const Verdict gates = judgeBody(cache, model, r.holes);
+  if (gates.test == RegionTest::kArea) {
+    // Outside the area tolerance, a body and boundary that fit the model
+    // scaled make the region a scaled copy: a whole part, not a blob.
+    const double area_ratio = r.area / body.area;
+    if (check_scale && area_ratio >= kMinCopyScale * kMinCopyScale &&
+        area_ratio <= kMaxCopyScale * kMaxCopyScale &&
+        huDistance(body, cache.logHu()) <= body.hu_tolerance &&
+        isScaledCopy(cache, model, std::sqrt(area_ratio))) {
+      return failed(RegionTest::kScale, std::sqrt(area_ratio), std::sqrt(1 - body.area_tolerance),
+                    std::sqrt(1 + body.area_tolerance));
+    }
+  }
+  if (gates.test != RegionTest::kPasses) return gates;
+  const double distance = gates.hu_distance;
   const EdgeDistance& edges = cache.edges();
   const int k = model.orientation_order;
   const double phase = cache.phaseDeg(k);

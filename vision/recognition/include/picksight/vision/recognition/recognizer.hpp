@@ -25,4 +25,12 @@ namespace picksight::vision {
 std::vector<Match> recognize(const std::vector<Region>& regions,
                              const std::vector<const PartModel*>& models);
 
+// recognize() with each model judging holes with its own minimum hole area
+// (the one it was trained with; byMinHoleArea): one recognize() per setting
+// on the regions as it sees them (withHolesAtLeast). Where several settings
+// found parts in one region, the setting whose best part there scores
+// highest keeps the region. Best score first.
+std::vector<Match> recognizeEachHoleSetting(const std::vector<Region>& regions,
+                                            const std::vector<const PartModel*>& models);
+
 }  // namespace picksight::vision

@@ -86,6 +86,27 @@ struct Verdict {
   double angle_deg = 0;
 };
 
+// The body tests of judgeRegion, in its order: holes (`holes`: the region's
+// count as the model sees them, see holesAtLeast), area, Hu distance. The
+// first failed, with its measured value and bounds, or kPasses with
+// hu_distance set (score unset). Without judgeRegion's scaled-copy search:
+// the gates recognize(), explainRegion() and the cell's `LOCATE <type>`
+// screen across types all apply.
+Verdict judgeBody(RegionCache& cache, const PartModel& model, int holes);
+
+// Of two verdicts that pass every test, whether `a` ranks above `b`: it
+// verifies on more of the boundary (by more than 1e-9), or as much and
+// nearer on the Hu distance. The one ranking of passing models:
+// recognize() reports the first, explainRegion() names it.
+bool ranksAbove(const Verdict& a, const Verdict& b);
+
+// The models by their minimum hole area, smallest first: each group judges
+// a region with its smaller holes left out (withHolesAtLeast), as it was
+// trained to see it. The one grouping of recognizeEachHoleSetting() and
+// explainRegion().
+std::map<double, std::vector<const PartModel*>> byMinHoleArea(
+    const std::vector<const PartModel*>& models);
+
 // The tests of recognize(), in its order, on the region as the model sees
 // it (its holes counted as the caller found them; see withHolesAtLeast):
 // holes, area (a region outside the area tolerance whose body and boundary

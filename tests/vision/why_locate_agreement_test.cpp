@@ -1,0 +1,85 @@
+// WHY against LOCATE on every region of silhouette scenes (separated,
+// touching and overlapping parts, mirrored and rescaled distractors), with
+// models of two minimum hole areas: the region WHY says passes every test
+// of a model is the region LOCATE reports as one whole part of that model,
+// and no other region is; a region WHY calls a whole part drawn other than
+// trained holds no part LOCATE reports.
+#include <catch2/catch.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
+#include "picksight/vision/recognition/region_judge.hpp"
+#include "silhouette_support.hpp"
+
+using namespace picksight::vision;
+using namespace picksight::test;
+namespace ps = picksight::synthetic;
+
+TEST_CASE("WHY names a passing model exactly where LOCATE reports that model's whole part",
+          "[vision][why]") {
+  const ps::SilhouetteSceneOptions look;
+  const std::vector<SilhouetteSpec> specs = {
+      {"turtle", "shapes/tari1000/obj4_1.png", 170},
+      {"bottle", "shapes/tari1000/obj32_1.png", 190},
+      {"twig", "shapes/tari1000/obj43_1.png", 220},
+      {"star", "shapes/tari1000/obj2_1.png", 170},
+      {"gear", "", 150},
+      {"l_shape", "", 160},
+  };
+  SilhouetteModels models = trainSilhouettes(specs, look);
+  // Half the models judge holes from 4 px up, as if taught with that
+  // setting: two groups, each seeing the regions its own way.
+  for (size_t i = 0; i < models.models.size(); i += 2) models.models[i].min_hole_area = 4;
+  const auto list = models.list();
+
+  std::map<RegionTest, int> verdicts;
+  int touching_parts = 0;
+  for (const auto arrangement :
+       {ps::Arrangement::kSeparated, ps::Arrangement::kTouching, ps::Arrangement::kOverlapping}) {
+    for (uint64_t seed = 1; seed <= 2; ++seed) {
+      const ps::SilhouetteScene scene(models.types, models.chiral,
+                                      smallScene(look, seed, 10, 0.3, arrangement));
+      const cv::Mat grey = scene.render(0);
+      // The regions as the cell finds them: the smallest minimum hole area
+      // of the models (0).
+      const auto regions = findRegions(binarize(grey, silhouetteBinarization()), {}, grey);
+      const auto matches = recognizeEachHoleSetting(regions, list);
+      for (const auto& m : matches) touching_parts += m.touching ? 1 : 0;
+      for (size_t i = 0; i < regions.size(); ++i) {
+        const RegionExplanation why = explainRegion(regions[i], list);
+        REQUIRE(why.nearest);
+        verdicts[why.test] += 1;
+        std::vector<const Match*> whole;
+        std::vector<const Match*> in_blob;
+        for (const auto& m : matches) {
+          if (m.region == i) (m.touching ? in_blob : whole).push_back(&m);
+        }
+        INFO(ps::arrangementName(arrangement)
+             << " seed " << seed << " region " << i << " at " << regions[i].centroid.x << ", "
+             << regions[i].centroid.y << ": WHY " << regionTestName(why.test) << " for "
+             << why.nearest->name << ", LOCATE " << whole.size() << " whole part(s), "
+             << in_blob.size() << " in a blob");
+        if (why.test == RegionTest::kPasses) {
+          REQUIRE(whole.size() == 1);
+          CHECK(whole.front()->model == why.nearest);
+          CHECK(in_blob.empty());
+        } else {
+          CHECK(whole.empty());
+        }
+        if (why.test == RegionTest::kScale || why.test == RegionTest::kMirror) {
+          CHECK(in_blob.empty());
+        }
+      }
+    }
+  }
+  // Otherwise the comparison would cover little.
+  CHECK(verdicts[RegionTest::kPasses] >= 10);
+  CHECK(verdicts[RegionTest::kMirror] + verdicts[RegionTest::kScale] >= 3);
+  CHECK(verdicts[RegionTest::kArea] >= 3);
+  CHECK(touching_parts >= 6);
+}
