@@ -162,13 +162,7 @@ std::string defaultAssetsDir() {
   return PICKSIGHT_WEB_INSTALLED_ASSETS;
 }
 
-std::string webUsage() {
-  CLI::App app = webApp();
-  WebOptions o;
-  RawOptions raw;
-  defineOptions(app, o, raw);
-  return app.help();
-}
+std::string webUsage() { return toolUsage(webApp, defineOptions); }
 
 Result<WebOptions> parseWebArgs(const std::vector<std::string>& args, bool* help) {
   return parseToolOptions<WebOptions, RawOptions>(args, help, webApp, defineOptions, finishOptions);

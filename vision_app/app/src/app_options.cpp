@@ -186,13 +186,7 @@ CLI::App visionApp() {
 
 }  // namespace
 
-std::string appUsage() {
-  CLI::App app = visionApp();
-  AppOptions options;
-  RawOptions raw;
-  defineAppOptions(app, options, raw);
-  return app.help();
-}
+std::string appUsage() { return toolUsage(visionApp, defineAppOptions); }
 
 namespace {
 

@@ -112,6 +112,16 @@ Result<T> parseWithConfigFile(const std::vector<std::string>& args, bool* help, 
   return parse(*words, nullptr, nullptr);
 }
 
+// A tool's --help text (`make` and `define` as for parseToolOptions).
+template <typename Options, typename Raw>
+std::string toolUsage(CLI::App (*make)(), void (*define)(CLI::App&, Options&, Raw&)) {
+  CLI::App app = make();
+  Options unused;
+  Raw raw;
+  define(app, unused, raw);
+  return app.help();
+}
+
 // A tool's whole option parse, --config included: `make` builds the app,
 // `define` declares every option into the tool's options and the raw
 // strings its validators check (Raw has a config_file member for
