@@ -8,11 +8,11 @@
 #include <iostream>
 #include <memory>
 
-#include "picksight/camera_link/video_server_camera.hpp"
 #include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
 #include "picksight/common/service_notify.hpp"
 #include "picksight/common/stop_signals.hpp"
+#include "picksight/link/video_server_camera.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/vision_app/app_options.hpp"
 #include "picksight/vision_app/offline_commands.hpp"

@@ -3,8 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include "picksight/calibration/calibration_errors.hpp"
-#include "picksight/camera_link/camera_link.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/protocol/robot_errors.hpp"
 #include "picksight/store/cell_calibration.hpp"

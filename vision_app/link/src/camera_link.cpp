@@ -1,5 +1,5 @@
 // Camera links without a video server: a still image, or none.
-#include "picksight/camera_link/camera_link.hpp"
+#include "picksight/link/camera_link.hpp"
 
 namespace picksight::app {
 

@@ -1,5 +1,5 @@
 // Frame feed thread: owns the SUB socket for its whole life.
-#include "picksight/camera_link/frame_feed.hpp"
+#include "picksight/link/frame_feed.hpp"
 
 #include "picksight/common/log.hpp"
 

@@ -1,5 +1,5 @@
 // The camera link to a video server: triggers, frames and settings.
-#include "picksight/camera_link/video_server_camera.hpp"
+#include "picksight/link/video_server_camera.hpp"
 
 #include <algorithm>
 

@@ -5,8 +5,8 @@
 #include <utility>
 
 #include "picksight/calibration/robot_camera.hpp"
-#include "picksight/camera_link/camera_link.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"

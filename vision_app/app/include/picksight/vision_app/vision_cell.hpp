@@ -11,9 +11,9 @@
 #include <string_view>
 #include <vector>
 
-#include "picksight/camera_link/camera_link.hpp"
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"
 #include "picksight/results/results_publisher.hpp"

@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "picksight/camera_link/camera_link.hpp"
 #include "picksight/common/frame.hpp"
 #include "picksight/common/result.hpp"
+#include "picksight/link/camera_link.hpp"
 #include "picksight/store/model_library.hpp"
 #include "picksight/vision/models/part_model.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"

@@ -15,8 +15,8 @@
 
 #include <zmq.hpp>
 
-#include "picksight/camera_link/camera_link.hpp"
-#include "picksight/camera_link/frame_feed.hpp"
+#include "picksight/link/camera_link.hpp"
+#include "picksight/link/frame_feed.hpp"
 #include "picksight/transport/control_client.hpp"
 
 namespace picksight::app {
