@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 
+#include "picksight/synthetic/front_light.hpp"
 #include "scene_internals.hpp"
 
 namespace picksight::synthetic {
@@ -122,7 +123,8 @@ cv::Point2d imageCentre(const Posed& p, cv::Point at) {
   return {(at.x + p.centroid.x + 0.5) / kS - 0.5, (at.y + p.centroid.y + 0.5) / kS - 0.5};
 }
 
-// Grey levels of a supersampled ink canvas: averaged down, lit, blurred.
+// Grey levels (or BGR levels, for a colour front light) of a supersampled ink
+// canvas: averaged down, lit, blurred.
 cv::Mat shade(const cv::Mat& canvas, const SilhouetteSceneOptions& o, uint64_t seed) {
   cv::Mat coverage;
   cv::resize(canvas, coverage, cv::Size(canvas.cols / kS, canvas.rows / kS), 0, 0, cv::INTER_AREA);
@@ -139,9 +141,18 @@ cv::Mat shade(const cv::Mat& canvas, const SilhouetteSceneOptions& o, uint64_t s
     for (int x = 0; x < grey.cols; ++x) {
       const double u = (x + 0.5) / grey.cols - 0.5;
       const double light = 1.0 + gx * u + gy * v - vignette * (u * u + v * v);
-      g[x] = static_cast<float>(light *
-                                (o.background_level - (o.background_level - o.part_level) * c[x]));
+      // Under the front light the plane holds the light alone; the surface,
+      // the part and their shading are laid on it below.
+      g[x] = o.front.any()
+                 ? static_cast<float>(light)
+                 : static_cast<float>(
+                       light * (o.background_level - (o.background_level - o.part_level) * c[x]));
     }
+  }
+  if (o.front.any()) {
+    const auto planes =
+        detail::shadeFrontLit(coverage, grey, o.front, o.part_level, o.background_level, seed);
+    cv::merge(planes, grey);
   }
   if (o.blur_sigma > 0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), o.blur_sigma);
   return grey;
@@ -150,7 +161,7 @@ cv::Mat shade(const cv::Mat& canvas, const SilhouetteSceneOptions& o, uint64_t s
 cv::Mat addNoise(const cv::Mat& clean, double sigma, uint64_t seed) {
   cv::Mat noisy = clean.clone();
   if (sigma > 0) {
-    cv::Mat noise(clean.size(), CV_32F);
+    cv::Mat noise(clean.size(), clean.type());  // a plane of noise per channel
     cv::RNG rng(detail::splitMix64(seed ^ detail::kNoiseStream) | 1);
     rng.fill(noise, cv::RNG::NORMAL, 0, sigma);
     noisy += noise;

@@ -15,6 +15,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/scene.hpp"
 
 namespace picksight::synthetic {
@@ -66,6 +67,8 @@ struct SilhouetteSceneOptions {
   double background_level = 200;
   double part_level = 45;
   bool uneven_light = true;
+  // The light of a front-lit cell (off: parts lit as from behind).
+  FrontLight front;
 };
 
 struct SilhouettePart {
@@ -87,7 +90,8 @@ class SilhouetteScene {
                   const SilhouetteSceneOptions& options);
 
   const std::vector<SilhouettePart>& truth() const { return truth_; }
-  // The frame with noise that differs per frame index (CV_8UC1).
+  // The frame with noise that differs per frame index (CV_8UC1; CV_8UC3,
+  // BGR, under a colour front light).
   cv::Mat render(uint64_t frame_index) const;
 
  private:
