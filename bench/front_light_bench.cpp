@@ -30,8 +30,8 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
-#include "picksight/vision/binarize.hpp"
-#include "picksight/vision/regions.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 #include "silhouette_types.hpp"
 
 namespace {
@@ -234,7 +234,7 @@ int main(int argc, char** argv) {
                                                                 picksight::bench::kTrainAngleDeg),
                                       jpeg_quality);
       const picksight::Frame frame = frameOf(image);
-      const cv::Mat grey = pa::greyImage(frame);
+      const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
       auto learned =
           pa::learnInImage(grey, frame.mapping, options, models,
                            static_cast<int>(models->size()) + 1, specs[i].name, std::nullopt);

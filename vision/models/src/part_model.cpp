@@ -156,6 +156,16 @@ std::string modelProblem(const PartModel& m) {
     return "area tolerance must be in (0, 1)";
   }
   if (m.body.holes < 0 || m.body.holes > 10000) return "hole count out of range";
+  if (m.colour) {
+    for (int c = 0; c < 3; ++c) {
+      for (const double v : {m.colour->part[c], m.colour->background[c]}) {
+        if (!finite(v) || v < 0 || v > 255) return "colour levels must be in [0, 255]";
+      }
+    }
+    if (cv::norm(m.colour->part - m.colour->background) <= 0) {
+      return "the part's colour must differ from its surface's";
+    }
+  }
   if (!finite(m.min_region_area) || m.min_region_area < 0 || !finite(m.min_hole_area) ||
       m.min_hole_area < 0) {
     return "minimum region and hole areas must be numbers >= 0";

@@ -23,6 +23,12 @@ constexpr int kReduce = 8;
 // contrast estimate is unreliable.
 constexpr double kMaxRatio = 0.85;
 constexpr double kMinRatio = 0.25;
+// Two populations whose means lie this many times their pooled spread apart
+// are parts and background, however little their contrast (30 grey levels
+// on 130 under a front light): the split may then go up to kMaxSeparatedRatio.
+// Noise on an empty field, which Otsu also splits in two, gives about 2.7.
+constexpr double kMinSeparation = 4.0;
+constexpr double kMaxSeparatedRatio = 0.95;
 
 // The mean of every `reduce` x `reduce` block, rounded as cv::resize
 // INTER_AREA rounds it (the same image where the blocks tile the frame),
@@ -154,9 +160,16 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
   double k_ratio = kMaxRatio;
   const int bright = cv::countNonZero(upper);
   if (bright > 0 && bright < upper.rows * upper.cols) {
-    const double mean_bright = cv::mean(ratio8, upper)[0];
-    const double mean_dark = cv::mean(ratio8, ~upper)[0];
-    k_ratio = std::clamp(0.5 * (mean_bright + mean_dark) / 200.0, kMinRatio, kMaxRatio);
+    cv::Scalar mean_bright;
+    cv::Scalar sd_bright;
+    cv::Scalar mean_dark;
+    cv::Scalar sd_dark;
+    cv::meanStdDev(ratio8, mean_bright, sd_bright, upper);
+    cv::meanStdDev(ratio8, mean_dark, sd_dark, ~upper);
+    const double spread = std::sqrt(0.5 * (sd_bright[0] * sd_bright[0] + sd_dark[0] * sd_dark[0]));
+    const bool separated = mean_bright[0] - mean_dark[0] > kMinSeparation * std::max(spread, 1.0);
+    k_ratio = std::clamp(0.5 * (mean_bright[0] + mean_dark[0]) / 200.0, kMinRatio,
+                         separated ? kMaxSeparatedRatio : kMaxRatio);
   } else {
     k_ratio = std::clamp(otsu / 200.0, kMinRatio, kMaxRatio);
   }

@@ -67,6 +67,77 @@ constexpr double kMaxBandTail = 0.01;
 // beyond it.
 constexpr int kBoxMargin = kMaxBand + 2;
 
+// A hole whose brightest pixel lies beyond the background's level, away from
+// the part's, by more than this share of the contrast shows no surface
+// through the part: it is a glint (the lamp reflected by a glossy part), and
+// the part is whole there. A real hole shows the surface under the part, at
+// the background's level give or take its texture and noise, or darker (its
+// rim blurred towards the part's, or in the part's shadow).
+constexpr double kGlintShare = 0.5;
+// The levels beside a region's boundary are read this far out and in.
+constexpr int kSideReachPx = 3;
+// Every this many boundary points is read for them.
+constexpr int kSideStep = 4;
+
+// The median of `values` (reordered); 0 when empty.
+double medianOf(std::vector<float>& values) {
+  if (values.empty()) return 0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+// The levels just outside (the background) and just inside (the part) a
+// region's outer boundary: read a few pixels along the boundary's normal
+// either way, each side where the mask says it is. False when either side
+// has no reading.
+bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
+                double* background, double* part) {
+  std::vector<float> out;
+  std::vector<float> in;
+  const int n = static_cast<int>(outer.size());
+  const cv::Rect frame(0, 0, grey.cols, grey.rows);
+  for (int i = 0; i < n; i += kSideStep) {
+    const cv::Point d =
+        outer[static_cast<size_t>((i + 2) % n)] - outer[static_cast<size_t>((i - 2 + n) % n)];
+    const double len = std::hypot(d.x, d.y);
+    if (len == 0) continue;
+    const cv::Point2d normal(-d.y / len, d.x / len);
+    for (const int sign : {-1, 1}) {
+      const cv::Point q(static_cast<int>(std::lround(outer[static_cast<size_t>(i)].x +
+                                                     sign * kSideReachPx * normal.x)),
+                        static_cast<int>(std::lround(outer[static_cast<size_t>(i)].y +
+                                                     sign * kSideReachPx * normal.y)));
+      if (!frame.contains(q)) continue;
+      (mask.at<uint8_t>(q) ? in : out).push_back(grey.at<uint8_t>(q));
+    }
+  }
+  if (out.empty() || in.empty()) return false;
+  *background = medianOf(out);
+  *part = medianOf(in);
+  return true;
+}
+
+// Whether the hole traced by `hole` is a glint (kGlintShare), given the
+// levels beside its region.
+bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& hole,
+             double background, double part) {
+  const cv::Rect box = cv::boundingRect(hole);
+  cv::Mat inside = cv::Mat::zeros(box.size(), CV_8UC1);
+  cv::drawContours(inside, std::vector<std::vector<cv::Point>>{hole}, 0, cv::Scalar(255),
+                   cv::FILLED, cv::LINE_8, cv::noArray(), 0, -box.tl());
+  // The hole's own pixels: inside its trace and not the part's.
+  cv::Mat free;
+  cv::compare(mask(box), 0, free, cv::CMP_EQ);
+  cv::bitwise_and(inside, free, inside);
+  if (cv::countNonZero(inside) == 0) return false;
+  double level = 0;
+  cv::minMaxLoc(grey(box), nullptr, &level, nullptr, nullptr, inside);
+  const double contrast = part - background;
+  return (level - background) * contrast < 0 &&
+         std::abs(level - background) > kGlintShare * std::abs(contrast);
+}
+
 // A least-squares plane z = a + b x + c y through grey levels, and the
 // spread of the pixels it was fitted to (their second moments about their
 // mean): the slope's noise is the grey noise times the spread's inverse.
@@ -614,6 +685,21 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
 // where they can be trusted), orientation and elongation. Moves its
 // contours out. False, nothing written, for a region smaller than
 // options.min_area.
+// The holes of region `i` (contour indices) that are glints (isGlint).
+std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
+                            const std::vector<std::vector<cv::Point>>& contours,
+                            const std::vector<cv::Vec4i>& hierarchy, int i) {
+  std::vector<int> glints;
+  if (grey.empty() || hierarchy[i][2] < 0) return glints;
+  double background = 0;
+  double part = 0;
+  if (!sideLevels(grey, mask, contours[i], &background, &part)) return glints;
+  for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
+    if (isGlint(grey, mask, contours[h], background, part)) glints.push_back(h);
+  }
+  return glints;
+}
+
 bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions& options,
                    std::vector<std::vector<cv::Point>>& contours,
                    const std::vector<cv::Vec4i>& hierarchy, const std::vector<cv::Rect>& boxes,
@@ -628,10 +714,21 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions
   for (size_t j = 0; j < boxes.size() && alone; ++j) {
     alone = static_cast<int>(j) == i || hierarchy[j][3] >= 0 || (boxes[j] & box).empty();
   }
+  // Glints are not holes: the part is whole under them, and is read so
+  // (filled in the region's mask and in the mask of every region).
+  const std::vector<int> glints = glintHoles(mask, grey, contours, hierarchy, i);
+  cv::Mat set = mask(box);
+  if (!glints.empty()) {
+    set = set.clone();
+    for (const int h : glints) {
+      cv::drawContours(set, contours, h, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
+                       -box.tl());
+    }
+  }
   // The region's pixels over the box: the set pixels 8-connected to its
   // boundary (islands in its holes and neighbours are other regions).
-  RowRuns own_runs = RowRuns::ofMask(mask(box));
-  cv::Mat own = mask(box);
+  RowRuns own_runs = RowRuns::ofMask(set);
+  cv::Mat own = set;
   if (!alone) {
     own_runs = own_runs.connectedTo(contours[i][0] - box.tl());
     own = own_runs.toMask();
@@ -648,11 +745,13 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions
   r.outer = std::move(contours[i]);
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
     if (options.min_hole_area > 0 && cv::contourArea(contours[h]) < options.min_hole_area) continue;
+    if (std::find(glints.begin(), glints.end(), h) != glints.end()) continue;
     r.hole_boundaries.push_back(std::move(contours[h]));
   }
   r.holes = static_cast<int>(r.hole_boundaries.size());
+  r.glints = static_cast<int>(glints.size());
 
-  if (!grey.empty() && greyMoments(grey(box), own, own_runs, mask(box), box, &r.moments,
+  if (!grey.empty() && greyMoments(grey(box), own, own_runs, set, box, &r.moments,
                                    &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
     r.area = r.moments.m00;
   } else {

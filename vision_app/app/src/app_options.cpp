@@ -129,7 +129,9 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
                  "adaptive illumination window, wider than the largest part")
       ->type_name("PIXELS")
       ->check(checkValue([](const std::string& v) { return checkRange(v, 8, 16384); }));
-  app.add_option("--min-area", raw.min_area, "smallest region that counts as a part (default 50)")
+  app.add_option("--min-area", raw.min_area,
+                 "smallest region that counts as a part (default: 50, or a twentieth of the "
+                 "smallest trained part when that is more)")
       ->type_name("PIXELS")
       ->check(checkValue([](const std::string& v) {
         auto m = parseDouble(v);
@@ -219,7 +221,10 @@ Result<AppOptions> finishOptions(AppOptions o, RawOptions& raw) {
   }
   if (!raw.window.empty())
     o.vision.binarize.adaptive_window = static_cast<int>(*parseInt(raw.window));
-  if (!raw.min_area.empty()) o.vision.regions.min_area = *parseDouble(raw.min_area);
+  if (!raw.min_area.empty()) {
+    o.vision.regions.min_area = *parseDouble(raw.min_area);
+    o.vision.min_area_follows_models = false;
+  }
   if (!raw.min_hole_area.empty()) o.vision.regions.min_hole_area = *parseDouble(raw.min_hole_area);
   o.plc.enabled = !raw.modbus_port.empty();
   if (o.plc.enabled) o.plc.server.listen.port = static_cast<uint16_t>(*parseInt(raw.modbus_port));

@@ -63,6 +63,17 @@ vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
   return o;
 }
 
+double speckAreaFor(const std::vector<vision::PartModel>& models) {
+  // A part half hidden under another, or the smaller of two scaled copies,
+  // is still ten times this; the coarse grain of a textured belt is not.
+  constexpr double kSpeckShare = 0.05;
+  double smallest = 0;
+  for (const auto& m : models) {
+    if (smallest == 0 || m.body.area < smallest) smallest = m.body.area;
+  }
+  return kSpeckShare * smallest;
+}
+
 RecognitionPass recognizeParts(const std::vector<vision::Region>& regions,
                                const std::vector<vision::PartModel>& models, int type) {
   std::vector<const vision::PartModel*> asked;

@@ -11,6 +11,7 @@
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/colour_axis.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
 namespace picksight::app {
@@ -44,13 +45,31 @@ cv::Mat greyImage(const Frame& frame) {
   return grey;
 }
 
+std::vector<vision::ColourAxis> colourAxes(const ModelList& models) {
+  std::vector<vision::ColourAxis> axes;
+  for (const auto& m : models) {
+    if (m.colour) axes.push_back(*m.colour);
+  }
+  return axes;
+}
+
+cv::Mat visionImage(const Frame& frame, const ModelList& models) {
+  if (frame.image.channels() != 3) return frame.image;
+  const auto axes = colourAxes(models);
+  return axes.empty() ? greyImage(frame) : vision::projectOnColourAxes(frame.image, axes);
+}
+
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
                                        int type, LocateScene* scene) {
   LocateScene local;
   LocateScene& s = scene ? *scene : local;
   s.mask = vision::binarize(grey, options.binarize);
-  s.regions = vision::findRegions(s.mask, regionOptionsFor(options.regions, models), grey);
+  vision::RegionOptions region_options = regionOptionsFor(options.regions, models);
+  if (options.min_area_follows_models) {
+    region_options.min_area = std::max(region_options.min_area, speckAreaFor(models));
+  }
+  s.regions = vision::findRegions(s.mask, region_options, grey);
   s.mapping = mapping;
   const auto& regions = s.regions;
   std::vector<LocatedPart> parts;
@@ -143,10 +162,14 @@ LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
   outcome.frame = frame.info;
   outcome.scene.models = cache ? cache->forFrame(std::move(models), frame.mapping)
                                : modelsForFrame(std::move(models), frame.mapping);
-  const cv::Mat grey = greyImage(frame);
-  outcome.parts = locateInImage(
-      grey, frame.mapping, frameOptions(options, frame.mapping, grey.size(), *outcome.scene.models),
-      *outcome.scene.models, type, &outcome.scene);
+  const cv::Mat grey = visionImage(frame, *outcome.scene.models);
+  VisionOptions o = frameOptions(options, frame.mapping, grey.size(), *outcome.scene.models);
+  // The colour projection makes every taught colour dark on its surface.
+  if (frame.image.channels() == 3 && !colourAxes(*outcome.scene.models).empty()) {
+    o.binarize.polarity = vision::Polarity::kDarkOnLight;
+  }
+  outcome.parts =
+      locateInImage(grey, frame.mapping, o, *outcome.scene.models, type, &outcome.scene);
   return outcome;
 }
 
@@ -227,7 +250,7 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  auto learned = learnInImage(greyImage(**frame), (*frame)->mapping, options_, models_->snapshot(),
+  auto learned = learnInImage((*frame)->image, (*frame)->mapping, options_, models_->snapshot(),
                               type, name, at, scaled_models_.get());
   if (!learned) return learned.error();
   auto stored = models_->store(learned->model);
@@ -244,6 +267,44 @@ constexpr double kInsideShare = 0.5;
 constexpr double kSmallHoleShare = 0.005;
 // A part under this many times the minimum region area is barely resolved.
 constexpr double kSmallPartFactor = 10;
+// Beside the largest region LEARN sees, regions under this share of its
+// area are specks and stains (a textured belt's grain and blotches, dust,
+// the rim of a glint), not parts: a person looking at the image sees one part
+// there. A second part of the same type, or a half-size one, is far above
+// it. (On a worn belt, stains reach 12 % of a 200 px part's area.)
+constexpr double kSpeckShare = 0.15;
+
+// The regions LEARN sees (indices): the one it will train on, the specks it
+// ignores beside it, and the others, which are parts.
+struct LearnRegions {
+  size_t part = 0;
+  std::vector<size_t> specks;
+  std::vector<size_t> others;
+};
+
+LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
+                          const std::vector<size_t>& inside) {
+  LearnRegions out;
+  out.part = inside.front();
+  for (const size_t i : inside) {
+    if (regions[i].area > regions[out.part].area) out.part = i;
+  }
+  for (const size_t i : inside) {
+    if (i == out.part) continue;
+    (regions[i].area < kSpeckShare * regions[out.part].area ? out.specks : out.others).push_back(i);
+  }
+  return out;
+}
+
+// What LEARN left out, for its reply (sensor pixels).
+std::string specksNote(const std::vector<vision::Region>& regions,
+                       const std::vector<size_t>& specks, const SensorMapping& mapping) {
+  double largest = 0;
+  for (const size_t i : specks) largest = std::max(largest, regions[i].area);
+  return "ignored " + std::to_string(specks.size()) + (specks.size() == 1 ? " speck" : " specks") +
+         " of up to " + std::to_string(std::lround(mapping.areaToSensor(largest))) +
+         " px beside the part";
+}
 
 // A rectangle of sensor pixels as the frame pixels it covers, clipped to
 // the image (empty when it covers none).
@@ -307,12 +368,25 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const SensorMapp
 }
 }  // namespace
 
-Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapping,
+Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& mapping,
                                   const VisionOptions& options,
                                   std::shared_ptr<const ModelList> models, int type,
                                   const std::string& name, const std::optional<cv::Rect>& at,
                                   ScaledModelCache* cache) {
-  const cv::Rect rect = at ? frameRect(*at, mapping, grey.size()) : cv::Rect({0, 0}, grey.size());
+  const cv::Rect rect = at ? frameRect(*at, mapping, image.size()) : cv::Rect({0, 0}, image.size());
+  // A colour frame is read in colour when the part's colour tells it from
+  // its surface clearly better than its grey level does.
+  std::optional<vision::ColourAxis> colour;
+  cv::Mat grey = image;
+  if (image.channels() == 3) {
+    if (!rect.empty()) colour = vision::colourAxisIn(image, rect);
+    if (colour && !vision::colourSeparatesBetter(*colour)) colour.reset();
+    if (colour) {
+      grey = vision::projectOnColourAxes(image, {*colour});
+    } else {
+      cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    }
+  }
   if (rect.empty()) {
     return makeError(VisionErrc::kOutsideFrame,
                      "LEARN AT " + sensorRectText(*at) +
@@ -323,6 +397,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapp
                                   : modelsForFrame(std::move(models), mapping);
   VisionOptions o = frameOptions(options, mapping, grey.size(), *frame_models);
   o.regions.keep_border_regions = true;
+  if (colour) o.binarize.polarity = vision::Polarity::kDarkOnLight;
   for (int pass = 0;; ++pass) {
     const auto regions = vision::findRegions(vision::binarize(grey, o.binarize), o.regions, grey);
     const auto inside = regionsInside(regions, rect);
@@ -331,8 +406,9 @@ Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapp
       return makeError(VisionErrc::kNoPartInRectangle,
                        "no part inside LEARN AT " + sensorRectText(*at));
     }
-    if (inside.size() > 1) {
-      const std::string count = std::to_string(inside.size()) + " parts";
+    const LearnRegions seen = sortForLearn(regions, inside);
+    if (!seen.others.empty()) {
+      const std::string count = std::to_string(seen.others.size() + 1) + " parts";
       if (!at) {
         return makeError(vision::PartModelErrc::kSeveralParts,
                          count + " in the frame, LEARN needs exactly one (or LEARN ... AT)");
@@ -341,7 +417,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapp
           VisionErrc::kSeveralPartsInRectangle,
           count + " inside LEARN AT " + sensorRectText(*at) + ", it needs exactly one");
     }
-    const vision::Region& r = regions[inside.front()];
+    const vision::Region& r = regions[seen.part];
     // A window narrower than the part (a tight crop, a small image) breaks
     // its middle into phantom holes: binarize again with one that fits it,
     // as LOCATE will once the model exists.
@@ -363,7 +439,9 @@ Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapp
     out.model.trained_angle_deg = mapping.directionToSensor(r.angle_deg);
     out.model.min_region_area = options.regions.min_area;
     out.model.min_hole_area = options.regions.min_hole_area;
+    out.model.colour = colour;
     out.warnings = learnWarnings(r, mapping, options);
+    if (!seen.specks.empty()) out.notes.push_back(specksNote(regions, seen.specks, mapping));
     return out;
   }
 }

@@ -30,6 +30,7 @@ std::string learnReply(const LearnOutcome& learned) {
       "OK " + modelSummary(learned.model) + " " + (learned.model.body.mirror_symmetric ? "1" : "0");
   // Robots read the fields up to the first ';' and may ignore the rest.
   for (const auto& w : learned.warnings) reply += " ; warning: " + w;
+  for (const auto& n : learned.notes) reply += " ; note: " + n;
   return reply;
 }
 

@@ -92,6 +92,18 @@ std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   out << YAML::Key << "min_hole_area" << YAML::Value << m.min_hole_area;
   out << YAML::EndMap;
 
+  // Optional on reading: a model taught in grey levels has none.
+  if (m.colour) {
+    out << YAML::Key << "colour" << YAML::Value << YAML::BeginMap;
+    for (const auto& [key, bgr] :
+         {std::pair<const char*, cv::Vec3d>{"part_bgr", m.colour->part},
+          std::pair<const char*, cv::Vec3d>{"background_bgr", m.colour->background}}) {
+      out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << bgr[0] << bgr[1]
+          << bgr[2] << YAML::EndSeq;
+    }
+    out << YAML::EndMap;
+  }
+
   out << YAML::Key << "body" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "area" << YAML::Value << m.body.area;
   out << YAML::Key << "area_tolerance" << YAML::Value << m.body.area_tolerance;
@@ -246,6 +258,19 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
       const YAML::Node regions = root["regions"];
       m.min_region_area = as<double>(regions, "min_area");
       m.min_hole_area = as<double>(regions, "min_hole_area");
+    }
+
+    if (root["colour"]) {
+      const YAML::Node colour = root["colour"];
+      vision::ColourAxis axis;
+      for (const auto& [key, bgr] :
+           {std::pair<const char*, cv::Vec3d*>{"part_bgr", &axis.part},
+            std::pair<const char*, cv::Vec3d*>{"background_bgr", &axis.background}}) {
+        const auto v = as<std::vector<double>>(colour, key);
+        if (v.size() != 3) throw FieldError{std::string("colour: ") + key + " needs 3 values"};
+        *bgr = cv::Vec3d(v[0], v[1], v[2]);
+      }
+      m.colour = axis;
     }
 
     const YAML::Node body = need(root, "body");

@@ -21,6 +21,12 @@ namespace picksight::app {
 vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
                                        const std::vector<vision::PartModel>& models);
 
+// The smallest region worth a look when every type is known: a share of the
+// smallest model's area (frame pixels; 0 with no models). Anything smaller is
+// a speck (a belt's grain, dust, a glint's rim) that no model can be, and
+// costs a region pass and a WHY line for nothing.
+double speckAreaFor(const std::vector<vision::PartModel>& models);
+
 // Why a region left out of `LOCATE <type>` by the screen is not the asked type.
 struct ScreenedOut {
   size_t region = 0;

@@ -100,11 +100,19 @@ struct TargetOutcome {
 struct VisionOptions {
   vision::BinarizeOptions binarize;
   vision::RegionOptions regions;
+  // LOCATE's smallest region follows the trained models (speckAreaFor) when
+  // the user did not set one: regions.min_area is then only its floor.
+  bool min_area_follows_models = true;
   std::chrono::milliseconds frame_timeout{3000};
 };
 
 // The frame's image as 8-bit grey: the image itself, or a converted copy.
 cv::Mat greyImage(const Frame& frame);
+
+// The image the vision pass reads from a frame: a colour frame projected on
+// the colour axes of the models taught in colour (vision/segmentation/colour_axis.hpp),
+// or its grey levels when none was; a grey frame as it is.
+cv::Mat visionImage(const Frame& frame, const ModelList& models);
 
 // Frame pixels per sensor pixel along no particular axis (the geometric
 // mean of the two scales), and whether that is a resize at all.
@@ -130,14 +138,21 @@ VisionOptions frameOptions(const VisionOptions& options, const SensorMapping& ma
 struct LearnOutcome {
   vision::PartModel model;
   std::vector<std::string> warnings;
+  // What LEARN left out and why (specks beside the part), for the reply.
+  std::vector<std::string> notes;
 };
 
 // LEARN on one grey frame: binarizes the whole frame as LOCATE would (with
 // `models`, sensor pixels, widening the window), then trains from the one
-// part inside `at` (sensor pixels; none: the whole frame). Parts touching
+// part inside `at` (sensor pixels; none: the whole frame): the largest
+// region there, ignoring specks far smaller than it (LearnOutcome::notes
+// says how many), refusing when another region is a part's size. `image` is
+// grey or BGR: in colour, the part is taught on its colour (the model keeps
+// the colour axis) when that tells it from its surface better than grey
+// levels do. Parts touching
 // the frame border are taken only when there is no other. `cache` (may be
 // null) keeps the models scaled for a resized frame.
-Result<LearnOutcome> learnInImage(const cv::Mat& grey, const SensorMapping& mapping,
+Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& mapping,
                                   const VisionOptions& options,
                                   std::shared_ptr<const ModelList> models, int type,
                                   const std::string& name, const std::optional<cv::Rect>& at,

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "picksight/vision/models/boundary_model.hpp"
 #include "picksight/vision/models/boundary_verification.hpp"
 #include "picksight/vision/segmentation/blob_features.hpp"
+#include "picksight/vision/segmentation/colour_axis.hpp"
 
 namespace picksight::vision {
 
@@ -69,6 +71,10 @@ struct PartModel {
   // smaller than these were not part of the image it learned from.
   double min_region_area = 0;
   double min_hole_area = 0;
+  // Taught in colour: the part's colour and its surface's, when colour told
+  // them apart better than grey levels (colourSeparatesBetter). Colour
+  // frames are then read projected on this axis. None: grey levels.
+  std::optional<ColourAxis> colour;
   // Boundary: primitives in the model frame, their corners, and the
   // verification settings.
   double conformity = 1.0;      // pixels

@@ -1,0 +1,72 @@
+// Regions under a front-lit cell's light: specular glints on a glossy part
+// are not holes (the part is whole under them, and placed as if they were not
+// there), while a real hole, which shows the surface, still counts.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "picksight/synthetic/front_light.hpp"
+#include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+
+namespace ps = picksight::synthetic;
+namespace pv = picksight::vision;
+
+namespace {
+// The one large region of `image` (dark parts on light), CHECKs there is one.
+pv::Region onlyPart(const cv::Mat& image) {
+  pv::BinarizeOptions b;
+  b.adaptive_window = 500;
+  pv::RegionOptions r;
+  r.min_area = 2000;
+  const auto regions = pv::findRegions(pv::binarize(image, b), r, image);
+  REQUIRE(regions.size() == 1);
+  return regions.front();
+}
+
+// A glossy look: the part at 85 on a surface at 150, a few glints per part.
+ps::SilhouetteSceneOptions glossy(int glints) {
+  ps::SilhouetteSceneOptions look;
+  look.part_level = 85;
+  look.background_level = 150;
+  look.uneven_light = false;
+  look.front.glints_per_part = glints;
+  look.front.glint_radius_px = 3;
+  return look;
+}
+}  // namespace
+
+TEST_CASE("glints on a glossy part are not holes, and do not move it", "[vision][regions][front]") {
+  for (const char* name : {"l_shape", "rectangle", "t_shape"}) {
+    CAPTURE(name);
+    const ps::SilhouetteType type = ps::silhouetteFromPartType(name, 200);
+    cv::Point2d drawn;
+    const cv::Mat plain = ps::renderSilhouetteAlone(type, 400, glossy(0), 3, &drawn, 20);
+    const cv::Mat shiny = ps::renderSilhouetteAlone(type, 400, glossy(3), 3, nullptr, 20);
+    // The glints are there: bright pixels inside the part, lighter than its
+    // surface.
+    double brightest = 0;
+    cv::minMaxLoc(shiny, nullptr, &brightest);
+    REQUIRE(brightest > 200);
+    const pv::Region without = onlyPart(plain);
+    const pv::Region with = onlyPart(shiny);
+    CHECK(without.holes == 0);
+    CHECK(with.holes == 0);
+    CHECK(with.area == Approx(without.area).epsilon(0.003));
+    CHECK(cv::norm(with.centroid - without.centroid) < 0.05);
+  }
+}
+
+TEST_CASE("a real hole still counts beside glints", "[vision][regions][front]") {
+  // disc_holes: a disc with holes that show the surface through it.
+  const ps::SilhouetteType type = ps::silhouetteFromPartType("disc_holes", 200);
+  const cv::Mat plain = ps::renderSilhouetteAlone(type, 400, glossy(0), 5, nullptr, 0);
+  const cv::Mat shiny = ps::renderSilhouetteAlone(type, 400, glossy(4), 5, nullptr, 0);
+  const pv::Region without = onlyPart(plain);
+  REQUIRE(without.holes > 0);
+  CHECK(onlyPart(shiny).holes == without.holes);
+}

@@ -1,0 +1,228 @@
+// Teaching and locating under a front-lit cell's light, as a user does it:
+// LEARN on a textured belt takes the one part a person sees and names the
+// specks it left out; LOCATE's smallest region follows the taught parts; a
+// green part on a grey belt of the same brightness is taught and found in
+// colour; a model's colour survives its file; the sweets photograph.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "picksight/cell/recognition_pass.hpp"
+#include "picksight/cell/vision_service.hpp"
+#include "picksight/common/frame.hpp"
+#include "picksight/store/model_file.hpp"
+#include "picksight/synthetic/front_light.hpp"
+#include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
+
+using namespace picksight;
+using namespace picksight::app;
+namespace ps = picksight::synthetic;
+namespace pv = picksight::vision;
+
+namespace {
+// A look of the named condition (front_light.hpp).
+ps::SilhouetteSceneOptions lookOf(const std::string& condition) {
+  ps::SilhouetteSceneOptions look;
+  REQUIRE(
+      ps::frontLightCondition(condition, &look.front, &look.part_level, &look.background_level));
+  return look;
+}
+
+VisionOptions cellOptions() {
+  VisionOptions o;
+  o.binarize.adaptive_window = 400;
+  return o;
+}
+
+std::shared_ptr<const ModelList> noModels() { return std::make_shared<const ModelList>(); }
+
+std::shared_ptr<const ModelList> listOf(const pv::PartModel& m) {
+  return std::make_shared<const ModelList>(ModelList{m});
+}
+
+// The box a user drags around a part drawn at `centre`, `size` across.
+cv::Rect boxAround(cv::Point2d centre, double size) {
+  const double half = 0.6 * size;
+  return {static_cast<int>(centre.x - half), static_cast<int>(centre.y - half),
+          static_cast<int>(2 * half), static_cast<int>(2 * half)};
+}
+
+// Parts of `truth` of kind kTrue found by `parts` within 2 px.
+int foundTrue(const std::vector<ps::SilhouettePart>& truth, const std::vector<LocatedPart>& parts) {
+  int found = 0;
+  for (const auto& t : truth) {
+    if (t.kind != ps::PartKind::kTrue) continue;
+    for (const auto& p : parts) {
+      if (p.type >= 0 && std::hypot(p.x - t.centre.x, p.y - t.centre.y) < 2) {
+        ++found;
+        break;
+      }
+    }
+  }
+  return found;
+}
+
+const ps::SilhouetteType& boneType() {
+  static const ps::SilhouetteType t = ps::silhouetteFromPartType("t_shape", 200);
+  return t;
+}
+}  // namespace
+
+// A worn belt: the textured condition with twice its grain and blotches, so
+// that its darkest spots binarize as specks and stains beside the part (with
+// seed 12, a stain of 12 % of the part's area and eleven specks).
+ps::SilhouetteSceneOptions wornBelt() {
+  ps::SilhouetteSceneOptions look = lookOf("textured");
+  look.front.texture = 0.12;
+  return look;
+}
+
+TEST_CASE("LEARN on a textured belt takes the part and names the specks it left out",
+          "[vision_app][learn][front]") {
+  const auto look = wornBelt();
+  cv::Point2d drawn;
+  const cv::Mat image = ps::renderSilhouetteAlone(boneType(), 600, look, 12, &drawn, 30);
+  // The belt's grain binarizes as specks beside the part, as a user's belt does.
+  const auto regions = pv::findRegions(pv::binarize(image, cellOptions().binarize), {}, image);
+  REQUIRE(regions.size() > 3);
+  const auto learned = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  INFO((learned.ok() ? std::string() : learned.error().message));
+  REQUIRE(learned.ok());
+  CHECK(std::abs(learned->model.trained_centroid.x - drawn.x) < 1);
+  CHECK(std::abs(learned->model.trained_centroid.y - drawn.y) < 1);
+  REQUIRE(learned->notes.size() == 1);
+  CHECK(learned->notes.front().find("specks") != std::string::npos);
+  // LEARN ... AT a box around it says the same.
+  const auto at =
+      learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+  REQUIRE(at.ok());
+  CHECK(at->model.body.area == Approx(learned->model.body.area).epsilon(1e-9));
+}
+
+TEST_CASE("LEARN still refuses two parts on a textured belt", "[vision_app][learn][front]") {
+  ps::SilhouetteSceneOptions o = wornBelt();
+  o.width = 800;
+  o.height = 600;
+  o.parts = 2;
+  o.distractor_share = 0;
+  const ps::SilhouetteScene scene({boneType()}, {true}, o);
+  REQUIRE(scene.truth().size() == 2);
+  const auto learned =
+      learnInImage(scene.render(0), {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  REQUIRE_FALSE(learned.ok());
+  CHECK(learned.error().code == pv::PartModelErrc::kSeveralParts);
+}
+
+TEST_CASE("LOCATE's smallest region follows the taught parts unless the user set one",
+          "[vision_app][locate][front]") {
+  ps::SilhouetteSceneOptions o = wornBelt();
+  cv::Point2d drawn;
+  const auto learned = learnInImage(ps::renderSilhouetteAlone(boneType(), 600, o, 12, &drawn, 30),
+                                    {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  REQUIRE(learned.ok());
+  o.width = 1280;
+  o.height = 960;
+  o.parts = 8;
+  o.distractor_share = 0;
+  const ps::SilhouetteScene scene({boneType()}, {true}, o);
+  const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+  const auto models = listOf(learned->model);
+  const LocateOutcome followed = locateInFrame(frame, cellOptions(), models, -1);
+  VisionOptions fixed = cellOptions();
+  fixed.min_area_follows_models = false;
+  const LocateOutcome set = locateInFrame(frame, fixed, models, -1);
+  // The parts are found either way; the specks are regions only when the
+  // user asked for regions that small.
+  CHECK(foundTrue(scene.truth(), followed.parts) == static_cast<int>(scene.truth().size()));
+  CHECK(foundTrue(scene.truth(), set.parts) == static_cast<int>(scene.truth().size()));
+  CHECK(set.scene.regions.size() > followed.scene.regions.size());
+  for (const auto& r : followed.scene.regions) {
+    CHECK(r.area >= speckAreaFor(*models));
+  }
+  CHECK(speckAreaFor(*models) == Approx(0.05 * learned->model.body.area));
+}
+
+TEST_CASE("a green part on a grey belt of the same brightness is taught and found in colour",
+          "[vision_app][colour][front]") {
+  ps::SilhouetteSceneOptions o = lookOf("colour");
+  cv::Point2d drawn;
+  const cv::Mat alone = ps::renderSilhouetteAlone(boneType(), 600, o, 13, &drawn, 30);
+  REQUIRE(alone.type() == CV_8UC3);
+  const auto learned =
+      learnInImage(alone, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+  REQUIRE(learned.ok());
+  REQUIRE(learned->model.colour.has_value());
+  CHECK(cv::norm(learned->model.trained_centroid - drawn) < 0.5);
+  // In grey the part is the belt's level: what LEARN finds there (a blotch
+  // of the belt, if anything) is not the part.
+  cv::Mat grey;
+  cv::cvtColor(alone, grey, cv::COLOR_BGR2GRAY);
+  const auto in_grey =
+      learnInImage(grey, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+  if (in_grey.ok()) {
+    CHECK(std::abs(in_grey->model.body.area / learned->model.body.area - 1) > 0.2);
+  }
+  CHECK(cv::norm(learned->model.colour->part - cv::Vec3d(60, 160, 70)) < 40);
+  o.width = 1280;
+  o.height = 960;
+  o.parts = 8;
+  o.distractor_share = 0;
+  const ps::SilhouetteScene scene({boneType()}, {true}, o);
+  const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+  const LocateOutcome located = locateInFrame(frame, cellOptions(), listOf(learned->model), -1);
+  CHECK(foundTrue(scene.truth(), located.parts) == static_cast<int>(scene.truth().size()));
+}
+
+TEST_CASE("a model's colour survives its file, and a damaged colour is refused",
+          "[vision_app][colour][front]") {
+  ps::SilhouetteSceneOptions o = lookOf("colour");
+  cv::Point2d drawn;
+  const cv::Mat alone = ps::renderSilhouetteAlone(boneType(), 600, o, 13, &drawn, 30);
+  const auto learned =
+      learnInImage(alone, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+  REQUIRE(learned.ok());
+  REQUIRE(learned->model.colour.has_value());
+  const std::string yaml = modelToYaml(learned->model);
+  const auto back = modelFromYaml(yaml);
+  REQUIRE(back.ok());
+  REQUIRE(back->colour.has_value());
+  CHECK(back->colour->part == learned->model.colour->part);
+  CHECK(back->colour->background == learned->model.colour->background);
+  std::string damaged = yaml;
+  const auto at = damaged.find("part_bgr: [");
+  REQUIRE(at != std::string::npos);
+  damaged.replace(at, 11, "part_bgr: [900, ");
+  CHECK_FALSE(modelFromYaml(damaged).ok());
+}
+
+TEST_CASE("the sweets photograph: a green sweet taught in colour is found",
+          "[vision_app][photograph][colour][front]") {
+  const cv::Mat photo =
+      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/smarties.png", cv::IMREAD_COLOR);
+  REQUIRE(!photo.empty());
+  VisionOptions options;
+  // The green sweet alone in the upper middle, as a user drags the box.
+  const cv::Rect box(236, 85, 64, 64);
+  const auto learned = learnInImage(photo, {}, options, noModels(), 1, "green", box);
+  REQUIRE(learned.ok());
+  REQUIRE(learned->model.colour.has_value());
+  // Green: its green level well above its blue and red ones.
+  const cv::Vec3d green = learned->model.colour->part;
+  CHECK(green[1] > green[0] + 40);
+  CHECK(green[1] > green[2] + 40);
+  const Frame frame = frameFromImage(photo, "cam0", 1);
+  const LocateOutcome located = locateInFrame(frame, options, listOf(learned->model), -1);
+  const cv::Point2d taught = learned->model.trained_centroid;
+  bool found = false;
+  for (const auto& p : located.parts) {
+    found = found || (p.type == 1 && std::hypot(p.x - taught.x, p.y - taught.y) < 1);
+  }
+  CHECK(found);
+}

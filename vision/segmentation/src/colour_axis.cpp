@@ -1,0 +1,118 @@
+// Colour axes: projection of a colour frame on the axis between a part's
+// colour and its surface's, and the axis of a part taught in a rectangle.
+#include "picksight/vision/segmentation/colour_axis.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace picksight::vision {
+namespace {
+// Two colours closer than this (BGR distance) are one, whatever the noise.
+constexpr double kMinColourDistance = 20;
+// ... or closer than this many times the rim's own spread (its texture and
+// noise).
+constexpr double kMinDistanceOverSpread = 3;
+// A rectangle narrower than this holds no part with a rim around it.
+constexpr int kMinSide = 8;
+
+double luma(const cv::Vec3d& bgr) { return 0.114 * bgr[0] + 0.587 * bgr[1] + 0.299 * bgr[2]; }
+
+// The per-channel median of `pixels` (BGR), and their spread: the root mean
+// square distance from it.
+cv::Vec3d medianColour(std::vector<cv::Vec3b>& pixels, double* spread) {
+  cv::Vec3d m;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<uint8_t> channel(pixels.size());
+    for (size_t i = 0; i < pixels.size(); ++i) channel[i] = pixels[i][c];
+    const auto mid = channel.begin() + static_cast<std::ptrdiff_t>(channel.size() / 2);
+    std::nth_element(channel.begin(), mid, channel.end());
+    m[c] = *mid;
+  }
+  if (spread) {
+    double sum = 0;
+    for (const auto& p : pixels) {
+      const cv::Vec3d d = cv::Vec3d(p[0], p[1], p[2]) - m;
+      sum += d.dot(d);
+    }
+    *spread = pixels.empty() ? 0 : std::sqrt(sum / static_cast<double>(pixels.size()));
+  }
+  return m;
+}
+}  // namespace
+
+cv::Mat projectOnColourAxes(const cv::Mat& bgr, const std::vector<ColourAxis>& axes) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  cv::Mat out;
+  for (const auto& axis : axes) {
+    const cv::Vec3d d = axis.background - axis.part;
+    const double d2 = d.dot(d);
+    if (d2 <= 0) continue;
+    // level = part + (background - part) * t, t = (p - part) . d / |d|^2: a
+    // linear map of the three channels, done by cv::transform at full speed.
+    const double gain = (kColourBackgroundLevel - kColourPartLevel) / d2;
+    const cv::Matx14d m(gain * d[0], gain * d[1], gain * d[2],
+                        kColourPartLevel - gain * axis.part.dot(d));
+    cv::Mat one;
+    cv::transform(bgr, one, m);
+    if (out.empty()) {
+      out = one;
+    } else {
+      cv::min(out, one, out);
+    }
+  }
+  if (out.empty()) cv::cvtColor(bgr, out, cv::COLOR_BGR2GRAY);
+  return out;
+}
+
+std::optional<ColourAxis> colourAxisIn(const cv::Mat& bgr, const cv::Rect& rect) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  const cv::Rect r = rect & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (r.width < kMinSide || r.height < kMinSide) return std::nullopt;
+  const cv::Mat box = bgr(r);
+  std::vector<cv::Vec3b> rim;
+  for (int x = 0; x < box.cols; ++x) {
+    rim.push_back(box.at<cv::Vec3b>(0, x));
+    rim.push_back(box.at<cv::Vec3b>(box.rows - 1, x));
+  }
+  for (int y = 1; y + 1 < box.rows; ++y) {
+    rim.push_back(box.at<cv::Vec3b>(y, 0));
+    rim.push_back(box.at<cv::Vec3b>(y, box.cols - 1));
+  }
+  double spread = 0;
+  ColourAxis axis;
+  axis.background = medianColour(rim, &spread);
+  // Distance from the surface's colour, on 8 bits for Otsu.
+  cv::Mat distance(box.size(), CV_8UC1);
+  for (int y = 0; y < box.rows; ++y) {
+    const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
+    uint8_t* d = distance.ptr<uint8_t>(y);
+    for (int x = 0; x < box.cols; ++x) {
+      const cv::Vec3d v = cv::Vec3d(p[x][0], p[x][1], p[x][2]) - axis.background;
+      d[x] = cv::saturate_cast<uint8_t>(std::sqrt(v.dot(v)));
+    }
+  }
+  cv::Mat far;
+  cv::threshold(distance, far, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  std::vector<cv::Vec3b> part;
+  for (int y = 0; y < box.rows; ++y) {
+    const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
+    const uint8_t* f = far.ptr<uint8_t>(y);
+    for (int x = 0; x < box.cols; ++x) {
+      if (f[x]) part.push_back(p[x]);
+    }
+  }
+  if (part.empty()) return std::nullopt;
+  axis.part = medianColour(part, nullptr);
+  const double apart = cv::norm(axis.part - axis.background);
+  if (apart < std::max(kMinColourDistance, kMinDistanceOverSpread * spread)) return std::nullopt;
+  return axis;
+}
+
+bool colourSeparatesBetter(const ColourAxis& axis, double factor) {
+  return cv::norm(axis.part - axis.background) >
+         factor * std::abs(luma(axis.part) - luma(axis.background));
+}
+
+}  // namespace picksight::vision
