@@ -226,3 +226,38 @@ TEST_CASE("the sweets photograph: a green sweet taught in colour is found",
   }
   CHECK(found);
 }
+
+namespace {
+// The warnings LEARN gives the t-shaped part alone under `condition`.
+std::vector<std::string> learnWarningsUnder(const std::string& condition) {
+  cv::Point2d drawn;
+  const cv::Mat image =
+      ps::renderSilhouetteAlone(boneType(), 600, lookOf(condition), 12, &drawn, 30);
+  const auto learned =
+      learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+  REQUIRE(learned.ok());
+  for (const auto& w : learned->warnings) UNSCOPED_INFO(condition << ": " << w);
+  return learned->warnings;
+}
+
+bool mentions(const std::vector<std::string>& warnings, const std::string& word) {
+  for (const auto& w : warnings) {
+    if (w.find(word) != std::string::npos) return true;
+  }
+  return false;
+}
+}  // namespace
+
+TEST_CASE("LEARN warns of the shadows and reflections it sees and of nothing else",
+          "[vision_app][learn][front]") {
+  const auto clean = learnWarningsUnder("clean");
+  const auto textured = learnWarningsUnder("textured");
+  const auto shadow = learnWarningsUnder("shadow");
+  const auto glossy = learnWarningsUnder("glossy");
+  CHECK(clean.empty());
+  CHECK(textured.empty());
+  CHECK(mentions(shadow, "shadow"));
+  CHECK_FALSE(mentions(shadow, "reflection"));
+  CHECK(mentions(glossy, "reflection"));
+  CHECK_FALSE(mentions(glossy, "shadow"));
+}

@@ -87,14 +87,11 @@ double medianOf(std::vector<float>& values) {
   return *mid;
 }
 
-// The levels just outside (the background) and just inside (the part) a
-// region's outer boundary: read a few pixels along the boundary's normal
-// either way, each side where the mask says it is. False when either side
-// has no reading.
-bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
-                double* background, double* part) {
-  std::vector<float> out;
-  std::vector<float> in;
+// The levels a few pixels out (`out`) and in (`in`) of every kSideStep-th
+// point of a region's outer boundary, along its normal, each where the mask
+// says it is.
+void sideSamples(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
+                 std::vector<float>* out, std::vector<float>* in) {
   const int n = static_cast<int>(outer.size());
   const cv::Rect frame(0, 0, grey.cols, grey.rows);
   for (int i = 0; i < n; i += kSideStep) {
@@ -109,9 +106,19 @@ bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::
                         static_cast<int>(std::lround(outer[static_cast<size_t>(i)].y +
                                                      sign * kSideReachPx * normal.y)));
       if (!frame.contains(q)) continue;
-      (mask.at<uint8_t>(q) ? in : out).push_back(grey.at<uint8_t>(q));
+      (mask.at<uint8_t>(q) ? in : out)->push_back(grey.at<uint8_t>(q));
     }
   }
+}
+
+// The levels just outside (the background) and just inside (the part) a
+// region's outer boundary: the medians of sideSamples. False when either
+// side has no reading.
+bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
+                double* background, double* part) {
+  std::vector<float> out;
+  std::vector<float> in;
+  sideSamples(grey, mask, outer, &out, &in);
   if (out.empty() || in.empty()) return false;
   *background = medianOf(out);
   *part = medianOf(in);
@@ -679,12 +686,6 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
   return true;
 }
 
-// Measures the region whose outer boundary is contours[i] (see
-// findRegions) into `region`: its pixels over its box (alone in its box, or
-// the set pixels connected to its boundary), holes, moments (grey-level
-// where they can be trusted), orientation and elongation. Moves its
-// contours out. False, nothing written, for a region smaller than
-// options.min_area.
 // The holes of region `i` (contour indices) that are glints (isGlint).
 std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
                             const std::vector<std::vector<cv::Point>>& contours,
@@ -700,6 +701,12 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
   return glints;
 }
 
+// Measures the region whose outer boundary is contours[i] (see
+// findRegions) into `region`: its pixels over its box (alone in its box, or
+// the set pixels connected to its boundary), holes (glints left out), (grey-level
+// where they can be trusted), orientation and elongation. Moves its
+// contours out. False, nothing written, for a region smaller than
+// options.min_area.
 bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions& options,
                    std::vector<std::vector<cv::Point>>& contours,
                    const std::vector<cv::Vec4i>& hierarchy, const std::vector<cv::Rect>& boxes,
@@ -775,6 +782,28 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions
 }
 
 }  // namespace
+
+double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& region) {
+  // A quarter of the contrast: well beyond noise and a belt's texture, well
+  // within a shadow's depth.
+  constexpr double kUnevenShare = 0.25;
+  std::vector<float> out;
+  std::vector<float> in;
+  sideSamples(grey, mask, region.outer, &out, &in);
+  if (out.empty() || in.empty()) return 0;
+  std::vector<float> sorted_out = out;
+  std::vector<float> sorted_in = in;
+  const double background = medianOf(sorted_out);
+  const double part = medianOf(sorted_in);
+  const double contrast = part - background;
+  if (std::abs(contrast) < 1) return 0;
+  size_t uneven = 0;
+  // Towards the part's level from the surface's, or away from the part's
+  // towards the surface's, by the share.
+  for (const float v : out) uneven += (v - background) / contrast > kUnevenShare ? 1 : 0;
+  for (const float v : in) uneven += (part - v) / contrast > kUnevenShare ? 1 : 0;
+  return static_cast<double>(uneven) / static_cast<double>(out.size() + in.size());
+}
 
 std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& options,
                                 const cv::Mat& grey) {

@@ -273,6 +273,11 @@ constexpr double kSmallPartFactor = 10;
 // there. A second part of the same type, or a half-size one, is far above
 // it. (On a worn belt, stains reach 12 % of a 200 px part's area.)
 constexpr double kSpeckShare = 0.15;
+// An evenly lit part has next to none of its outline beside a shadow or
+// uneven light (vision::unevenEdgeShare): under this share, on a plain or a
+// textured belt, for the t-shaped part of the tests; a soft shadow 8 px
+// beside it gave 15 %.
+constexpr double kShadowShare = 0.05;
 
 // The regions LEARN sees (indices): the one it will train on, the specks it
 // ignores beside it, and the others, which are parts.
@@ -346,9 +351,22 @@ std::string sensorRectText(const cv::Rect& r) {
 }
 
 // What looks wrong with a part about to be learned (sensor pixels in the text).
-std::vector<std::string> learnWarnings(const vision::Region& r, const SensorMapping& mapping,
+std::vector<std::string> learnWarnings(const vision::Region& r, const cv::Mat& grey,
+                                       const cv::Mat& mask, const SensorMapping& mapping,
                                        const VisionOptions& options) {
   std::vector<std::string> warnings;
+  if (r.glints > 0) {
+    warnings.push_back(std::to_string(r.glints) + (r.glints == 1 ? " reflection" : " reflections") +
+                       " inside the part read as part (lighter than the surface: a glossy part "
+                       "under a direct light)");
+  }
+  const double uneven = vision::unevenEdgeShare(grey, mask, r);
+  if (uneven > kShadowShare) {
+    warnings.push_back("a shadow or uneven light along " +
+                       std::to_string(std::lround(100 * uneven)) +
+                       " % of the outline (the part may be placed a pixel or more off: light "
+                       "the cell along the camera's axis, a ring light or a dome)");
+  }
   const double small_hole = kSmallHoleShare * r.area;
   int small = 0;
   for (const auto& hole : r.hole_boundaries) small += cv::contourArea(hole) < small_hole ? 1 : 0;
@@ -399,7 +417,8 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
   o.regions.keep_border_regions = true;
   if (colour) o.binarize.polarity = vision::Polarity::kDarkOnLight;
   for (int pass = 0;; ++pass) {
-    const auto regions = vision::findRegions(vision::binarize(grey, o.binarize), o.regions, grey);
+    const cv::Mat mask = vision::binarize(grey, o.binarize);
+    const auto regions = vision::findRegions(mask, o.regions, grey);
     const auto inside = regionsInside(regions, rect);
     if (inside.empty()) {
       if (!at) return makeError(vision::PartModelErrc::kNoPart, "no part in the frame");
@@ -440,7 +459,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     out.model.min_region_area = options.regions.min_area;
     out.model.min_hole_area = options.regions.min_hole_area;
     out.model.colour = colour;
-    out.warnings = learnWarnings(r, mapping, options);
+    out.warnings = learnWarnings(r, grey, mask, mapping, options);
     if (!seen.specks.empty()) out.notes.push_back(specksNote(regions, seen.specks, mapping));
     return out;
   }

@@ -20,6 +20,9 @@ struct Region {
   // 1 - (minor/major inertia): 0 for a disc or a square, where no axis exists.
   double elongation = 0;
   int holes = 0;
+  // Holes read as glints (lighter than the surface beside the part: the lamp
+  // reflected, not the surface seen through it), filled and not counted.
+  int glints = 0;
   cv::Rect bbox;
   bool touches_border = false;
   // Moments (grey-weighted with a grey image, else binary). Raw moments
@@ -63,6 +66,14 @@ struct RegionOptions {
 // result does not depend on their number.
 std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& options = {},
                                 const cv::Mat& grey = cv::Mat());
+
+// Where a region's outline meets something other than the part and its
+// surface: the share of points along its outer boundary whose level a few
+// pixels out is darker than the surface's (for dark parts; lighter for light
+// ones) by a quarter of the contrast, or a few pixels in lighter than the
+// part's by as much. A cast shadow beside the part, or joined to it, shows
+// as such a share; an evenly lit part on its surface has next to none.
+double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& region);
 
 // Orientation of a region from its moments and outer boundary (see Region).
 double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
