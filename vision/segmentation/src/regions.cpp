@@ -703,7 +703,7 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
 
 // Measures the region whose outer boundary is contours[i] (see
 // findRegions) into `region`: its pixels over its box (alone in its box, or
-// the set pixels connected to its boundary), holes (glints left out), (grey-level
+// the set pixels connected to its boundary), holes (glints left out), moments (grey-level
 // where they can be trusted), orientation and elongation. Moves its
 // contours out. False, nothing written, for a region smaller than
 // options.min_area.
@@ -758,8 +758,8 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions
   r.holes = static_cast<int>(r.hole_boundaries.size());
   r.glints = static_cast<int>(glints.size());
 
-  if (!grey.empty() && greyMoments(grey(box), own, own_runs, set, box, &r.moments,
-                                   &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
+  if (!grey.empty() && greyMoments(grey(box), own, own_runs, set, box, &r.moments, &r.centroid,
+                                   &r.coverage, &r.coverage_origin, &r.covered)) {
     r.area = r.moments.m00;
   } else {
     // Binary moments only where the grey levels cannot be trusted.
