@@ -35,6 +35,14 @@ cv::Mat lowResolutionNoise(cv::Size size, double step, std::mt19937_64& rng) {
   return big;
 }
 
+// `m` scaled to unit standard deviation (its mean kept).
+cv::Mat unitSpread(const cv::Mat& m) {
+  cv::Scalar mean;
+  cv::Scalar sd;
+  cv::meanStdDev(m, mean, sd);
+  return m / std::max(1e-6, sd[0]);
+}
+
 cv::Mat whiteNoise(cv::Size size, double sigma, std::mt19937_64& rng) {
   cv::Mat n(size, CV_32F);
   cv::RNG cv_rng(rng() | 1);
@@ -200,11 +208,7 @@ cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_
       // (hundreds): a conveyor belt's rubber.
       cv::Mat grain = whiteNoise(size, 1, rng);
       cv::GaussianBlur(grain, grain, cv::Size(0, 0), 0.8);
-      cv::Scalar m;
-      cv::Scalar sd;
-      cv::meanStdDev(grain, m, sd);
-      grain /= std::max(1e-6, sd[0]);
-      dev = 0.5 * grain + 0.7 * lowResolutionNoise(size, 24, rng) +
+      dev = 0.5 * unitSpread(grain) + 0.7 * lowResolutionNoise(size, 24, rng) +
             0.5 * lowResolutionNoise(size, 160, rng);
       break;
     }
@@ -223,20 +227,14 @@ cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_
       }
       cv::Mat streaks = whiteNoise(size, 1, rng);
       cv::GaussianBlur(streaks, streaks, cv::Size(0, 0), 12, 0.7);
-      cv::Scalar m;
-      cv::Scalar sd;
-      cv::meanStdDev(streaks, m, sd);
-      dev = dev + 0.6 * streaks / std::max(1e-6, sd[0]);
+      dev = dev + 0.6 * unitSpread(streaks);
       break;
     }
     case Surface::kBrushedMetal: {
       // Long thin streaks along x, and a slow sheen.
       cv::Mat streaks = whiteNoise(size, 1, rng);
       cv::GaussianBlur(streaks, streaks, cv::Size(0, 0), 30, 0.6);
-      cv::Scalar m;
-      cv::Scalar sd;
-      cv::meanStdDev(streaks, m, sd);
-      dev = streaks / std::max(1e-6, sd[0]) + 0.6 * lowResolutionNoise(size, 300, rng);
+      dev = unitSpread(streaks) + 0.6 * lowResolutionNoise(size, 300, rng);
       break;
     }
     case Surface::kPlain:
