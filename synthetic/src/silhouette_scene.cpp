@@ -30,6 +30,11 @@ struct Posed {
   cv::Point2d centroid;            // within the patch, supersampled px
   double radius = 0;               // of the ink about the centroid
   std::vector<cv::Point> outline;  // every contour pixel (outer and holes)
+  // Footprints grown by the scene's gap, by placement offset modulo kS:
+  // placing a part tries up to kAttempts spots, and findNonZero over the
+  // supersampled patch at each made scene building the slowest part of the
+  // tests that draw many scenes (minutes under AddressSanitizer).
+  mutable std::vector<cv::Mat> footprints = std::vector<cv::Mat>(kS * kS);
 };
 
 Posed pose(const cv::Mat& type_mask, double deg, bool mirrored, double scale) {
@@ -84,19 +89,22 @@ Footprint footprintOf(const Posed& p, cv::Point at, double gap) {
   const int g = static_cast<int>(std::ceil(gap)) + 1;
   const cv::Point origin(static_cast<int>(std::floor(static_cast<double>(at.x) / kS)) - g,
                          static_cast<int>(std::floor(static_cast<double>(at.y) / kS)) - g);
-  const int w = (p.mask.cols + kS - 1) / kS + 2 * g + 2;
-  const int h = (p.mask.rows + kS - 1) / kS + 2 * g + 2;
-  Footprint f{cv::Mat::zeros(h, w, CV_8UC1), origin};
-  std::vector<cv::Point> ink;
-  cv::findNonZero(p.mask, ink);
-  for (const auto& q : ink) {
-    const int x = (at.x + q.x) / kS - origin.x;
-    const int y = (at.y + q.y) / kS - origin.y;
-    f.mask.at<uchar>(y, x) = 255;
+  // Below zero the footprint lies off the image and isFree refuses it
+  // whatever its mask, so the offset's floor modulo is all that matters.
+  const int ox = ((at.x % kS) + kS) % kS;
+  const int oy = ((at.y % kS) + kS) % kS;
+  cv::Mat& mask = p.footprints[static_cast<size_t>(oy * kS + ox)];
+  if (mask.empty()) {
+    const int w = (p.mask.cols + kS - 1) / kS + 2 * g + 2;
+    const int h = (p.mask.rows + kS - 1) / kS + 2 * g + 2;
+    mask = cv::Mat::zeros(h, w, CV_8UC1);
+    std::vector<cv::Point> ink;
+    cv::findNonZero(p.mask, ink);
+    for (const auto& q : ink) mask.at<uchar>((oy + q.y) / kS + g, (ox + q.x) / kS + g) = 255;
+    const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * g - 1, 2 * g - 1));
+    cv::dilate(mask, mask, k);
   }
-  const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * g - 1, 2 * g - 1));
-  cv::dilate(f.mask, f.mask, k);
-  return f;
+  return Footprint{mask, origin};
 }
 
 // Whether the footprint lies inside the image and clear of `occupied`.
