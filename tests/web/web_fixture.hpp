@@ -12,6 +12,7 @@
 
 #include <httplib.h>
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include "cell_fixture.hpp"
 #include "picksight/common/text.hpp"
@@ -51,6 +52,12 @@ struct WebProcess {
     c.set_read_timeout(std::chrono::seconds(10));
     return c;
   }
+  // A client that sends `cookie` (a session from login()).
+  httplib::Client as(const std::string& cookie) const {
+    httplib::Client c = anonymousClient();
+    c.set_default_headers({{"Cookie", cookie}});
+    return c;
+  }
   // POST /api/login; the session's "name=value" for a Cookie header, empty
   // when refused.
   std::string login(const std::string& user, const std::string& password) const {
@@ -68,6 +75,12 @@ struct WebProcess {
   std::string admin_password;
   std::string cookie;
 };
+
+// A POST as the page sends it: JSON with the X-PickSight header.
+inline httplib::Result postJson(httplib::Client& client, const std::string& path,
+                                const nlohmann::json& body) {
+  return client.Post(path.c_str(), {{"X-PickSight", "1"}}, body.dump(), "application/json");
+}
 
 // Calls `done` until it returns true or `timeout` passes; its last answer.
 inline bool pollUntil(const std::function<bool()>& done,

@@ -17,13 +17,7 @@ using e2e::VisionProcess;
 using nlohmann::json;
 
 httplib::Result post(httplib::Client& client, const std::string& path, const json& body) {
-  return client.Post(path.c_str(), {{"X-PickSight", "1"}}, body.dump(), "application/json");
-}
-
-httplib::Client as(const WebProcess& web, const std::string& cookie) {
-  auto c = web.anonymousClient();
-  c.set_default_headers({{"Cookie", cookie}});
-  return c;
+  return postJson(client, path, body);
 }
 
 }  // namespace
@@ -53,7 +47,7 @@ TEST_CASE("without a session only the page and the login answer", "[web][users]"
   REQUIRE(res);
   CHECK(res->status == 401);
   // The admin's session, from the printed password.
-  res = as(web, web.cookie).Get("/api/session");
+  res = web.as(web.cookie).Get("/api/session");
   REQUIRE(res);
   CHECK(res->status == 200);
   CHECK(json::parse(res->body)["role"] == "admin");
@@ -70,7 +64,7 @@ TEST_CASE("the session cookie is HttpOnly and SameSite=Strict and ends at logout
   CHECK(set.find("HttpOnly") != std::string::npos);
   CHECK(set.find("SameSite=Strict") != std::string::npos);
   CHECK(set.find("Max-Age=") != std::string::npos);
-  auto session = as(web, set.substr(0, set.find(';')));
+  auto session = web.as(set.substr(0, set.find(';')));
   CHECK(session.Get("/api/cameras")->status == 200);
   CHECK(post(session, "/api/logout", json::object())->status == 200);
   CHECK(session.Get("/api/cameras")->status == 401);
@@ -95,7 +89,7 @@ TEST_CASE("an operator locates but cannot teach nor close the camera nor manage 
   REQUIRE(post(admin, "/api/users",
                {{"name", "emil"}, {"role", "engineer"}, {"password", "engineer-emil"}})
               ->status == 200);
-  auto olga = as(web, web.login("olga", "operator-olga"));
+  auto olga = web.as(web.login("olga", "operator-olga"));
   auto res = post(olga, "/api/apps/cam0/command", {{"line", "LOCATE 1"}});
   REQUIRE(res);
   CHECK(res->status == 200);
@@ -116,7 +110,7 @@ TEST_CASE("an operator locates but cannot teach nor close the camera nor manage 
   // Nothing changed; the engineer teaches.
   auto robot = vision.connect();
   CHECK(*robot.request("MODELS", 5s) == "OK 0");
-  auto emil = as(web, web.login("emil", "engineer-emil"));
+  auto emil = web.as(web.login("emil", "engineer-emil"));
   res = post(emil, "/api/apps/cam0/command", {{"line", "LEARN 4"}});
   REQUIRE(res);
   CHECK(res->status == 200);

@@ -44,6 +44,20 @@ Role roleForCommand(std::string_view line) {
   return Role::kEngineer;
 }
 
+std::optional<std::string> readBackLine(std::string_view line) {
+  if (roleForCommand(line) != Role::kEngineer) return std::nullopt;
+  const auto w = words(line);
+  const std::string& command = w[0];
+  if ((command == "TOLERANCE" || command == "GRASP" || command == "GRIPPER") && w.size() > 2) {
+    // The type must be a number: anything else is the app's to refuse.
+    if (w[1].find_first_not_of("0123456789") != std::string::npos || w[1].size() > 9)
+      return std::nullopt;
+    return command == "TOLERANCE" ? command + " " + w[1] : command + " " + w[1] + " LIST";
+  }
+  if (command == "EXPOSURE" || command == "ROI" || command == "CAMMODE") return command;
+  return std::nullopt;
+}
+
 Role roleForCameraAction(std::string_view action) {
   // A software trigger takes a frame, as LOCATE does; everything else
   // changes how the camera works.

@@ -20,6 +20,7 @@ struct RawOptions {
   std::vector<std::string> allow_hosts;
   int header_timeout_s = 10;
   int session_timeout_s = 3600;
+  int audit_max_kib = 1024;
   std::string config_file;
 };
 
@@ -106,6 +107,18 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
                  "seconds without a request after which a login ends")
       ->check(CLI::Range(1, 86400))
       ->capture_default_str();
+  app.add_option("--audit-file", o.audit_file,
+                 "the audit trail: every change made and every login through the page, one JSON "
+                 "record a line (default: audit.jsonl beside the --users file; without one, the "
+                 "newest 1000 records in memory)");
+  app.add_option("--audit-max-kib", raw.audit_max_kib,
+                 "KiB one audit file may hold before the next is started")
+      ->check(CLI::Range(16, 65536))
+      ->capture_default_str();
+  app.add_option("--audit-files", o.audit_files,
+                 "audit files kept, the current one included (the oldest beyond is deleted)")
+      ->check(CLI::Range(2, 100))
+      ->capture_default_str();
   app.add_option("--config", raw.config_file,
                  "YAML file of options, each named as its flag without dashes "
                  "(lists for the repeatable ones); the command line overrides it");
@@ -134,6 +147,9 @@ Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
   if (!raw.allow.empty()) o.allow = *AllowList::parse(raw.allow);
   o.header_timeout = std::chrono::seconds(raw.header_timeout_s);
   o.session_timeout = std::chrono::seconds(raw.session_timeout_s);
+  o.audit_max_bytes = static_cast<size_t>(raw.audit_max_kib) * 1024;
+  if (o.audit_file.empty() && !o.users_file.empty())
+    o.audit_file = (std::filesystem::path(o.users_file).parent_path() / "audit.jsonl").string();
   for (const auto& v : raw.allow_hosts)
     for (const auto& name : splitFields(v, ","))
       if (!name.empty()) o.allow_hosts.emplace_back(name);

@@ -25,6 +25,7 @@
 #include "picksight/transport/control_client.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/web/access_policy.hpp"
+#include "picksight/web/audit_trail.hpp"
 #include "picksight/web/camera_actions.hpp"
 #include "picksight/web/camera_monitor.hpp"
 #include "picksight/web/event_hub.hpp"
@@ -194,6 +195,7 @@ class WebServer::Impl {
   std::unique_ptr<httplib::Server> http_ = std::make_unique<httplib::Server>();
   std::unique_ptr<HttpGate> gate_;
   std::optional<UserStore> users_;
+  std::unique_ptr<AuditTrail> audit_;
   std::unique_ptr<Sessions> sessions_;
   LoginLimiter logins_;
   // Snapshots' PNGs and binarized images, made on request at SCHED_IDLE.
@@ -205,6 +207,22 @@ class WebServer::Impl {
  private:
   void routes();
   void userRoutes();
+  void auditRoutes();
+  // Records a change or login of `session` (or of nobody) from the request's
+  // client in the audit trail.
+  void audit(const httplib::Request& req, const std::optional<Session>& session,
+             AuditRecord record);
+  // A robot line from the page: sent, and recorded when it changes
+  // something, with what its read-back line says before and after.
+  void command(ResultFeed& app, const std::string& line, const httplib::Request& req,
+               httplib::Response& res);
+  // A camera action (POST /api/cameras/<camera>/<action>), recorded unless
+  // it is a trigger.
+  void cameraAction(const std::string& camera, const std::string& action,
+                    const httplib::Request& req, httplib::Response& res);
+  // What the audit trail keeps as a camera's state before `action`.
+  nlohmann::json cameraBefore(const std::string& camera, const std::string& action,
+                              const nlohmann::json& body);
   // The session of the request's cookie, if any is valid.
   std::optional<Session> sessionOf(const httplib::Request& req);
   // The role a request needs; nullopt: none (the page, login).
@@ -230,6 +248,12 @@ Result<void> WebServer::Impl::start() {
   if (!users) return users.error();
   users_.emplace(std::move(*users));
   sessions_ = std::make_unique<Sessions>(options_.session_timeout, kSessionMaxAge);
+  auto trail =
+      AuditTrail::open({options_.audit_file, options_.audit_max_bytes, options_.audit_files});
+  if (!trail) return trail.error();
+  audit_ = std::move(*trail);
+  logInfo("audit trail: ", options_.audit_file.empty() ? "in memory (no --users or --audit-file)"
+                                                       : options_.audit_file);
   if (users_->empty()) {
     // Never a fixed default: a random password, said once.
     const std::string password = UserStore::randomPassword();
@@ -303,6 +327,16 @@ Result<void> WebServer::Impl::start() {
       return httplib::Server::HandlerResponse::Handled;
     }
     if (session->role < *needed) {
+      // A change refused for the role is recorded: who tried what.
+      if (changesState(req.method) && req.path != "/api/logout") {
+        AuditRecord record;
+        record.action = "request";
+        record.target = req.path.substr(0, 128);
+        record.outcome = "refused";
+        record.status = 403;
+        record.reply = std::string("needs the ") + roleName(*needed) + " role";
+        audit(req, session, std::move(record));
+      }
       sendJson(res,
                {{"error", std::string("this needs the ") + roleName(*needed) + " role; " +
                               session->user + " is " + roleName(session->role)}},
@@ -313,6 +347,7 @@ Result<void> WebServer::Impl::start() {
   });
   routes();
   userRoutes();
+  auditRoutes();
   GateOptions gate;
   gate.header_timeout = options_.header_timeout;
   gate.per_address = options_.per_address;
@@ -583,6 +618,10 @@ std::optional<Role> WebServer::Impl::roleNeeded(const httplib::Request& req) {
       path == "/api/session")
     return std::nullopt;
   if (path.rfind("/api/users", 0) == 0) return Role::kAdmin;
+  // The trail is read by engineers (who changed the cell) and exported by
+  // admins.
+  if (path == "/api/audit.jsonl") return Role::kAdmin;
+  if (path == "/api/audit") return Role::kEngineer;
   if (!changesState(req.method)) return Role::kOperator;
   // POST /api/apps/<app>/command: a session here; the role its line needs
   // is checked by the route, since httplib reads the body after this.
@@ -612,6 +651,18 @@ void WebServer::Impl::userRoutes() {
     if (!role) {
       logins_.failed(req.remote_addr);
       refusals_.refused(req.remote_addr, "failed login as '" + name.substr(0, 32) + "'");
+      // The name only when it is a user's: an unknown one may be a
+      // password typed in the wrong field.
+      bool known = false;
+      for (const auto& u : users_->list()) known = known || u.name == name;
+      AuditRecord record;
+      record.action = "login";
+      record.user = known ? name : "";
+      record.arguments = {{"user", known ? name : "(not a user)"}};
+      record.outcome = "refused";
+      record.status = 401;
+      record.reply = "wrong user or password";
+      audit(req, std::nullopt, std::move(record));
       return sendJson(res, {{"error", "wrong user or password"}}, 401);
     }
     logins_.succeeded(req.remote_addr);
@@ -622,10 +673,21 @@ void WebServer::Impl::userRoutes() {
     res.set_header("Set-Cookie", std::string(kSessionCookie) + "=" + token +
                                      "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
                                      std::to_string(sessions_->maxAge().count()));
-    logInfo("login: ", name, " (", roleName(*role), ") from ", req.remote_addr);
+    AuditRecord record;
+    record.action = "login";
+    record.outcome = "ok";
+    record.status = 200;
+    audit(req, Session{name, *role}, std::move(record));
     sendJson(res, {{"user", name}, {"role", roleName(*role)}});
   });
   http_->Post("/api/logout", [this](const httplib::Request& req, httplib::Response& res) {
+    if (const auto session = sessionOf(req)) {
+      AuditRecord record;
+      record.action = "logout";
+      record.outcome = "ok";
+      record.status = 200;
+      audit(req, session, std::move(record));
+    }
     const std::string cookies = req.get_header_value("Cookie");
     const size_t at = cookies.find(std::string(kSessionCookie) + "=");
     if (at != std::string::npos)
@@ -655,15 +717,40 @@ void WebServer::Impl::userRoutes() {
     if (!name.is_string() || !role || !password.is_string())
       return sendError(res, WebErrc::kBadRequest,
                        "\"name\", \"password\" and \"role\" (operator, engineer, admin)");
-    if (auto set = users_->set(name.get<std::string>(), *role, password.get<std::string>()); !set)
-      return sendError(res, set.error());
+    AuditRecord record;
+    record.action = "user.set";
+    record.target = name.get<std::string>();
+    // Never the password: only that one was set.
+    record.arguments = {{"name", record.target}, {"role", roleName(*role)}, {"password", "(set)"}};
+    record.before = nullptr;
+    for (const auto& u : users_->list())
+      if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
+    if (record.before.is_null()) record.before = "(no such user)";
+    auto set = users_->set(name.get<std::string>(), *role, password.get<std::string>());
+    record.outcome = set ? "ok" : "error";
+    record.status = set ? 200 : httpStatus(set.error());
+    if (set)
+      record.after = {{"role", roleName(*role)}};
+    else
+      record.reply = set.error().message;
+    audit(req, sessionOf(req), std::move(record));
+    if (!set) return sendError(res, set.error());
     sessions_->removeUser(name.get<std::string>());  // the old password or role ends here
     sendJson(res, {{"ok", true}});
   });
   http_->Post(R"(/api/users/([^/]+)/delete)",
               [this](const httplib::Request& req, httplib::Response& res) {
-                if (auto removed = users_->remove(req.matches[1]); !removed)
-                  return sendError(res, removed.error());
+                AuditRecord record;
+                record.action = "user.delete";
+                record.target = req.matches[1];
+                for (const auto& u : users_->list())
+                  if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
+                auto removed = users_->remove(req.matches[1]);
+                record.outcome = removed ? "ok" : "error";
+                record.status = removed ? 200 : httpStatus(removed.error());
+                if (!removed) record.reply = removed.error().message;
+                audit(req, sessionOf(req), std::move(record));
+                if (!removed) return sendError(res, removed.error());
                 sessions_->removeUser(req.matches[1]);
                 sendJson(res, {{"ok", true}});
               });
@@ -707,24 +794,17 @@ void WebServer::Impl::routes() {
   http_->Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics(), "text/plain; version=0.0.4; charset=utf-8");
   });
-  http_->Post(R"(/api/apps/([^/]+)/command)", [this](const httplib::Request& req,
-                                                     httplib::Response& res) {
-    ResultFeed* app = appOr404(req.matches[1], res);
-    if (!app) return;
-    auto body = parseJsonBody(req.body);
-    if (!body) return sendError(res, body.error());
-    auto line = body->find("line");
-    if (line == body->end() || !line->is_string())
-      return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
-    const auto session = sessionOf(req);
-    const Role needed = roleForCommand(line->get<std::string>());
-    if (!session || session->role < needed)
-      return sendJson(
-          res, {{"error", std::string("this line needs the ") + roleName(needed) + " role"}}, 403);
-    auto reply = app->command(line->get<std::string>());
-    if (!reply) return sendError(res, reply.error());
-    sendJson(res, {{"reply", *reply}});
-  });
+  http_->Post(R"(/api/apps/([^/]+)/command)",
+              [this](const httplib::Request& req, httplib::Response& res) {
+                ResultFeed* app = appOr404(req.matches[1], res);
+                if (!app) return;
+                auto body = parseJsonBody(req.body);
+                if (!body) return sendError(res, body.error());
+                auto line = body->find("line");
+                if (line == body->end() || !line->is_string())
+                  return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
+                command(*app, line->get<std::string>(), req, res);
+              });
   http_->Get(R"(/api/cameras/([^/]+)/features)",
              [this](const httplib::Request& req, httplib::Response& res) {
                proto::ControlRequest request;
@@ -738,17 +818,151 @@ void WebServer::Impl::routes() {
              });
   http_->Post(R"(/api/cameras/([^/]+)/([a-z]+))",
               [this](const httplib::Request& req, httplib::Response& res) {
-                const std::string camera = req.matches[1];
-                if (!cameras_->feed(camera))
-                  return sendError(res, WebErrc::kNotFound, "no camera '" + camera + "'");
-                auto body = parseJsonBody(req.body);
-                if (!body) return sendError(res, body.error());
-                auto request = cameraAction(camera, req.matches[2], *body);
-                if (!request) return sendError(res, request.error());
-                auto reply = cameras_->control(camera, *request);
-                if (!reply) return sendError(res, reply.error());
-                sendJson(res, actionReplyJson(*reply));
+                cameraAction(req.matches[1], req.matches[2], req, res);
               });
+}
+
+void WebServer::Impl::audit(const httplib::Request& req, const std::optional<Session>& session,
+                            AuditRecord record) {
+  if (session) {
+    record.user = session->user;
+    record.role = roleName(session->role);
+  }
+  record.address = req.remote_addr;
+  audit_->record(std::move(record));
+}
+
+void WebServer::Impl::command(ResultFeed& app, const std::string& line, const httplib::Request& req,
+                              httplib::Response& res) {
+  const auto session = sessionOf(req);
+  const Role needed = roleForCommand(line);
+  // Reads and LOCATEs are not changes: not recorded.
+  const bool change = needed > Role::kOperator;
+  AuditRecord record;
+  record.action = "command";
+  record.target = app.name();
+  record.arguments = {{"line", line}};
+  if (!session || session->role < needed) {
+    if (change && session) {
+      record.outcome = "refused";
+      record.status = 403;
+      record.reply = std::string("needs the ") + roleName(needed) + " role";
+      audit(req, session, std::move(record));
+    }
+    return sendJson(
+        res, {{"error", std::string("this line needs the ") + roleName(needed) + " role"}}, 403);
+  }
+  const auto read_back = change ? readBackLine(line) : std::nullopt;
+  const auto ask = [&](const std::string& read) -> nlohmann::json {
+    auto r = app.command(read);
+    return r ? nlohmann::json(*r) : nlohmann::json("(" + r.error().message + ")");
+  };
+  if (read_back) record.before = ask(*read_back);
+  auto reply = app.command(line);
+  if (change) {
+    if (!reply) {
+      record.outcome = "error";
+      record.status = httpStatus(reply.error());
+      record.reply = reply.error().message;
+    } else {
+      const bool ok = reply->rfind("ERROR", 0) != 0;
+      record.outcome = ok ? "ok" : "error";
+      record.status = 200;
+      record.reply = *reply;
+      if (!ok) record.code = std::atoi(reply->c_str() + 5);
+      if (ok && read_back) record.after = ask(*read_back);
+    }
+    audit(req, session, std::move(record));
+  }
+  if (!reply) return sendError(res, reply.error());
+  sendJson(res, {{"reply", *reply}});
+}
+
+nlohmann::json WebServer::Impl::cameraBefore(const std::string& camera, const std::string& action,
+                                             const nlohmann::json& body) {
+  if (action == "feature") {
+    const auto name = body.find("name");
+    if (name == body.end() || !name->is_string()) return nullptr;
+    proto::ControlRequest request;
+    request.mutable_get_feature()->set_camera(camera);
+    request.mutable_get_feature()->set_name(name->get<std::string>());
+    auto reply = cameras_->control(camera, request);
+    if (!reply || !reply->has_feature()) return nullptr;
+    return {{"name", reply->feature().feature().name()},
+            {"value", reply->feature().feature().value()}};
+  }
+  // The rest from the camera list the poller keeps (refreshed every second).
+  for (const auto& c : cameras_->cameras()) {
+    if (c.value("name", "") != camera) continue;
+    nlohmann::json out = nlohmann::json::object();
+    const auto copy = [&](std::initializer_list<const char*> keys) {
+      for (const char* key : keys)
+        if (c.contains(key)) out[key] = c[key];
+    };
+    if (action == "roi") copy({"roi"});
+    if (action == "size") copy({"width", "height", "scale_x", "scale_y"});
+    if (action == "mode")
+      copy({"mode", "fps", "trigger_line", "trigger_activation", "trigger_timeout_ms"});
+    if (action == "open" || action == "close") copy({"state"});
+    if (action == "target") copy({"simulated_robot"});
+    return out.empty() ? nlohmann::json() : out;
+  }
+  return nullptr;
+}
+
+void WebServer::Impl::cameraAction(const std::string& camera, const std::string& action,
+                                   const httplib::Request& req, httplib::Response& res) {
+  if (!cameras_->feed(camera))
+    return sendError(res, WebErrc::kNotFound, "no camera '" + camera + "'");
+  auto body = parseJsonBody(req.body);
+  if (!body) return sendError(res, body.error());
+  auto request = web::cameraAction(camera, action, *body);
+  if (!request) return sendError(res, request.error());
+  // A trigger takes a frame as LOCATE does: not a change of the cell.
+  const bool change = action != "trigger";
+  AuditRecord record;
+  if (change) {
+    record.action = "camera." + action;
+    record.target = camera;
+    record.arguments = *body;
+    record.before = cameraBefore(camera, action, *body);
+  }
+  auto reply = cameras_->control(camera, *request);
+  if (change) {
+    record.outcome = reply ? "ok" : "error";
+    record.status = reply ? 200 : httpStatus(reply.error());
+    if (!reply)
+      record.reply = reply.error().message;
+    else if (reply->has_feature())
+      record.after = {{"name", reply->feature().feature().name()},
+                      {"value", reply->feature().feature().value()}};
+    audit(req, sessionOf(req), std::move(record));
+  }
+  if (!reply) return sendError(res, reply.error());
+  sendJson(res, actionReplyJson(*reply));
+}
+
+void WebServer::Impl::auditRoutes() {
+  http_->Get("/api/audit", [this](const httplib::Request& req, httplib::Response& res) {
+    size_t limit = 100;
+    if (req.has_param("limit")) {
+      const auto n = parseInt(req.get_param_value("limit"));
+      if (!n || *n < 1 || *n > 1000)
+        return sendError(res, WebErrc::kBadRequest, "limit: a number of records, 1..1000");
+      limit = static_cast<size_t>(*n);
+    }
+    auto read = audit_->newest(limit);
+    for (const auto& note : read.notes) logWarning("audit trail: ", note);
+    sendJson(res, {{"records", read.records},
+                   {"notes", read.notes},
+                   {"file", options_.audit_file.empty() ? nlohmann::json(nullptr)
+                                                        : nlohmann::json(options_.audit_file)}});
+  });
+  http_->Get("/api/audit.jsonl", [this](const httplib::Request&, httplib::Response& res) {
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("Content-Disposition", "attachment; filename=\"picksight-audit.jsonl\"");
+    res.set_content(audit_->exportAll(), "application/jsonl");
+  });
 }
 
 WebServer::WebServer(WebOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}

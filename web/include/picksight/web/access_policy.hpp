@@ -15,6 +15,12 @@ namespace picksight::web {
 
 // The role a robot-protocol line sent from the page needs.
 Role roleForCommand(std::string_view line);
+// The read-only line whose reply shows what the change `line` changes
+// ("TOLERANCE 3 area_tolerance 0.2" -> "TOLERANCE 3", "GRASP 2 ADD ..." ->
+// "GRASP 2 LIST", "EXPOSURE 900" -> "EXPOSURE"), asked before and after it
+// for the audit trail; nullopt for a line that changes nothing or whose
+// state no cheap read shows (LEARN, CALCAM...).
+std::optional<std::string> readBackLine(std::string_view line);
 // The role a camera action (POST /api/cameras/<camera>/<action>) needs.
 Role roleForCameraAction(std::string_view action);
 

@@ -49,6 +49,11 @@ struct WebOptions {
   std::string users_file;
   // A login ends after this long without a request (and after 12 h).
   std::chrono::seconds session_timeout{3600};
+  // The audit trail (audit_trail.hpp); empty: audit.jsonl beside the users
+  // file, or in memory without one.
+  std::string audit_file;
+  size_t audit_max_bytes = 1 << 20;
+  int audit_files = 5;
 };
 
 // Parses argv without the program name; errors name the option. With
