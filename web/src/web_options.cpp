@@ -1,9 +1,15 @@
 // picksight-web's options (CLI11) and its YAML file.
 #include "picksight/web/web_options.hpp"
 
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <set>
 
+#include "picksight/common/atomic_file.hpp"
 #include "picksight/common/command_line.hpp"
 #include "picksight/common/config_file.hpp"
 #include "picksight/common/text.hpp"
@@ -21,6 +27,8 @@ struct RawOptions {
   int header_timeout_s = 10;
   int session_timeout_s = 3600;
   int audit_max_kib = 1024;
+  std::string metrics_token_file;
+  std::string metrics_allow;
   std::string config_file;
 };
 
@@ -56,6 +64,13 @@ CLI::Validator checkEach(F parse) {
   });
 }
 
+CLI::Validator checkAllowList() {
+  return checkValue([](const std::string& v) {
+    auto list = AllowList::parse(v);
+    return list ? std::string() : list.error().message;
+  });
+}
+
 void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
   app.set_help_flag("-h,--help", "print this help");
   app.add_option("--listen", raw.listen,
@@ -76,10 +91,7 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
   app.add_option("--allow", raw.allow,
                  "peers allowed to connect: addresses or CIDR networks (default: everyone "
                  "that reaches the listen address)")
-      ->check(checkValue([](const std::string& v) {
-        auto list = AllowList::parse(v);
-        return list ? std::string() : list.error().message;
-      }));
+      ->check(checkAllowList());
   app.add_option("--allow-host", raw.allow_hosts,
                  "names and addresses this server answers to, as a request's Host and a "
                  "browser's Origin give them (repeatable, or comma-separated; '*': any; default: "
@@ -119,6 +131,13 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
                  "audit files kept, the current one included (the oldest beyond is deleted)")
       ->check(CLI::Range(2, 100))
       ->capture_default_str();
+  app.add_option("--metrics-token", raw.metrics_token_file,
+                 "FILE holding a bearer token (16..256 printable characters; the file not "
+                 "readable by others) with which GET /metrics needs no login: "
+                 "'Authorization: Bearer TOKEN'");
+  app.add_option("--metrics-allow", raw.metrics_allow,
+                 "peers (addresses or CIDR networks) that may GET /metrics without a login")
+      ->check(checkAllowList());
   app.add_option("--config", raw.config_file,
                  "YAML file of options, each named as its flag without dashes "
                  "(lists for the repeatable ones); the command line overrides it");
@@ -148,6 +167,15 @@ Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
   o.header_timeout = std::chrono::seconds(raw.header_timeout_s);
   o.session_timeout = std::chrono::seconds(raw.session_timeout_s);
   o.audit_max_bytes = static_cast<size_t>(raw.audit_max_kib) * 1024;
+  if (!raw.metrics_token_file.empty()) {
+    auto token = readMetricsToken(raw.metrics_token_file);
+    if (!token) return makeError(WebErrc::kBadConfig, "--metrics-token: " + token.error().message);
+    o.metrics_token = *token;
+  }
+  if (!raw.metrics_allow.empty()) {
+    o.metrics_allow = *AllowList::parse(raw.metrics_allow);
+    o.metrics_allow_set = true;
+  }
   if (o.audit_file.empty() && !o.users_file.empty())
     o.audit_file = (std::filesystem::path(o.users_file).parent_path() / "audit.jsonl").string();
   for (const auto& v : raw.allow_hosts)
@@ -157,6 +185,35 @@ Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
 }
 
 }  // namespace
+
+Result<std::string> readMetricsToken(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0)
+    return makeError(WebErrc::kBadConfig, path + ": " + std::strerror(errno));
+  // A secret, as ssh treats a private key: others may not read it (the
+  // service's group may).
+  if ((info.st_mode & 0007) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof(mode), "%04o", static_cast<unsigned>(info.st_mode & 07777));
+    return makeError(WebErrc::kBadConfig, std::string("permissions ") + mode + " for " + path +
+                                              " are too open: others may read it (chmod 640)");
+  }
+  if (info.st_size > 4096)
+    return makeError(WebErrc::kBadConfig, path + ": over 4096 bytes, not a token");
+  auto text = readFile(path);
+  if (!text) return text.error();
+  const size_t first = text->find_first_not_of(" \t\r\n");
+  const size_t last = text->find_last_not_of(" \t\r\n");
+  const std::string token =
+      first == std::string::npos ? std::string() : text->substr(first, last - first + 1);
+  if (token.size() < 16 || token.size() > 256)
+    return makeError(WebErrc::kBadConfig, path + ": the token must be 16..256 characters");
+  for (char c : token)
+    if (c <= ' ' || c > '~')
+      return makeError(WebErrc::kBadConfig,
+                       path + ": the token must be printable ASCII without spaces");
+  return token;
+}
 
 Result<std::pair<std::string, uint16_t>> parseHostPort(const std::string& text) {
   const size_t colon = text.rfind(':');

@@ -3,6 +3,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <strings.h>
 
 #include <atomic>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include <thread>
 
 #include <httplib.h>
+#include <sodium.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -163,6 +165,25 @@ struct HttplibInternals {
 };
 template struct HttplibInternals<&httplib::Server::process_and_close_socket,
                                  &httplib::Server::svr_sock_>;
+
+// Whether an Authorization header is "Bearer <token>", compared in a time
+// that does not depend on where they differ.
+bool bearerMatches(const std::string& authorization, const std::string& token) {
+  constexpr std::string_view kScheme = "Bearer ";
+  if (authorization.size() <= kScheme.size() ||
+      strncasecmp(authorization.c_str(), kScheme.data(), kScheme.size()) != 0)
+    return false;
+  const std::string given = authorization.substr(kScheme.size());
+  // Hashes of equal length, so that neither the length nor the content of
+  // the token shows in the time.
+  unsigned char a[32];
+  unsigned char b[32];
+  crypto_generichash(a, sizeof(a), reinterpret_cast<const unsigned char*>(given.data()),
+                     given.size(), nullptr, 0);
+  crypto_generichash(b, sizeof(b), reinterpret_cast<const unsigned char*>(token.data()),
+                     token.size(), nullptr, 0);
+  return sodium_memcmp(a, b, sizeof(a)) == 0;
+}
 
 void setFrameHeaders(httplib::Response& res, uint64_t sequence, uint64_t timestamp_ns) {
   res.set_header("X-Frame-Sequence", std::to_string(sequence));
@@ -319,6 +340,17 @@ Result<void> WebServer::Impl::start() {
     facts.request_header = req.get_header_value(kRequestHeader);
     if (auto refusal = checkRequest(hosts_, facts))
       return refuse(refusal->status, refusal->message);
+    if (req.path == "/metrics" && !changesState(req.method)) {
+      // A scraper's way in, besides a login.
+      const std::string authorization = req.get_header_value("Authorization");
+      if (!options_.metrics_token.empty() && !authorization.empty()) {
+        if (bearerMatches(authorization, options_.metrics_token))
+          return httplib::Server::HandlerResponse::Unhandled;
+        return refuse(401, "wrong metrics token (--metrics-token)");
+      }
+      if (options_.metrics_allow_set && peerAllowed(options_.metrics_allow, req.remote_addr))
+        return httplib::Server::HandlerResponse::Unhandled;
+    }
     const auto needed = roleNeeded(req);
     if (!needed) return httplib::Server::HandlerResponse::Unhandled;
     const auto session = sessionOf(req);
@@ -364,6 +396,10 @@ Result<void> WebServer::Impl::start() {
   http_->set_keep_alive_max_count(1);
   http_.get()->*listenSocketOf() = gate_->listeningSocket();
   logInfo("requests must name one of these hosts (--allow-host): ", hosts_.describe());
+  if (!options_.metrics_token.empty() || options_.metrics_allow_set)
+    logInfo("GET /metrics without a login:",
+            options_.metrics_token.empty() ? "" : " with the --metrics-token bearer token",
+            options_.metrics_allow_set ? " from " + options_.metrics_allow.describe() : "");
   gate_->start([this](int fd) { (http_.get()->*processSocketOf())(fd); });
   return {};
 }

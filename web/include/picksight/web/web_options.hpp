@@ -54,6 +54,12 @@ struct WebOptions {
   std::string audit_file;
   size_t audit_max_bytes = 1 << 20;
   int audit_files = 5;
+  // GET /metrics without a login, for a scraper: with this bearer token
+  // (read from --metrics-token FILE; empty: none), or from a peer of
+  // metrics_allow (when metrics_allow_set). Neither: a login as for the rest.
+  std::string metrics_token;
+  AllowList metrics_allow;
+  bool metrics_allow_set = false;
 };
 
 // Parses argv without the program name; errors name the option. With
@@ -65,6 +71,10 @@ std::string webUsage();
 
 // "HOST:PORT" ("[::1]:80" for IPv6); the error says what is wrong.
 Result<std::pair<std::string, uint16_t>> parseHostPort(const std::string& text);
+
+// The bearer token in `path` (whitespace around it dropped): 16..256
+// printable characters, in a file others may not read; errors name the file.
+Result<std::string> readMetricsToken(const std::string& path);
 
 // The page's directory when --assets is not given: the source tree's
 // web/assets when it exists (a build tree), else the installed one.
