@@ -97,10 +97,13 @@ Footprint footprintOf(const Posed& p, cv::Point at, double gap) {
   if (mask.empty()) {
     const int w = (p.mask.cols + kS - 1) / kS + 2 * g + 2;
     const int h = (p.mask.rows + kS - 1) / kS + 2 * g + 2;
-    mask = cv::Mat::zeros(h, w, CV_8UC1);
-    std::vector<cv::Point> ink;
-    cv::findNonZero(p.mask, ink);
-    for (const auto& q : ink) mask.at<uchar>((oy + q.y) / kS + g, (ox + q.x) / kS + g) = 255;
+    // Any ink in a pixel's kS x kS cell marks it: the cells' means, which
+    // are above zero wherever one supersampled pixel is inked (255 / kS^2
+    // rounds to more than 0).
+    cv::Mat cells = cv::Mat::zeros(h * kS, w * kS, CV_8UC1);
+    p.mask.copyTo(cells(cv::Rect(g * kS + ox, g * kS + oy, p.mask.cols, p.mask.rows)));
+    cv::resize(cells, mask, cv::Size(w, h), 0, 0, cv::INTER_AREA);
+    cv::threshold(mask, mask, 0, 255, cv::THRESH_BINARY);
     const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * g - 1, 2 * g - 1));
     cv::dilate(mask, mask, k);
   }
