@@ -26,16 +26,17 @@ PACKAGES=(
   iptables
   # container images without a registry (deploy/containers, opt-in test)
   mmdebstrap podman
-  # tests
-  catch2
+  # tests (curl: the package test's HTTPS client)
+  catch2 curl
   # services: sd_notify readiness and watchdog
   libsystemd-dev
   # Debian package (CPack: dpkg-shlibdeps, file) and its unit tests (systemd-analyze)
   dpkg-dev file systemd
   # PLC port: Modbus TCP server (libmodbus), and the independent client of its tests
   libmodbus-dev python3-pymodbus
-  # web HMI (picksight-web): HTTP server, JPEG encoding, argon2id password hashes
-  libcpp-httplib-dev libsodium-dev
+  # web HMI (picksight-web): HTTP(S) server, JPEG encoding, argon2id password hashes;
+  # OpenSSL for its TLS settings and the package's certificate (postinst, tests)
+  libcpp-httplib-dev libsodium-dev libssl-dev openssl
   libturbojpeg0-dev
   # pymodbus imports its serial client with every client (a Recommends of python3-pymodbus)
   python3-serial-asyncio

@@ -6,6 +6,7 @@
 #include "picksight/common/log.hpp"
 #include "picksight/common/service_notify.hpp"
 #include "picksight/common/stop_signals.hpp"
+#include "picksight/web/user_store.hpp"
 #include "picksight/web/web_server.hpp"
 
 int main(int argc, char** argv) {
@@ -21,6 +22,19 @@ int main(int argc, char** argv) {
     std::cerr << "picksight-web: " << options.error().message << "\n\n" << web::webUsage();
     return 2;
   }
+  if (!options->first_admin_file.empty()) {
+    auto made = web::UserStore::makeFirstAdmin(options->users_file, options->first_admin_file);
+    if (!made) {
+      std::cerr << "picksight-web: " << made.error().message << "\n";
+      return 1;
+    }
+    if (*made)
+      std::cout << "made 'admin' in " << options->users_file << "; its password is in "
+                << options->first_admin_file << " (mode 0600)" << std::endl;
+    else
+      std::cout << options->users_file << " has users already: nothing changed" << std::endl;
+    return 0;
+  }
   retainLargeBuffers();
   const StopSignals stop_signals;
   ServiceNotifier notifier;
@@ -31,6 +45,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     // Machine-readable: tests and the demo listen on port 0 and read this.
+    if (!server.redirectUrl().empty()) std::cout << "redirect " << server.redirectUrl() << "\n";
     std::cout << "web " << server.url() << "\nready" << std::endl;
     logInfo("serving ", server.url(), " for ", options->video_servers.size(), " video servers and ",
             options->vision_apps.size(),

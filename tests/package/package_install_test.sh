@@ -23,7 +23,7 @@ skip() { echo "SKIPPED: $*"; exit "$SKIP"; }
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 [ "$(id -u)" = 0 ] || skip "needs root (dpkg -i into this machine)"
-for tool in dpkg dpkg-deb setpriv flock getent; do
+for tool in dpkg dpkg-deb setpriv flock getent openssl curl; do
   command -v "$tool" >/dev/null || skip "no $tool"
 done
 [ -w /var/lib/dpkg ] || skip "dpkg's database is not writable"
@@ -108,6 +108,26 @@ id -nG picksight | tr ' ' '\n' | grep -qx video || fail "picksight is not in gro
 [ "$(stat -c '%U %a' /var/lib/picksight)" = "picksight 750" ] ||
   fail "/var/lib/picksight is $(stat -c '%U %a' /var/lib/picksight), not picksight 750"
 
+# The web HMI's certificate and first admin, made by postinst: the key
+# readable by the service's group only, the password by root only.
+tls=/etc/picksight/tls
+[ "$(stat -c '%U:%G %a' "$tls/web.key")" = "root:picksight 640" ] ||
+  fail "$tls/web.key is $(stat -c '%U:%G %a' "$tls/web.key"), not root:picksight 640"
+openssl x509 -noout -in "$tls/web.crt" -ext subjectAltName | grep -q 'IP Address:127.0.0.1' ||
+  fail "$tls/web.crt does not name 127.0.0.1"
+[ "$(stat -c '%U %a' /etc/picksight/web-admin-password)" = "root 600" ] ||
+  fail "/etc/picksight/web-admin-password is not root's alone"
+[ "$(stat -c '%U %a' /var/lib/picksight-web/users.json)" = "picksight 600" ] ||
+  fail "/var/lib/picksight-web/users.json is not picksight's alone"
+grep -q 'argon2id' /var/lib/picksight-web/users.json || fail "users.json holds no argon2id hash"
+admin_password="$(cat /etc/picksight/web-admin-password)"
+[ "${#admin_password}" = 20 ] || fail "the first admin's password is not 20 characters"
+grep -qF "$admin_password" /var/lib/picksight-web/users.json && fail "users.json holds the password"
+made="$(sha256sum "$tls/web.crt" "$tls/web.key" /etc/picksight/web-admin-password \
+          /var/lib/picksight-web/users.json)"
+echo "web HMI: $(openssl x509 -noout -subject -in "$tls/web.crt"), first admin's password in" \
+  "/etc/picksight/web-admin-password"
+
 # The installed units, at their real paths, with their real ExecStart.
 out="$(systemd-analyze verify --man=no picksight-video-server.service \
          picksight-vision@cam0.service 2>&1)" || fail "systemd-analyze verify: $out"
@@ -120,6 +140,9 @@ echo "# edited on this cell" >>/etc/picksight/vision/cam0.yaml
 dpkg -i "$deb" >"$work/dpkg-i2.log" 2>&1 || { cat "$work/dpkg-i2.log" >&2; fail "dpkg -i over itself"; }
 grep -q '^# edited on this cell$' /etc/picksight/vision/cam0.yaml ||
   fail "reinstalling lost the edit of a conffile"
+[ "$(sha256sum "$tls/web.crt" "$tls/web.key" /etc/picksight/web-admin-password \
+      /var/lib/picksight-web/users.json)" = "$made" ] ||
+  fail "reinstalling made a new certificate or admin"
 
 # Starts a unit's ExecStart (instance %i = cam0, %S = /var/lib) as its
 # User=, with extra arguments; its stdout goes to $work/<name>.out.
@@ -160,9 +183,27 @@ install -d -o picksight -g picksight -m 0750 /var/lib/picksight/cam0
 start_unit picksight-vision@.service vision \
   --frames "$frames" --control "$control" --robot-port 0 --bind 127.0.0.1
 port="$(wait_line vision robot)" || fail "the installed vision app did not start"
+# The web HMI as its unit runs it (web.yaml: HTTPS with the package's
+# certificate, a redirecting plain port), on free ports.
+start_unit picksight-web.service web --listen 127.0.0.1:0 --http-redirect 127.0.0.1:0
+web_url="$(wait_line web web)" || fail "the installed web HMI did not start"
+redirect_url="$(wait_line web redirect)" || fail "the installed web HMI has no redirect port"
+[[ "$web_url" == https://* ]] || fail "the installed web HMI serves $web_url, not HTTPS"
 for pid in "${pids[@]}"; do
   [ "$(stat -c %U "/proc/$pid")" = picksight ] || fail "process $pid does not run as picksight"
 done
+# A client that verifies the certificate logs in with the first password.
+headers="$(curl -sS --cacert "$tls/web.crt" -o /dev/null -D - -H 'Content-Type: application/json' \
+             -H 'X-PickSight: 1' -d "{\"user\":\"admin\",\"password\":\"$admin_password\"}" \
+             "$web_url/api/login")" || fail "curl --cacert $tls/web.crt $web_url/api/login failed"
+grep -qiE '^HTTP/1.1 200' <<<"$headers" || fail "the first admin's login: $headers"
+grep -qiE '^set-cookie: picksight_session=.*; Secure' <<<"$headers" ||
+  fail "the session cookie is not Secure: $headers"
+redirect="$(curl -sS -o /dev/null -w '%{http_code} %{redirect_url}' "$redirect_url/static/app.js")"
+[ "$redirect" = "301 $web_url/static/app.js" ] || fail "the plain port answered '$redirect'"
+echo "web HMI: $web_url (verified against $tls/web.crt), admin logged in; $redirect_url -> 301"
+grep -q '"action":"login"' /var/lib/picksight-web/audit.jsonl || fail "the login is not in the audit trail"
+
 
 # The packaged robot client, as an integrator would use it.
 reply="$(/usr/bin/picksight-robot --port "$port" --timeout 30 'LOCATE 1')" ||

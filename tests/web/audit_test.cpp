@@ -116,8 +116,9 @@ TEST_CASE("a damaged audit line is skipped with a note and a cut last line is cl
   CHECK_THAT(read.notes[2], Catch::Contains("audit.jsonl line 4"));
 }
 
-TEST_CASE("an engineer's changes are in the audit trail with the user, before and after",
-          "[web][audit]") {
+TEST_CASE(
+    "an engineer's changes are in the audit trail with the user and the values before and after",
+    "[web][audit]") {
   test::TempDir dir;
   VideoServerProcess server(
       {"--source", "cam0=synthetic:width=640,height=480,parts=1", "--fps", "10"});

@@ -77,7 +77,7 @@ TEST_CASE("without a metrics token or allow-list /metrics needs a login", "[web]
   CHECK(statusOf(rawGet(web, "/metrics", "127.0.0.1", web.cookieLine())) == 200);
 }
 
-TEST_CASE("a metrics token file others may read, or too short, is refused", "[web][metrics]") {
+TEST_CASE("a metrics token file others may read or too short is refused", "[web][metrics]") {
   test::TempDir dir;
   const std::string open_file = dir.write("open", "0123456789abcdef0123\n");
   REQUIRE(::chmod(open_file.c_str(), 0644) == 0);

@@ -45,6 +45,7 @@ class RawSocket {
   RawSocket& operator=(const RawSocket&) = delete;
 
   bool valid() const { return fd_ >= 0; }
+  int fd() const { return fd_; }  // borrowed: still closed by this
   bool send(const std::string& bytes) {
     size_t sent = 0;
     while (fd_ >= 0 && sent < bytes.size()) {

@@ -21,17 +21,25 @@
 namespace picksight::webtest {
 
 struct WebProcess {
-  // Starts picksight-web on 127.0.0.1 port 0 with `args`; REQUIREs its URL line.
-  explicit WebProcess(std::vector<std::string> args) {
+  // Starts picksight-web on 127.0.0.1 port 0 with `args`; REQUIREs its URL
+  // line. With --tls-cert among `args`, `ca_cert` is the certificate the
+  // clients verify the server's against.
+  explicit WebProcess(std::vector<std::string> args, std::string ca_cert = "")
+      : ca(std::move(ca_cert)) {
     std::vector<std::string> argv = {e2e::binPath("picksight-web"), "--listen", "127.0.0.1:0"};
     argv.insert(argv.end(), args.begin(), args.end());
     process = std::make_unique<Subprocess>(argv);
     // With no users yet the server makes 'admin' and prints its password
     // once, before its URL; the tests log in with it.
-    const std::string url_prefix = "web http://127.0.0.1:";
+    std::string url_prefix = "web http://127.0.0.1:";
     std::optional<std::string> line;
     while ((line = process->readLine(std::chrono::seconds(10)))) {
       if (line->rfind("admin-password ", 0) == 0) admin_password = line->substr(15);
+      if (line->rfind("redirect ", 0) == 0) redirect_url = line->substr(9);
+      if (line->rfind("web https://", 0) == 0) {
+        https = true;
+        url_prefix = "web https://127.0.0.1:";
+      }
       if (line->rfind(url_prefix, 0) == 0) break;
     }
     REQUIRE(line);
@@ -47,7 +55,11 @@ struct WebProcess {
     return c;
   }
   httplib::Client anonymousClient() const {
-    httplib::Client c("127.0.0.1", port);
+    httplib::Client c((https ? "https://127.0.0.1:" : "http://127.0.0.1:") + std::to_string(port));
+    if (https) {
+      c.set_ca_cert_path(ca.c_str());
+      c.enable_server_certificate_verification(true);
+    }
     c.set_connection_timeout(std::chrono::seconds(5));
     c.set_read_timeout(std::chrono::seconds(10));
     return c;
@@ -70,8 +82,11 @@ struct WebProcess {
   }
   // "Cookie: ...\r\n" for a raw request, logged in as the admin.
   std::string cookieLine() const { return cookie.empty() ? "" : "Cookie: " + cookie + "\r\n"; }
+  std::string ca;
   std::unique_ptr<Subprocess> process;
   int port = 0;
+  bool https = false;
+  std::string redirect_url;  // "http://127.0.0.1:PORT" with --http-redirect
   std::string admin_password;
   std::string cookie;
 };

@@ -2,6 +2,11 @@
 // without a session, an operator who can locate but not teach or close the
 // camera, logout and expiry, the login limit, the users file kept across
 // restarts.
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+
 #include <nlohmann/json.hpp>
 
 #include "picksight/common/atomic_file.hpp"
@@ -162,6 +167,49 @@ TEST_CASE("the users file keeps the users and no new password is printed", "[web
   WebProcess second(args);
   CHECK(second.admin_password.empty());
   CHECK(!second.login("admin", password).empty());
+}
+
+}  // namespace picksight::webtest
+
+namespace picksight::webtest {
+
+TEST_CASE("the installer's first admin gets a random password in a 0600 file", "[web][users]") {
+  test::TempDir dir;
+  const std::string users = (dir.path() / "users.json").string();
+  const std::string password_file = (dir.path() / "admin-password").string();
+  const auto run = [&](const std::string& out) {
+    Subprocess web({e2e::binPath("picksight-web"), "--users", users, "--first-admin", out});
+    const auto status = web.wait(std::chrono::seconds(20));
+    REQUIRE(status);
+    REQUIRE(WIFEXITED(*status));
+    return WEXITSTATUS(*status);
+  };
+  // A password file that exists is never overwritten, and nothing is made.
+  const std::string taken = dir.write("taken", "someone's\n");
+  CHECK(run(taken) == 1);
+  CHECK(!std::filesystem::exists(users));
+  CHECK(*readFile(taken) == "someone's\n");
+
+  REQUIRE(run(password_file) == 0);
+  struct stat info {};
+  REQUIRE(::stat(password_file.c_str(), &info) == 0);
+  CHECK((info.st_mode & 0777) == 0600);
+  const auto text = readFile(password_file);
+  REQUIRE(text);
+  const std::string password = text->substr(0, text->find('\n'));
+  CHECK(password.size() == 20);
+  CHECK(readFile(users)->find(password) == std::string::npos);
+  // Users exist: a second run changes nothing and writes no password.
+  const std::string second = (dir.path() / "second").string();
+  CHECK(run(second) == 0);
+  CHECK(!std::filesystem::exists(second));
+  // The server starts with that admin and prints no password.
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  auto args = videoServerArgs(server);
+  args.insert(args.end(), {"--users", users});
+  WebProcess web(args);
+  CHECK(web.admin_password.empty());
+  CHECK(!web.login("admin", password).empty());
 }
 
 }  // namespace picksight::webtest

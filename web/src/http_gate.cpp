@@ -2,6 +2,7 @@
 #include "picksight/web/http_gate.hpp"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <sys/epoll.h>
@@ -42,6 +43,20 @@ std::string peerAddress(const sockaddr_storage& peer) {
   return text;
 }
 
+int peerPort(const sockaddr_storage& peer) {
+  if (peer.ss_family == AF_INET)
+    return ntohs(reinterpret_cast<const sockaddr_in*>(&peer)->sin_port);
+  if (peer.ss_family == AF_INET6)
+    return ntohs(reinterpret_cast<const sockaddr_in6*>(&peer)->sin6_port);
+  return 0;
+}
+
+// "address|port": a connection being served (unique among open ones).
+std::string connectionKey(std::string_view address, int port) {
+  // httplib's address of a link-local IPv6 peer carries "%scope".
+  return std::string(address.substr(0, address.find('%'))) + "|" + std::to_string(port);
+}
+
 // A waiting connection's file may hold 1024 + the pool: the soft limit of
 // a service is often 1024, the hard one far higher.
 void raiseDescriptorLimit() {
@@ -74,7 +89,7 @@ constexpr size_t kLingerBytes = 1 << 20;
 constexpr size_t kMaxLingering = 1024;
 
 // What the bytes received so far say about a request.
-enum class Progress { kWaiting, kComplete, kHeaderTooLarge, kBodyTooLarge, kChunked };
+enum class Progress { kWaiting, kComplete, kHeaderTooLarge, kBodyTooLarge, kChunked, kNotTls };
 
 // `head`: the first bytes of the connection (peeked, not consumed);
 // `available`: all the bytes received. The request is complete once its
@@ -104,6 +119,9 @@ Progress requestProgress(std::string_view head, size_t available, const GateOpti
 
 // TLS: the first record (5 bytes of header, then its length) has arrived.
 Progress tlsProgress(std::string_view head, const GateOptions& options) {
+  // A TLS connection starts with a handshake record (22); plain HTTP
+  // ("GET ...") would otherwise be awaited as a record of kilobytes.
+  if (!head.empty() && static_cast<unsigned char>(head[0]) != 22) return Progress::kNotTls;
   if (head.size() < 5) return Progress::kWaiting;
   const size_t length =
       (static_cast<unsigned char>(head[3]) << 8) | static_cast<unsigned char>(head[4]);
@@ -129,6 +147,7 @@ class HttpGate::Impl {
   void stop();
   void join();
   size_t waiting() const { return waiting_count_.load(); }
+  void arrived(const std::string& address, int port);
   int listening() const { return listen_fd_; }
 
  private:
@@ -136,7 +155,20 @@ class HttpGate::Impl {
     std::string address;
     uint64_t serial = 0;
     Clock::time_point deadline;
+    int port = 0;
   };
+  // TLS: a connection handed to the pool before its request could be seen
+  // (encrypted), held to the same deadline: a duplicate of its socket is
+  // kept, and shut down at the deadline unless arrived() said the request
+  // was read; the serving thread then ends.
+  struct Served {
+    int watch = -1;
+    Clock::time_point deadline;
+    std::string address;
+    bool arrived = false;
+    bool cut = false;
+  };
+  void cutLateServed(Clock::time_point now);
   void run();
   void acceptAll();
   void check(int fd);
@@ -175,6 +207,9 @@ class HttpGate::Impl {
   };
   std::unordered_map<int, Lingering> lingering_;
   std::deque<std::pair<Clock::time_point, int>> linger_deadlines_;  // in order
+
+  std::mutex served_mutex_;
+  std::unordered_map<std::string, Served> served_;  // under served_mutex_
 
   std::mutex per_address_mutex_;
   std::map<std::string, int> per_address_;  // under per_address_mutex_
@@ -259,6 +294,7 @@ void HttpGate::Impl::run() {
     if (!linger_deadlines_.empty())
       timeout_ms = std::min(timeout_ms, until(linger_deadlines_.front().first));
     if (accept_paused_) timeout_ms = std::min(timeout_ms, 100);
+    if (options_.tls) timeout_ms = std::min(timeout_ms, 100);
     const int n = ::epoll_wait(epoll_fd_, events, 64, timeout_ms);
     if (stopping_) break;
     for (int i = 0; i < n; ++i) {
@@ -272,6 +308,7 @@ void HttpGate::Impl::run() {
         check(fd);
     }
     expire(Clock::now());
+    if (options_.tls) cutLateServed(Clock::now());
     if (accept_paused_ && Clock::now() >= accept_resume_) {
       accept_paused_ = false;
       epoll_event e{};
@@ -330,7 +367,7 @@ void HttpGate::Impl::acceptAll() {
     }
     const auto deadline = Clock::now() + options_.header_timeout;
     const uint64_t serial = ++next_serial_;
-    waiting_[fd] = Waiting{address, serial, deadline};
+    waiting_[fd] = Waiting{address, serial, deadline, peerPort(peer)};
     waiting_count_ = waiting_.size();
     deadlines_.push_back({deadline, {fd, serial}});
     // Edge-triggered: woken at each arrival of bytes, which stay in the
@@ -383,12 +420,34 @@ void HttpGate::Impl::check(int fd) {
       return refuse(fd, w.address, 411, "Length Required",
                     "a request body must be sent with Content-Length");
     }
+    case Progress::kNotTls: {
+      const Waiting w = forget(fd);
+      return refuse(fd, w.address, 400, "Bad Request",
+                    "this port speaks HTTPS: use an https:// address");
+    }
     case Progress::kComplete:
       break;
   }
   const Waiting w = forget(fd);
-  pool_->enqueue([this, fd, address = w.address] {
+  int watch = -1;
+  std::string key;
+  if (options_.tls) {
+    key = connectionKey(w.address, w.port);
+    watch = ::fcntl(fd, F_DUPFD_CLOEXEC, 0);
+    if (watch >= 0) {
+      std::lock_guard<std::mutex> lock(served_mutex_);
+      served_[key] = Served{watch, w.deadline, w.address};
+    }
+  }
+  pool_->enqueue([this, fd, address = w.address, watch, key] {
     serve_(fd);
+    if (watch >= 0) {
+      {
+        std::lock_guard<std::mutex> lock(served_mutex_);
+        served_.erase(key);
+      }
+      ::close(watch);  // after the erase: the gate's thread never uses a closed one
+    }
     release(address);
   });
 }
@@ -426,6 +485,27 @@ void HttpGate::Impl::expire(Clock::time_point now) {
   // Served and closed connections leave their entries behind: dropped
   // from the front as they come due, so the queue holds at most one entry
   // per connection accepted within the last header_timeout.
+}
+
+void HttpGate::Impl::arrived(const std::string& address, int port) {
+  std::lock_guard<std::mutex> lock(served_mutex_);
+  auto it = served_.find(connectionKey(address, port));
+  if (it != served_.end()) it->second.arrived = true;
+}
+
+void HttpGate::Impl::cutLateServed(Clock::time_point now) {
+  std::lock_guard<std::mutex> lock(served_mutex_);
+  for (auto& [key, s] : served_) {
+    if (s.arrived || s.cut || s.deadline > now) continue;
+    // Both ways: the serving thread's read (handshake or request) ends.
+    ::shutdown(s.watch, SHUT_RDWR);
+    s.cut = true;
+    refusals_.refused(
+        s.address,
+        "no complete TLS handshake and request within " +
+            formatFixed(static_cast<double>(options_.header_timeout.count()) / 1000.0, 1) +
+            " s of connecting (--header-timeout)");
+  }
 }
 
 void HttpGate::Impl::release(const std::string& address) {
@@ -487,5 +567,6 @@ void HttpGate::start(Serve serve) { impl_->start(std::move(serve)); }
 void HttpGate::stop() { impl_->stop(); }
 void HttpGate::join() { impl_->join(); }
 size_t HttpGate::waiting() const { return impl_->waiting(); }
+void HttpGate::arrived(const std::string& address, int port) { impl_->arrived(address, port); }
 
 }  // namespace picksight::web

@@ -1,9 +1,13 @@
 // The users file of the web HMI, with argon2id hashes (user_store.hpp).
 #include "picksight/web/user_store.hpp"
 
+#include <fcntl.h>
 #include <sodium.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -107,6 +111,34 @@ Result<UserStore> UserStore::open(const std::string& path) {
       return makeError(WebErrc::kBadConfig, path + ": more than 256 users");
   }
   return store;
+}
+
+Result<bool> UserStore::makeFirstAdmin(const std::string& users_file,
+                                       const std::string& password_file) {
+  if (users_file.empty()) return makeError(WebErrc::kBadConfig, "no users file (--users)");
+  auto store = open(users_file);
+  if (!store) return store.error();
+  if (!store->empty()) return false;
+  const std::string password = randomPassword(20);
+  // O_EXCL: a password file that exists is someone's; 0600: root's alone.
+  const int fd =
+      ::open(password_file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
+  if (fd < 0)
+    return makeError(WebErrc::kBadConfig,
+                     password_file + ": cannot create (" + std::strerror(errno) + ")");
+  const std::string line = password + "\n";
+  const bool written = ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size()) &&
+                       ::fsync(fd) == 0;
+  ::close(fd);
+  if (!written) {
+    ::unlink(password_file.c_str());
+    return makeError(WebErrc::kBadConfig, password_file + ": cannot write");
+  }
+  if (auto set = store->set("admin", Role::kAdmin, password); !set) {
+    ::unlink(password_file.c_str());
+    return set.error();
+  }
+  return true;
 }
 
 Result<void> UserStore::save() const {

@@ -29,6 +29,7 @@ struct RawOptions {
   int audit_max_kib = 1024;
   std::string metrics_token_file;
   std::string metrics_allow;
+  std::string http_redirect;
   std::string config_file;
 };
 
@@ -138,6 +139,21 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
   app.add_option("--metrics-allow", raw.metrics_allow,
                  "peers (addresses or CIDR networks) that may GET /metrics without a login")
       ->check(checkAllowList());
+  app.add_option("--tls-cert", o.tls_cert,
+                 "PEM certificate (its chain after it): serve HTTPS instead of HTTP; with "
+                 "--tls-key")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-key", o.tls_key,
+                 "PEM private key of --tls-cert (a file others may not read)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--http-redirect", raw.http_redirect,
+                 "HOST:PORT of a plain-HTTP port that only redirects to the HTTPS one (with "
+                 "--tls-cert; port 0: any free port, printed as 'redirect http://...')")
+      ->check(checkValue(checkHostPort));
+  app.add_option("--first-admin", o.first_admin_file,
+                 "with --users: when the users file holds no user, make 'admin' with a random "
+                 "password, write the password to FILE (created 0600, never overwritten) and "
+                 "exit; with users already, exit and change nothing (for installers)");
   app.add_option("--config", raw.config_file,
                  "YAML file of options, each named as its flag without dashes "
                  "(lists for the repeatable ones); the command line overrides it");
@@ -171,6 +187,12 @@ Result<WebOptions> finishOptions(WebOptions o, RawOptions& raw) {
     auto token = readMetricsToken(raw.metrics_token_file);
     if (!token) return makeError(WebErrc::kBadConfig, "--metrics-token: " + token.error().message);
     o.metrics_token = *token;
+  }
+  if (!raw.http_redirect.empty()) {
+    auto redirect = parseHostPort(raw.http_redirect);
+    o.redirect_host = redirect->first;
+    o.redirect_port = redirect->second;
+    o.redirect = true;
   }
   if (!raw.metrics_allow.empty()) {
     o.metrics_allow = *AllowList::parse(raw.metrics_allow);
@@ -237,8 +259,35 @@ std::string defaultAssetsDir() {
 
 std::string webUsage() { return toolUsage(webApp, defineOptions); }
 
+namespace {
+
+// What options say together, once the file's and the line's are merged
+// (finishOptions sees the line alone first).
+Result<void> checkCombinations(const WebOptions& o) {
+  if (!o.first_admin_file.empty() && o.users_file.empty())
+    return makeError(WebErrc::kBadConfig, "--first-admin needs --users FILE");
+  if (o.tls_cert.empty() != o.tls_key.empty())
+    return makeError(WebErrc::kBadConfig, "--tls-cert and --tls-key go together");
+  if (!o.tls_key.empty()) {
+    struct stat info {};
+    if (::stat(o.tls_key.c_str(), &info) == 0 && (info.st_mode & 0007) != 0)
+      return makeError(WebErrc::kBadConfig,
+                       "--tls-key: " + o.tls_key + " may be read by others (chmod 640 or 600)");
+  }
+  if (o.redirect && o.tls_cert.empty())
+    return makeError(WebErrc::kBadConfig,
+                     "--http-redirect redirects to HTTPS: it needs --tls-cert and --tls-key");
+  return {};
+}
+
+}  // namespace
+
 Result<WebOptions> parseWebArgs(const std::vector<std::string>& args, bool* help) {
-  return parseToolOptions<WebOptions, RawOptions>(args, help, webApp, defineOptions, finishOptions);
+  auto o =
+      parseToolOptions<WebOptions, RawOptions>(args, help, webApp, defineOptions, finishOptions);
+  if (!o || (help && *help)) return o;
+  if (auto checked = checkCombinations(*o); !checked) return checked.error();
+  return o;
 }
 
 }  // namespace picksight::web

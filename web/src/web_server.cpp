@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 #include <strings.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <fstream>
@@ -22,6 +23,7 @@
 #include <opencv2/imgproc.hpp>
 #include <zmq.hpp>
 
+#include "picksight/common/atomic_file.hpp"
 #include "picksight/common/log.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/transport/control_client.hpp"
@@ -213,8 +215,13 @@ class WebServer::Impl {
   std::unique_ptr<CameraMonitor> cameras_;
   std::map<std::string, std::unique_ptr<ResultFeed>> apps_;
   RefusalLog refusals_{"HTTP"};
+  // An httplib::SSLServer with --tls-cert.
   std::unique_ptr<httplib::Server> http_ = std::make_unique<httplib::Server>();
   std::unique_ptr<HttpGate> gate_;
+  // --http-redirect: plain HTTP that only redirects to the HTTPS port.
+  std::unique_ptr<httplib::Server> redirect_http_;
+  std::unique_ptr<HttpGate> redirect_gate_;
+  int redirect_port_ = 0;
   std::optional<UserStore> users_;
   std::unique_ptr<AuditTrail> audit_;
   std::unique_ptr<Sessions> sessions_;
@@ -222,6 +229,7 @@ class WebServer::Impl {
   // Snapshots' PNGs and binarized images, made on request at SCHED_IDLE.
   IdleWorker images_{"snapshot and binarized images"};
   int port_ = 0;
+  bool tls() const { return !options_.tls_cert.empty(); }
   std::atomic<bool> stopping_{false};
   std::atomic<int> streams_{0};
 
@@ -229,6 +237,11 @@ class WebServer::Impl {
   void routes();
   void userRoutes();
   void auditRoutes();
+  // http_->Post(pattern, handler), telling the gate (with TLS) that the
+  // request has arrived whole before the handler runs.
+  void post(const std::string& pattern, httplib::Server::Handler handler);
+  // The plain-HTTP port that redirects to HTTPS (--http-redirect).
+  Result<void> startRedirect();
   // Records a change or login of `session` (or of nobody) from the request's
   // client in the audit trail.
   void audit(const httplib::Request& req, const std::optional<Session>& session,
@@ -265,6 +278,19 @@ class WebServer::Impl {
 };
 
 Result<void> WebServer::Impl::start() {
+  if (tls()) {
+    for (const auto& file : {options_.tls_cert, options_.tls_key})
+      if (auto read = readFile(file); !read) return read.error();
+    auto https =
+        std::make_unique<httplib::SSLServer>(options_.tls_cert.c_str(), options_.tls_key.c_str());
+    if (!https->is_valid())
+      return makeError(WebErrc::kBadConfig, "TLS: " + options_.tls_cert + " and " +
+                                                options_.tls_key +
+                                                " are not a PEM certificate and its private key");
+    // TLS 1.2 at least, whatever the system's OpenSSL configuration says.
+    SSL_CTX_set_min_proto_version(https->ssl_context(), TLS1_2_VERSION);
+    http_ = std::move(https);
+  }
   auto users = UserStore::open(options_.users_file);
   if (!users) return users.error();
   users_.emplace(std::move(*users));
@@ -324,6 +350,12 @@ Result<void> WebServer::Impl::start() {
         return httplib::Server::HandlerResponse::Handled;
       }));
   http_->set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    // httplib calls this once the request's header is read, before its
+    // body: with TLS, the gate's deadline ends here for a request without
+    // a body, in post() after the body for the others.
+    const std::string length = req.get_header_value("Content-Length");
+    if (tls() && (length.empty() || length == "0") && !req.has_header("Transfer-Encoding"))
+      gate_->arrived(req.remote_addr, req.remote_port);
     const auto refuse = [&](int status, const std::string& message) {
       refusals_.refused(req.remote_addr, req.method + " " + req.path + ": " + message);
       sendJson(res, {{"error", message}}, status);
@@ -386,6 +418,9 @@ Result<void> WebServer::Impl::start() {
   gate.max_body_bytes = kMaxBodyBytes;
   // Every stream holds a thread; the rest serve the page and the API.
   gate.threads = static_cast<size_t>(options_.max_streams) + 16;
+  // With TLS the gate can only wait for the ClientHello: the handshake and
+  // the request are read by the serving thread (http_gate.hpp).
+  gate.tls = tls();
   gate_ = std::make_unique<HttpGate>(gate, refusals_);
   auto port = gate_->listen(options_.listen_host, options_.listen_port);
   if (!port) return port.error();
@@ -401,6 +436,60 @@ Result<void> WebServer::Impl::start() {
             options_.metrics_token.empty() ? "" : " with the --metrics-token bearer token",
             options_.metrics_allow_set ? " from " + options_.metrics_allow.describe() : "");
   gate_->start([this](int fd) { (http_.get()->*processSocketOf())(fd); });
+  if (options_.redirect) return startRedirect();
+  return {};
+}
+
+Result<void> WebServer::Impl::startRedirect() {
+  redirect_http_ = std::make_unique<httplib::Server>();
+  redirect_http_->set_default_headers({{"X-Frame-Options", "DENY"},
+                                       {"Content-Security-Policy", kContentSecurityPolicy},
+                                       {"X-Content-Type-Options", "nosniff"},
+                                       {"Referrer-Policy", "no-referrer"}});
+  redirect_http_->set_read_timeout(10s);
+  redirect_http_->set_write_timeout(5s);
+  redirect_http_->set_keep_alive_max_count(1);
+  // Every request is answered here: a redirect to the same name and path
+  // on the HTTPS port, for a name this server answers to.
+  redirect_http_->set_pre_routing_handler(
+      [this](const httplib::Request& req, httplib::Response& res) {
+        const auto refuse = [&](int status, const std::string& message) {
+          refusals_.refused(req.remote_addr, "HTTP redirect: " + message);
+          sendJson(res, {{"error", message}}, status);
+          return httplib::Server::HandlerResponse::Handled;
+        };
+        if (!peerAllowed(options_.allow, req.remote_addr))
+          return refuse(403, "forbidden: " + req.remote_addr + " is not in the allow-list");
+        const std::string host = req.get_header_value("Host");
+        if (host.empty()) return refuse(400, "a request needs a Host header");
+        if (!hosts_.allowsHost(host)) return refuse(403, "Host '" + host + "' is not one of ours");
+        if (req.method != "GET" && req.method != "HEAD")
+          return refuse(403, "this port only redirects to HTTPS: send the request there");
+        // The name without its port ("[v6]" kept whole).
+        std::string name = host;
+        if (name.front() == '[') {
+          name = name.substr(0, name.find(']') + 1);
+        } else if (std::count(name.begin(), name.end(), ':') == 1) {
+          name = name.substr(0, name.find(':'));
+        }
+        const std::string target = req.target.empty() || req.target[0] != '/' ? "/" : req.target;
+        res.status = 301;
+        res.set_header("Location", "https://" + name + ":" + std::to_string(port_) + target);
+        res.set_header("Cache-Control", "no-store");
+        res.set_content("{\"redirect\":\"https\"}", "application/json");
+        return httplib::Server::HandlerResponse::Handled;
+      });
+  GateOptions gate;
+  gate.header_timeout = options_.header_timeout;
+  gate.per_address = options_.per_address;
+  gate.max_body_bytes = kMaxBodyBytes;
+  gate.threads = 4;
+  redirect_gate_ = std::make_unique<HttpGate>(gate, refusals_);
+  auto port = redirect_gate_->listen(options_.redirect_host, options_.redirect_port);
+  if (!port) return port.error();
+  redirect_port_ = *port;
+  redirect_http_.get()->*listenSocketOf() = redirect_gate_->listeningSocket();
+  redirect_gate_->start([this](int fd) { (redirect_http_.get()->*processSocketOf())(fd); });
   return {};
 }
 
@@ -408,10 +497,13 @@ void WebServer::Impl::stop() {
   if (stopping_.exchange(true)) return;
   events_.closeAll();
   if (gate_) gate_->stop();
+  if (redirect_gate_) redirect_gate_->stop();
   // httplib's keep-alive loops end when its listening socket is invalid.
   if (http_) http_.get()->*listenSocketOf() = INVALID_SOCKET;
+  if (redirect_http_) redirect_http_.get()->*listenSocketOf() = INVALID_SOCKET;
   if (cameras_) cameras_->stop();  // wakes the streams waiting on frames
   if (gate_) gate_->join();
+  if (redirect_gate_) redirect_gate_->join();
   for (auto& [name, app] : apps_) app->stop();
 }
 
@@ -668,7 +760,7 @@ std::optional<Role> WebServer::Impl::roleNeeded(const httplib::Request& req) {
 }
 
 void WebServer::Impl::userRoutes() {
-  http_->Post("/api/login", [this](const httplib::Request& req, httplib::Response& res) {
+  post("/api/login", [this](const httplib::Request& req, httplib::Response& res) {
     if (auto wait = logins_.blocked(req.remote_addr)) {
       res.set_header("Retry-After", std::to_string(wait->count()));
       return sendJson(
@@ -704,11 +796,13 @@ void WebServer::Impl::userRoutes() {
     logins_.succeeded(req.remote_addr);
     const std::string token = sessions_->create({name, *role});
     // HttpOnly: no script reads it; SameSite=Strict: no other site's page
-    // sends it. Secure once the server speaks TLS (plain HTTP is for
-    // loopback and SSH tunnels, where a Secure cookie would not be sent).
+    // sends it; Secure with TLS: never sent over plain HTTP (without TLS
+    // the browser would not send a Secure cookie back: plain HTTP is for
+    // loopback and SSH tunnels).
     res.set_header("Set-Cookie", std::string(kSessionCookie) + "=" + token +
                                      "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" +
-                                     std::to_string(sessions_->maxAge().count()));
+                                     std::to_string(sessions_->maxAge().count()) +
+                                     (tls() ? "; Secure" : ""));
     AuditRecord record;
     record.action = "login";
     record.outcome = "ok";
@@ -716,7 +810,7 @@ void WebServer::Impl::userRoutes() {
     audit(req, Session{name, *role}, std::move(record));
     sendJson(res, {{"user", name}, {"role", roleName(*role)}});
   });
-  http_->Post("/api/logout", [this](const httplib::Request& req, httplib::Response& res) {
+  post("/api/logout", [this](const httplib::Request& req, httplib::Response& res) {
     if (const auto session = sessionOf(req)) {
       AuditRecord record;
       record.action = "logout";
@@ -728,8 +822,9 @@ void WebServer::Impl::userRoutes() {
     const size_t at = cookies.find(std::string(kSessionCookie) + "=");
     if (at != std::string::npos)
       sessions_->remove(cookies.substr(at + std::strlen(kSessionCookie) + 1, 64));
-    res.set_header("Set-Cookie",
-                   std::string(kSessionCookie) + "=; Path=/; HttpOnly; SameSite=Strict; Max-Age=0");
+    res.set_header("Set-Cookie", std::string(kSessionCookie) +
+                                     "=; Path=/; HttpOnly; SameSite=Strict; Max-Age=0" +
+                                     (tls() ? "; Secure" : ""));
     sendJson(res, {{"ok", true}});
   });
   http_->Get("/api/session", [this](const httplib::Request& req, httplib::Response& res) {
@@ -744,7 +839,7 @@ void WebServer::Impl::userRoutes() {
       list.push_back({{"name", u.name}, {"role", roleName(u.role)}});
     sendJson(res, list);
   });
-  http_->Post("/api/users", [this](const httplib::Request& req, httplib::Response& res) {
+  post("/api/users", [this](const httplib::Request& req, httplib::Response& res) {
     auto body = parseJsonBody(req.body);
     if (!body) return sendError(res, body.error());
     const auto name = body->value("name", nlohmann::json());
@@ -774,22 +869,21 @@ void WebServer::Impl::userRoutes() {
     sessions_->removeUser(name.get<std::string>());  // the old password or role ends here
     sendJson(res, {{"ok", true}});
   });
-  http_->Post(R"(/api/users/([^/]+)/delete)",
-              [this](const httplib::Request& req, httplib::Response& res) {
-                AuditRecord record;
-                record.action = "user.delete";
-                record.target = req.matches[1];
-                for (const auto& u : users_->list())
-                  if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
-                auto removed = users_->remove(req.matches[1]);
-                record.outcome = removed ? "ok" : "error";
-                record.status = removed ? 200 : httpStatus(removed.error());
-                if (!removed) record.reply = removed.error().message;
-                audit(req, sessionOf(req), std::move(record));
-                if (!removed) return sendError(res, removed.error());
-                sessions_->removeUser(req.matches[1]);
-                sendJson(res, {{"ok", true}});
-              });
+  post(R"(/api/users/([^/]+)/delete)", [this](const httplib::Request& req, httplib::Response& res) {
+    AuditRecord record;
+    record.action = "user.delete";
+    record.target = req.matches[1];
+    for (const auto& u : users_->list())
+      if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
+    auto removed = users_->remove(req.matches[1]);
+    record.outcome = removed ? "ok" : "error";
+    record.status = removed ? 200 : httpStatus(removed.error());
+    if (!removed) record.reply = removed.error().message;
+    audit(req, sessionOf(req), std::move(record));
+    if (!removed) return sendError(res, removed.error());
+    sessions_->removeUser(req.matches[1]);
+    sendJson(res, {{"ok", true}});
+  });
 }
 
 void WebServer::Impl::routes() {
@@ -830,17 +924,16 @@ void WebServer::Impl::routes() {
   http_->Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(metrics(), "text/plain; version=0.0.4; charset=utf-8");
   });
-  http_->Post(R"(/api/apps/([^/]+)/command)",
-              [this](const httplib::Request& req, httplib::Response& res) {
-                ResultFeed* app = appOr404(req.matches[1], res);
-                if (!app) return;
-                auto body = parseJsonBody(req.body);
-                if (!body) return sendError(res, body.error());
-                auto line = body->find("line");
-                if (line == body->end() || !line->is_string())
-                  return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
-                command(*app, line->get<std::string>(), req, res);
-              });
+  post(R"(/api/apps/([^/]+)/command)", [this](const httplib::Request& req, httplib::Response& res) {
+    ResultFeed* app = appOr404(req.matches[1], res);
+    if (!app) return;
+    auto body = parseJsonBody(req.body);
+    if (!body) return sendError(res, body.error());
+    auto line = body->find("line");
+    if (line == body->end() || !line->is_string())
+      return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
+    command(*app, line->get<std::string>(), req, res);
+  });
   http_->Get(R"(/api/cameras/([^/]+)/features)",
              [this](const httplib::Request& req, httplib::Response& res) {
                proto::ControlRequest request;
@@ -852,10 +945,18 @@ void WebServer::Impl::routes() {
                  list.push_back(protoJson(f, true));
                sendJson(res, list);
              });
-  http_->Post(R"(/api/cameras/([^/]+)/([a-z]+))",
-              [this](const httplib::Request& req, httplib::Response& res) {
-                cameraAction(req.matches[1], req.matches[2], req, res);
-              });
+  post(R"(/api/cameras/([^/]+)/([a-z]+))",
+       [this](const httplib::Request& req, httplib::Response& res) {
+         cameraAction(req.matches[1], req.matches[2], req, res);
+       });
+}
+
+void WebServer::Impl::post(const std::string& pattern, httplib::Server::Handler handler) {
+  http_->Post(pattern, [this, handler = std::move(handler)](const httplib::Request& req,
+                                                            httplib::Response& res) {
+    if (tls()) gate_->arrived(req.remote_addr, req.remote_port);
+    handler(req, res);
+  });
 }
 
 void WebServer::Impl::audit(const httplib::Request& req, const std::optional<Session>& session,
@@ -1007,10 +1108,20 @@ Result<void> WebServer::start() { return impl_->start(); }
 void WebServer::stop() { impl_->stop(); }
 uint16_t WebServer::port() const { return static_cast<uint16_t>(impl_->port_); }
 
-std::string WebServer::url() const {
-  const std::string& host = impl_->options_.listen_host;
+namespace {
+std::string urlOf(const std::string& scheme, const std::string& host, int port) {
   const bool v6 = host.find(':') != std::string::npos;
-  return "http://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(impl_->port_);
+  return scheme + "://" + (v6 ? "[" + host + "]" : host) + ":" + std::to_string(port);
+}
+}  // namespace
+
+std::string WebServer::url() const {
+  return urlOf(impl_->tls() ? "https" : "http", impl_->options_.listen_host, impl_->port_);
+}
+
+std::string WebServer::redirectUrl() const {
+  if (!impl_->redirect_gate_) return "";
+  return urlOf("http", impl_->options_.redirect_host, impl_->redirect_port_);
 }
 
 }  // namespace picksight::web

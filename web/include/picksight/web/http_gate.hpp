@@ -37,7 +37,9 @@ struct GateOptions {
   size_t threads = 64;
   // TLS: the bytes are encrypted, so only the first record (the
   // ClientHello) is awaited here; the handshake and the request are then
-  // read by the serving thread under its own timeouts.
+  // read by the serving thread, held to the same deadline: the gate shuts
+  // the socket down at header_timeout unless arrived() was called for it.
+  // Anything but a TLS handshake record first is refused at once (400).
   bool tls = false;
 };
 
@@ -62,6 +64,9 @@ class HttpGate {
 
   // Connections waiting for their request now (for tests and /metrics).
   size_t waiting() const;
+  // TLS: the request of the connection from address:port has been read
+  // whole; the header deadline no longer applies to it. Any thread.
+  void arrived(const std::string& address, int port);
 
  private:
   class Impl;

@@ -48,6 +48,13 @@ class UserStore {
   // A random password of `length` letters and digits (first start).
   static std::string randomPassword(size_t length = 16);
 
+  // At install (the package's postinst): when `users_file` holds no user,
+  // makes 'admin' with a random password and writes that password to
+  // `password_file`, created with mode 0600 (never over an existing file);
+  // true when it did, false when there were users already.
+  static Result<bool> makeFirstAdmin(const std::string& users_file,
+                                     const std::string& password_file);
+
  private:
   explicit UserStore(std::string path) : path_(std::move(path)) {}
   struct Entry {

@@ -60,6 +60,17 @@ struct WebOptions {
   std::string metrics_token;
   AllowList metrics_allow;
   bool metrics_allow_set = false;
+  // HTTPS with this certificate (PEM, its chain after it) and key (PEM, a
+  // file others may not read); both or neither. redirect_port (with
+  // redirect_host) serves plain HTTP that only redirects to HTTPS; 0: off.
+  std::string tls_cert;
+  std::string tls_key;
+  std::string redirect_host;
+  uint16_t redirect_port = 0;
+  bool redirect = false;
+  // --first-admin FILE: make the first admin of users_file, its password
+  // to FILE, and exit (the package's postinst); empty: serve.
+  std::string first_admin_file;
 };
 
 // Parses argv without the program name; errors name the option. With

@@ -28,9 +28,11 @@ class WebServer {
 
   // Binds the listen address, starts the feeds and serves on a thread.
   Result<void> start();
-  // The bound port, and "http://HOST:PORT".
+  // The bound port, and "http://HOST:PORT" ("https://" with TLS).
   uint16_t port() const;
   std::string url() const;
+  // "http://HOST:PORT" of --http-redirect; empty without.
+  std::string redirectUrl() const;
   void stop();
 
  private:
