@@ -178,6 +178,8 @@ int main(int argc, char** argv) {
   int jpeg_quality = 0;
   bool standard_types = false;
   bool list_errors = false;
+  std::string save_frames;
+  bool keep_shadows = false;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> conditions = {"clean",        "textured", "shadow", "glossy",
                                          "low-contrast", "colour",   "wood",   "metal"};
@@ -202,6 +204,11 @@ int main(int argc, char** argv) {
   app.add_flag("--standard-types", standard_types,
                "the 15 types of picksight-bench-silhouettes instead of unseen ones");
   app.add_flag("--list-errors", list_errors, "print each false report and each part missed");
+  app.add_flag("--keep-shadows", keep_shadows,
+               "leave cast shadows joined to the parts (to measure what cutting them gains and "
+               "costs)");
+  app.add_option("--save-frames", save_frames,
+                 "write each scene's first frame and each teach image here (PNG), to look at");
   app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
 
@@ -217,6 +224,7 @@ int main(int argc, char** argv) {
     // The vision app's defaults, with the window a user sets for these parts.
     pa::VisionOptions options;
     options.binarize.adaptive_window = kWindow;
+    options.regions.cut_shadows = !keep_shadows;
     if (look.part_level > look.background_level) {
       options.binarize.polarity = pv::Polarity::kLightOnDark;
     }
@@ -233,6 +241,9 @@ int main(int argc, char** argv) {
       const cv::Mat image = delivered(ps::renderSilhouetteAlone(types[i], side, look, 7 + i, &drawn,
                                                                 picksight::bench::kTrainAngleDeg),
                                       jpeg_quality);
+      if (!save_frames.empty()) {
+        cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + ".png", image);
+      }
       const picksight::Frame frame = frameOf(image);
       const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
       auto learned =
@@ -303,6 +314,11 @@ int main(int argc, char** argv) {
         const ps::SilhouetteScene scene(types, chiral, o);
         for (int r = 0; r < rounds; ++r) {
           const cv::Mat image = delivered(scene.render(static_cast<uint64_t>(r)), jpeg_quality);
+          if (!save_frames.empty() && r == 0) {
+            cv::imwrite(
+                save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) + ".png",
+                image);
+          }
           const picksight::Frame frame = frameOf(image);
           pa::LocateOutcome outcome;
           double sink = 0;

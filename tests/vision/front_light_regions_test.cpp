@@ -1,6 +1,7 @@
 // Regions under a front-lit cell's light: specular glints on a glossy part
 // are not holes (the part is whole under them, and placed as if they were not
-// there), while a real hole, which shows the surface, still counts.
+// there), while a real hole, which shows the surface, still counts; a cast
+// shadow joined to a part is cut off it, and does not move it.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -18,10 +19,9 @@ namespace pv = picksight::vision;
 
 namespace {
 // The one large region of `image` (dark parts on light), CHECKs there is one.
-pv::Region onlyPart(const cv::Mat& image) {
+pv::Region onlyPart(const cv::Mat& image, pv::RegionOptions r = {}) {
   pv::BinarizeOptions b;
   b.adaptive_window = 500;
-  pv::RegionOptions r;
   r.min_area = 2000;
   const auto regions = pv::findRegions(pv::binarize(image, b), r, image);
   REQUIRE(regions.size() == 1);
@@ -69,4 +69,53 @@ TEST_CASE("a real hole still counts beside glints", "[vision][regions][front]") 
   const pv::Region without = onlyPart(plain);
   REQUIRE(without.holes > 0);
   CHECK(onlyPart(shiny).holes == without.holes);
+}
+
+namespace {
+// A part on a plain surface with a soft cast shadow `offset` px along
+// `angle_deg`, or none (offset 0).
+ps::SilhouetteSceneOptions shadowed(double offset, double angle_deg) {
+  ps::SilhouetteSceneOptions look;
+  look.uneven_light = false;
+  look.front.shadow_offset_px = offset;
+  look.front.shadow_angle_deg = angle_deg;
+  look.front.shadow_softness_px = 3;
+  look.front.shadow_depth = 0.45;
+  return look;
+}
+}  // namespace
+
+TEST_CASE("a cast shadow is cut off the part, and does not move it", "[vision][regions][front]") {
+  // Shapes and turns the shadow code was not written on: the public
+  // silhouettes of the front-light benchmark too.
+  struct Case {
+    const char* name;
+    double part_deg;
+    double light_deg;
+  };
+  const std::vector<Case> cases = {{"l_shape", 20, 45},
+                                   {"gear", 200, 135},
+                                   {"rectangle", 75, -30},
+                                   {"disc_holes", 0, 90},
+                                   {"l_shape_mirror", 310, 10}};
+  for (const Case& c : cases) {
+    CAPTURE(c.name, c.part_deg, c.light_deg);
+    const ps::SilhouetteType type = ps::silhouetteFromPartType(c.name, 200);
+    const cv::Mat plain =
+        ps::renderSilhouetteAlone(type, 400, shadowed(0, 0), 3, nullptr, c.part_deg);
+    const cv::Mat shade =
+        ps::renderSilhouetteAlone(type, 400, shadowed(8, c.light_deg), 3, nullptr, c.part_deg);
+    const pv::Region without = onlyPart(plain);
+    const pv::Region with = onlyPart(shade);
+    pv::RegionOptions joined;
+    joined.cut_shadows = false;
+    const pv::Region kept = onlyPart(shade, joined);
+    CAPTURE(with.area, without.area, kept.area, with.centroid, without.centroid, kept.centroid);
+    // The shadow joins the part when left: the scene tests something.
+    CHECK(kept.area > 1.03 * without.area);
+    CHECK(cv::norm(kept.centroid - without.centroid) > 1.0);
+    CHECK(with.holes == without.holes);
+    CHECK(with.area == Approx(without.area).epsilon(0.015));
+    CHECK(cv::norm(with.centroid - without.centroid) < 0.3);
+  }
 }

@@ -13,6 +13,7 @@
 
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/segmentation/row_runs.hpp"
+#include "picksight/vision/segmentation/shadows.hpp"
 
 namespace picksight::vision {
 
@@ -74,10 +75,6 @@ constexpr int kBoxMargin = kMaxBand + 2;
 // the background's level give or take its texture and noise, or darker (its
 // rim blurred towards the part's, or in the part's shadow).
 constexpr double kGlintShare = 0.5;
-// The levels beside a region's boundary are read this far out and in.
-constexpr int kSideReachPx = 3;
-// Every this many boundary points is read for them.
-constexpr int kSideStep = 4;
 
 // The median of `values` (reordered); 0 when empty.
 double medianOf(std::vector<float>& values) {
@@ -85,30 +82,6 @@ double medianOf(std::vector<float>& values) {
   const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
   std::nth_element(values.begin(), mid, values.end());
   return *mid;
-}
-
-// The levels a few pixels out (`out`) and in (`in`) of every kSideStep-th
-// point of a region's outer boundary, along its normal, each where the mask
-// says it is.
-void sideSamples(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
-                 std::vector<float>* out, std::vector<float>* in) {
-  const int n = static_cast<int>(outer.size());
-  const cv::Rect frame(0, 0, grey.cols, grey.rows);
-  for (int i = 0; i < n; i += kSideStep) {
-    const cv::Point d =
-        outer[static_cast<size_t>((i + 2) % n)] - outer[static_cast<size_t>((i - 2 + n) % n)];
-    const double len = std::hypot(d.x, d.y);
-    if (len == 0) continue;
-    const cv::Point2d normal(-d.y / len, d.x / len);
-    for (const int sign : {-1, 1}) {
-      const cv::Point q(static_cast<int>(std::lround(outer[static_cast<size_t>(i)].x +
-                                                     sign * kSideReachPx * normal.x)),
-                        static_cast<int>(std::lround(outer[static_cast<size_t>(i)].y +
-                                                     sign * kSideReachPx * normal.y)));
-      if (!frame.contains(q)) continue;
-      (mask.at<uint8_t>(q) ? in : out)->push_back(grey.at<uint8_t>(q));
-    }
-  }
 }
 
 // The levels just outside (the background) and just inside (the part) a
@@ -302,6 +275,11 @@ struct BandPixels {
   const cv::Mat& own;   // the region's pixels
   const cv::Mat& set;   // every region's pixels
   float* raw;           // room for a row of the box
+  // Where the level outside the part is its cast shadow's (see
+  // shadows.hpp), and that level there (CV_32F, read from the shadow beside
+  // each stretch of edge; -1 elsewhere): both empty without a shadow.
+  cv::Mat zone;
+  cv::Mat local;
 
   // Whether other regions' pixels lie in the box (a region alone in its
   // box is read from the frame's mask itself, so `own` is `set`).
@@ -314,8 +292,9 @@ struct BandPixels {
 // same to the bit.
 class RawCoverage {
  public:
-  explicit RawCoverage(const BandReading& reading)
-      : reading_(reading)
+  RawCoverage(const BandReading& reading, const cv::Mat& local)
+      : reading_(reading),
+        local_(local)
 #if CV_SIMD128_64F
         ,
         slope_(cv::v_setall_f64(reading.plane[1])),
@@ -331,6 +310,19 @@ class RawCoverage {
     const double row_span = r.span(0, y);
     const double span_slope = r.part[1] - r.plane[1];
     int x = a;
+    if (!local_.empty()) {
+      // Beside a shadow, each pixel between the part's level and the
+      // shadow's beside it; the part's light still follows the plane.
+      const float* outside = local_.ptr<float>(y);
+      for (; x < b; ++x) {
+        const auto part =
+            static_cast<float>(row_background + r.plane[1] * x + row_span + span_slope * x);
+        const float background =
+            outside[x] >= 0 ? outside[x] : static_cast<float>(row_background + r.plane[1] * x);
+        raw[x - a] = (static_cast<float>(g[x]) - background) / (part - background);
+      }
+      return;
+    }
 #if CV_SIMD128_64F
     const cv::v_float64x2 row = cv::v_setall_f64(row_background);
     const cv::v_float64x2 span_row = cv::v_setall_f64(row_span);
@@ -359,6 +351,7 @@ class RawCoverage {
 
  private:
   const BandReading& reading_;
+  const cv::Mat& local_;
 #if CV_SIMD128_64F
   cv::v_float64x2 slope_;
   cv::v_float64x2 span_slope_;
@@ -372,7 +365,7 @@ class RawCoverage {
 template <class F>
 void forEachCoverage(const BandReading& reading, const BandPixels& pixels, const RowRuns& runs,
                      F&& f) {
-  const RawCoverage coverage(reading);
+  const RawCoverage coverage(reading, pixels.local);
   const bool shared = pixels.shared();
   runs.forEachRun([&](int y, int a, int b) {
     coverage.run(pixels.grey.ptr<uint8_t>(y), y, a, b, pixels.raw);
@@ -538,8 +531,18 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
   // Background from a ring just outside the edge blur, free of other parts.
   const cv::Mat& set = pixels.set;
   const auto free = [&](int y, int x, uint8_t) { return set.ptr<uint8_t>(y)[x] == 0; };
+  // The surface's light, not a shadow's: beside a shadow, the ring where
+  // it is lit (all of it when that is too little).
+  const cv::Mat& zone = pixels.zone;
+  const auto unshaded = [&](int y, int x, uint8_t v) {
+    return free(y, x, v) && zone.ptr<uint8_t>(y)[x] == 0;
+  };
   PlaneFit background;
-  if (!fitPlane(pixels.grey, far.minus(near), free, &background)) return false;
+  const RowRuns ring = far.minus(near);
+  if ((zone.empty() || !fitPlane(pixels.grey, ring, unshaded, &background)) &&
+      !fitPlane(pixels.grey, ring, free, &background)) {
+    return false;
+  }
   BandReading& r = *reading;
 
   // The interior's moments, run by run in closed form.
@@ -592,11 +595,19 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
 // px off with 2 pixels, 0.018 with 4; sigma 2.5, 0.158 with 2 and 0.028 as
 // widened). So the band starts at 2 pixels and widens while its outermost
 // pixels are still measurably covered.
+//
+// `zone` (over `box`, or empty) is where a cast shadow lies beside the part
+// (see shadows.hpp): there each band pixel is read against the shadow's
+// level beside it (outsideLevels), not the surface's.
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
-                 const cv::Mat& set, const cv::Rect& box, cv::Moments* moments,
+                 const cv::Mat& set, const cv::Mat& zone, const cv::Rect& box, cv::Moments* moments,
                  cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin, RowRuns* covered) {
   std::vector<float> raw_row(static_cast<size_t>(box.width));
-  const BandPixels pixels{grey_box, own, set, raw_row.data()};
+  BandPixels pixels{grey_box, own, set, raw_row.data(), {}, {}};
+  if (!zone.empty() && cv::countNonZero(zone) > 0) {
+    pixels.zone = zone;
+    pixels.local = outsideLevels(grey_box, own, set == 0, zone);
+  }
   Dilations dilations(own_runs);
   BandReading kept;
   int kept_reach = 0;
@@ -707,8 +718,8 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
 // where they can be trusted), orientation and elongation. Moves its
 // contours out. False, nothing written, for a region smaller than
 // options.min_area.
-bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions& options,
-                   std::vector<std::vector<cv::Point>>& contours,
+bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone,
+                   const RegionOptions& options, std::vector<std::vector<cv::Point>>& contours,
                    const std::vector<cv::Vec4i>& hierarchy, const std::vector<cv::Rect>& boxes,
                    int i, Region* region) {
   const cv::Rect frame(0, 0, mask.cols, mask.rows);
@@ -758,8 +769,9 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const RegionOptions
   r.holes = static_cast<int>(r.hole_boundaries.size());
   r.glints = static_cast<int>(glints.size());
 
-  if (!grey.empty() && greyMoments(grey(box), own, own_runs, set, box, &r.moments, &r.centroid,
-                                   &r.coverage, &r.coverage_origin, &r.covered)) {
+  if (!grey.empty() &&
+      greyMoments(grey(box), own, own_runs, set, zone.empty() ? cv::Mat() : zone(box), box,
+                  &r.moments, &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
     r.area = r.moments.m00;
   } else {
     // Binary moments only where the grey levels cannot be trusted.
@@ -815,6 +827,18 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
   cv::findContours(mask, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+  // Shadows cut off the parts they joined, and the boundaries traced again
+  // (only then: most frames have none).
+  ShadowCut shadows;
+  if (!grey.empty() && options.cut_shadows) {
+    shadows = cutShadows(mask, grey, contours, hierarchy, options.min_area);
+    if (shadows.shadows > 0) {
+      contours.clear();
+      hierarchy.clear();
+      cv::findContours(shadows.mask, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+    }
+  }
+  const cv::Mat& cut = shadows.shadows > 0 ? shadows.mask : mask;
   std::vector<int> outers;
   // Boxes of every region, noise too: a region whose box meets no other
   // region's box owns every set pixel of its box, and needs no labelling.
@@ -839,10 +863,11 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   cv::parallel_for_(cv::Range(0, static_cast<int>(outers.size())), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       const int i = outers[static_cast<size_t>(k)];
-      kept[static_cast<size_t>(k)] = measureRegion(mask, grey, options, contours, hierarchy, boxes,
-                                                   i, &found[static_cast<size_t>(k)])
-                                         ? 1
-                                         : 0;
+      kept[static_cast<size_t>(k)] =
+          measureRegion(cut, grey, shadows.zone, options, contours, hierarchy, boxes, i,
+                        &found[static_cast<size_t>(k)])
+              ? 1
+              : 0;
     }
   });
   std::vector<Region> regions;

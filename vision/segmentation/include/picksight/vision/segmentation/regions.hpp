@@ -51,6 +51,10 @@ struct RegionOptions {
   // (the hole count must match exactly).
   double min_hole_area = 0;
   bool keep_border_regions = false;  // a part cut by the image edge cannot be located
+  // With a grey image, cast shadows joined to dark parts are cut off them
+  // (see shadows.hpp), and each edge beside a shadow is read against the
+  // shadow's level.
+  bool cut_shadows = true;
 };
 
 // Regions of a CV_8UC1 mask (non-zero = part), 8-connected, largest first.

@@ -1,0 +1,364 @@
+// Cast shadows cut off dark parts (see shadows.hpp): per region, on its box,
+// the thick layer of levels between the part's and the surface's.
+#include "picksight/vision/segmentation/shadows.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace picksight::vision {
+namespace {
+// Pixels lighter than the part by this share of the contrast are the edge's
+// blur or a shadow; the blur between 25 % and the threshold (near 50 %) is
+// under a pixel thick for an edge blurred by 1.5 px.
+constexpr double kLighterShare = 0.25;
+// The part's own level is read this deep inside it, and a shadow's core
+// lies deeper in the mask than this (pixels): past the blur of any edge at
+// kLighterShare, so that a layer from 4 px thick (the shadow of a part a few
+// millimetres high under a lamp at 45 degrees) shows.
+constexpr int kCoreDepth = 2;
+// Fewer pixels than these are noise, or a corner of the blur.
+constexpr int kMinShadowPixels = 30;
+constexpr int kMinCorePixels = 12;
+// The shadow's level lies this many times the part's own spread (its noise,
+// texture and shading) above the part's level: a part shaded across its
+// face has no second level, only a wider first one.
+constexpr double kSpreadsApart = 4;
+// And below the surface's by this share of the contrast: a layer at the
+// surface's level is the surface.
+constexpr double kBelowSurface = 0.15;
+// Parts less contrasted than this (grey levels) are not searched for
+// shadows: a shadow would be within the noise.
+constexpr double kMinContrast = 20;
+// The surface is read in a ring this far out of the region (pixels), past
+// the edge's blur.
+constexpr int kRingInner = 3;
+constexpr int kRingOuter = 6;
+// The part is thresholded against its shadow within this distance of the
+// shadow (pixels): the shadow's own edge blur and the part's.
+constexpr int kCutReach = 3;
+// The level outside the part is read this far past the ring it is read in.
+constexpr int kZoneReach = 2;
+// The level just outside the part is read in a ring this far out (pixels),
+// past the edge's blur and within a shadow, averaged with Gaussian weights
+// of this sigma; where they sum to less than kMinOutsideWeight no ring pixel
+// is near.
+constexpr int kNearOut = 2;
+constexpr int kFarOut = 5;
+constexpr double kOutsideSigma = 2.5;
+constexpr float kMinOutsideWeight = 0.02f;
+// A ring pixel is in a shadow when darker than the surface by more than
+// this many times the surface's spread (its texture) and kBelowSurface of
+// the contrast.
+constexpr double kTextureSpreads = 3;
+// Fewer points of the outline than this (or a twentieth of them) showing
+// a shadow's levels beside them are noise and texture.
+constexpr size_t kMinOddSides = 3;
+
+cv::Mat disc(int radius) {
+  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+}
+
+// The median of the levels of `grey` where `where` is set, and their spread
+// (the median absolute deviation, scaled to a standard deviation); false
+// when fewer than `min_count` pixels.
+bool levelsOf(const cv::Mat& grey, const cv::Mat& where, int min_count, double* median,
+              double* spread = nullptr) {
+  std::array<int, 256> histogram{};
+  int count = 0;
+  for (int y = 0; y < grey.rows; ++y) {
+    const uint8_t* g = grey.ptr<uint8_t>(y);
+    const uint8_t* w = where.ptr<uint8_t>(y);
+    for (int x = 0; x < grey.cols; ++x) {
+      if (w[x] == 0) continue;
+      ++histogram[g[x]];
+      ++count;
+    }
+  }
+  if (count < min_count) return false;
+  const auto quantile = [&](const std::array<int, 256>& h, double share) {
+    int below = 0;
+    for (size_t v = 0; v < h.size(); ++v) {
+      below += h[v];
+      if (below >= share * count) return static_cast<double>(v);
+    }
+    return 255.0;
+  };
+  *median = quantile(histogram, 0.5);
+  if (spread != nullptr) {
+    std::array<int, 256> deviations{};
+    for (size_t v = 0; v < histogram.size(); ++v) {
+      deviations[static_cast<size_t>(std::abs(static_cast<double>(v) - *median))] += histogram[v];
+    }
+    *spread = 1.4826 * quantile(deviations, 0.5);
+  }
+  return true;
+}
+
+// What one region's shadow changes, over its box.
+struct RegionCut {
+  cv::Rect box;
+  cv::Mat removed;  // the region's pixels that are its shadow
+  cv::Mat zone;     // where the level outside the part is the shadow's
+};
+
+// The levels of a region's box it is read against: the part's (its median
+// deep inside, and its spread), the surface's in a ring past the edge's
+// blur (and the ring's spread: the surface's texture and noise).
+struct Levels {
+  double part = 0;
+  double part_spread = 0;
+  double surface = 0;
+  double surface_spread = 0;
+  double contrast() const { return surface - part; }
+};
+
+// The thick layer of a shadow inside the mask (see shadows.hpp): pixels
+// lighter than the part by kLighterShare of the contrast around a core
+// deeper in the mask than any edge's blur reaches at that level (3 px in,
+// an edge blurred by 2.5 px is 2 % of the way to the surface), on the
+// outline, at a level of their own. 255 there; empty when none.
+cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const Levels& l) {
+  cv::Mat lighter;
+  cv::compare(g, l.part + kLighterShare * l.contrast(), lighter, cv::CMP_GT);
+  cv::bitwise_and(lighter, own, lighter);
+  if (cv::countNonZero(lighter) < kMinShadowPixels) return {};
+  cv::Mat core;
+  cv::erode(own, core, disc(kCoreDepth));
+  cv::bitwise_and(core, lighter, core);
+  if (cv::countNonZero(core) < kMinCorePixels) return {};
+  cv::Mat shadow;
+  cv::dilate(core, shadow, disc(kCoreDepth + 1));
+  cv::bitwise_and(shadow, lighter, shadow);
+  // Only layers on the outline: a lighter patch inside the part (a mark, a
+  // highlight) is the part's.
+  cv::Mat outline;
+  cv::erode(own, outline, cv::Mat());
+  cv::bitwise_xor(own, outline, outline);
+  cv::Mat labels;
+  const int n = cv::connectedComponents(shadow, labels, 8, CV_32S);
+  std::vector<char> on_outline(static_cast<size_t>(n), 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* lab = labels.ptr<int>(y);
+    const uint8_t* o = outline.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (lab[x] > 0 && o[x]) on_outline[static_cast<size_t>(lab[x])] = 1;
+    }
+  }
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* lab = labels.ptr<int>(y);
+    uint8_t* sh = shadow.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) sh[x] = on_outline[static_cast<size_t>(lab[x])] ? 255 : 0;
+  }
+  double level = 0;
+  if (!levelsOf(g, shadow, kMinShadowPixels, &level)) return {};
+  if (level - l.part < kSpreadsApart * l.part_spread ||
+      l.surface - level < kBelowSurface * l.contrast()) {
+    return {};
+  }
+  return shadow;
+}
+
+// Whether the levels a few pixels in and out of the region's outline
+// (sideSamples) leave room for a shadow: some inside lighter than the part
+// by kLighterShare of the contrast, or outside darker than the surface by
+// kBelowSurface of it. Most regions have none, and this costs a few hundred
+// reads where the search costs a few morphological passes over the box.
+bool mayHaveShadow(const cv::Mat& mask, const cv::Mat& grey, const std::vector<cv::Point>& outer) {
+  std::vector<float> out;
+  std::vector<float> in;
+  sideSamples(grey, mask, outer, &out, &in);
+  if (out.size() < 8 || in.size() < 8) return false;
+  const auto middle = [](std::vector<float> v) {
+    std::sort(v.begin(), v.end());
+    return static_cast<double>(v[v.size() / 2]);
+  };
+  const double part = middle(in);
+  const double surface = middle(out);
+  const double contrast = surface - part;
+  if (contrast < kMinContrast) return false;
+  size_t odd = 0;
+  for (const float v : in) odd += v > part + kLighterShare * contrast ? 1 : 0;
+  for (const float v : out) odd += v < surface - kBelowSurface * contrast ? 1 : 0;
+  return odd >= std::max<size_t>(kMinOddSides, (in.size() + out.size()) / 20);
+}
+
+bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
+               const std::vector<std::vector<cv::Point>>& contours, int i, RegionCut* cut) {
+  const cv::Rect frame(0, 0, mask.cols, mask.rows);
+  const int margin = kRingOuter + 1;
+  const cv::Rect box = (cv::boundingRect(contours[static_cast<size_t>(i)]) +
+                        cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
+                       frame;
+  if (!mayHaveShadow(mask, grey, contours[static_cast<size_t>(i)])) return false;
+  const cv::Mat g = grey(box);
+  cv::Mat own = cv::Mat::zeros(box.size(), CV_8UC1);
+  cv::drawContours(own, contours, i, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
+                   -box.tl());
+  cv::bitwise_and(own, mask(box), own);
+
+  Levels l;
+  cv::Mat interior;
+  cv::erode(own, interior, disc(kCoreDepth));
+  if (!levelsOf(g, interior, kMinShadowPixels, &l.part, &l.part_spread)) return false;
+  cv::Mat near;
+  cv::Mat ring;
+  cv::dilate(own, near, disc(kRingInner));
+  cv::dilate(own, ring, disc(kRingOuter));
+  cv::bitwise_xor(ring, near, ring);
+  cv::Mat free;
+  cv::compare(mask(box), 0, free, cv::CMP_EQ);
+  cv::bitwise_and(ring, free, ring);
+  if (!levelsOf(g, ring, kMinShadowPixels, &l.surface, &l.surface_spread)) return false;
+  if (l.contrast() < kMinContrast) return false;  // a light part, or too faint
+
+  // A thick layer inside the mask: near it, the part is what is darker
+  // than halfway to the shadow's level.
+  cv::Mat removed = cv::Mat::zeros(box.size(), CV_8UC1);
+  cv::Mat zone = cv::Mat::zeros(box.size(), CV_8UC1);
+  const cv::Mat layer = thickLayer(g, own, l);
+  if (!layer.empty()) {
+    double level = 0;
+    levelsOf(g, layer, 1, &level);
+    cv::Mat reach;
+    cv::dilate(layer, reach, disc(kCutReach));
+    cv::bitwise_and(reach, own, reach);
+    cv::Mat beyond;
+    cv::compare(g, 0.5 * (l.part + level), beyond, cv::CMP_GE);
+    cv::bitwise_and(reach, beyond, removed);
+    own.setTo(0, removed);
+    cv::bitwise_or(free, removed, free);
+  }
+  // What is left of a shadow outside the mask, or a thin one inside it,
+  // darkens the surface's ring, 3 to 6 px out, below the surface's level by
+  // more than its texture (nearer, the blur of a defocused edge darkens it
+  // too: by 16 % of the contrast 2 px out of an edge blurred by 2 px).
+  cv::Mat dark = ring.clone();
+  const double gap = std::max(kBelowSurface * l.contrast(), kTextureSpreads * l.surface_spread);
+  cv::Mat darker;
+  cv::compare(g, l.surface - gap, darker, cv::CMP_LT);
+  cv::bitwise_and(dark, darker, dark);
+  if (layer.empty() && cv::countNonZero(dark) < kMinShadowPixels) return false;
+  // A shadow's soft edge darkens the surface beside the part well beyond
+  // where it shows clearly (the ring a tenth darker along an edge that runs
+  // with the light moved a part by half a pixel): with a shadow, every edge
+  // of the part is read against the level beside it.
+  cv::dilate(own, zone, disc(kFarOut + kZoneReach));
+  const cv::Mat outside = outsideLevels(g, own, free, zone);
+  int thin = 0;
+  for (int y = 0; y < own.rows; ++y) {
+    const uint8_t* o = own.ptr<uint8_t>(y);
+    const uint8_t* v = g.ptr<uint8_t>(y);
+    const float* level = outside.ptr<float>(y);
+    uint8_t* r = removed.ptr<uint8_t>(y);
+    for (int x = 0; x < own.cols; ++x) {
+      if (o[x] && level[x] >= 0 && v[x] >= 0.5 * (l.part + level[x])) {
+        r[x] = 255;
+        ++thin;
+      }
+    }
+  }
+  if (layer.empty() && thin == 0) return false;
+  cut->removed = removed;
+  cut->zone = zone;
+  cut->box = box;
+  return true;
+}
+}  // namespace
+
+cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
+                      const cv::Mat& where) {
+  cv::Mat inner;
+  cv::Mat ring;
+  cv::dilate(own, inner, disc(kNearOut));
+  cv::dilate(own, ring, disc(kFarOut));
+  ring.setTo(0, inner);
+  cv::bitwise_and(ring, free, ring);
+  cv::bitwise_and(ring, where, ring);
+  cv::Mat weight;
+  ring.convertTo(weight, CV_32F, 1.0 / 255.0);
+  cv::Mat level;
+  g.convertTo(level, CV_32F);
+  level = level.mul(weight);
+  cv::GaussianBlur(weight, weight, cv::Size(), kOutsideSigma);
+  cv::GaussianBlur(level, level, cv::Size(), kOutsideSigma);
+  cv::Mat out(g.size(), CV_32F, cv::Scalar(-1));
+  for (int y = 0; y < out.rows; ++y) {
+    const float* w = weight.ptr<float>(y);
+    const float* v = level.ptr<float>(y);
+    const uint8_t* z = where.ptr<uint8_t>(y);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < out.cols; ++x) {
+      if (z[x] && w[x] >= kMinOutsideWeight) o[x] = v[x] / w[x];
+    }
+  }
+  return out;
+}
+
+void sideSamples(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
+                 std::vector<float>* out, std::vector<float>* in) {
+  // Every this many boundary points is read, this far out and in.
+  constexpr int kStep = 4;
+  constexpr int kReachPx = 3;
+  const int n = static_cast<int>(outer.size());
+  const cv::Rect frame(0, 0, grey.cols, grey.rows);
+  for (int i = 0; i < n; i += kStep) {
+    const cv::Point d =
+        outer[static_cast<size_t>((i + 2) % n)] - outer[static_cast<size_t>((i - 2 + n) % n)];
+    const double len = std::hypot(d.x, d.y);
+    if (len == 0) continue;
+    const cv::Point2d normal(-d.y / len, d.x / len);
+    for (const int sign : {-1, 1}) {
+      const cv::Point q(static_cast<int>(std::lround(outer[static_cast<size_t>(i)].x +
+                                                     sign * kReachPx * normal.x)),
+                        static_cast<int>(std::lround(outer[static_cast<size_t>(i)].y +
+                                                     sign * kReachPx * normal.y)));
+      if (!frame.contains(q)) continue;
+      (mask.at<uint8_t>(q) ? in : out)->push_back(grey.at<uint8_t>(q));
+    }
+  }
+}
+
+ShadowCut cutShadows(const cv::Mat& mask, const cv::Mat& grey,
+                     const std::vector<std::vector<cv::Point>>& contours,
+                     const std::vector<cv::Vec4i>& hierarchy, double min_area) {
+  CV_Assert(mask.type() == CV_8UC1 && grey.type() == CV_8UC1 && grey.size() == mask.size());
+  ShadowCut out;
+  out.mask = mask;
+  std::vector<int> outers;
+  for (int i = 0; i < static_cast<int>(contours.size()); ++i) {
+    if (hierarchy[static_cast<size_t>(i)][3] < 0 &&
+        cv::boundingRect(contours[static_cast<size_t>(i)]).area() >= min_area) {
+      outers.push_back(i);
+    }
+  }
+  std::vector<RegionCut> cuts(outers.size());
+  std::vector<char> found(outers.size(), 0);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(outers.size())), [&](const cv::Range& range) {
+    for (int k = range.start; k < range.end; ++k) {
+      found[static_cast<size_t>(k)] =
+          cutRegion(mask, grey, contours, outers[static_cast<size_t>(k)],
+                    &cuts[static_cast<size_t>(k)])
+              ? 1
+              : 0;
+    }
+  });
+  // Applied in region order, after all were read from the mask as given.
+  for (size_t k = 0; k < cuts.size(); ++k) {
+    if (!found[k]) continue;
+    if (out.shadows == 0) {
+      out.mask = mask.clone();
+      out.zone = cv::Mat::zeros(mask.size(), CV_8UC1);
+    }
+    ++out.shadows;
+    cv::Mat kept = out.mask(cuts[k].box);
+    kept.setTo(0, cuts[k].removed);
+    cv::Mat zone = out.zone(cuts[k].box);
+    cv::bitwise_or(zone, cuts[k].zone, zone);
+  }
+  return out;
+}
+
+}  // namespace picksight::vision
