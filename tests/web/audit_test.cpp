@@ -9,6 +9,7 @@
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/web/access_policy.hpp"
 #include "picksight/web/audit_trail.hpp"
+#include "picksight/web/web_options.hpp"
 #include "temp_dir.hpp"
 #include "web_fixture.hpp"
 
@@ -90,6 +91,11 @@ TEST_CASE("the audit trail rotates at its cap and never holds more than cap x fi
   const std::string line = AuditTrail::line(long_reply);
   CHECK(line.size() < web::kMaxRecordBytes);
   CHECK_THAT(line, Catch::Contains("5000 bytes"));
+  // The trail is bounded as a whole too.
+  CHECK(web::parseWebArgs({"--audit-max-kib", "16384", "--audit-files", "4"}, nullptr));
+  auto too_much = web::parseWebArgs({"--audit-max-kib", "16384", "--audit-files", "5"}, nullptr);
+  REQUIRE_FALSE(too_much);
+  CHECK_THAT(too_much.error().message, Catch::Contains("65536 KiB"));
 }
 
 TEST_CASE("a damaged audit line is skipped with a note and a cut last line is closed",

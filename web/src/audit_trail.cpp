@@ -198,7 +198,17 @@ void AuditTrail::record(AuditRecord record) {
     return;
   }
   if (fd_ >= 0 && size_ > 0 && size_ + text.size() + 1 > options_.max_bytes) rotate();
-  if (fd_ < 0 && !rotate()) return;
+  if (fd_ < 0) {
+    // A rotation that could not open the new file: tried again here, not
+    // rotated again (that would drop one more old file).
+    fd_ = ::open(options_.path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0640);
+    struct stat info {};
+    size_ = fd_ >= 0 && ::fstat(fd_, &info) == 0 ? static_cast<size_t>(info.st_size) : 0;
+    if (fd_ < 0) {
+      logError("audit trail ", options_.path, ": cannot open: ", std::strerror(errno));
+      return;
+    }
+  }
   // One write of the whole line: a crash cuts at most this record.
   if (!writeAll(fd_, text + "\n")) {
     logError("audit trail ", options_.path, ": cannot write: ", std::strerror(errno));

@@ -125,7 +125,8 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
                  "record a line (default: audit.jsonl beside the --users file; without one, the "
                  "newest 1000 records in memory)");
   app.add_option("--audit-max-kib", raw.audit_max_kib,
-                 "KiB one audit file may hold before the next is started")
+                 "KiB one audit file may hold before the next is started (x --audit-files: "
+                 "65536 at most)")
       ->check(CLI::Range(16, 65536))
       ->capture_default_str();
   app.add_option("--audit-files", o.audit_files,
@@ -274,6 +275,10 @@ Result<void> checkCombinations(const WebOptions& o) {
       return makeError(WebErrc::kBadConfig,
                        "--tls-key: " + o.tls_key + " may be read by others (chmod 640 or 600)");
   }
+  // The trail is read back and exported whole: 64 MiB in all at most.
+  if (o.audit_max_bytes * static_cast<size_t>(o.audit_files) > (size_t{64} << 20))
+    return makeError(WebErrc::kBadConfig,
+                     "--audit-max-kib x --audit-files: at most 65536 KiB in all");
   if (o.redirect && o.tls_cert.empty())
     return makeError(WebErrc::kBadConfig,
                      "--http-redirect redirects to HTTPS: it needs --tls-cert and --tls-key");

@@ -1089,7 +1089,8 @@ void WebServer::Impl::auditRoutes() {
       limit = static_cast<size_t>(*n);
     }
     auto read = audit_->newest(limit);
-    for (const auto& note : read.notes) logWarning("audit trail: ", note);
+    // The notes go to the reader only: the log would repeat them at every
+    // refresh of the panel.
     sendJson(res, {{"records", read.records},
                    {"notes", read.notes},
                    {"file", options_.audit_file.empty() ? nlohmann::json(nullptr)
