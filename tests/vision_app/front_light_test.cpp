@@ -2,7 +2,8 @@
 // LEARN on a textured belt takes the one part a person sees and names the
 // specks it left out; LOCATE's smallest region follows the taught parts; a
 // green part on a grey belt of the same brightness is taught and found in
-// colour; a model's colour survives its file; the sweets photograph.
+// colour; a model's colour survives its file; the sweets photograph; a part
+// taught beside its shadow is found beside shadows falling elsewhere.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -269,4 +270,46 @@ TEST_CASE("LEARN warns of the shadows and reflections it sees and of nothing els
   CHECK_FALSE(mentions(shadow, "reflection"));
   CHECK(mentions(glossy, "reflection"));
   CHECK_FALSE(mentions(glossy, "shadow"));
+}
+
+TEST_CASE("a part taught beside its shadow is found and placed beside shadows falling elsewhere",
+          "[vision_app][locate][front]") {
+  // The shadow condition: a textured belt, a soft shadow 8 px long. Taught
+  // at 30 degrees, the part's shadow lies along other edges of it at every
+  // other angle of the scene; left joined, it changes the region's shape.
+  const ps::SilhouetteSceneOptions look = lookOf("shadow");
+  cv::Point2d drawn;
+  const cv::Mat teach = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);
+  ps::SilhouetteSceneOptions o = look;
+  o.width = 1000;
+  o.height = 800;
+  o.parts = 6;
+  o.distractor_share = 0;
+  o.seed = 3;
+  const ps::SilhouetteScene scene({boneType()}, {true}, o);
+  REQUIRE(scene.truth().size() == 6);
+  const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+  int found_cut = 0;
+  int found_joined = 0;
+  for (const bool cut : {true, false}) {
+    VisionOptions options = cellOptions();
+    options.regions.cut_shadows = cut;
+    const auto learned = learnInImage(teach, {}, options, noModels(), 1, "tee", std::nullopt);
+    INFO((learned.ok() ? std::string() : learned.error().message));
+    REQUIRE(learned.ok());
+    const LocateOutcome outcome = locateInFrame(frame, options, listOf(learned->model), -1);
+    (cut ? found_cut : found_joined) = foundTrue(scene.truth(), outcome.parts);
+    if (!cut) continue;
+    // Each within a pixel of the drawn part (its shadow left out).
+    for (const auto& p : outcome.parts) {
+      double nearest = 1e9;
+      for (const auto& t : scene.truth()) {
+        nearest = std::min(nearest, std::hypot(p.x - t.centre.x, p.y - t.centre.y));
+      }
+      CHECK(nearest < 1.0);
+    }
+  }
+  CHECK(found_cut == 6);
+  // Left joined, the shadows cost parts: the scene tests the cut.
+  CHECK(found_joined < 6);
 }

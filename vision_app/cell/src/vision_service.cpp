@@ -362,10 +362,10 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const cv::Mat& g
   }
   const double uneven = vision::unevenEdgeShare(grey, mask, r);
   if (uneven > kShadowShare) {
-    warnings.push_back("a shadow or uneven light along " +
-                       std::to_string(std::lround(100 * uneven)) +
-                       " % of the outline (the part may be placed a pixel or more off: light "
-                       "the cell along the camera's axis, a ring light or a dome)");
+    warnings.push_back(
+        "a shadow or uneven light along " + std::to_string(std::lround(100 * uneven)) +
+        " % of the outline (a shadow is cut off the part, which may still be placed half a "
+        "pixel off: light the cell along the camera's axis, a ring light or a dome)");
   }
   const double small_hole = kSmallHoleShare * r.area;
   int small = 0;
