@@ -1,5 +1,6 @@
 // Pins angle differences modulo a part's symmetry period and the wraps into
-// [0, period), [0, 360) and (-180, 180], edge cases included.
+// [0, period), [0, 360), (-180, 180] and (-period / 2, period / 2], edge
+// cases included.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -8,6 +9,8 @@
 
 using Catch::Detail::Approx;
 using picksight::angleDiffDeg;
+using picksight::centredDeg;
+using picksight::nearestTurnDeg;
 using picksight::normalizeDeg;
 using picksight::signedDeg;
 using picksight::wrapDeg;
@@ -103,4 +106,44 @@ TEST_CASE("angleDiffDeg is symmetric and at most half the period", "[common]") {
         CHECK(d <= period / 2 + 1e-9);
         CHECK(d == angleDiffDeg(b, a, period));
       }
+}
+
+TEST_CASE("centredDeg maps into minus half the period excluded up to half of it", "[common]") {
+  // A bar lying a hair either side of its taught angle: 0.1 and -0.1, not
+  // 0.1 and 179.9.
+  CHECK(centredDeg(179.9, 180) == Approx(-0.1));
+  CHECK(centredDeg(-0.1, 180) == Approx(-0.1));
+  CHECK(centredDeg(0.1, 180) == Approx(0.1));
+  CHECK(centredDeg(90, 180) == Approx(90));
+  CHECK(centredDeg(-90, 180) == Approx(90));
+  CHECK(centredDeg(270, 180) == Approx(90));
+  CHECK(centredDeg(91, 180) == Approx(-89));
+  CHECK(centredDeg(44, 90) == Approx(44));
+  CHECK(centredDeg(46, 90) == Approx(-44));
+  CHECK(centredDeg(-45, 90) == Approx(45));
+  CHECK(centredDeg(359, 360) == Approx(-1));
+  CHECK(centredDeg(180, 360) == Approx(180));
+  CHECK(centredDeg(-180, 360) == Approx(180));
+  CHECK(centredDeg(725, 360) == Approx(5));
+  CHECK_FALSE(std::signbit(centredDeg(-0.0, 180)));
+  CHECK_FALSE(std::signbit(centredDeg(-180.0, 180)));
+  // No angle: a disc.
+  CHECK(centredDeg(123, 0) == 0.0);
+  CHECK(centredDeg(45, std::numeric_limits<double>::quiet_NaN()) == 0.0);
+  for (double a = -800; a <= 800; a += 13.75) {
+    for (double period : {360.0, 180.0, 120.0, 90.0, 60.0}) {
+      const double c = centredDeg(a, period);
+      CHECK(c > -period / 2);
+      CHECK(c <= period / 2);
+      CHECK(angleDiffDeg(c, a, period) == Approx(0).margin(1e-9));
+    }
+  }
+}
+
+TEST_CASE("nearestTurnDeg picks the turn within half a period of the reference", "[common]") {
+  CHECK(nearestTurnDeg(359.9, 30, 360) == Approx(-0.1));
+  CHECK(nearestTurnDeg(209.99, 30, 180) == Approx(29.99));
+  CHECK(nearestTurnDeg(30.01, 30, 180) == Approx(30.01));
+  CHECK(nearestTurnDeg(10, 350, 360) == Approx(370));
+  CHECK(nearestTurnDeg(10, 350, 0) == 350);
 }

@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 
+#include "picksight/common/angles.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/transport/control_client.hpp"
 
@@ -159,7 +160,7 @@ std::vector<Pose> imagePoses(const std::string& reply) {
   auto poses = parseLocateReply(reply);
   for (auto& p : poses) {
     p.y = -p.y;
-    p.rz = p.rz == 0 ? 0 : 360 - p.rz;
+    p.rz = normalizeDeg(-p.rz);  // a recognized part's rz may be negative
   }
   return poses;
 }

@@ -70,8 +70,9 @@ struct Pose {
   double x, y, rz;
 };
 std::vector<Pose> parseLocateReply(const std::string& reply);
-// The same poses back in image axes (y down, angles clockwise on screen):
-// LOCATE replies in the vision frame (y up) before any calibration.
+// The same poses back in image axes (y down, angles clockwise on screen),
+// angles in [0, 360): LOCATE replies in the vision frame (y up) before any
+// calibration.
 std::vector<Pose> imagePoses(const std::string& reply);
 
 }  // namespace picksight::e2e

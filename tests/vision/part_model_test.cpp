@@ -170,8 +170,13 @@ TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vi
       const double angle =
           angleDiffDeg(m->angle_deg, t.angle_deg - trained.at(t.type).truth_angle, m->symmetry_deg);
       CHECK(angle < 0.3);
-      CHECK(m->angle_deg >= 0);
-      CHECK(m->angle_deg < (m->symmetry_deg > 0 ? m->symmetry_deg : 360));
+      // The turn nearest the taught pose (reportedTurnDeg).
+      if (m->symmetry_deg > 0) {
+        CHECK(m->angle_deg > -m->symmetry_deg / 2);
+        CHECK(m->angle_deg <= m->symmetry_deg / 2);
+      } else {
+        CHECK(m->angle_deg == 0);
+      }
       worst_position = std::max(worst_position, position);
       worst_angle = std::max(worst_angle, angle);
     }

@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "picksight/cell/grasp_planner.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision_app/offline_commands.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
@@ -179,4 +180,90 @@ TEST_CASE("the lens subcommand stores the chessboard lens model the cell then us
   CHECK(reloaded.load().empty());
   CHECK(reloaded.handle("STATUS").find(" lens=1 ") != std::string::npos);
   CHECK(reloaded.calibration().geometry()->vision.calibrated() == false);  // no scale yet
+}
+
+namespace {
+// A recognized part of type 1 at image (320, 240), turned `angle_deg` from
+// its taught pose (as the vision library reports it), with its model's
+// symmetry period.
+LocatedPart partAt(double angle_deg, double symmetry_deg) {
+  LocatedPart p;
+  p.x = 320;
+  p.y = 240;
+  p.angle_deg = angle_deg;
+  p.type = 1;
+  p.symmetry_deg = symmetry_deg;
+  return p;
+}
+
+grasp::Pose replied(const CellGeometry& geometry, double angle_deg, double symmetry_deg,
+                    const grasp::GraspStyle& style = {}) {
+  const LocatedPart part = partAt(angle_deg, symmetry_deg);
+  return replyPose(part, partPoseInVisionFrame(part, geometry.vision), style, geometry);
+}
+
+CellGeometry robotCell(double rz_deg, bool mirrored) {
+  CellGeometry g;
+  g.transform = calibration::PlaneTransform::rigid({100, 50, rz_deg, mirrored});
+  return g;
+}
+}  // namespace
+
+TEST_CASE("a part a hair either side of its taught angle gets one reply angle in every frame",
+          "[cell][grasp][symmetry]") {
+  // The vision library reports the turn nearest the taught pose (a bar
+  // lying still there: -0.02 or 0.02 as the noise has it); every frame the
+  // cell replies in keeps it so: no half turn (the bar's 0 and 180), no
+  // whole turn (0.01 and 359.99) between two LOCATEs of one part.
+  for (const double symmetry : {180.0, 90.0, 360.0}) {
+    INFO("symmetry " << symmetry);
+    // Vision frame, no calibration: y up, so the image's -0.02 is 0.02.
+    CHECK(replied(CellGeometry{}, -0.02, symmetry).rz_deg == Approx(0.02).margin(1e-9));
+    CHECK(replied(CellGeometry{}, 0.02, symmetry).rz_deg == Approx(-0.02).margin(1e-9));
+    // The robot frame at rz 30 (the issue's cell: 30.00 and 209.99).
+    CHECK(replied(robotCell(30, false), -0.02, symmetry).rz_deg == Approx(30.02));
+    CHECK(replied(robotCell(30, false), 0.02, symmetry).rz_deg == Approx(29.98));
+    // A robot frame lined up with the camera: around 0, not 0 and 360.
+    CHECK(replied(robotCell(0, false), 0.02, symmetry).rz_deg == Approx(-0.02).margin(1e-9));
+    // Across the frame's own wrap at 180: 179.98 and 180.02, not -179.98.
+    CHECK(replied(robotCell(180, false), 0.02, symmetry).rz_deg == Approx(179.98));
+    CHECK(replied(robotCell(180, false), -0.02, symmetry).rz_deg == Approx(180.02));
+  }
+  // A grasp style turned a quarter from the part: within half the bar's
+  // period of 30 + 90.
+  CHECK(replied(robotCell(30, false), 0.02, 180, {0, 0, 90}).rz_deg == Approx(119.98));
+  CHECK(replied(robotCell(30, false), -0.02, 180, {0, 0, 90}).rz_deg == Approx(120.02));
+}
+
+TEST_CASE("the reply angle turns the way the part does, through a mirrored calibration too",
+          "[cell][grasp][symmetry]") {
+  // A part turned counter-clockwise on screen (image angle -d, y down) turns
+  // counter-clockwise in the vision frame (+d); a calibration that holds a
+  // mirror turns it the other way in the robot frame. A bar's range is the
+  // half turn centred on the taught angle in each frame.
+  for (const double d : {10.0, 60.0, 89.0}) {
+    INFO("turned " << d);
+    CHECK(replied(CellGeometry{}, -d, 180).rz_deg == Approx(d));
+    CHECK(replied(robotCell(30, false), -d, 180).rz_deg == Approx(30 + d));
+    CHECK(replied(robotCell(30, false), d, 180).rz_deg == Approx(30 - d));
+    CHECK(replied(robotCell(30, true), -d, 180).rz_deg == Approx(30 - d));
+    CHECK(replied(robotCell(30, true), d, 180).rz_deg == Approx(30 + d));
+  }
+  // A chiral part (no symmetry) turned 170 either way: the whole turn's
+  // range centred on the taught angle, not [0, 360).
+  CHECK(replied(robotCell(0, false), 170, 360).rz_deg == Approx(-170));
+  CHECK(replied(robotCell(0, false), -170, 360).rz_deg == Approx(170));
+}
+
+TEST_CASE("a grasp off a symmetric part's centre stays at the same end of it in every frame",
+          "[cell][grasp][symmetry]") {
+  // 20 px along the bar from its centre: the bar's turn decides which end
+  // that is, so the gripper's place follows the reported turn (the end
+  // nearest where it was taught), whichever side of 0 the noise puts it.
+  const grasp::GraspStyle style{20, 0, 0};
+  for (const double angle : {-0.02, 0.02}) {
+    const grasp::Pose p = replied(CellGeometry{}, angle, 180, style);
+    CHECK(p.x == Approx(340).margin(0.01));
+    CHECK(p.y == Approx(-240).margin(0.02));
+  }
 }

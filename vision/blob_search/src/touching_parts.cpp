@@ -25,7 +25,6 @@ namespace picksight::vision {
 namespace {
 using namespace touching;
 using picksight::angleDiffDeg;
-using picksight::wrapDeg;
 
 constexpr int kMaxRefinedPerModel = 8;
 // Poses refined per blob, for each part the blob can hold: the best
@@ -566,7 +565,7 @@ std::vector<Match> BlobSearch::matches() const {
     match.score = c.score;
     match.centroid = c.pose.centre;
     match.symmetry_deg = c.model->symmetryDeg();
-    match.angle_deg = wrapDeg(c.pose.angle_deg, match.symmetry_deg);
+    match.angle_deg = reportedTurnDeg(*c.model, c.pose.angle_deg);
     match.touching = true;
     found.push_back(match);
   }

@@ -132,6 +132,10 @@ double huDistance(const BodyModel& body, const HuArray& log_hu) {
   return d;
 }
 
+double reportedTurnDeg(const PartModel& model, double turn_deg) {
+  return centredDeg(turn_deg, model.symmetryDeg());
+}
+
 const char* errorName(PartModelErrc e) {
   switch (e) {
     case PartModelErrc::kNotGrey:

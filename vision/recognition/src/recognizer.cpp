@@ -9,7 +9,6 @@
 #include <map>
 #include <utility>
 
-#include "picksight/common/angles.hpp"
 #include "picksight/vision/blob_search/touching_parts.hpp"
 #include "picksight/vision/recognition/region_judge.hpp"
 
@@ -41,7 +40,7 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
     match.score = best_verdict.score;
     match.centroid = r.centroid;
     match.symmetry_deg = best->symmetryDeg();
-    match.angle_deg = wrapDeg(best_verdict.angle_deg, match.symmetry_deg);
+    match.angle_deg = reportedTurnDeg(*best, best_verdict.angle_deg);
     match.body_distance = best_verdict.hu_distance;
     return {match};
   }

@@ -101,8 +101,31 @@ grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::Vi
   // The vision frame flips y, so an image rotation turns the other way; a
   // tilted camera's rectification turns directions a little more, locally.
   const double direction = vision.directionToVision(part.angle_deg, {part.x, part.y});
-  const double rz = part.type >= 0 ? wrapDeg(direction, part.symmetry_deg) : direction;
-  return {at.x, at.y, rz};
+  if (part.type < 0) return {at.x, at.y, direction};
+  // The turn nearest the taught pose, as the vision library chose it in
+  // the image (reportedTurnDeg), kept so here: wrapped into [0, S) instead,
+  // a bar lying at its taught angle (image -0.01 -> vision 0.01, image 0.01
+  // -> vision -0.01 -> 179.99) would flip half a turn between frames, and
+  // its grasp with it. The taught direction here is ~0 (the y flip keeps
+  // it), a tilted camera's rectification turning it a little.
+  const double taught = signedDeg(vision.directionToVision(0, {part.x, part.y}));
+  return {at.x, at.y, nearestTurnDeg(direction, taught, part.symmetry_deg)};
+}
+
+grasp::Pose replyPose(const LocatedPart& part, const grasp::Pose& pose,
+                      const grasp::GraspStyle& style, const CellGeometry& geometry) {
+  grasp::Pose reply = geometry.toReply(grasp::gripperPose(pose, style));
+  if (part.type < 0) return reply;
+  // The frames' conversions wrap angles into [0, 360): a part near its
+  // taught angle whose grasp points along the robot's x axis would read
+  // 0.01 one LOCATE and 359.99 the next. The reply is the turn within half
+  // a turn of this grasp's angle on a part lying as taught (vision angle
+  // 0), taken at the vision origin so that it is one number per
+  // calibration and style, never a wrap of its own.
+  const double taught =
+      signedDeg(geometry.toReply(grasp::gripperPose({0.0, 0.0, 0.0}, style)).rz_deg);
+  reply.rz_deg = nearestTurnDeg(reply.rz_deg, taught, 360.0);
+  return reply;
 }
 
 CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
@@ -118,7 +141,7 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
     const auto& styles =
         has_setup && !setup->second.styles.empty() ? setup->second.styles : kOwnPose;
     if (!has_setup || setup->second.gripper.fingers.empty()) {
-      pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles.front())));
+      pick.poses.push_back(replyPose(part, pose, styles.front(), geometry));
       pick.parts.push_back(index);
       pick.styles.push_back(&styles == &kOwnPose ? -1 : 0);
       continue;
@@ -136,7 +159,7 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
       ++pick.skipped;
       continue;
     }
-    pick.poses.push_back(geometry.toReply(grasp::gripperPose(pose, styles[*chosen])));
+    pick.poses.push_back(replyPose(part, pose, styles[*chosen], geometry));
     pick.parts.push_back(index);
     pick.styles.push_back(&styles == &kOwnPose ? -1 : static_cast<int>(*chosen));
   }

@@ -35,6 +35,26 @@ inline double signedDeg(double deg) {
   return d;
 }
 
+// Into (-period / 2, period / 2]: of the turns a part with that period looks
+// alike at, the one nearest 0 (a bar's turn of 179.9 is -0.1). Centred on 0
+// so that a part lying near 0 (as it was taught) never crosses the wrap,
+// which the [0, period) of wrapDeg has right there. A period of 0 (or not a
+// number) means no angle exists: the result is 0. Never negative zero.
+inline double centredDeg(double deg, double period) {
+  if (!(period > 0)) return 0.0;
+  const double half = period / 2;
+  double d = std::fmod(deg, period);
+  if (d > half) d -= period;
+  if (d <= -half) d += period;
+  return d + 0.0;
+}
+
+// The angle equal to `deg` modulo `period` that lies in (reference -
+// period / 2, reference + period / 2]; `reference` itself for a period of 0.
+inline double nearestTurnDeg(double deg, double reference, double period) {
+  return reference + centredDeg(deg - reference, period);
+}
+
 // Smallest absolute difference between two angles, modulo `period` degrees
 // (360 for a directed part, 180 for one whose direction is ambiguous, 90 for a
 // square...), in [0, period / 2]. A period of 0 means no angle exists: the

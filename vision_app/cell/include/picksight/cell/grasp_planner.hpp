@@ -25,9 +25,19 @@ struct CellPick {
 const vision::PartModel* modelOf(const LocateScene& scene, int type);
 
 // A located part's own pose in the vision frame: position in vision units,
-// rotation counter-clockwise (a recognized part: from its trained pose, in
-// [0, symmetry); a region: its axis direction, [0, 360)).
+// rotation counter-clockwise (a recognized part: from its trained pose, the
+// turn nearest it, within half a symmetry period of the taught direction;
+// a region: its axis direction, [0, 360)).
 grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::VisionFrame& vision);
+
+// The reply-frame pose of the gripper holding `part` (its vision-frame pose
+// `pose`) by `style`. For a recognized part the angle is the one within
+// half a turn of the same grasp's angle on a part lying as taught (vision
+// angle 0, at the vision origin) in the reply frame, that angle taken in
+// (-180, 180]: the same part in the same place gives the same number, never
+// one 360 apart. A region's (no model) is in [0, 360).
+grasp::Pose replyPose(const LocatedPart& part, const grasp::Pose& pose,
+                      const grasp::GraspStyle& style, const CellGeometry& geometry);
 
 // The grasp poses of the parts of `outcome`. Obstacles are the scene's
 // mask without the part's own pixels (for a part found touching others,

@@ -45,7 +45,8 @@ PICKSIGHT_ERROR_DOMAIN(VisionErrc, "vision")
 struct LocatedPart {
   double x = 0;  // sensor pixels
   double y = 0;
-  // Recognized part: rotation from the trained pose, [0, symmetry_deg).
+  // Recognized part: rotation from the trained pose, the turn nearest it in
+  // (-symmetry_deg / 2, symmetry_deg / 2] (vision::reportedTurnDeg).
   // Region (no models): direction of its axis, [0, 360), image axes.
   double angle_deg = 0;
   double area = 0;  // sensor pixels

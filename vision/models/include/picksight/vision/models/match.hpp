@@ -16,7 +16,8 @@ struct Match {
   size_t region = 0;                 // index into the regions
   double score = 0;                  // verified fraction of the weighted boundary, 0..1
   cv::Point2d centroid;              // pixels
-  // Rotation from the trained pose, in [0, symmetry) (or [0, 360)).
+  // Rotation from the trained pose (image axes, degrees): the turn nearest
+  // the taught pose, in (-symmetry / 2, symmetry / 2] (reportedTurnDeg).
   double angle_deg = 0;
   double symmetry_deg = 360;  // the model's: 360 none, 180, 120..., 0 any turn
   double body_distance = 0;   // Hu distance (0 for a part found inside a merged blob)

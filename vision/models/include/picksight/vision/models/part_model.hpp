@@ -99,6 +99,19 @@ struct PartModel {
   double symmetryDeg() const { return symmetry_order == 0 ? 0.0 : 360.0 / symmetry_order; }
 };
 
+// The rotation reported for a part of `model` found turned by `turn_deg`
+// from its taught pose: of the turns the model's symmetry makes look alike,
+// the one nearest the taught pose, in (-S/2, S/2] with S = symmetryDeg():
+// (-180, 180] for a part with none, (-90, 90] for a bar, (-45, 45] for a
+// square; 0 for a disc. The one rule of every reported angle (recognition
+// and the blob search; LOCATE, LOCATE ALL, the PLC and the results stream
+// take it from the Match). Parts are taught lying as they usually lie, so
+// the range's edge, where a turn of S/2 either way looks alike and noise
+// picks the sign, sits as far from where parts lie as it can; the
+// [0, S) this replaced had its edge at the taught pose itself, and a bar
+// lying still there came out 0.0 or 179.9 frame by frame.
+double reportedTurnDeg(const PartModel& model, double turn_deg);
+
 // Why a model could not be trained, or is not valid.
 enum class PartModelErrc {
   kNotGrey = 1,   // the training image is not 8-bit grey
