@@ -67,6 +67,7 @@ TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][mo
     CHECK(t.model.symmetryDeg() == deg);
     CHECK(t.model.body.mirror_symmetric == mirror.at(type));
     CHECK(validateModel(t.model));
+    CHECK(checkSymmetry(t.model));
   }
   // A plain disc turns into itself at any angle.
   cv::Mat grey(300, 300, CV_8UC1, cv::Scalar(200));
@@ -74,6 +75,7 @@ TEST_CASE("trained models know their symmetry and mirror symmetry", "[vision][mo
   const auto disc = trainModel(grey, 9, "disc");
   REQUIRE(disc.ok());
   CHECK(disc.value().symmetryDeg() == 0);
+  CHECK(checkSymmetry(disc.value()));
   CHECK(disc.value().orientation_order == 0);
 }
 

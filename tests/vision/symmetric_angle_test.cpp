@@ -104,6 +104,32 @@ TEST_CASE("taught parts know their rotational symmetry", "[vision][model][symmet
   CHECK(t.ell.symmetryDeg() == 360);
   CHECK(t.ell_mirror.symmetryDeg() == 360);
   CHECK_FALSE(t.ell.body.mirror_symmetric);
+  // What a model file's order is checked against: each fits its boundary.
+  for (const PartModel* m : t.all()) {
+    INFO(m->name);
+    CHECK(checkSymmetry(*m));
+  }
+}
+
+TEST_CASE("a symmetry order the boundary does not have is refused, naming it",
+          "[vision][model][symmetry]") {
+  const Taught t;
+  const auto withOrder = [](PartModel m, int order) {
+    m.symmetry_order = order;
+    return checkSymmetry(m);
+  };
+  // An L is not a half turn from itself, nor a bar a quarter; a disc (0)
+  // is alike at every turn, a bar is not.
+  const auto ell = withOrder(t.ell, 2);
+  REQUIRE_FALSE(ell);
+  CHECK_THAT(ell.error().message, Catch::StartsWith("symmetry order 2 does not fit the boundary: "
+                                                    "turned by 180.0 deg"));
+  CHECK_FALSE(withOrder(t.bar, 4));
+  CHECK_FALSE(withOrder(t.bar, 0));
+  CHECK_FALSE(withOrder(t.pinwheel, 8));
+  // A lower order the part also has is consistent (its range is wider).
+  CHECK(withOrder(t.pinwheel, 2));
+  CHECK(withOrder(t.bar, 1));
 }
 
 TEST_CASE("the same part in the same place gives the same angle, frame after frame",

@@ -145,6 +145,27 @@ TEST_CASE("bad model files are rejected with the problem", "[vision_app][models]
   CHECK_FALSE(modelFromYaml(nan_area));
 }
 
+TEST_CASE("a model file whose symmetry order its boundary does not have is rejected",
+          "[vision_app][models]") {
+  // The order sets the range the part's angles are reported in: an L
+  // taken for half-turn symmetric would be gripped a half turn wrong one
+  // time in two. Its file is refused naming the order, as any bad value.
+  const std::string ell = modelToYaml(trainedModel("l_shape", 3));
+  const std::string order = "symmetry_order: 1";
+  REQUIRE(ell.find(order) != std::string::npos);
+  REQUIRE(modelFromYaml(ell));
+  std::string tampered = ell;
+  tampered.replace(tampered.find(order), order.size(), "symmetry_order: 2");
+  const auto r = modelFromYaml(tampered);
+  REQUIRE_FALSE(r);
+  CHECK(r.error().code == ModelErrc::kBadFile);
+  CHECK(r.error().message.find("symmetry order 2 does not fit the boundary") != std::string::npos);
+  // A bar's half-turn symmetry is its own.
+  const std::string bar = modelToYaml(trainedModel("rectangle", 4));
+  REQUIRE(bar.find("symmetry_order: 2") != std::string::npos);
+  CHECK(modelFromYaml(bar));
+}
+
 TEST_CASE("the library stores, reloads, forgets, and skips bad files by name",
           "[vision_app][models]") {
   TempDir dir;

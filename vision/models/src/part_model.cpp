@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "picksight/common/angles.hpp"
 
@@ -223,6 +225,57 @@ bool showsMirrorImage(const PartModel& model, const ImagePose& direct, const Ima
   const double on_mirror = m.on / m.weight;
   if (std::abs(on_direct - on_mirror) > 1e-9) return on_mirror > on_direct;
   return m.distance / m.weight <= d.distance / d.weight;
+}
+
+namespace {
+// A stored symmetry order is checked as far off as the training image's
+// edges may lie from the model's fitted boundary: training keeps an order
+// when 97 % of the boundary, turned, lies within the edge tolerance
+// (conformity + 1 px) of those edges, which lie within the conformity of
+// the boundary; twice the training tolerance covers both with room for the
+// pixel grid. Over 90 % of a part's boundary lies that close to itself
+// turned by its symmetry; an L turned by a half turn, or a bar by a
+// quarter, has a third of it or less.
+constexpr double kMinSymmetryShare = 0.9;
+
+// The share of the boundary's weight that, turned by `turn_deg`, lies
+// within `reach` pixels of the boundary.
+double turnedShare(const PartModel& m, double turn_deg, double reach) {
+  const double c = std::cos(turn_deg * kRadPerDeg);
+  const double s = std::sin(turn_deg * kRadPerDeg);
+  double on = 0;
+  double total = 0;
+  for (const auto& sample : m.samples) {
+    const cv::Point2d p = sample.point;
+    total += sample.weight;
+    if (boundaryDistance(m.loops, {c * p.x - s * p.y, s * p.x + c * p.y}) <= reach)
+      on += sample.weight;
+  }
+  return total > 0 ? on / total : 0;
+}
+}  // namespace
+
+Result<void> checkSymmetry(const PartModel& model) {
+  if (model.symmetry_order == 1) return {};
+  std::vector<double> turns;
+  if (model.symmetry_order == 0) {
+    for (int k = 1; k < 24; ++k) turns.push_back(15.0 * k);
+  } else {
+    turns.push_back(360.0 / model.symmetry_order);
+  }
+  const double reach = 2 * (model.conformity + 1.0);
+  for (const double turn : turns) {
+    const double share = turnedShare(model, turn, reach);
+    if (share < kMinSymmetryShare) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "symmetry order %d does not fit the boundary: turned by %.1f deg, %.0f %% of "
+                    "it lies within %.1f px of itself (%.0f %% needed)",
+                    model.symmetry_order, turn, 100 * share, reach, 100 * kMinSymmetryShare);
+      return makeError(PartModelErrc::kInvalid, text);
+    }
+  }
+  return {};
 }
 
 Result<void> validateModel(const PartModel& model) {

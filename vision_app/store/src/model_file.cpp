@@ -382,6 +382,12 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
   if (auto valid = vision::validateModel(m); !valid)
     return makeError(ModelErrc::kBadFile, valid.error().message);
   vision::prepareModel(m);
+  // The symmetry order sets the range every angle of the part is reported
+  // in: a wrong one (a file edited, or damaged within its bounds) would
+  // turn a chiral part's grasp by a half turn, so it is checked against
+  // the boundary, not taken on trust nor replaced by a default.
+  if (auto symmetric = vision::checkSymmetry(m); !symmetric)
+    return makeError(ModelErrc::kBadFile, symmetric.error().message);
   return record;
 }
 

@@ -149,6 +149,13 @@ double chiralLength(const PartModel& model, double turn_deg);
 // what is wrong.
 Result<void> validateModel(const PartModel& model);
 
+// Checks a prepared model's symmetry order against its own boundary (a
+// model file's value, which decides the range every angle is reported in):
+// turned by 360 / symmetry_order (by every 15 degrees for 0, a disc), the
+// boundary must lie on itself. kInvalid names the order and how much of the
+// boundary fits.
+Result<void> checkSymmetry(const PartModel& model);
+
 // Sum |H_i(a) - H_i(b)| over the invariants the model uses, the 7th (the
 // mirror's sign) left out; H2..H6 compared above a floor set by the model's
 // H1 (part_model.cpp), below which a part counts as round.
