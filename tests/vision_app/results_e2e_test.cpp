@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -371,4 +372,41 @@ TEST_CASE("a part with no free grasp shows its blocked finger and the region und
     no_grasp = no_grasp || (rejection.region() == part.region() && rejection.test() == "no grasp");
   CHECK(no_grasp);
   CHECK(ask(robot, "WHY").find(" no free grasp of type 1") != std::string::npos);
+}
+
+TEST_CASE("the results stream gives a still bar the turn LOCATE gives it, in every frame",
+          "[e2e][results][symmetry]") {
+  // A bar (alike turned by 180) lying where it was taught, fresh noise in
+  // every frame of the synthetic camera: the stream's angle (image axes,
+  // the turn nearest the taught pose) and reply pose agree with the reply,
+  // and stay within noise of 0, never 180.
+  VideoServerProcess server({"--source",
+                             "cam0=synthetic:width=640,height=480,parts=1,types=rectangle,seed=4",
+                             "--mode", "trigger"});
+  VisionProcess vision(server);
+  LineClient robot = vision.connect();
+  Results results(vision.results_endpoint);
+  results.join(robot, "BLOBS");
+  REQUIRE(ask(robot, "LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);
+  results.after("LEARN");
+  std::vector<double> angles;
+  for (int i = 0; i < 20; ++i) {
+    const std::string reply = ask(robot, "LOCATE 1");
+    const auto poses = parseLocateReply(reply);
+    REQUIRE(poses.size() == 1);
+    const auto r = results.after("LOCATE");
+    CHECK(r.reply() == reply);
+    REQUIRE(r.parts_size() == 1);
+    const auto& part = r.parts(0);
+    CHECK(part.symmetry_deg() == 180);
+    CHECK(part.reply_pose().rz_deg() == Approx(poses[0].rz).margin(0.001));
+    // Image axes (y down) against the vision frame's (y up): the same turn.
+    CHECK(part.angle_deg() == Approx(-poses[0].rz).margin(0.001));
+    angles.push_back(part.angle_deg());
+  }
+  const auto [lo, hi] = std::minmax_element(angles.begin(), angles.end());
+  INFO("angles from " << *lo << " to " << *hi);
+  CHECK(*hi - *lo < 0.3);
+  CHECK(std::abs(*lo) < 0.3);
+  CHECK(std::abs(*hi) < 0.3);
 }
