@@ -111,7 +111,7 @@ TEST_CASE("taught parts know their rotational symmetry", "[vision][model][symmet
   }
 }
 
-TEST_CASE("a symmetry order the boundary does not have is refused, naming it",
+TEST_CASE("a symmetry order the boundary does not have is refused with the share that fits",
           "[vision][model][symmetry]") {
   const Taught t;
   const auto withOrder = [](PartModel m, int order) {
@@ -132,7 +132,7 @@ TEST_CASE("a symmetry order the boundary does not have is refused, naming it",
   CHECK(withOrder(t.bar, 1));
 }
 
-TEST_CASE("the same part in the same place gives the same angle, frame after frame",
+TEST_CASE("the same part in the same place gives the same angle frame after frame",
           "[vision][model][symmetry]") {
   const Taught t;
   struct Case {
@@ -167,7 +167,7 @@ TEST_CASE("the same part in the same place gives the same angle, frame after fra
   }
 }
 
-TEST_CASE("at the edge of its range a bar's angle is one end or the other, as documented",
+TEST_CASE("at the edge of its range a bar's angle is one end or the other as documented",
           "[vision][model][symmetry]") {
   // Lying across its taught pose (90 degrees) a bar looks the same turned
   // either way: noise picks +90 or -90 (PROTOCOL.md, "Rotations"). Both

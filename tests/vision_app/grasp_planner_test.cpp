@@ -235,8 +235,9 @@ TEST_CASE("a part a hair either side of its taught angle gets one reply angle in
   CHECK(replied(robotCell(30, false), -0.02, 180, {0, 0, 90}).rz_deg == Approx(120.02));
 }
 
-TEST_CASE("the reply angle turns the way the part does, through a mirrored calibration too",
-          "[cell][grasp][symmetry]") {
+TEST_CASE(
+    "the reply angle turns the way the part does and the other way through a mirrored calibration",
+    "[cell][grasp][symmetry]") {
   // A part turned counter-clockwise on screen (image angle -d, y down) turns
   // counter-clockwise in the vision frame (+d); a calibration that holds a
   // mirror turns it the other way in the robot frame. A bar's range is the

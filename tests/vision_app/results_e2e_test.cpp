@@ -374,7 +374,7 @@ TEST_CASE("a part with no free grasp shows its blocked finger and the region und
   CHECK(ask(robot, "WHY").find(" no free grasp of type 1") != std::string::npos);
 }
 
-TEST_CASE("the results stream gives a still bar the turn LOCATE gives it, in every frame",
+TEST_CASE("the results stream gives a still bar the turn LOCATE gives it in every frame",
           "[e2e][results][symmetry]") {
   // A bar (alike turned by 180) lying where it was taught, fresh noise in
   // every frame of the synthetic camera: the stream's angle (image axes,
