@@ -118,6 +118,17 @@ TEST_CASE("LEARN on a textured belt takes the part and names the specks it left 
       learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
   REQUIRE(at.ok());
   CHECK(at->model.body.area == Approx(learned->model.body.area).epsilon(1e-9));
+  // A stain of a tenth of the part's area (a worn belt's, at the part's
+  // level) is still a stain beside it, not a second part.
+  cv::Mat stained = image.clone();
+  const double radius = std::sqrt(0.10 * learned->model.body.area / M_PI);
+  cv::circle(stained, cv::Point(75, 75), static_cast<int>(std::lround(radius)), cv::Scalar(45),
+             cv::FILLED, cv::LINE_AA);
+  const auto with_stain =
+      learnInImage(stained, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  INFO((with_stain.ok() ? std::string() : with_stain.error().message));
+  REQUIRE(with_stain.ok());
+  CHECK(with_stain->model.body.area == Approx(learned->model.body.area).epsilon(0.01));
 }
 
 TEST_CASE("LEARN still refuses two parts on a textured belt", "[vision_app][learn][front]") {
