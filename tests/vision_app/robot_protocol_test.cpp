@@ -1,7 +1,14 @@
-// Robot protocol parsing and the replies that need no camera.
+// Robot protocol parsing, the replies that need no camera, and the log of
+// the changes asked over a port.
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "picksight/vision_app/vision_cell.hpp"
 #include "temp_dir.hpp"
@@ -144,4 +151,38 @@ TEST_CASE("a read-only port answers reads and refuses every change with ERROR 17
   CHECK(readOnly("FLY").rfind("ERROR 10 ", 0) == 0);
   CHECK(readOnly("").rfind("ERROR 14 ", 0) == 0);
   CHECK(f.protocol.models().snapshot()->empty());
+}
+
+TEST_CASE("every change asked over a port is logged with who asked and the reply",
+          "[vision_app][protocol][audit]") {
+  CommandTable table;
+  table.add("SET", "SET <n>", [](const Request&) { return std::string("OK"); });
+  table.add(
+      "GET", "GET", [](const Request&) { return std::string("OK 1"); }, neverChanges);
+  Session session;
+  session.client = "robot 10.0.0.5:4000";
+  // The log goes to stderr: caught in a file for the length of the requests.
+  picksight::test::TempDir dir;
+  const std::string path = (dir.path() / "log").string();
+  std::fflush(stderr);
+  const int saved = ::dup(2);
+  const int file = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  REQUIRE(saved >= 0);
+  REQUIRE(file >= 0);
+  ::dup2(file, 2);
+  table.dispatch("SET 1", false, &session);
+  table.dispatch("GET", false, &session);
+  table.dispatch("SET 2", true, &session);  // refused on a read-only port: nothing changed
+  table.dispatch("SET 3");                  // from inside the app
+  std::fflush(stderr);
+  ::dup2(saved, 2);
+  ::close(saved);
+  ::close(file);
+  std::ifstream in(path);
+  const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(log);
+  CHECK(log.find("audit: robot 10.0.0.5:4000 'SET 1' -> OK") != std::string::npos);
+  CHECK(log.find("audit: local 'SET 3' -> OK") != std::string::npos);
+  CHECK(log.find("GET") == std::string::npos);
+  CHECK(log.find("SET 2") == std::string::npos);
 }

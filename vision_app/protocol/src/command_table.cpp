@@ -1,6 +1,7 @@
 // Robot protocol command table and request parsing.
 #include "picksight/protocol/command_table.hpp"
 
+#include "picksight/common/log.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/robot_errors.hpp"
 
@@ -107,6 +108,15 @@ std::string CommandTable::dispatch(std::string_view line, bool read_only, Sessio
   if (!session) local.received = std::chrono::steady_clock::now();
   request->session = session ? session : &local;
   std::string reply = it->second.handler(*request);
+  // Every change a robot, a PLC or the set-up port asks for, in the log
+  // (journald under systemd), with who asked and what came back: the web
+  // keeps its own trail of the changes made through it, and sees none of
+  // these. Bounded: the line as the request limit allows it, the reply's
+  // first 120 characters.
+  if (it->second.changes(*request)) {
+    logInfo("audit: ", session && !session->client.empty() ? session->client : "local", " '",
+            printable(line, 200), "' -> ", printable(reply, 120));
+  }
   if (!session && local.after_reply) local.after_reply(reply);
   return reply;
 }

@@ -82,7 +82,8 @@ class CommandTable {
   void add(const std::string& word, const std::string& usage, Handler handler,
            ChangesCell changes = alwaysChanges, Publishes publishes = Publishes::kNothing);
   // Parses and runs one request line. On a read-only port a request that
-  // changes the cell gets ProtocolErrc::kReadOnly and does nothing. The
+  // changes the cell gets ProtocolErrc::kReadOnly and does nothing; one that
+  // runs is logged as `audit: <client> '<line>' -> <reply>`. The
   // session's command and publishes are its entry's, refused or not. With
   // `session` (a connection's), its after_reply is left for the caller to
   // run once the reply is sent; without, it runs before this returns.
