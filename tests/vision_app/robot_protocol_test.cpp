@@ -153,10 +153,11 @@ TEST_CASE("a read-only port answers reads and refuses every change with ERROR 17
   CHECK(f.protocol.models().snapshot()->empty());
 }
 
-TEST_CASE("every change asked over a port is logged with who asked and the reply",
+TEST_CASE("every change made at a port's request is logged with who asked and the reply",
           "[vision_app][protocol][audit]") {
   CommandTable table;
   table.add("SET", "SET <n>", [](const Request&) { return std::string("OK"); });
+  table.add("BAD", "BAD", [](const Request&) { return std::string("ERROR 11 usage: BAD"); });
   table.add(
       "GET", "GET", [](const Request&) { return std::string("OK 1"); }, neverChanges);
   Session session;
@@ -174,6 +175,7 @@ TEST_CASE("every change asked over a port is logged with who asked and the reply
   table.dispatch("GET", false, &session);
   table.dispatch("SET 2", true, &session);  // refused on a read-only port: nothing changed
   table.dispatch("SET 3");                  // from inside the app
+  table.dispatch("BAD", false, &session);   // refused by the command: nothing changed
   std::fflush(stderr);
   ::dup2(saved, 2);
   ::close(saved);
@@ -185,4 +187,5 @@ TEST_CASE("every change asked over a port is logged with who asked and the reply
   CHECK(log.find("audit: local 'SET 3' -> OK") != std::string::npos);
   CHECK(log.find("GET") == std::string::npos);
   CHECK(log.find("SET 2") == std::string::npos);
+  CHECK(log.find("BAD") == std::string::npos);
 }
