@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
@@ -211,6 +212,10 @@ int main(int argc, char** argv) {
                  "write each scene's first frame and each teach image here (PNG), to look at");
   app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  if (!save_frames.empty() && !std::filesystem::is_directory(save_frames)) {
+    std::fprintf(stderr, "--save-frames: %s is not a directory\n", save_frames.c_str());
+    return 2;
+  }
 
   const std::vector<TypeSpec>& specs =
       standard_types ? picksight::bench::silhouetteTypeSpecs() : unseenTypeSpecs();
