@@ -113,9 +113,10 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
                  "connections open at once from one address (streams included)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
-  app.add_option("--users", o.users_file,
-                 "the users file (argon2id hashes, written by the page's Users panel); with no "
-                 "users, an 'admin' with a random password printed once (default: in memory)");
+  app.add_option(
+      "--users", o.users_file,
+      "the users file (argon2id hashes, written through the admin's /api/users); with no "
+      "users, an 'admin' with a random password printed once (default: in memory)");
   app.add_option("--session-timeout", raw.session_timeout_s,
                  "seconds without a request after which a login ends")
       ->check(CLI::Range(1, 86400))

@@ -76,14 +76,6 @@ constexpr int kBoxMargin = kMaxBand + 2;
 // rim blurred towards the part's, or in the part's shadow).
 constexpr double kGlintShare = 0.5;
 
-// The median of `values` (reordered); 0 when empty.
-double medianOf(std::vector<float>& values) {
-  if (values.empty()) return 0;
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
-
 // The levels just outside (the background) and just inside (the part) a
 // region's outer boundary: the medians of sideSamples. False when either
 // side has no reading.
@@ -275,10 +267,9 @@ struct BandPixels {
   const cv::Mat& own;   // the region's pixels
   const cv::Mat& set;   // every region's pixels
   float* raw;           // room for a row of the box
-  // Where the level outside the part is its cast shadow's (see
-  // shadows.hpp), and that level there (CV_32F, read from the shadow beside
-  // each stretch of edge; -1 elsewhere): both empty without a shadow.
-  cv::Mat zone;
+  // Beside a cast shadow (see shadows.hpp), the level just outside the
+  // part that each band pixel is read against (CV_32F, -1 where the plane
+  // holds); empty without a shadow.
   cv::Mat local;
 
   // Whether other regions' pixels lie in the box (a region alone in its
@@ -531,18 +522,8 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
   // Background from a ring just outside the edge blur, free of other parts.
   const cv::Mat& set = pixels.set;
   const auto free = [&](int y, int x, uint8_t) { return set.ptr<uint8_t>(y)[x] == 0; };
-  // The surface's light, not a shadow's: beside a shadow, the ring where
-  // it is lit (all of it when that is too little).
-  const cv::Mat& zone = pixels.zone;
-  const auto unshaded = [&](int y, int x, uint8_t v) {
-    return free(y, x, v) && zone.ptr<uint8_t>(y)[x] == 0;
-  };
   PlaneFit background;
-  const RowRuns ring = far.minus(near);
-  if ((zone.empty() || !fitPlane(pixels.grey, ring, unshaded, &background)) &&
-      !fitPlane(pixels.grey, ring, free, &background)) {
-    return false;
-  }
+  if (!fitPlane(pixels.grey, far.minus(near), free, &background)) return false;
   BandReading& r = *reading;
 
   // The interior's moments, run by run in closed form.
@@ -603,9 +584,8 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
                  const cv::Mat& set, const cv::Mat& zone, const cv::Rect& box, cv::Moments* moments,
                  cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin, RowRuns* covered) {
   std::vector<float> raw_row(static_cast<size_t>(box.width));
-  BandPixels pixels{grey_box, own, set, raw_row.data(), {}, {}};
+  BandPixels pixels{grey_box, own, set, raw_row.data(), {}};
   if (!zone.empty() && cv::countNonZero(zone) > 0) {
-    pixels.zone = zone;
     pixels.local = outsideLevels(grey_box, own, set == 0, zone);
   }
   Dilations dilations(own_runs);

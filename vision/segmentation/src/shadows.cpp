@@ -171,12 +171,9 @@ bool mayHaveShadow(const cv::Mat& mask, const cv::Mat& grey, const std::vector<c
   std::vector<float> in;
   sideSamples(grey, mask, outer, &out, &in);
   if (out.size() < 8 || in.size() < 8) return false;
-  const auto middle = [](std::vector<float> v) {
-    std::sort(v.begin(), v.end());
-    return static_cast<double>(v[v.size() / 2]);
-  };
-  const double part = middle(in);
-  const double surface = middle(out);
+  // (medianOf reorders the samples; the counts below need no order.)
+  const double part = medianOf(in);
+  const double surface = medianOf(out);
   const double contrast = surface - part;
   if (contrast < kMinContrast) return false;
   size_t odd = 0;
@@ -295,6 +292,13 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
     }
   }
   return out;
+}
+
+double medianOf(std::vector<float>& values) {
+  if (values.empty()) return 0;
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
 }
 
 void sideSamples(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,

@@ -47,6 +47,9 @@ ShadowCut cutShadows(const cv::Mat& mask, const cv::Mat& grey,
 cv::Mat outsideLevels(const cv::Mat& grey, const cv::Mat& own, const cv::Mat& free,
                       const cv::Mat& where);
 
+// The median of `values` (reordered); 0 when empty.
+double medianOf(std::vector<float>& values);
+
 // The levels 3 px out (`out`) and in (`in`) of every 4th point of a
 // region's outer boundary, along its normal, each where the mask says it
 // is: what lies beside the part and just inside its edge.
