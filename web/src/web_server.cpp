@@ -307,7 +307,8 @@ Result<void> WebServer::Impl::start() {
     if (auto set = users_->set("admin", Role::kAdmin, password); !set) return set.error();
     std::cout << "admin-password " << password << std::endl;
     logInfo("no users yet", options_.users_file.empty() ? " (no --users file: kept in memory)" : "",
-            ": made 'admin' with the password printed on stdout (change it under Users)");
+            ": made 'admin' with the password printed on stdout (an admin changes it through "
+            "/api/users)");
   }
   cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
                                              options_.jpeg_quality);
