@@ -5,7 +5,11 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -121,6 +125,108 @@ TEST_CASE("an operator locates but cannot teach nor close the camera nor manage 
   CHECK(res->status == 200);
   CHECK(json::parse(res->body)["reply"].get<std::string>().rfind("OK 4 ", 0) == 0);
   CHECK(emil.Get("/api/users")->status == 403);
+}
+
+TEST_CASE(
+    "an admin adds users and changes a role and a password and removes one but never the last "
+    "admin",
+    "[web][users][audit]") {
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  WebProcess web(videoServerArgs(server));
+  auto admin = web.client();
+  const auto users = [&](httplib::Client& as) {
+    std::map<std::string, std::string> roles;
+    for (const auto& u : json::parse(as.Get("/api/users")->body))
+      roles[u["name"].get<std::string>()] = u["role"].get<std::string>();
+    return roles;
+  };
+  const auto error = [](const httplib::Result& res) {
+    return json::parse(res->body)["error"].get<std::string>();
+  };
+  REQUIRE(post(admin, "/api/users",
+               {{"name", "ida"}, {"role", "operator"}, {"password", "operator-ida"}, {"new", true}})
+              ->status == 200);
+  // "new": an existing name is a conflict, nothing replaced.
+  auto res = post(admin, "/api/users",
+                  {{"name", "ida"}, {"role", "admin"}, {"password", "another-one"}, {"new", true}});
+  CHECK(res->status == 409);
+  CHECK_THAT(error(res), Catch::Contains("exists"));
+  CHECK(users(admin)["ida"] == "operator");
+  const std::string ida_cookie = web.login("ida", "operator-ida");
+  auto ida = web.as(ida_cookie);
+  CHECK(ida.Get("/api/cameras")->status == 200);
+  // Only an admin changes users.
+  CHECK(post(ida, "/api/users/ida/role", {{"role", "admin"}})->status == 403);
+
+  // A new role keeps the password and ends the user's sessions.
+  REQUIRE(post(admin, "/api/users/ida/role", {{"role", "engineer"}})->status == 200);
+  CHECK(users(admin)["ida"] == "engineer");
+  CHECK(ida.Get("/api/cameras")->status == 401);
+  CHECK(!web.login("ida", "operator-ida").empty());
+  // A new password keeps the role.
+  REQUIRE(post(admin, "/api/users/ida/password", {{"password", "engineer-ida"}})->status == 200);
+  CHECK(web.login("ida", "operator-ida").empty());
+  CHECK(!web.login("ida", "engineer-ida").empty());
+  CHECK(users(admin)["ida"] == "engineer");
+  // Bad input: a clear 4xx, nothing changed.
+  res = post(admin, "/api/users/ida/role", {{"role", "root"}});
+  CHECK(res->status == 400);
+  CHECK_THAT(error(res), Catch::Contains("operator, engineer or admin"));
+  res = post(admin, "/api/users/ida/password", {{"password", "short"}});
+  CHECK(res->status == 400);
+  CHECK_THAT(error(res), Catch::Contains("8 to 256"));
+  CHECK(post(admin, "/api/users/nobody/role", {{"role", "operator"}})->status == 404);
+  CHECK(!web.login("ida", "engineer-ida").empty());
+
+  // The last admin can neither lose the role nor go.
+  res = post(admin, "/api/users/admin/role", {{"role", "engineer"}});
+  CHECK(res->status == 409);
+  CHECK_THAT(error(res), Catch::Contains("last admin"));
+  res = post(admin, "/api/users/admin/delete", json::object());
+  CHECK(res->status == 409);
+  CHECK_THAT(error(res), Catch::Contains("last admin"));
+  CHECK(users(admin)["admin"] == "admin");
+  CHECK(admin.Get("/api/users")->status == 200);  // that session goes on
+  // With a second admin, the first may step down.
+  REQUIRE(post(admin, "/api/users/ida/role", {{"role", "admin"}})->status == 200);
+  auto ida_admin = web.as(web.login("ida", "engineer-ida"));
+  REQUIRE(post(admin, "/api/users/admin/role", {{"role", "engineer"}})->status == 200);
+  CHECK(admin.Get("/api/users")->status == 401);  // its own session ended with the role
+  CHECK(users(ida_admin)["admin"] == "engineer");
+  REQUIRE(post(ida_admin, "/api/users/admin/delete", json::object())->status == 200);
+  CHECK(users(ida_admin).count("admin") == 0);
+
+  // Each change in the trail, by whom, with the role before and after;
+  // never a password.
+  auto trail = ida_admin.Get("/api/audit?limit=100");
+  REQUIRE(trail);
+  REQUIRE(trail->status == 200);
+  CHECK(trail->body.find("operator-ida") == std::string::npos);
+  CHECK(trail->body.find("engineer-ida") == std::string::npos);
+  const json records = json::parse(trail->body)["records"];
+  std::vector<std::string> seen;
+  for (const auto& r : records) {
+    const std::string action = r.value("action", "");
+    if (action.rfind("user.", 0) != 0) continue;
+    seen.push_back(action + " " + r.value("target", "") + " " + r.value("user", "") + " " +
+                   r.value("outcome", "") + " " + r.value("before", json()).dump() + " " +
+                   r.value("after", json()).dump());
+  }
+  std::reverse(seen.begin(), seen.end());  // oldest first
+  const std::vector<std::string> expected = {
+      R"x(user.add ida admin ok "(no such user)" {"role":"operator"})x",
+      R"x(user.add ida admin error {"role":"operator"} null)x",
+      R"x(user.role ida admin ok {"role":"operator"} {"role":"engineer"})x",
+      R"x(user.password ida admin ok {"role":"engineer"} {"role":"engineer"})x",
+      R"x(user.password ida admin error {"role":"engineer"} null)x",
+      R"x(user.role nobody admin error "(no such user)" null)x",
+      R"x(user.role admin admin error {"role":"admin"} null)x",
+      R"x(user.delete admin admin error {"role":"admin"} null)x",
+      R"x(user.role ida admin ok {"role":"engineer"} {"role":"admin"})x",
+      R"x(user.role admin admin ok {"role":"admin"} {"role":"engineer"})x",
+      R"x(user.delete admin ida ok {"role":"engineer"} "(removed)")x",
+  };
+  CHECK(seen == expected);
 }
 
 TEST_CASE("a session ends after --session-timeout without a request", "[web][users]") {

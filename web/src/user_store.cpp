@@ -150,26 +150,55 @@ Result<void> UserStore::save() const {
 }
 
 Result<void> UserStore::set(const std::string& name, Role role, const std::string& password) {
+  return change(name, role, password, Mode::kAddOrReplace);
+}
+
+Result<void> UserStore::add(const std::string& name, Role role, const std::string& password) {
+  return change(name, role, password, Mode::kAdd);
+}
+
+Result<void> UserStore::setRole(const std::string& name, Role role) {
+  return change(name, role, std::nullopt, Mode::kChange);
+}
+
+Result<void> UserStore::setPassword(const std::string& name, const std::string& password) {
+  return change(name, std::nullopt, password, Mode::kChange);
+}
+
+Result<void> UserStore::change(const std::string& name, std::optional<Role> role,
+                               const std::optional<std::string>& password, Mode mode) {
   if (!validName(name))
     return makeError(WebErrc::kBadRequest, "a user name is 1 to 32 of A-Z a-z 0-9 _ - .");
-  if (password.size() < 8 || password.size() > 256)
+  if (password && (password->size() < 8 || password->size() > 256))
     return makeError(WebErrc::kBadRequest, "a password is 8 to 256 bytes");
-  const std::string hash = hashPassword(password);  // outside the lock: ~50 ms, 64 MiB
-  if (hash.empty()) return makeError(WebErrc::kBadRequest, "out of memory hashing the password");
+  std::string hash;
+  if (password) {
+    hash = hashPassword(*password);  // outside the lock: ~50 ms, 64 MiB
+    if (hash.empty()) return makeError(WebErrc::kBadRequest, "out of memory hashing the password");
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   auto it =
       std::find_if(users_.begin(), users_.end(), [&](const Entry& e) { return e.name == name; });
   const auto old = users_;
   if (it == users_.end()) {
+    if (mode == Mode::kChange) return makeError(WebErrc::kNotFound, "no user '" + name + "'");
+    if (!role || !password)
+      return makeError(WebErrc::kBadRequest, "a new user needs a role and a password");
     if (users_.size() >= kMaxUsers) return makeError(WebErrc::kBadRequest, "256 users already");
-    users_.push_back({name, role, hash});
+    users_.push_back({name, *role, hash});
   } else {
-    const bool last_admin = it->role == Role::kAdmin && role != Role::kAdmin &&
+    if (mode == Mode::kAdd)
+      return makeError(WebErrc::kConflict, "user '" + name + "' exists already");
+    const bool last_admin = it->role == Role::kAdmin && role && *role != Role::kAdmin &&
                             std::count_if(users_.begin(), users_.end(), [](const Entry& e) {
                               return e.role == Role::kAdmin;
                             }) == 1;
-    if (last_admin) return makeError(WebErrc::kBadRequest, "the last admin stays an admin");
-    *it = {name, role, hash};
+    if (last_admin)
+      return makeError(
+          WebErrc::kConflict,
+          "'" + name + "' is the last admin and stays an admin: make another admin first");
+    if (role) it->role = *role;
+    if (password) it->hash = hash;
   }
   if (auto saved = save(); !saved) {
     users_ = old;  // nothing changed, in memory either
@@ -186,7 +215,9 @@ Result<void> UserStore::remove(const std::string& name) {
   if (it->role == Role::kAdmin && std::count_if(users_.begin(), users_.end(), [](const Entry& e) {
                                     return e.role == Role::kAdmin;
                                   }) == 1)
-    return makeError(WebErrc::kBadRequest, "the last admin cannot be removed");
+    return makeError(
+        WebErrc::kConflict,
+        "'" + name + "' is the last admin and cannot be removed: make another admin first");
   const auto old = users_;
   users_.erase(it);
   if (auto saved = save(); !saved) {

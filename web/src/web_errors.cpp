@@ -15,6 +15,8 @@ const char* errorName(WebErrc e) {
       return "encode";
     case WebErrc::kBadConfig:
       return "bad config";
+    case WebErrc::kConflict:
+      return "conflict";
   }
   return "unknown";
 }

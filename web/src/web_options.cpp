@@ -115,7 +115,7 @@ void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
       ->capture_default_str();
   app.add_option(
       "--users", o.users_file,
-      "the users file (argon2id hashes, written through the admin's /api/users); with no "
+      "the users file (argon2id hashes, written through the page's Users tab); with no "
       "users, an 'admin' with a random password printed once (default: in memory)");
   app.add_option("--session-timeout", raw.session_timeout_s,
                  "seconds without a request after which a login ends")

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -66,6 +67,7 @@ int httpStatus(const Error& error) {
   const auto& code = error.code;
   if (code == WebErrc::kBadRequest) return 400;
   if (code == WebErrc::kNotFound) return 404;
+  if (code == WebErrc::kConflict) return 409;
   if (code == WebErrc::kUnreachable) return 502;
   if (code == ControlErrc::kBadRequest || code == ControlErrc::kOutOfRange ||
       code == ControlErrc::kUnknownFeature || code == ControlErrc::kNotSupported)
@@ -236,6 +238,11 @@ class WebServer::Impl {
  private:
   void routes();
   void userRoutes();
+  // Runs `change` on the users, records it (before: the user's role; after:
+  // `after`, or the same role when null) and answers the request; ends the
+  // user's sessions when it is done.
+  void changeUser(const httplib::Request& req, httplib::Response& res, AuditRecord record,
+                  nlohmann::json after, const std::function<Result<void>()>& change);
   void auditRoutes();
   // http_->Post(pattern, handler), telling the gate (with TLS) that the
   // request has arrived whole before the handler runs.
@@ -307,8 +314,8 @@ Result<void> WebServer::Impl::start() {
     if (auto set = users_->set("admin", Role::kAdmin, password); !set) return set.error();
     std::cout << "admin-password " << password << std::endl;
     logInfo("no users yet", options_.users_file.empty() ? " (no --users file: kept in memory)" : "",
-            ": made 'admin' with the password printed on stdout (an admin changes it through "
-            "/api/users)");
+            ": made 'admin' with the password printed on stdout (an admin changes it in the "
+            "page's Users tab)");
   }
   cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
                                              options_.jpeg_quality);
@@ -840,51 +847,81 @@ void WebServer::Impl::userRoutes() {
       list.push_back({{"name", u.name}, {"role", roleName(u.role)}});
     sendJson(res, list);
   });
+  // Adds a user, or with "new": false (the default, as before the page's
+  // Users panel) adds or replaces one.
   post("/api/users", [this](const httplib::Request& req, httplib::Response& res) {
     auto body = parseJsonBody(req.body);
     if (!body) return sendError(res, body.error());
     const auto name = body->value("name", nlohmann::json());
     const auto role = parseRole(body->value("role", std::string()));
     const auto password = body->value("password", nlohmann::json());
-    if (!name.is_string() || !role || !password.is_string())
+    const auto fresh = body->value("new", nlohmann::json(false));
+    if (!name.is_string() || !role || !password.is_string() || !fresh.is_boolean())
       return sendError(res, WebErrc::kBadRequest,
-                       "\"name\", \"password\" and \"role\" (operator, engineer, admin)");
+                       "\"name\", \"password\" and \"role\" (operator, engineer, admin); "
+                       "\"new\": true or false");
     AuditRecord record;
-    record.action = "user.set";
+    record.action = fresh.get<bool>() ? "user.add" : "user.set";
     record.target = name.get<std::string>();
     // Never the password: only that one was set.
     record.arguments = {{"name", record.target}, {"role", roleName(*role)}, {"password", "(set)"}};
-    record.before = nullptr;
-    for (const auto& u : users_->list())
-      if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
-    if (record.before.is_null()) record.before = "(no such user)";
-    auto set = users_->set(name.get<std::string>(), *role, password.get<std::string>());
-    record.outcome = set ? "ok" : "error";
-    record.status = set ? 200 : httpStatus(set.error());
-    if (set)
-      record.after = {{"role", roleName(*role)}};
-    else
-      record.reply = set.error().message;
-    audit(req, sessionOf(req), std::move(record));
-    if (!set) return sendError(res, set.error());
-    sessions_->removeUser(name.get<std::string>());  // the old password or role ends here
-    sendJson(res, {{"ok", true}});
+    const std::string user = record.target;  // record is moved into changeUser
+    const std::string& secret = password.get_ref<const std::string&>();
+    changeUser(req, res, std::move(record), {{"role", roleName(*role)}}, [&] {
+      return fresh.get<bool>() ? users_->add(user, *role, secret)
+                               : users_->set(user, *role, secret);
+    });
   });
-  post(R"(/api/users/([^/]+)/delete)", [this](const httplib::Request& req, httplib::Response& res) {
-    AuditRecord record;
-    record.action = "user.delete";
-    record.target = req.matches[1];
-    for (const auto& u : users_->list())
-      if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
-    auto removed = users_->remove(req.matches[1]);
-    record.outcome = removed ? "ok" : "error";
-    record.status = removed ? 200 : httpStatus(removed.error());
-    if (!removed) record.reply = removed.error().message;
-    audit(req, sessionOf(req), std::move(record));
-    if (!removed) return sendError(res, removed.error());
-    sessions_->removeUser(req.matches[1]);
-    sendJson(res, {{"ok", true}});
-  });
+  // An existing user's role, password or removal (the Users panel).
+  post(R"(/api/users/([^/]+)/(role|password|delete))",
+       [this](const httplib::Request& req, httplib::Response& res) {
+         const std::string user = req.matches[1];
+         const std::string what = req.matches[2];
+         AuditRecord record;
+         record.action = "user." + what;
+         record.target = user;
+         if (what == "delete")
+           return changeUser(req, res, std::move(record), "(removed)",
+                             [&] { return users_->remove(user); });
+         auto body = parseJsonBody(req.body);
+         if (!body) return sendError(res, body.error());
+         if (what == "role") {
+           const auto role = parseRole(body->value("role", std::string()));
+           if (!role)
+             return sendError(res, WebErrc::kBadRequest, "\"role\": operator, engineer or admin");
+           record.arguments = {{"role", roleName(*role)}};
+           return changeUser(req, res, std::move(record), {{"role", roleName(*role)}},
+                             [&] { return users_->setRole(user, *role); });
+         }
+         const auto password = body->value("password", nlohmann::json());
+         if (!password.is_string())
+           return sendError(res, WebErrc::kBadRequest, "\"password\": a string of 8 to 256 bytes");
+         record.arguments = {{"password", "(set)"}};
+         changeUser(req, res, std::move(record), nlohmann::json(), [&] {
+           return users_->setPassword(user, password.get_ref<const std::string&>());
+         });
+       });
+}
+
+void WebServer::Impl::changeUser(const httplib::Request& req, httplib::Response& res,
+                                 AuditRecord record, nlohmann::json after,
+                                 const std::function<Result<void>()>& change) {
+  for (const auto& u : users_->list())
+    if (u.name == record.target) record.before = {{"role", roleName(u.role)}};
+  if (record.before.is_null()) record.before = "(no such user)";
+  auto done = change();
+  record.outcome = done ? "ok" : "error";
+  record.status = done ? 200 : httpStatus(done.error());
+  if (done)
+    record.after = after.is_null() ? record.before : std::move(after);
+  else
+    record.reply = done.error().message;
+  const std::string user = record.target;
+  audit(req, sessionOf(req), std::move(record));
+  if (!done) return sendError(res, done.error());
+  // The old password or role ends here: its sessions log in again.
+  sessions_->removeUser(user);
+  sendJson(res, {{"ok", true}});
 }
 
 void WebServer::Impl::routes() {

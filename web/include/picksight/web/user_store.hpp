@@ -37,7 +37,15 @@ class UserStore {
   // Adds or replaces a user (name: 1..32 of A-Z a-z 0-9 _ - .; password:
   // 8..256 bytes) and writes the file.
   Result<void> set(const std::string& name, Role role, const std::string& password);
-  // Removes a user and writes the file; the last admin cannot be removed.
+  // Adds a user; one of that name already is a conflict (WebErrc::kConflict).
+  Result<void> add(const std::string& name, Role role, const std::string& password);
+  // Changes an existing user's role, or password, keeping the rest
+  // (WebErrc::kNotFound for an unknown name).
+  Result<void> setRole(const std::string& name, Role role);
+  Result<void> setPassword(const std::string& name, const std::string& password);
+  // Removes a user and writes the file. The last admin can neither be
+  // removed nor lose the role (WebErrc::kConflict): nobody could manage the
+  // users any more.
   Result<void> remove(const std::string& name);
   // The user's role when `password` is theirs. An unknown name costs the
   // same time as a wrong password.
@@ -63,6 +71,12 @@ class UserStore {
     std::string hash;
   };
   Result<void> save() const;  // under mutex_
+  // What add, set, setRole and setPassword share: `role` and `password`
+  // (either may be absent for an existing user) applied to user `name`,
+  // who must not exist (kAdd), may (kAddOrReplace) or must (kChange).
+  enum class Mode { kAdd, kAddOrReplace, kChange };
+  Result<void> change(const std::string& name, std::optional<Role> role,
+                      const std::optional<std::string>& password, Mode mode);
 
   std::string path_;
   mutable std::mutex mutex_;

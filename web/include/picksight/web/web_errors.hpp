@@ -12,6 +12,7 @@ enum class WebErrc {
   kUnreachable,     // a video server or vision app did not answer
   kEncode,          // an image could not be encoded
   kBadConfig,       // options or the YAML file
+  kConflict,        // the request contradicts the state: the last admin, a user that exists
 };
 const char* errorName(WebErrc e);
 PICKSIGHT_ERROR_DOMAIN(WebErrc, "web")
