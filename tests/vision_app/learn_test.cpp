@@ -6,9 +6,12 @@
 
 #include <filesystem>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "../vision/drawn_parts.hpp"
@@ -17,6 +20,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/model_file.hpp"
+#include "picksight/vision_app/offline_commands.hpp"
 #include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight;
@@ -397,4 +401,81 @@ TEST_CASE(
 
   std::error_code ignored;
   std::filesystem::remove_all(dir, ignored);
+}
+
+TEST_CASE("LEARN's errors say what is wrong with a name and how to write it", "[learn][errors]") {
+  StillCell cell(test::drawParts(640, 480, {{kBar, 320, 240, 0}}, 7));
+  std::string reply = cell.ask("LEARN 1 my part");
+  INFO(reply);
+  CHECK_THAT(reply, Catch::StartsWith("ERROR 11 LEARN: the name is one word"));
+  CHECK_THAT(reply, Catch::Contains("got 2 words 'my part': write it as LEARN 1 my_part ("));
+  reply = cell.ask("LEARN 1 my big part at 10 10 600 400");
+  CHECK_THAT(reply, Catch::Contains("write it as LEARN 1 my_big_part AT <x> <y> <w> <h>"));
+  reply = cell.ask("LEARN 1 my/part");
+  CHECK_THAT(reply, Catch::StartsWith("ERROR 11 LEARN: name must be 1-32 of"));
+  CHECK_THAT(reply, Catch::EndsWith("got 'my/part' ('/')"));
+  CHECK(cell.ask("MODELS") == "OK 0");
+  // AT in any case, as robot programs write it.
+  CHECK(cell.ask("LEARN 1 bar at 10 10 600 400").rfind("OK 1 bar ", 0) == 0);
+}
+
+TEST_CASE("LEARN warns when the part is one another type's model already recognizes",
+          "[learn][warnings]") {
+  StillCell cell(test::drawParts(640, 480, {{kBar, 320, 240, 0}}, 7));
+  std::string reply = cell.ask("LEARN 1 bar");
+  INFO(reply);
+  REQUIRE(reply.rfind("OK 1 bar ", 0) == 0);
+  CHECK(reply.find("looks like") == std::string::npos);
+  // The same bar taught again as type 1: itself, no warning.
+  CHECK(cell.ask("LEARN 1 bar").find("looks like") == std::string::npos);
+  // As a second type: LOCATE ALL would split such bars between the two.
+  reply = cell.ask("LEARN 2 copy");
+  CHECK_THAT(reply, Catch::StartsWith("OK 2 copy "));
+  CHECK_THAT(reply, Catch::Contains(" ; warning: looks like type 1 (bar): this part passes "
+                                    "every test of that model"));
+  CHECK_THAT(reply, Catch::Contains("split parts of this shape between types 1 and 2"));
+  // Another shape as a second type: no warning.
+  cell.camera->setImage(test::drawParts(640, 480, {{kDisc, 320, 240, 0}}, 7));
+  reply = cell.ask("LEARN 3 disc");
+  CHECK_THAT(reply, Catch::StartsWith("OK 3 disc "));
+  CHECK(reply.find("looks like") == std::string::npos);
+}
+
+TEST_CASE("offline learn --at learns the one part inside a rectangle as LEARN AT does",
+          "[learn][learn_at][offline]") {
+  StillCell cell(fullFrame());
+  const std::string image = cell.dir + "/scene.png";
+  REQUIRE(cv::imwrite(image, fullFrame()));
+  const auto run = [&](std::vector<std::string> extra, std::string* err_text = nullptr) {
+    std::vector<std::string> args{"learn", "--data-dir", cell.dir + "/offline", "--type", "4"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.push_back(image);
+    std::ostringstream out, err;
+    const int status = runOfflineCommand(args, out, err);
+    if (err_text) *err_text = err.str();
+    return std::make_pair(status, out.str());
+  };
+  // Three parts: refused, and the reply says how to pick one offline.
+  auto [status, out] = run({});
+  CHECK(status == 1);
+  CHECK_THAT(out, Catch::StartsWith("ERROR 31 3 parts in the frame"));
+  CHECK_THAT(out, Catch::Contains("offline: learn --at <x> <y> <w> <h>"));
+  const cv::Rect box = boxAround(kParts[1], 4);
+  std::tie(status, out) =
+      run({"--name", "disc", "--at", std::to_string(box.x), std::to_string(box.y),
+           std::to_string(box.width), std::to_string(box.height)});
+  INFO(out);
+  CHECK(status == 0);
+  CHECK_THAT(out, Catch::StartsWith("OK 4 disc "));
+  const auto fields = splitFields(out, " \n");
+  REQUIRE(fields.size() >= 4);
+  CHECK(*parseDouble(fields[3]) == Approx(M_PI * 110 * 110).epsilon(0.01));
+  CHECK(std::filesystem::exists(cell.dir + "/offline/models/type_4.yaml"));
+  std::string err;
+  std::tie(status, out) = run({"--at", "1", "2", "x", "4"}, &err);
+  CHECK(status == 2);
+  CHECK_THAT(err, Catch::Contains("--at needs four integers X Y W H"));
+  std::tie(status, out) = run({"--at", "0", "0", "60", "60"});
+  CHECK(status == 1);
+  CHECK_THAT(out, Catch::StartsWith("ERROR 35 no part inside LEARN AT"));
 }

@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
+#include <optional>
 #include <ostream>
 
 #include "picksight/calibration/camera_calibration.hpp"
@@ -20,12 +21,13 @@
 namespace picksight::app {
 
 std::string offlineUsage() {
-  return "usage: picksight-vision learn --type N [--name NAME] [options] IMAGE\n"
+  return "usage: picksight-vision learn --type N [--name NAME] [--at X Y W H] [options] IMAGE\n"
          "       picksight-vision locate [--type N] [options] IMAGE...\n"
          "       picksight-vision blobs [options] IMAGE...\n"
          "       picksight-vision lens [--data-dir DIR] [--corners 9x6] [--square MM] IMAGE...\n"
          "\n"
          "  learn   trains type N from the single part in IMAGE into DATA_DIR/models\n"
+         "          (with --at, the one part inside that rectangle, as LEARN ... AT)\n"
          "  locate  prints one 'OK <n> x y rz ...' line per image: grasp poses of type N\n"
          "          (all trained types without --type; every region without models), in\n"
          "          the frame the data dir's calibration gives (docs/PROTOCOL.md)\n"
@@ -119,8 +121,27 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   std::vector<std::string> images;
   int type = -1;
   std::string name;
+  std::optional<cv::Rect> at;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
+    if (a == "--at") {
+      // As LEARN ... AT: x y in [0, 65535], w h in [1, 65535] image pixels.
+      int v[4];
+      for (int k = 0; k < 4; ++k) {
+        const auto n = i + 1 < args.size() ? parseInt(args[i + 1]) : std::nullopt;
+        if (!n || *n < (k < 2 ? 0 : 1) || *n > 65535) {
+          err << "picksight-vision " << command
+              << ": --at needs four integers X Y W H (x y in [0, 65535], w h in [1, 65535] "
+                 "pixels of the image), got '"
+              << (i + 1 < args.size() ? printable(args[i + 1]) : std::string("nothing")) << "'\n";
+          return 2;
+        }
+        v[k] = static_cast<int>(*n);
+        ++i;
+      }
+      at = cv::Rect(v[0], v[1], v[2], v[3]);
+      continue;
+    }
     if ((a == "--type" || a == "--name") && i + 1 < args.size()) {
       const std::string& v = args[++i];
       if (a == "--name") {
@@ -145,6 +166,10 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   if (!options) {
     err << "picksight-vision " << command << ": " << options.error().message << "\n\n"
         << offlineUsage();
+    return 2;
+  }
+  if (at && command != "learn") {
+    err << "picksight-vision " << command << ": --at is an option of learn\n";
     return 2;
   }
   if (images.empty() || (command == "learn" && (images.size() != 1 || type < 0))) {
@@ -177,12 +202,18 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       // As LEARN does it: the whole image binarized the way LOCATE will see it.
       const SensorMapping full;
       const auto learned =
-          learnInImage(grey, full, options->vision, library.snapshot(), type, name, std::nullopt);
+          learnInImage(grey, full, options->vision, library.snapshot(), type, name, at);
       if (!learned) {
         out << errorReply(learned.error()) << "\n";
         return 1;
       }
-      auto stored = library.store(learned->model);
+      std::string change =
+          "picksight-vision learn --type " + std::to_string(type) + " --name " + name;
+      if (at) {
+        change += " --at " + std::to_string(at->x) + " " + std::to_string(at->y) + " " +
+                  std::to_string(at->width) + " " + std::to_string(at->height);
+      }
+      auto stored = library.store(learned->model, change + " " + path);
       if (!stored) {
         out << errorReply(VisionErrc::kStorageFailed,
                           "cannot store the model: " + stored.error().message)

@@ -24,6 +24,7 @@ VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> 
 std::vector<std::string> VisionCell::load() {
   std::vector<std::string> problems;
   for (auto& p : models_.load()) problems.push_back("model rejected: " + p);
+  for (auto& p : models_.checkHistory()) problems.push_back("undo history: " + p);
   if (auto ok = calibration_.load(); !ok)
     problems.push_back(
         "calibration rejected (LOCATE and changes refused until repaired, or CLEARCAL): " +

@@ -11,6 +11,7 @@
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/colour_axis.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
@@ -245,7 +246,8 @@ Result<LocateOutcome> VisionService::locate(int type) {
 }
 
 Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
-                                          const std::optional<cv::Rect>& at) {
+                                          const std::optional<cv::Rect>& at,
+                                          std::string_view change) {
   if (!models_) return makeError(VisionErrc::kStorageFailed, "no model library");
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
@@ -253,7 +255,7 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
   auto learned = learnInImage((*frame)->image, (*frame)->mapping, options_, models_->snapshot(),
                               type, name, at, scaled_models_.get());
   if (!learned) return learned.error();
-  auto stored = models_->store(learned->model);
+  auto stored = models_->store(learned->model, change);
   if (!stored)
     return makeError(VisionErrc::kStorageFailed,
                      "cannot store the model: " + stored.error().message);
@@ -386,6 +388,29 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const cv::Mat& g
 }
 }  // namespace
 
+namespace {
+// The warning of LEARN when the part it teaches as `type` is one another
+// type's model already recognizes (frame pixels).
+std::optional<std::string> lookAlikeWarning(const vision::Region& region,
+                                            const ModelList& frame_models, int type) {
+  std::vector<const vision::PartModel*> others;
+  for (const auto& m : frame_models) {
+    if (m.type != type) others.push_back(&m);
+  }
+  // The recognizer's own tests (holes, area, Hu distance, boundary
+  // verification, mirror) on the part being taught: one that passes them
+  // all for another type is a part LOCATE ALL would give either type, at
+  // the same score, by which fits a few edge pixels better.
+  const auto seen = vision::explainRegion(region, others);
+  if (!seen.nearest || seen.test != vision::RegionTest::kPasses) return std::nullopt;
+  const std::string other = std::to_string(seen.nearest->type);
+  return "looks like type " + other + " (" + seen.nearest->name +
+         "): this part passes every test of that model (boundary " + formatFixed(seen.measured, 1) +
+         " % verified), so LOCATE ALL would split parts of this " + "shape between types " + other +
+         " and " + std::to_string(type) + " (teach it as type " + other + ", or UNDO)";
+}
+}  // namespace
+
 Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& mapping,
                                   const VisionOptions& options,
                                   std::shared_ptr<const ModelList> models, int type,
@@ -429,8 +454,11 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     if (!seen.others.empty()) {
       const std::string count = std::to_string(seen.others.size() + 1) + " parts";
       if (!at) {
-        return makeError(vision::PartModelErrc::kSeveralParts,
-                         count + " in the frame, LEARN needs exactly one (or LEARN ... AT)");
+        return makeError(
+            vision::PartModelErrc::kSeveralParts,
+            count +
+                " in the frame, LEARN needs exactly one (or LEARN ... AT <x> <y> <w> <h> "
+                "around one; offline: learn --at <x> <y> <w> <h>)");
       }
       return makeError(
           VisionErrc::kSeveralPartsInRectangle,
@@ -460,6 +488,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     out.model.min_hole_area = options.regions.min_hole_area;
     out.model.colour = colour;
     out.warnings = learnWarnings(r, grey, mask, mapping, options);
+    if (auto alike = lookAlikeWarning(r, *frame_models, type)) out.warnings.push_back(*alike);
     if (!seen.specks.empty()) out.notes.push_back(specksNote(regions, seen.specks, mapping));
     return out;
   }

@@ -107,7 +107,7 @@ std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
   }
   if (auto valid = validateGrasp(setup); !valid)
     return errorReply(ProtocolErrc::kBadArguments, valid.error().message);
-  auto ok = library.setGrasp(*type, setup);
+  auto ok = library.setGrasp(*type, setup, r.line);
   if (!ok) {
     if (ok.error().code == ModelErrc::kUnknownType)
       return errorReply(VisionErrc::kUnknownType, ok.error().message);

@@ -1,4 +1,4 @@
-// LEARN, MODELS, TOLERANCE, FORGET and BLOBS.
+// LEARN, MODELS, TOLERANCE, FORGET, UNDO and BLOBS.
 #include "picksight/protocol/model_commands.hpp"
 
 #include <algorithm>
@@ -32,6 +32,14 @@ std::string learnReply(const LearnOutcome& learned) {
   for (const auto& w : learned.warnings) reply += " ; warning: " + w;
   for (const auto& n : learned.notes) reply += " ; note: " + n;
   return reply;
+}
+
+std::string undoReply(const UndoOutcome& undone) {
+  const std::string type = std::to_string(undone.type);
+  return "OK " + type + (undone.restored ? " restored " : " removed ") +
+         std::to_string(undone.left) + " ; undid: " + printable(undone.change, 200) + " ; " +
+         (undone.restored ? "type " + type + " is " + modelSummary(*undone.restored) + " again"
+                          : "type " + type + " has no model again");
 }
 
 std::string blobSummary(const vision::BlobFeatures& b) {
@@ -187,9 +195,12 @@ std::string tolerance(VisionService& vision, const Request& r) {
     }
     return no_model();
   }
-  auto updated = vision.models()->update(*type, [&](vision::PartModel& m) {
-    for (const auto& [key, value] : changes) key->set(m, value);
-  });
+  auto updated = vision.models()->update(
+      *type,
+      [&](vision::PartModel& m) {
+        for (const auto& [key, value] : changes) key->set(m, value);
+      },
+      r.line);
   if (!updated) {
     // The bounds above are validateModel's or tighter: an invalid model
     // here would be a bug, reported as such rather than as a bad request.
@@ -209,7 +220,8 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         // "AT" and its four numbers close the line; a name comes before them.
         std::vector<std::string> args = r.args;
         std::optional<cv::Rect> at;
-        const auto keyword = std::find(args.begin(), args.end(), "AT");
+        const auto keyword = std::find_if(args.begin(), args.end(),
+                                          [](const std::string& a) { return toUpper(a) == "AT"; });
         if (keyword != args.end()) {
           if (args.end() - keyword != 5) {
             return errorReply(ProtocolErrc::kBadArguments, "LEARN: AT needs <x> <y> <w> <h>");
@@ -224,7 +236,23 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
           at = rect;
           args.erase(keyword, args.end());
         }
-        if (args.empty() || args.size() > 2) return errorReply(ProtocolErrc::kBadArguments, kUsage);
+        if (args.empty()) return errorReply(ProtocolErrc::kBadArguments, kUsage);
+        if (args.size() > 2) {
+          // "LEARN 1 my part": a name of several words, the commonest slip.
+          std::string words;
+          std::string joined;
+          for (size_t i = 1; i < args.size(); ++i) {
+            words += (i > 1 ? " " : "") + args[i];
+            joined += (i > 1 ? "_" : "") + args[i];
+          }
+          return errorReply(ProtocolErrc::kBadArguments,
+                            "LEARN: the name is one word (1-32 of A-Z a-z 0-9 _ - ., no spaces or "
+                            "commas), got " +
+                                std::to_string(args.size() - 1) + " words '" + printable(words) +
+                                "': write it as LEARN " + printable(args[0], 8) + " " +
+                                printable(joined) + (at ? " AT <x> <y> <w> <h>" : "") + " (" +
+                                kUsage + ")");
+        }
         const auto type = parseType(args[0]);
         if (!type) {
           return errorReply(
@@ -233,11 +261,16 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         }
         const std::string name = args.size() > 1 ? args[1] : "type" + std::to_string(*type);
         if (!validModelName(name)) {
-          return errorReply(
-              ProtocolErrc::kBadArguments,
-              "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" + printable(name) + "'");
+          std::string why = name.size() > 32 ? std::to_string(name.size()) + " characters" : "";
+          for (char c : name) {
+            if (why.empty() && !validModelName(std::string(1, c)))
+              why = "'" + printable(std::string(1, c)) + "'";
+          }
+          return errorReply(ProtocolErrc::kBadArguments,
+                            "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" +
+                                printable(name) + "' (" + why + ")");
         }
-        auto learned = vision.learn(*type, name, at);
+        auto learned = vision.learn(*type, name, at, r.line);
         if (!learned) return errorReply(learned.error());
         return learnReply(*learned);
       },
@@ -268,7 +301,7 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
     }
     if (!vision.models())
       return errorReply(VisionErrc::kUnknownType, "no model for type " + std::to_string(*type));
-    auto removed = vision.models()->remove(*type);
+    auto removed = vision.models()->remove(*type, r.line);
     if (!removed) {
       return errorReply(removed.error().code == ModelErrc::kUnknownType
                             ? VisionErrc::kUnknownType
@@ -276,6 +309,14 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
                         removed.error().message);
     }
     return std::string("OK");
+  });
+  table.add("UNDO", "UNDO", [&vision](const Request& r) {
+    if (!r.args.empty()) return errorReply(ProtocolErrc::kBadArguments, "UNDO takes no arguments");
+    if (!vision.models())
+      return errorReply(ModelErrc::kNothingToUndo, "nothing to undo (no model library)");
+    auto undone = vision.models()->undo();
+    if (!undone) return errorReply(undone.error());
+    return undoReply(*undone);
   });
   table.add(
       "BLOBS", "BLOBS",

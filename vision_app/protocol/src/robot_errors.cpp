@@ -46,6 +46,8 @@ const std::pair<std::error_code, int> kTable[] = {
     {VisionErrc::kOutsideFrame, 34},
     {VisionErrc::kNoPartInRectangle, 35},
     {VisionErrc::kSeveralPartsInRectangle, 36},
+    {ModelErrc::kNothingToUndo, 37},
+    {ModelErrc::kUndoRefused, 38},
     {CellCalibrationErrc::kNoSuchPoint, 40},
     {CalibrationErrc::kTooFewPoints, 41},
     {CalibrationErrc::kDegeneratePoints, 42},

@@ -17,6 +17,10 @@ const char* errorName(ModelErrc e) {
       return "invalid model";
     case ModelErrc::kBadFile:
       return "bad file";
+    case ModelErrc::kNothingToUndo:
+      return "nothing to undo";
+    case ModelErrc::kUndoRefused:
+      return "undo refused";
   }
   return "unknown";
 }

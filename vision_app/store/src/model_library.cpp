@@ -15,6 +15,7 @@ namespace fs = std::filesystem;
 
 ModelLibrary::ModelLibrary(std::string directory)
     : directory_(std::move(directory)),
+      history_(directory_ + "/undo"),
       models_(std::make_shared<const ModelList>()),
       grasps_(std::make_shared<const GraspMap>()) {}
 
@@ -25,11 +26,13 @@ std::string ModelLibrary::pathOf(int type) const {
 std::vector<std::string> ModelLibrary::load() {
   std::vector<std::string> problems;
   // Left by a write that a crash interrupted; this process owns the directory.
-  if (auto removed = removeStaleTemporaries(directory_); !removed) {
-    problems.push_back(removed.error().message);
-  } else {
-    for (const auto& name : *removed) {
-      logInfo(directory_, ": removed ", name, " (left by an interrupted write)");
+  for (const auto& dir : {directory_, history_.directory()}) {
+    if (auto removed = removeStaleTemporaries(dir); !removed) {
+      problems.push_back(removed.error().message);
+    } else {
+      for (const auto& name : *removed) {
+        logInfo(dir, ": removed ", name, " (left by an interrupted write)");
+      }
     }
   }
   std::error_code ec;
@@ -84,7 +87,24 @@ std::vector<std::string> ModelLibrary::load() {
   return problems;
 }
 
-Result<void> ModelLibrary::store(const vision::PartModel& model) {
+Result<std::string> ModelLibrary::recordChange(int type, std::string_view change,
+                                               const std::optional<std::string>& after) {
+  const std::string path = pathOf(type);
+  std::error_code ec;
+  std::optional<std::string> before;
+  if (fs::exists(path, ec)) {
+    auto text = readFile(path);
+    if (!text)
+      return makeError(ModelErrc::kStorage,
+                       "cannot keep the file for UNDO: " + text.error().message);
+    before = std::move(*text);
+  } else if (ec) {
+    return makeError(ModelErrc::kStorage, path + ": " + ec.message());
+  }
+  return history_.record(type, change, before, after);
+}
+
+Result<void> ModelLibrary::store(const vision::PartModel& model, std::string_view change) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
   if (fs::create_directories(directory_, ec)) {
@@ -95,9 +115,18 @@ Result<void> ModelLibrary::store(const vision::PartModel& model) {
   }
   if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   const auto kept = grasps_->find(model.type);
-  auto written = writeFileAtomically(
-      pathOf(model.type), modelToYaml(model, kept == grasps_->end() ? GraspSetup{} : kept->second));
-  if (!written) return written;
+  const std::string text = modelToYaml(model, kept == grasps_->end() ? GraspSetup{} : kept->second);
+  auto entry =
+      recordChange(model.type,
+                   change.empty() ? "LEARN " + std::to_string(model.type) + " " + model.name
+                                  : std::string(change),
+                   text);
+  if (!entry) return entry.error();
+  auto written = writeFileAtomically(pathOf(model.type), text);
+  if (!written) {
+    history_.drop(*entry);
+    return written;
+  }
   auto models = std::make_shared<ModelList>(*models_);
   models->erase(std::remove_if(models->begin(), models->end(),
                                [&](const vision::PartModel& m) { return m.type == model.type; }),
@@ -109,15 +138,21 @@ Result<void> ModelLibrary::store(const vision::PartModel& model) {
   return {};
 }
 
-Result<void> ModelLibrary::remove(int type) {
+Result<void> ModelLibrary::remove(int type, std::string_view change) {
   std::lock_guard<std::mutex> lock(mutex_);
   const bool known = std::any_of(models_->begin(), models_->end(),
                                  [&](const vision::PartModel& m) { return m.type == type; });
   if (!known)
     return makeError(ModelErrc::kUnknownType, "no model for type " + std::to_string(type));
+  auto entry = recordChange(
+      type, change.empty() ? "FORGET " + std::to_string(type) : std::string(change), std::nullopt);
+  if (!entry) return entry.error();
   std::error_code ec;
   fs::remove(pathOf(type), ec);
-  if (ec) return makeError(ModelErrc::kStorage, pathOf(type) + ": " + ec.message());
+  if (ec) {
+    history_.drop(*entry);
+    return makeError(ModelErrc::kStorage, pathOf(type) + ": " + ec.message());
+  }
   // Without this a crash can bring the forgotten model back at restart.
   (void)syncDirectory(directory_);
   auto models = std::make_shared<ModelList>(*models_);
@@ -131,15 +166,22 @@ Result<void> ModelLibrary::remove(int type) {
   return {};
 }
 
-Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp) {
+Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp, std::string_view change) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto model = std::find_if(models_->begin(), models_->end(),
                                   [&](const vision::PartModel& m) { return m.type == type; });
   if (model == models_->end())
     return makeError(ModelErrc::kUnknownType, "no model for type " + std::to_string(type));
   if (auto valid = validateGrasp(grasp); !valid) return valid.error();
-  auto written = writeFileAtomically(pathOf(type), modelToYaml(*model, grasp));
-  if (!written) return makeError(ModelErrc::kStorage, written.error().message);
+  const std::string text = modelToYaml(*model, grasp);
+  auto entry = recordChange(
+      type, change.empty() ? "GRASP " + std::to_string(type) : std::string(change), text);
+  if (!entry) return entry.error();
+  auto written = writeFileAtomically(pathOf(type), text);
+  if (!written) {
+    history_.drop(*entry);
+    return makeError(ModelErrc::kStorage, written.error().message);
+  }
   auto grasps = std::make_shared<GraspMap>(*grasps_);
   (*grasps)[type] = grasp;
   grasps_ = std::move(grasps);
@@ -147,7 +189,7 @@ Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp) {
 }
 
 Result<vision::PartModel> ModelLibrary::update(
-    int type, const std::function<void(vision::PartModel&)>& change) {
+    int type, const std::function<void(vision::PartModel&)>& change, std::string_view what) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto found = std::find_if(models_->begin(), models_->end(),
                                   [&](const vision::PartModel& m) { return m.type == type; });
@@ -160,15 +202,109 @@ Result<vision::PartModel> ModelLibrary::update(
     return makeError(ModelErrc::kInvalidModel, valid.error().message);
   vision::prepareModel(changed);
   const auto kept = grasps_->find(type);
-  auto written = writeFileAtomically(
-      pathOf(type), modelToYaml(changed, kept == grasps_->end() ? GraspSetup{} : kept->second));
-  if (!written) return makeError(ModelErrc::kStorage, written.error().message);
+  const std::string text =
+      modelToYaml(changed, kept == grasps_->end() ? GraspSetup{} : kept->second);
+  auto entry = recordChange(
+      type, what.empty() ? "TOLERANCE " + std::to_string(type) : std::string(what), text);
+  if (!entry) return entry.error();
+  auto written = writeFileAtomically(pathOf(type), text);
+  if (!written) {
+    history_.drop(*entry);
+    return makeError(ModelErrc::kStorage, written.error().message);
+  }
   auto models = std::make_shared<ModelList>(*models_);
   for (auto& m : *models) {
     if (m.type == type) m = changed;
   }
   models_ = std::move(models);
   return changed;
+}
+
+Result<UndoOutcome> ModelLibrary::undo() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto newest = history_.newest();
+  if (!newest) {
+    return makeError(ModelErrc::kNothingToUndo,
+                     "nothing to undo (the last " + std::to_string(kUndoDepth) +
+                         " changes to models are kept; each UNDO takes back one)");
+  }
+  // Every way an entry can fail to apply sets it aside, so that one bad
+  // entry never blocks the changes before it, and says so.
+  const auto refuse = [&](const std::string& why) -> Error {
+    const std::string aside = fs::path(history_.setAside(*newest)).filename().string();
+    return makeError(ModelErrc::kUndoRefused,
+                     why + ": not applied, nothing changed; set aside as " + aside +
+                         " (UNDO again takes back the change before it)");
+  };
+  auto entry = ModelHistory::read(*newest);
+  if (!entry) return refuse(entry.error().message);
+  const std::string path = pathOf(entry->type);
+  std::error_code ec;
+  std::optional<std::string> now;
+  if (fs::exists(path, ec)) {
+    auto text = readFile(path);
+    if (!text) return makeError(ModelErrc::kStorage, text.error().message);
+    now = std::move(*text);
+  } else if (ec) {
+    return makeError(ModelErrc::kStorage, path + ": " + ec.message());
+  }
+  const std::string now_sha = now ? sha256Hex(*now) : "";
+  if (now_sha != entry->after_sha256) {
+    return refuse("type " + std::to_string(entry->type) + "'s model file is not what '" +
+                  entry->change +
+                  "' left (changed since by hand, or that change did not complete)");
+  }
+  std::optional<ModelRecord> record;
+  if (entry->before) {
+    auto parsed = modelRecordFromYaml(*entry->before);
+    if (!parsed || parsed->model.type != entry->type) {
+      return refuse("type " + std::to_string(entry->type) + "'s file before '" + entry->change +
+                    "' does not read as its model" +
+                    (parsed ? std::string() : ": " + parsed.error().message));
+    }
+    record = std::move(*parsed);
+  }
+  if (record) {
+    if (auto written = writeFileAtomically(path, *entry->before); !written)
+      return makeError(ModelErrc::kStorage, written.error().message);
+  } else {
+    fs::remove(path, ec);
+    if (ec) return makeError(ModelErrc::kStorage, path + ": " + ec.message());
+    (void)syncDirectory(directory_);
+  }
+  history_.drop(*newest);
+  const int type = entry->type;
+  auto models = std::make_shared<ModelList>(*models_);
+  models->erase(std::remove_if(models->begin(), models->end(),
+                               [&](const vision::PartModel& m) { return m.type == type; }),
+                models->end());
+  auto grasps = std::make_shared<GraspMap>(*grasps_);
+  grasps->erase(type);
+  UndoOutcome out;
+  out.type = type;
+  out.change = entry->change;
+  if (record) {
+    (*grasps)[type] = record->grasp;
+    out.restored = record->model;
+    models->push_back(std::move(record->model));
+    std::sort(
+        models->begin(), models->end(),
+        [](const vision::PartModel& a, const vision::PartModel& b) { return a.type < b.type; });
+  }
+  models_ = std::move(models);
+  grasps_ = std::move(grasps);
+  out.left = history_.size();
+  return out;
+}
+
+size_t ModelLibrary::undoDepth() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return history_.size();
+}
+
+std::vector<std::string> ModelLibrary::checkHistory() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return history_.check();
 }
 
 std::shared_ptr<const ModelList> ModelLibrary::snapshot() const {

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "picksight/common/frame.hpp"
@@ -201,9 +202,11 @@ class VisionService {
   // when models exist but none of `type`).
   Result<LocateOutcome> locate(int type);
   // Trains type `type` from the single part in a fresh frame (inside `at`,
-  // sensor pixels, when given; the camera's ROI is left alone) and stores it.
+  // sensor pixels, when given; the camera's ROI is left alone) and stores it
+  // (`change`: the request, for the undo history).
   Result<LearnOutcome> learn(int type, const std::string& name,
-                             const std::optional<cv::Rect>& at = std::nullopt);
+                             const std::optional<cv::Rect>& at = std::nullopt,
+                             std::string_view change = {});
   // Blob features of every region in a fresh frame, sensor pixels.
   Result<std::vector<vision::BlobFeatures>> blobs();
   // The single calibration target in a fresh frame.

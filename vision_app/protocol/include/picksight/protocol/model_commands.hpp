@@ -1,5 +1,5 @@
 // Robot protocol commands for part models and blob analysis: LEARN, MODELS,
-// TOLERANCE, FORGET, BLOBS (docs/PROTOCOL.md).
+// TOLERANCE, FORGET, UNDO, BLOBS (docs/PROTOCOL.md).
 #pragma once
 
 #include "picksight/cell/vision_service.hpp"
@@ -19,6 +19,9 @@ std::string learnReply(const LearnOutcome& learned);
 // tolerance a model file stores (area_tolerance, hu_tolerance,
 // verify_percent, edge_tolerance_px, mirror_symmetric).
 std::string toleranceReply(const vision::PartModel& model);
+// UNDO's reply: "OK <type> restored|removed <changes left> ; undid: <request>
+// ; type <type> is <model summary> again" (or "has no model again").
+std::string undoReply(const UndoOutcome& undone);
 // The reply fields of one region's features (see BLOBS).
 std::string blobSummary(const vision::BlobFeatures& blob);
 

@@ -19,6 +19,8 @@ enum class ModelErrc {
   kStorage,          // the file or its directory could not be written or removed
   kInvalidModel,     // the model breaks a rule (tolerances, weights, grasps...)
   kBadFile,          // the file is not a readable part model
+  kNothingToUndo,    // UNDO: no change left in the history
+  kUndoRefused,      // UNDO: the newest entry is damaged or no longer applies (set aside)
 };
 const char* errorName(ModelErrc e);
 PICKSIGHT_ERROR_DOMAIN(ModelErrc, "model")

@@ -1,5 +1,7 @@
 // The model library: one file per trained part type under
-// <data dir>/models/, loaded at start, written atomically on every change.
+// <data dir>/models/, loaded at start, written atomically on every change,
+// each change recorded first in the undo history (<models>/undo/, see
+// model_history.hpp) so that undo() can put the file back byte for byte.
 //
 // Threading: every member is thread-safe. Readers get an immutable snapshot
 // (shared_ptr), so a recognition in progress never sees a half-changed list.
@@ -9,17 +11,30 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "picksight/common/result.hpp"
 #include "picksight/store/model_file.hpp"
+#include "picksight/store/model_history.hpp"
 #include "picksight/vision/models/part_model.hpp"
 
 namespace picksight::app {
 
 using ModelList = std::vector<vision::PartModel>;
 using GraspMap = std::map<int, GraspSetup>;  // by type; a type without grasps may be absent
+
+// What undo() put back.
+struct UndoOutcome {
+  int type = -1;
+  std::string change;  // the request undone, as recorded ("LEARN 3 bracket")
+  // The model now in force for `type`; nullopt: the undone change had
+  // created it, and the type has no model again.
+  std::optional<vision::PartModel> restored;
+  size_t left = 0;  // changes UNDO can still walk back
+};
 
 class ModelLibrary {
  public:
@@ -34,15 +49,20 @@ class ModelLibrary {
   // owns its directory; call before any store()).
   std::vector<std::string> load();
 
+  // Every change below is recorded in the undo history first, described by
+  // `change` (the request line; empty: the method's own words); a history
+  // that cannot be written refuses the change (kStorage), so that no change
+  // is made that UNDO could not take back.
+
   // Adds or replaces the model of model.type: the file first, then memory.
   // A replaced model keeps its grasp styles and gripper.
-  Result<void> store(const vision::PartModel& model);
+  Result<void> store(const vision::PartModel& model, std::string_view change = {});
   // Removes the model of `type` (file and memory); ModelErrc::kUnknownType
   // if there is none.
-  Result<void> remove(int type);
+  Result<void> remove(int type, std::string_view change = {});
   // Replaces the grasp styles and gripper of `type`, written with its model;
   // ModelErrc::kUnknownType if there is no model of `type`.
-  Result<void> setGrasp(int type, const GraspSetup& grasp);
+  Result<void> setGrasp(int type, const GraspSetup& grasp, std::string_view change = {});
   // Changes the model of `type` in place: `change` edits a copy (under the
   // library's lock, so a LEARN of the same type at the same moment is never
   // overwritten by the older model), which is validated, prepared again
@@ -51,7 +71,24 @@ class ModelLibrary {
   // ModelErrc::kUnknownType if there is no model of `type`, kInvalidModel
   // (nothing written) if the changed model is not valid, kStorage if the file
   // cannot be written.
-  Result<vision::PartModel> update(int type, const std::function<void(vision::PartModel&)>& change);
+  Result<vision::PartModel> update(int type, const std::function<void(vision::PartModel&)>& change,
+                                   std::string_view what = {});
+
+  // Takes back the newest change still in the history: its type's file
+  // written again with the bytes it had before (atomically), or removed if
+  // the change had created it, then the model and grasps in memory read from
+  // those bytes. ModelErrc::kNothingToUndo when the history is empty;
+  // kUndoRefused when the newest entry is damaged, when the file is no longer
+  // what that change wrote (edited by hand since, or the change did not
+  // complete), or when the old bytes do not read as a model: nothing is
+  // changed, the entry is set aside (<name>.damaged) and the message names
+  // it; the next undo() reaches the change before it. kStorage when the
+  // file cannot be written (the entry is kept).
+  Result<UndoOutcome> undo();
+  // Changes undo() can still walk back (at most kUndoDepth).
+  size_t undoDepth() const;
+  // The history's entries that do not read back, one line each.
+  std::vector<std::string> checkHistory() const;
 
   std::shared_ptr<const ModelList> snapshot() const;
   std::shared_ptr<const GraspMap> grasps() const;
@@ -60,7 +97,13 @@ class ModelLibrary {
   std::string pathOf(int type) const;
 
  private:
+  // Call with mutex_ held: records the change of `type`'s file to `after`
+  // (nullopt: removed) with the file's bytes now; the entry's path.
+  Result<std::string> recordChange(int type, std::string_view change,
+                                   const std::optional<std::string>& after);
+
   const std::string directory_;
+  ModelHistory history_;
   mutable std::mutex mutex_;  // guards models_ and grasps_, serializes writers
   std::shared_ptr<const ModelList> models_;
   std::shared_ptr<const GraspMap> grasps_;
