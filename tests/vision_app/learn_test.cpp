@@ -479,3 +479,51 @@ TEST_CASE("offline learn --at learns the one part inside a rectangle as LEARN AT
   CHECK(status == 1);
   CHECK_THAT(out, Catch::StartsWith("ERROR 35 no part inside LEARN AT"));
 }
+
+TEST_CASE("TRYLEARN says what LEARN would teach and LOCATE ALL then find and stores nothing",
+          "[learn][learn_at][trylearn]") {
+  StillCell cell(fullFrame());
+  const std::string bar = "AT " + rectArgs(boxAround(kParts[0], 4));
+  std::string reply = cell.ask("TRYLEARN 1 bar " + bar);
+  INFO(reply);
+  // The two bars found with the new model; nothing else is a part yet.
+  // The fields before the first ';' (kept: splitFields returns views).
+  std::string head = reply.substr(0, reply.find(" ;"));
+  auto fields = splitFields(head, " ");
+  REQUIRE(fields.size() == 9);
+  CHECK(fields[0] == "OK");
+  CHECK(fields[1] == "1");
+  CHECK(fields[2] == "bar");
+  CHECK(fields[7] == "2");
+  CHECK(fields[8] == "2");
+  CHECK_THAT(reply, Catch::EndsWith(" ; note: nothing stored"));
+  CHECK(cell.ask("MODELS") == "OK 0");
+  CHECK_THAT(cell.ask("UNDO"), Catch::StartsWith("ERROR 37 "));
+  CHECK(!std::filesystem::exists(cell.dir + "/models/type_1.yaml"));
+
+  REQUIRE(cell.ask("LEARN 1 bar " + bar).rfind("OK 1 bar ", 0) == 0);
+  const std::string file = cell.dir + "/models/type_1.yaml";
+  // The disc tried as type 2: one of it, three parts in all.
+  reply = cell.ask("TRYLEARN 2 disc AT " + rectArgs(boxAround(kParts[1], 4)));
+  head = reply.substr(0, reply.find(" ;"));
+  fields = splitFields(head, " ");
+  REQUIRE(fields.size() == 9);
+  CHECK(fields[7] == "1");
+  CHECK(fields[8] == "3");
+  // The disc tried over type 1: the bars are no longer type 1's.
+  reply = cell.ask("TRYLEARN 1 disc AT " + rectArgs(boxAround(kParts[1], 4)));
+  head = reply.substr(0, reply.find(" ;"));
+  fields = splitFields(head, " ");
+  REQUIRE(fields.size() == 9);
+  CHECK(fields[7] == "1");
+  CHECK(fields[8] == "1");
+  CHECK_THAT(cell.ask("MODELS"), Catch::StartsWith("OK 1 1 bar "));
+  // Errors as LEARN's, named for TRYLEARN; on a read-only port it is allowed.
+  CHECK_THAT(cell.ask("TRYLEARN 1 my part"),
+             Catch::StartsWith("ERROR 11 TRYLEARN: the name is one word"));
+  CHECK_THAT(cell.ask("TRYLEARN 3"), Catch::StartsWith("ERROR 31 "));
+  CHECK(cell.cell->handle("TRYLEARN 3 AT " + rectArgs(boxAround(kParts[1], 4)), true)
+            .rfind("OK 3 type3 ", 0) == 0);
+  CHECK(cell.ask("MODELS").rfind("OK 1 1 bar ", 0) == 0);
+  CHECK(std::filesystem::exists(file));
+}

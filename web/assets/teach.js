@@ -1,13 +1,23 @@
 // The Teach panel: LEARN the part inside a rectangle drawn on the image
-// (LEARN <type> <name> AT x y w h, sensor pixels), the model list (MODELS,
-// FORGET), each model's tolerances (TOLERANCE), and a type's grasp styles and gripper fingers (GRASP, GRIPPER)
-// with their footprint drawn live on the latest located part of that type.
+// (LEARN <type> <name> AT x y w h, sensor pixels) in two steps that cannot
+// replace work unseen: Teach tries it (TRYLEARN: the model, what LOCATE ALL
+// would then find, drawn on the overlay, and any warning), Save stores it,
+// after a confirmation naming the model it replaces; Undo takes back the
+// last change to models (UNDO). The type defaults to the next free one.
+// Also the model list (MODELS, FORGET), each model's tolerances
+// (TOLERANCE), and a type's grasp styles and gripper fingers (GRASP,
+// GRIPPER) with their footprint drawn live on the latest located part of
+// that type.
 "use strict";
 
 (function () {
   const ps = window.picksight;
   const $ = ps.$;
   const grasp = { type: null, styles: [], fingers: [], mmPerPx: [1, 1] };
+  // The models as MODELS last listed them: [type, name, area, holes, symmetry].
+  let models = [];
+  // The TRYLEARN whose result is shown, {type, name, args}: what Save stores.
+  let pending = null;
 
   async function say(pre, line) {
     const reply = await ps.command(line);
@@ -30,23 +40,119 @@
     $("teach-rect-text").textContent = r ? r.x + " " + r.y + " " + r.width + " " + r.height : "none";
   }
 
+  // A model name as LEARN takes it; the reason it does not, or "".
+  function nameProblem(name) {
+    if (name === "") return "";  // LEARN names it type<N>
+    if (name.length > 32) return "the name has " + name.length + " characters, 32 at most";
+    const bad = name.match(/[^A-Za-z0-9_.\-]/);
+    if (!bad) return "";
+    const what = bad[0] === " " ? "a space" : bad[0] === "," ? "a comma" : "'" + bad[0] + "'";
+    return "the name holds " + what + ": use A-Z a-z 0-9 _ - . only (e.g. " +
+           name.replace(/[^A-Za-z0-9_.\-]+/g, "_").slice(0, 32) + ")";
+  }
+
+  // The smallest type number from 1 up that has no model.
+  function nextFreeType() {
+    const used = new Set(models.map((m) => Number(m[0])));
+    let t = 1;
+    while (used.has(t)) ++t;
+    return t;
+  }
+
+  const modelOf = (type) => models.find((m) => Number(m[0]) === type) || null;
+
+  function refusal(text) {
+    const pre = $("teach-reply");
+    ps.show(pre, "(not sent)", "ERROR " + text);
+    pre.dataset.lastReply = "ERROR " + text;
+  }
+
+  function clearPreview(why) {
+    pending = null;
+    $("teach-preview").hidden = true;
+    $("teach-save").disabled = true;
+    if (why) $("teach-preview-text").textContent = why;
+  }
+
+  // Step one: TRYLEARN with the fields and the rectangle; nothing stored.
   async function teach() {
     const r = ps.rect.teach;
     const type = Math.round(Number($("teach-type").value));
     const name = $("teach-name").value.trim();
-    let line = "LEARN " + type + (name ? " " + name : "");
-    if (r) line += " AT " + r.x + " " + r.y + " " + r.width + " " + r.height;
-    const reply = await say("teach-reply", line);
+    clearPreview();
+    if (!Number.isInteger(type) || type < 0 || type > 9999 || $("teach-type").value.trim() === "") {
+      refusal("the type must be an integer in [0, 9999]");
+      return;
+    }
+    const problem = nameProblem(name);
+    if (problem) {
+      refusal(problem);
+      return;
+    }
+    let args = type + (name ? " " + name : "");
+    if (r) args += " AT " + r.x + " " + r.y + " " + r.width + " " + r.height;
+    const reply = await say("teach-reply", "TRYLEARN " + args);
+    $("teach-preview").dataset.reply = reply;
+    const f = ps.okFields(reply.split(" ; ")[0]);
+    if (!f || f.length < 8) return;
+    await refreshModels();
+    const old = modelOf(type);
+    const parts = reply.split(" ; ").slice(1);
+    const warnings = parts.filter((p) => p.startsWith("warning: ")).map((p) => p.slice(9));
+    $("teach-preview-text").textContent =
+      "Type " + f[0] + " '" + f[1] + "': " + Number(f[2]).toFixed(0) + " px, " + f[3] + " holes. " +
+      "LOCATE ALL on this frame would find " + f[6] + " of type " + f[0] + " (" + f[7] +
+      " parts in all; outlines on the image). " +
+      (old ? "Saving replaces type " + old[0] + " '" + old[1] + "' (its tolerances back to the defaults, its grasps kept)."
+           : "Type " + f[0] + " has no model yet.");
+    const list = $("teach-warnings");
+    list.textContent = "";
+    for (const w of warnings) {
+      const li = document.createElement("li");
+      li.textContent = w;
+      list.appendChild(li);
+    }
+    pending = { type, name: f[1], args, replaces: old ? old[1] : null };
+    $("teach-preview").hidden = false;
+    $("teach-save").disabled = false;
+  }
+
+  // Step two: LEARN what was tried, after a confirmation when it replaces a
+  // model (LEARN takes a new frame: the part must still be there).
+  async function save() {
+    if (!pending) return;
+    const p = pending;
+    await refreshModels();
+    const old = modelOf(p.type);
+    if (old && !window.confirm("Replace model " + old[0] + " '" + old[1] + "' (area " +
+                               Number(old[2]).toFixed(0) + " px) with the new '" + p.name +
+                               "'? Its tolerances go back to the defaults; Undo takes this back.")) {
+      ps.show("teach-reply", "LEARN " + p.args, "not sent: model " + old[0] + " '" + old[1] + "' kept");
+      return;
+    }
+    clearPreview();
+    const reply = await say("teach-reply", "LEARN " + p.args);
     $("teach-reply").dataset.lastReply = reply;
     if (reply.startsWith("OK")) {
-      refreshModels();
-      ps.setField("grasp-type", type);  // its grasps next, unless another type is being typed
+      ps.clearDirty($("teach-type").parentNode);  // the next free type from now on
+      await refreshModels();
+      ps.setField("grasp-type", p.type);  // its grasps next, unless another type is being typed
       loadGrasp();
     }
   }
 
+  async function undo() {
+    clearPreview();
+    const reply = await say("teach-reply", "UNDO");
+    $("teach-reply").dataset.lastReply = reply;
+    await refreshModels();
+    loadGrasp();
+  }
+
   async function refreshModels() {
     const reply = await ps.command("MODELS");
+    if (reply.startsWith("OK")) models = groups(reply, 5);
+    ps.setField("teach-type", nextFreeType());  // unless a type is being typed
     const tbody = $("models-list").querySelector("tbody");
     tbody.textContent = "";
     for (const m of groups(reply, 5)) {
@@ -231,10 +337,20 @@
 
   document.addEventListener("DOMContentLoaded", () => {
     ps.toolDrawers.push(drawFootprints);
-    ps.on("rect", (e) => { if (e.mode === "teach") showRect(); });
+    ps.on("rect", (e) => { if (e.mode === "teach") { showRect(); clearPreview("the rectangle changed: Teach again"); } });
     ps.on("tab", (tab) => { if (tab === "teach") { refreshModels(); loadGrasp(); } });
     ps.on("result", () => { if (ps.tab === "teach") ps.drawTool(); });
     $("teach-button").addEventListener("click", teach);
+    $("teach-save").addEventListener("click", save);
+    $("teach-cancel").addEventListener("click", () => clearPreview());
+    $("teach-undo").addEventListener("click", undo);
+    for (const id of ["teach-type", "teach-name"]) {
+      $(id).addEventListener("input", () => {
+        if (pending) clearPreview("the fields changed: Teach again");
+        const problem = nameProblem($("teach-name").value.trim());
+        $("teach-name-error").textContent = problem;
+      });
+    }
     $("models-refresh").addEventListener("click", refreshModels);
     $("grasp-load").addEventListener("click", loadGrasp);
     $("style-add").addEventListener("click", () =>

@@ -69,6 +69,7 @@ class Cell:
 
     def __init__(self, data_dir):
         self.processes = []
+        self.data_dir = Path(data_dir)  # the vision app's: models/type_<N>.yaml
         server = self._start([bin_path("picksight-video-server"), "--source", SOURCE,
                               "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"])
         lines = stdout_lines(server)

@@ -109,6 +109,19 @@ def click(browser, element_id):
     browser.driver.find_element(By.ID, element_id).click()
 
 
+def teach_on_page(browser):
+    """Teach (TRYLEARN: the preview), then Save (LEARN) once the preview
+    shows; the LEARN reply."""
+    browser.js("document.getElementById('teach-reply').dataset.lastReply = '';")
+    click(browser, "teach-button")
+    wait_until(lambda: browser.js("return !document.getElementById('teach-preview').hidden && "
+                                  "!document.getElementById('teach-save').disabled"),
+               what="the TRYLEARN preview")
+    click(browser, "teach-save")
+    return wait_until(lambda: browser.js("return document.getElementById('teach-reply').dataset.lastReply"),
+                      what="the LEARN reply")
+
+
 def select_tab(browser, tab):
     browser.driver.find_element(By.CSS_SELECTOR, f'#tabs button[data-tab="{tab}"]').click()
     wait_until(lambda: browser.js(f"return document.getElementById('panel-{tab}').offsetParent !== null"),
@@ -294,9 +307,7 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     browser.js("""document.getElementById('teach-type').value = '5';
                   document.getElementById('teach-name').value = 'bracket';""")
     browser.screenshot("teach")
-    click(browser, "teach-button")
-    reply = wait_until(lambda: browser.js("return document.getElementById('teach-reply').dataset.lastReply"),
-                       what="the LEARN reply")
+    reply = teach_on_page(browser)
     assert reply.startswith("OK 5 bracket"), reply
     try:
         check_locate_finds_the_taught_part(cell, browser, centroid)
@@ -354,11 +365,8 @@ def test_grasp_styles_and_fingers_edited_and_drawn(cell, browser):
         select_tab(browser, "teach")
         browser.js("""window.picksight.rect.teach = null; window.picksight.drawTool();
                       document.getElementById('teach-type').value = '7';
-                      document.getElementById('teach-name').value = 'single';
-                      document.getElementById('teach-reply').dataset.lastReply = '';""")
-        click(browser, "teach-button")
-        reply = wait_until(lambda: browser.js("return document.getElementById('teach-reply').dataset.lastReply"),
-                           what="the LEARN reply")
+                      document.getElementById('teach-name').value = 'single';""")
+        reply = teach_on_page(browser)
         assert reply.startswith("OK 7 single"), reply
         browser.js("""document.getElementById('grasp-type').value = '7';
                       document.getElementById('style-x').value = '0';

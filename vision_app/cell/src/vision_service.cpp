@@ -262,6 +262,31 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
   return learned;
 }
 
+Result<TryLearnOutcome> VisionService::tryLearn(int type, const std::string& name,
+                                                const std::optional<cv::Rect>& at) {
+  const auto stored = models_ ? models_->snapshot() : std::make_shared<const ModelList>();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto frame = freshFrame();
+  if (!frame) return frame.error();
+  auto learned = learnInImage((*frame)->image, (*frame)->mapping, options_, stored, type, name, at,
+                              scaled_models_.get());
+  if (!learned) return learned.error();
+  auto models = std::make_shared<ModelList>();
+  for (const auto& m : *stored) {
+    if (m.type != type) models->push_back(m);
+  }
+  models->push_back(learned->model);
+  std::sort(models->begin(), models->end(),
+            [](const vision::PartModel& a, const vision::PartModel& b) { return a.type < b.type; });
+  TryLearnOutcome out;
+  // No cache: a list that is not the library's would evict the scaled models
+  // LOCATE keeps.
+  out.located = locateInFrame(**frame, options_, std::move(models), -1, nullptr);
+  for (const auto& p : out.located.parts) out.found += p.type == type ? 1 : 0;
+  out.learned = std::move(*learned);
+  return out;
+}
+
 namespace {
 // A region counts as inside LEARN's rectangle when this share of its box is.
 constexpr double kInsideShare = 0.5;

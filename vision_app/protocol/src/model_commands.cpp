@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "picksight/common/text.hpp"
+#include "picksight/results/request_record.hpp"
 
 namespace picksight::app {
 
@@ -32,6 +33,16 @@ std::string learnReply(const LearnOutcome& learned) {
   for (const auto& w : learned.warnings) reply += " ; warning: " + w;
   for (const auto& n : learned.notes) reply += " ; note: " + n;
   return reply;
+}
+
+std::string tryLearnReply(const TryLearnOutcome& tried) {
+  const auto& m = tried.learned.model;
+  std::string reply = "OK " + modelSummary(m) + " " + (m.body.mirror_symmetric ? "1" : "0") + " " +
+                      std::to_string(tried.found) + " " +
+                      std::to_string(tried.located.parts.size());
+  for (const auto& w : tried.learned.warnings) reply += " ; warning: " + w;
+  for (const auto& n : tried.learned.notes) reply += " ; note: " + n;
+  return reply + " ; note: nothing stored";
 }
 
 std::string undoReply(const UndoOutcome& undone) {
@@ -156,6 +167,67 @@ std::string toleranceReply(const vision::PartModel& m) {
 }
 
 namespace {
+// LEARN's and TRYLEARN's arguments: <type> [name] [AT <x> <y> <w> <h>].
+struct LearnArgs {
+  int type = 0;
+  std::string name;
+  std::optional<cv::Rect> at;
+};
+
+Result<LearnArgs> parseLearnArgs(const std::string& word, const Request& r) {
+  const std::string usage = "usage: " + word + " <type> [name] [AT <x> <y> <w> <h>]";
+  const auto bad = [](const std::string& text) {
+    return makeError(ProtocolErrc::kBadArguments, text);
+  };
+  // "AT" and its four numbers close the line; a name comes before them.
+  std::vector<std::string> args = r.args;
+  LearnArgs out;
+  const auto keyword = std::find_if(args.begin(), args.end(),
+                                    [](const std::string& a) { return toUpper(a) == "AT"; });
+  if (keyword != args.end()) {
+    if (args.end() - keyword != 5) return bad(word + ": AT needs <x> <y> <w> <h>");
+    const auto rect = parseRect(args, static_cast<size_t>(keyword - args.begin()) + 1);
+    if (!rect) {
+      return bad(word + ": AT x y in [0, " + std::to_string(kMaxSensorPx) + "], w h in [1, " +
+                 std::to_string(kMaxSensorPx) + "] sensor pixels");
+    }
+    out.at = rect;
+    args.erase(keyword, args.end());
+  }
+  if (args.empty()) return bad(usage);
+  if (args.size() > 2) {
+    // "LEARN 1 my part": a name of several words, the commonest slip.
+    std::string words;
+    std::string joined;
+    for (size_t i = 1; i < args.size(); ++i) {
+      words += (i > 1 ? " " : "") + args[i];
+      joined += (i > 1 ? "_" : "") + args[i];
+    }
+    return bad(word +
+               ": the name is one word (1-32 of A-Z a-z 0-9 _ - ., no spaces or commas), got " +
+               std::to_string(args.size() - 1) + " words '" + printable(words) + "': write it as " +
+               word + " " + printable(args[0], 8) + " " + printable(joined) +
+               (out.at ? " AT <x> <y> <w> <h>" : "") + " (" + usage + ")");
+  }
+  const auto type = parseType(args[0]);
+  if (!type) {
+    return bad(word + ": type must be an integer in [0, 9999], got '" + printable(args[0]) + "'");
+  }
+  out.type = *type;
+  out.name = args.size() > 1 ? args[1] : "type" + std::to_string(*type);
+  if (!validModelName(out.name)) {
+    std::string why =
+        out.name.size() > 32 ? std::to_string(out.name.size()) + " characters" : std::string();
+    for (char c : out.name) {
+      if (why.empty() && !validModelName(std::string(1, c)))
+        why = "'" + printable(std::string(1, c)) + "'";
+    }
+    return bad(word + ": name must be 1-32 of A-Z a-z 0-9 _ - ., got '" + printable(out.name) +
+               "' (" + why + ")");
+  }
+  return out;
+}
+
 std::string tolerance(VisionService& vision, const Request& r) {
   constexpr const char* kUsage = "usage: TOLERANCE <type> [<key> <value>]...";
   if (r.args.empty() || r.args.size() % 2 == 0)
@@ -216,65 +288,34 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
   table.add(
       "LEARN", "LEARN <type> [name] [AT <x> <y> <w> <h>]",
       [&vision](const Request& r) {
-        constexpr const char* kUsage = "usage: LEARN <type> [name] [AT <x> <y> <w> <h>]";
-        // "AT" and its four numbers close the line; a name comes before them.
-        std::vector<std::string> args = r.args;
-        std::optional<cv::Rect> at;
-        const auto keyword = std::find_if(args.begin(), args.end(),
-                                          [](const std::string& a) { return toUpper(a) == "AT"; });
-        if (keyword != args.end()) {
-          if (args.end() - keyword != 5) {
-            return errorReply(ProtocolErrc::kBadArguments, "LEARN: AT needs <x> <y> <w> <h>");
-          }
-          const auto rect = parseRect(args, static_cast<size_t>(keyword - args.begin()) + 1);
-          if (!rect) {
-            return errorReply(ProtocolErrc::kBadArguments,
-                              "LEARN: AT x y in [0, " + std::to_string(kMaxSensorPx) +
-                                  "], w h in [1, " + std::to_string(kMaxSensorPx) +
-                                  "] sensor pixels");
-          }
-          at = rect;
-          args.erase(keyword, args.end());
-        }
-        if (args.empty()) return errorReply(ProtocolErrc::kBadArguments, kUsage);
-        if (args.size() > 2) {
-          // "LEARN 1 my part": a name of several words, the commonest slip.
-          std::string words;
-          std::string joined;
-          for (size_t i = 1; i < args.size(); ++i) {
-            words += (i > 1 ? " " : "") + args[i];
-            joined += (i > 1 ? "_" : "") + args[i];
-          }
-          return errorReply(ProtocolErrc::kBadArguments,
-                            "LEARN: the name is one word (1-32 of A-Z a-z 0-9 _ - ., no spaces or "
-                            "commas), got " +
-                                std::to_string(args.size() - 1) + " words '" + printable(words) +
-                                "': write it as LEARN " + printable(args[0], 8) + " " +
-                                printable(joined) + (at ? " AT <x> <y> <w> <h>" : "") + " (" +
-                                kUsage + ")");
-        }
-        const auto type = parseType(args[0]);
-        if (!type) {
-          return errorReply(
-              ProtocolErrc::kBadArguments,
-              "LEARN: type must be an integer in [0, 9999], got '" + printable(args[0]) + "'");
-        }
-        const std::string name = args.size() > 1 ? args[1] : "type" + std::to_string(*type);
-        if (!validModelName(name)) {
-          std::string why = name.size() > 32 ? std::to_string(name.size()) + " characters" : "";
-          for (char c : name) {
-            if (why.empty() && !validModelName(std::string(1, c)))
-              why = "'" + printable(std::string(1, c)) + "'";
-          }
-          return errorReply(ProtocolErrc::kBadArguments,
-                            "LEARN: name must be 1-32 of A-Z a-z 0-9 _ - ., got '" +
-                                printable(name) + "' (" + why + ")");
-        }
-        auto learned = vision.learn(*type, name, at, r.line);
+        auto args = parseLearnArgs("LEARN", r);
+        if (!args) return errorReply(args.error());
+        auto learned = vision.learn(args->type, args->name, args->at, r.line);
         if (!learned) return errorReply(learned.error());
         return learnReply(*learned);
       },
       alwaysChanges, Publishes::kFrame);
+  table.add(
+      "TRYLEARN", "TRYLEARN <type> [name] [AT <x> <y> <w> <h>]",
+      [&vision](const Request& r) {
+        auto args = parseLearnArgs("TRYLEARN", r);
+        if (!args) return errorReply(args.error());
+        auto tried = vision.tryLearn(args->type, args->name, args->at);
+        if (!tried) return errorReply(tried.error());
+        const std::string reply = tryLearnReply(*tried);
+        // The parts found with the new model go to the results stream as a
+        // LOCATE's would (the overlay draws the model's outline on each);
+        // not kept for WHY, which explains the last real LOCATE.
+        CellLocate located;
+        located.outcome = std::move(tried->located);
+        auto record = locateRecord(std::move(located), -1, vision.options());
+        record->request = "TRYLEARN";
+        record->request_line = r.line;
+        record->client = r.session->client;
+        r.session->record = std::move(record);
+        return reply;
+      },
+      neverChanges, Publishes::kRecord);
   table.add(
       "MODELS", "MODELS",
       [&vision](const Request& r) {

@@ -144,6 +144,14 @@ struct LearnOutcome {
   std::vector<std::string> notes;
 };
 
+// A LEARN tried without storing (TRYLEARN): the model it would store, and
+// LOCATE ALL on the same frame with that model in place of the type's.
+struct TryLearnOutcome {
+  LearnOutcome learned;
+  LocateOutcome located;
+  int found = 0;  // parts of the taught type among located.parts
+};
+
 // LEARN on one grey frame: binarizes the whole frame as LOCATE would (with
 // `models`, sensor pixels, widening the window), then trains from the one
 // part inside `at` (sensor pixels; none: the whole frame): the largest
@@ -207,6 +215,11 @@ class VisionService {
   Result<LearnOutcome> learn(int type, const std::string& name,
                              const std::optional<cv::Rect>& at = std::nullopt,
                              std::string_view change = {});
+  // LEARN on a fresh frame without storing anything, then LOCATE ALL on that
+  // frame with the new model in place of any model of `type`: what LEARN
+  // would teach and what LOCATE would then find, for a person to judge first.
+  Result<TryLearnOutcome> tryLearn(int type, const std::string& name,
+                                   const std::optional<cv::Rect>& at = std::nullopt);
   // Blob features of every region in a fresh frame, sensor pixels.
   Result<std::vector<vision::BlobFeatures>> blobs();
   // The single calibration target in a fresh frame.

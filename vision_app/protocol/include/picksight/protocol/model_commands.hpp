@@ -1,5 +1,5 @@
 // Robot protocol commands for part models and blob analysis: LEARN, MODELS,
-// TOLERANCE, FORGET, UNDO, BLOBS (docs/PROTOCOL.md).
+// TRYLEARN, TOLERANCE, FORGET, UNDO, BLOBS (docs/PROTOCOL.md).
 #pragma once
 
 #include "picksight/cell/vision_service.hpp"
@@ -19,6 +19,10 @@ std::string learnReply(const LearnOutcome& learned);
 // tolerance a model file stores (area_tolerance, hu_tolerance,
 // verify_percent, edge_tolerance_px, mirror_symmetric).
 std::string toleranceReply(const vision::PartModel& model);
+// TRYLEARN's reply: LEARN's fields, then "<found> <parts>" (the parts of
+// the type LOCATE ALL finds on the same frame with the new model, and all
+// it finds), LEARN's warnings and notes, and " ; note: nothing stored".
+std::string tryLearnReply(const TryLearnOutcome& tried);
 // UNDO's reply: "OK <type> restored|removed <changes left> ; undid: <request>
 // ; type <type> is <model summary> again" (or "has no model again").
 std::string undoReply(const UndoOutcome& undone);
