@@ -2,7 +2,9 @@
 // lines, and over real HTTP against a real cell, an engineer's changes with
 // their before and after, an operator's refused ones, who may read and
 // export the trail.
+#include <chrono>
 #include <filesystem>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -282,3 +284,81 @@ TEST_CASE("a change's read-back line is the read of what it changes", "[web][aud
 }
 
 }  // namespace picksight::web
+
+namespace picksight::webtest {
+
+TEST_CASE("a change made on the robot port is in the web's audit trail with the robot's address",
+          "[web][audit]") {
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=1", "--fps", "10"});
+  VisionProcess vision(server);
+  REQUIRE(!vision.results_endpoint.empty());
+  WebProcess web(
+      {"--video-server", server.frames + "," + server.control, "--vision-app",
+       "cam0," + vision.results_endpoint + ",127.0.0.1:" + std::to_string(vision.robot_port)});
+  auto admin = web.client();
+  auto robot = vision.connect();
+  // The web's subscription has reached the app once a result of ours
+  // arrives (a SUB socket joins a moment after it connects).
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (true) {
+    REQUIRE(robot.request("LOCATE ALL", 5s));
+    const json apps = json::parse(admin.Get("/api/apps")->body);
+    if (apps[0].value("last_result_id", 0) > 0) break;
+    REQUIRE(std::chrono::steady_clock::now() < deadline);
+    std::this_thread::sleep_for(100ms);
+  }
+  REQUIRE(robot.request("LEARN 4", 5s)->rfind("OK 4 ", 0) == 0);
+  // The page's own change: recorded by the web once, with its user, not a
+  // second time from the app's stream.
+  auto res = post(admin, "/api/apps/cam0/command", {{"line", "TOLERANCE 4 area_tolerance 0.3"}});
+  REQUIRE(res);
+  REQUIRE(res->status == 200);
+  // Refused (no such model) and read-only lines: nothing changed, not recorded.
+  CHECK(robot.request("FORGET 77", 5s)->rfind("ERROR", 0) == 0);
+  CHECK(robot.request("MODELS", 5s)->rfind("OK 1 4", 0) == 0);
+  const std::string tolerance = *robot.request("TOLERANCE 4 area_tolerance 0.25", 5s);
+  REQUIRE(tolerance.rfind("OK", 0) == 0);
+
+  // The app publishes each change after its reply: the trail has it soon
+  // after, in the order made.
+  const std::string peer = robot.localEndpoint();
+  REQUIRE(peer.rfind("127.0.0.1:", 0) == 0);
+  json records;
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (find(records, {{"arguments", {{"line", "TOLERANCE 4 area_tolerance 0.25"}}}}).is_null()) {
+    REQUIRE(std::chrono::steady_clock::now() < until);
+    std::this_thread::sleep_for(100ms);
+    records = auditOf(admin, 1000)["records"];
+  }
+  INFO(records.dump(1));
+  const json changed =
+      find(records, {{"arguments", {{"line", "TOLERANCE 4 area_tolerance 0.25"}}}});
+  CHECK(changed["user"] == "robot " + peer);
+  CHECK(changed["role"] == "robot port");
+  CHECK(changed["address"] == "127.0.0.1");
+  CHECK(changed["action"] == "command");
+  CHECK(changed["target"] == "cam0");
+  CHECK(changed["outcome"] == "ok");
+  CHECK(changed["reply"] == tolerance);
+  const json learned = find(records, {{"arguments", {{"line", "LEARN 4"}}}});
+  REQUIRE(!learned.is_null());
+  CHECK(learned["user"] == "robot " + peer);
+  CHECK(learned["reply"].get<std::string>().rfind("OK 4 ", 0) == 0);
+  int page_changes = 0;
+  for (const auto& r : records)
+    if (r.value("arguments", json::object()).value("line", "") ==
+        "TOLERANCE 4 area_tolerance 0.3") {
+      ++page_changes;
+      CHECK(r["user"] == "admin");
+    }
+  CHECK(page_changes == 1);
+  CHECK(find(records, {{"arguments", {{"line", "FORGET 77"}}}}).is_null());
+  CHECK(find(records, {{"arguments", {{"line", "MODELS"}}}}).is_null());
+  CHECK(find(records, {{"arguments", {{"line", "LOCATE ALL"}}}}).is_null());
+  // A change that worked on no frame is no result for the page to draw.
+  const json latest = json::parse(admin.Get("/api/results/cam0/latest")->body);
+  CHECK(latest["request"] == "LEARN");
+}
+
+}  // namespace picksight::webtest

@@ -37,8 +37,9 @@ bool isIdleClose(const std::string& reply) { return reply.rfind("ERROR 16 ", 0) 
 
 }  // namespace
 
-ResultFeed::ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events)
-    : app_(std::move(app)), events_(events) {
+ResultFeed::ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events,
+                       ChangeHandler on_change)
+    : app_(std::move(app)), events_(events), on_change_(std::move(on_change)) {
   convert_thread_ = std::thread([this] { convertLoop(); });
   if (app_.results != "none") thread_ = std::thread([this, &context] { run(context); });
 }
@@ -129,6 +130,12 @@ void ResultFeed::run(zmq::context_t& context) {
         logWarning("vision app ", app_.name, ": malformed result message skipped");
         continue;
       }
+      if (result.changed()) {
+        if (on_change_ && !ownClient(result.client())) on_change_(result);
+        // A change that worked on no frame (TOLERANCE, FORGET...) is the
+        // trail's, not a result for the page to draw.
+        if (result.frame_width() == 0) continue;
+      }
       accept(std::move(result));
     }
     monitor.abort();
@@ -164,6 +171,14 @@ void ResultFeed::accept(proto::VisionResult result) {
   pending_ = std::move(shared);  // replaces one the converter has not taken yet
   ++pending_number_;
   convert_wake_.notify_one();
+}
+
+bool ResultFeed::ownClient(const std::string& client) const {
+  // "<port label> <address>:<port>"
+  const size_t space = client.find(' ');
+  const std::string endpoint = space == std::string::npos ? client : client.substr(space + 1);
+  std::lock_guard<std::mutex> lock(own_mutex_);
+  return std::find(own_endpoints_.begin(), own_endpoints_.end(), endpoint) != own_endpoints_.end();
 }
 
 std::string ResultFeed::camera() const {
@@ -224,6 +239,9 @@ Result<std::string> ResultFeed::command(const std::string& line) {
                                                     "): " + client.error().message);
       }
       line_ = std::move(*client);
+      std::lock_guard<std::mutex> own(own_mutex_);
+      own_endpoints_.push_back(line_.localEndpoint());
+      if (own_endpoints_.size() > 8) own_endpoints_.pop_front();
     }
     const auto start = std::chrono::steady_clock::now();
     auto reply = line_.request(line, kReplyTimeout);

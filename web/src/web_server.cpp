@@ -253,6 +253,9 @@ class WebServer::Impl {
   // client in the audit trail.
   void audit(const httplib::Request& req, const std::optional<Session>& session,
              AuditRecord record);
+  // A change a robot, a PLC or the set-up port made in vision app `app`
+  // (its results stream says so), recorded with the client as the user.
+  void recordAppChange(const std::string& app, const proto::VisionResult& change);
   // A robot line from the page: sent, and recorded when it changes
   // something, with what its read-back line says before and after.
   void command(ResultFeed& app, const std::string& line, const httplib::Request& req,
@@ -320,7 +323,10 @@ Result<void> WebServer::Impl::start() {
   cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
                                              options_.jpeg_quality);
   for (const auto& app : options_.vision_apps)
-    apps_[app.name] = std::make_unique<ResultFeed>(context_, app, events_);
+    apps_[app.name] = std::make_unique<ResultFeed>(
+        context_, app, events_, [this, name = app.name](const proto::VisionResult& change) {
+          recordAppChange(name, change);
+        });
   http_->set_payload_max_length(kMaxBodyBytes);
   // A viewer whose socket takes no bytes for this long is dropped: it held
   // one HTTP thread, never a camera or another viewer.
@@ -1004,6 +1010,25 @@ void WebServer::Impl::audit(const httplib::Request& req, const std::optional<Ses
     record.role = roleName(session->role);
   }
   record.address = req.remote_addr;
+  audit_->record(std::move(record));
+}
+
+void WebServer::Impl::recordAppChange(const std::string& app, const proto::VisionResult& change) {
+  // client: "robot 10.0.0.5:41234", "setup 127.0.0.1:50112", "plc ...".
+  const std::string& client = change.client();
+  const size_t space = client.find(' ');
+  const std::string port = space == std::string::npos ? std::string() : client.substr(0, space);
+  std::string address = space == std::string::npos ? client : client.substr(space + 1);
+  address = address.substr(0, address.rfind(':'));
+  AuditRecord record;
+  record.user = client.empty() ? "(vision app)" : client;
+  record.role = port == "setup" ? "set-up port" : port.empty() ? "" : port + " port";
+  record.address = address;
+  record.action = "command";
+  record.target = app;
+  record.arguments = {{"line", change.request_line()}};
+  record.outcome = "ok";  // only changes answered OK are published
+  record.reply = change.reply();
   audit_->record(std::move(record));
 }
 

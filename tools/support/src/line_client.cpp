@@ -12,6 +12,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "picksight/common/allow_list.hpp"
+
 namespace picksight {
 
 LineClient::~LineClient() { close(); }
@@ -29,6 +31,17 @@ LineClient& LineClient::operator=(LineClient&& other) noexcept {
     other.fd_ = -1;
   }
   return *this;
+}
+
+std::string LineClient::localEndpoint() const {
+  sockaddr_storage local{};
+  socklen_t length = sizeof local;
+  if (fd_ < 0 || ::getsockname(fd_, reinterpret_cast<sockaddr*>(&local), &length) != 0) return "";
+  const auto* address = reinterpret_cast<const sockaddr*>(&local);
+  const uint16_t port = local.ss_family == AF_INET6
+                            ? ntohs(reinterpret_cast<const sockaddr_in6*>(&local)->sin6_port)
+                            : ntohs(reinterpret_cast<const sockaddr_in*>(&local)->sin_port);
+  return peerAddress(address) + ":" + std::to_string(port);
 }
 
 void LineClient::close() {

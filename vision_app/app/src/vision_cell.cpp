@@ -45,14 +45,17 @@ std::string VisionCell::handle(std::string_view line, bool read_only, Session* s
   if (s.publishes == Publishes::kRecord && s.record) {
     // Filled in (reply, time) even with no results stream: WHY keeps it.
     s.after_reply = publishWhenSent(std::move(s.record), s.received, results_);
-  } else if (s.publishes == Publishes::kFrame && results_) {
+  } else if ((s.publishes == Publishes::kFrame || s.changed) && results_) {
     auto record = std::make_shared<RequestRecord>();
     record->request = s.command;
     record->request_line = std::string(line);
     record->client = s.client;
     record->options = vision_.options();
+    // A change (TOLERANCE, FORGET, COMPUTE...) is published for the web's
+    // audit trail even when it works on no frame.
+    record->changed = s.changed;
     // A request refused before it took a frame has none of its own.
-    auto frame = vision_.lastFramePixels();
+    auto frame = s.publishes == Publishes::kFrame ? vision_.lastFramePixels() : nullptr;
     if (frame != frame_before) record->frame = std::move(frame);
     s.after_reply = publishWhenSent(std::move(record), s.received, results_);
   }

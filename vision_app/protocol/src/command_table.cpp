@@ -86,6 +86,7 @@ std::string CommandTable::dispatch(std::string_view line, bool read_only, Sessio
     session->command.clear();
     session->publishes = Publishes::kNothing;
     session->record = nullptr;
+    session->changed = false;
   }
   auto request = parseRequest(line);
   if (!request) return errorReply(ProtocolErrc::kEmptyRequest, "empty request");
@@ -110,12 +111,14 @@ std::string CommandTable::dispatch(std::string_view line, bool read_only, Sessio
   std::string reply = it->second.handler(*request);
   // Every change made at a robot's, a PLC's or the set-up port's request,
   // in the log (journald under systemd), with who asked and what came back:
-  // the web keeps its own trail of the changes made through it, and sees
-  // none of these. Only changes made (an OK): a refused one changed
-  // nothing, and a peer sending garbage in a loop (the robot fuzzer logged
-  // 290,000 lines in 20 s) must not fill the journal. Bounded: the line as
-  // the request limit allows it, the reply's first 120 characters.
+  // the web keeps its own trail of the changes made through it and learns
+  // of these from the results stream (Session::changed). Only changes
+  // made (an OK): a refused one changed nothing, and a peer sending garbage
+  // in a loop (the robot fuzzer logged 290,000 lines in 20 s) must not fill
+  // the journal. Bounded: the line as the request limit allows it, the
+  // reply's first 120 characters.
   if (it->second.changes(*request) && reply.rfind("OK", 0) == 0) {
+    request->session->changed = true;
     logInfo("audit: ", session && !session->client.empty() ? session->client : "local", " '",
             printable(line, 200), "' -> ", printable(reply, 120));
   }

@@ -203,6 +203,7 @@ void buildVisionResult(const RequestRecord& record, const std::string& app, uint
   out.set_why(record.why());
   out.set_elapsed_ms(record.elapsed_ms);
   out.set_asked_type(record.asked_type);
+  out.set_changed(record.changed);
   const vision::BinarizeOptions& binarize = record.options.binarize;
   auto* settings = out.mutable_binarize();
   settings->set_method(methodName(binarize.method));

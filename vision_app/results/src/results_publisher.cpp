@@ -134,8 +134,14 @@ void ResultsPublisher::publish(std::shared_ptr<const RequestRecord> record) {
   if (!record) return;
   {
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    if (impl_->queue.size() >= std::max<size_t>(impl_->options.queue, 1)) {
-      impl_->queue.pop_front();  // the oldest: a viewer wants the newest
+    auto& queue = impl_->queue;
+    if (queue.size() >= std::max<size_t>(impl_->options.queue, 1)) {
+      // The oldest: a viewer wants the newest. But a change is the audit
+      // trail's record of who changed the cell: the oldest of the others
+      // goes first (LOCATEs in a loop never push a change out).
+      auto victim = std::find_if(queue.begin(), queue.end(),
+                                 [](const auto& entry) { return !entry.first->changed; });
+      queue.erase(victim == queue.end() ? queue.begin() : victim);
       ++impl_->dropped;
     }
     impl_->queue.emplace_back(std::move(record), impl_->next_id++);

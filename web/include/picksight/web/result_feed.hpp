@@ -14,12 +14,20 @@
 // saturated machine still shows results. latestJson() converts on demand
 // in the caller's thread. command() holds line_mutex_ for one request and
 // reply, on a kept connection (so WHY speaks of the page's last LOCATE).
+//
+// A result marked `changed` is a change made at a robot's, a PLC's or the
+// set-up port's request: the feed's thread hands it to the change handler
+// (the web's audit trail), unless it came over the web's own command
+// connection (the page's changes are recorded by the web itself, with
+// their user); one that worked on no frame is not shown as a result.
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -56,7 +64,10 @@ constexpr size_t kMaxCommandBytes = 256;
 
 class ResultFeed {
  public:
-  ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events);
+  // Called on the feed's thread for each change another client made.
+  using ChangeHandler = std::function<void(const proto::VisionResult& change)>;
+  ResultFeed(zmq::context_t& context, VisionAppEndpoint app, EventHub& events,
+             ChangeHandler on_change = {});
   ~ResultFeed();
   ResultFeed(const ResultFeed&) = delete;
   ResultFeed& operator=(const ResultFeed&) = delete;
@@ -80,6 +91,9 @@ class ResultFeed {
 
   // Handles one received result as the thread does (also for tests).
   void accept(proto::VisionResult result);
+  // Whether a result's client ("robot 127.0.0.1:41234") is one of the
+  // recent command connections of this feed.
+  bool ownClient(const std::string& client) const;
 
   void stop();
 
@@ -110,8 +124,14 @@ class ResultFeed {
   std::mutex publish_mutex_;                             // one event published at a time, in order
   uint64_t published_number_ = 0;                        // under publish_mutex_
 
+  const ChangeHandler on_change_;
+
   std::mutex line_mutex_;
   LineClient line_;  // under line_mutex_
+  // This end of the last few command connections ("127.0.0.1:41234"): a
+  // change's record may arrive after its connection was replaced.
+  mutable std::mutex own_mutex_;
+  std::deque<std::string> own_endpoints_;  // under own_mutex_
 
   std::atomic<bool> connected_{false};
   std::atomic<bool> stop_{false};

@@ -31,6 +31,9 @@ class LineClient {
   Result<std::string> request(const std::string& line, std::chrono::milliseconds timeout);
   void close();
   bool isOpen() const { return fd_ >= 0; }
+  // This end of the connection as the server names its peer, "a.b.c.d:port"
+  // (an IPv4-mapped address as IPv4); empty when closed.
+  std::string localEndpoint() const;
 
  private:
   explicit LineClient(int fd) : fd_(fd) {}

@@ -37,6 +37,9 @@ struct Session {
   // it publishes; and the record its handler leaves (Publishes::kRecord).
   std::string command;
   Publishes publishes = Publishes::kNothing;
+  // Whether the current request changed the cell (answered OK): published
+  // for the web's audit trail.
+  bool changed = false;
   std::shared_ptr<RequestRecord> record;
 };
 

@@ -53,6 +53,7 @@ class RequestRecord {
   std::string reply;         // set once the reply is known
   double elapsed_ms = 0;     // request to reply
   int asked_type = -1;       // LOCATE: -1 every type
+  bool changed = false;      // a change answered OK (Session::changed)
 
   // LOCATE: its outcome and what the grasps were chosen with (none when
   // the request failed before a frame).

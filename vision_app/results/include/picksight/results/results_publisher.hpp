@@ -3,7 +3,7 @@
 // app's name, then the message).
 //
 // Never on the robot's critical path: publish() only queues the record (a
-// full queue drops the oldest record and counts it); a publisher thread
+// full queue drops the oldest record but a change, and counts it); a publisher thread
 // builds the message (regions, outlines, rejections) and sends it without
 // blocking (a small send high-water mark: a slow subscriber loses
 // messages, never delays the cell). While nobody subscribes to the topic
