@@ -226,11 +226,25 @@ TEST_CASE("picksight-cam target refuses bad positions and cameras without a robo
         2);
   CHECK(run({cam, "--control", server.control, "target", "cam0", "1", "2e7"}).exit_code == 1);
   CHECK(run({cam, "--control", server.control, "target", "cam1", "1", "2"}).exit_code == 1);
-  const CommandResult negative =
-      run({cam, "--control", server.control, "--json", "target", "cam0", "-12.5", "-600"});
-  CHECK(negative.exit_code == 0);
-  CHECK(negative.out.find("\"target_x_mm\":-12.5") != std::string::npos);
-  CHECK(negative.out.find("\"target_visible\":true") != std::string::npos);
+  // Held where the camera sees it whole: shown (y is negative all over this
+  // cell's view).
+  const cv::Point2d inside = robotAt({640, 480});
+  const CommandResult held = run({cam, "--control", server.control, "--json", "target", "cam0",
+                                  formatFixed(inside.x, 3), formatFixed(inside.y, 3)});
+  CHECK(held.exit_code == 0);
+  CHECK(held.out.find("\"target_visible\":true") != std::string::npos);
+  // Off the image (x = -12.5 mm lies 72 px past its right edge) or across
+  // its edge: refused (the server's error, which picksight-cam prints on
+  // stderr, names it), and the target stays where it was.
+  for (const cv::Point2d& off : {cv::Point2d(-12.5, -600), robotAt({1279, 480})}) {
+    const CommandResult refused = run({cam, "--control", server.control, "--json", "target", "cam0",
+                                       formatFixed(off.x, 3), formatFixed(off.y, 3)});
+    CHECK(refused.exit_code == 1);
+    CHECK(refused.out.find("target_visible") == std::string::npos);
+  }
+  const CommandResult still = run({cam, "--control", server.control, "info", "cam0"});
+  CHECK(still.out.find("at robot " + formatFixed(inside.x, 3) + " " + formatFixed(inside.y, 3) +
+                       " mm = sensor ") != std::string::npos);
   // The table is loaded or cleared through the camera's Parts feature.
   CHECK(run({cam, "--control", server.control, "set", "cam0", "Parts", "2"}).out == "Parts = 2\n");
   CHECK(run({cam, "--control", server.control, "set", "cam0", "Parts", "900"}).exit_code == 1);

@@ -1,7 +1,10 @@
 // The Calibrate panel: CALCAM, STORE, LIST, DELETE, COMPUTE (each method),
 // RESIDUALS and CLEARCAL as protocol lines; the stored points and their
 // residual arrows drawn on the image; and, with a synthetic camera, the
-// whole calibration run by its simulated robot.
+// whole calibration run by its simulated robot. A refusal (CALCAM without a
+// target, a target moved off the image) stays on top of the panel in red
+// until the next button is pressed: the refreshes that follow (STATUS, LIST)
+// would scroll it out of the reply log.
 "use strict";
 
 (function () {
@@ -11,9 +14,17 @@
   const LONGEST_ARROW_PX = 40;
   const cal = { points: [], residuals: {}, mmPerPx: [1, 1], rz: 0, pxPerMm: 1 };
 
+  // The panel's last refusal, on top; cleared when a button is pressed.
+  function showError(line, reply) {
+    if (!reply.startsWith("ERROR")) return;
+    $("cal-error").textContent = line + ": " + reply;
+    $("cal-error").hidden = false;
+  }
+
   async function say(line) {
     const reply = await ps.command(line);
     ps.show("cal-reply", line, reply);
+    showError(line, reply);
     return reply;
   }
 
@@ -89,7 +100,10 @@
 
   async function moveTarget(body) {
     const r = await ps.cameraAction("target", body);
-    ps.show("cal-reply", "target " + JSON.stringify(body), r.ok ? "OK" : "ERROR " + r.body.error);
+    const line = body.hide ? "hide target" : "move target to robot " + body.x_mm + " " + body.y_mm + " mm";
+    const reply = r.ok ? "OK" : "ERROR " + r.body.error;
+    ps.show("cal-reply", line, reply);
+    showError(line, reply);
     return r;
   }
 
@@ -159,6 +173,13 @@
   const val = (id) => Number($(id).value) || 0;
 
   document.addEventListener("DOMContentLoaded", () => {
+    // Each press starts with no refusal shown (capture: before its handler).
+    $("panel-calibrate").addEventListener("click", (e) => {
+      if (e.target.tagName === "BUTTON") {
+        $("cal-error").textContent = "";
+        $("cal-error").hidden = true;
+      }
+    }, true);
     ps.toolDrawers.push(drawPoints);
     ps.on("tab", (tab) => { if (tab === "calibrate") refreshPoints(); });
     $("cal-status").addEventListener("click", status);

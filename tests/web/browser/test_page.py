@@ -111,7 +111,9 @@ def click(browser, element_id):
 
 def teach_on_page(browser):
     """Teach (TRYLEARN: the preview), then Save (LEARN) once the preview
-    shows; the LEARN reply."""
+    shows; the LEARN reply. A type set from a script must be followed by an
+    input event, as typing makes one, or the page's refresh puts the next
+    free type back."""
     browser.js("document.getElementById('teach-reply').dataset.lastReply = '';")
     click(browser, "teach-button")
     wait_until(lambda: browser.js("return !document.getElementById('teach-preview').hidden && "
@@ -305,6 +307,7 @@ def test_teach_a_rectangle_then_locate_finds_the_part(cell, browser):
     assert abs(rect[0] - x0) <= slack and abs(rect[1] - y0) <= slack, rect
     assert abs(rect[0] + rect[2] - x1) <= slack and abs(rect[1] + rect[3] - y1) <= slack, rect
     browser.js("""document.getElementById('teach-type').value = '5';
+                  document.getElementById('teach-type').dispatchEvent(new Event('input', {bubbles: true}));
                   document.getElementById('teach-name').value = 'bracket';""")
     browser.screenshot("teach")
     reply = teach_on_page(browser)
@@ -365,6 +368,7 @@ def test_grasp_styles_and_fingers_edited_and_drawn(cell, browser):
         select_tab(browser, "teach")
         browser.js("""window.picksight.rect.teach = null; window.picksight.drawTool();
                       document.getElementById('teach-type').value = '7';
+                      document.getElementById('teach-type').dispatchEvent(new Event('input', {bubbles: true}));
                       document.getElementById('teach-name').value = 'single';""")
         reply = teach_on_page(browser)
         assert reply.startswith("OK 7 single"), reply

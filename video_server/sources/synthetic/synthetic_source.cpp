@@ -163,6 +163,29 @@ Result<SimulatedRobot> SyntheticSource::moveTarget(std::optional<cv::Point2d> at
                  std::abs(at_mm->y) <= 1e6)) {
     return makeError(SourceErrc::kBadValue, "target position must be finite, within 1e6 mm");
   }
+  if (at_mm) {
+    // A target the camera does not see whole is measured wrong (a cut disc's
+    // centroid moves) or not at all: refused, as a real cell's robot program
+    // would be told, and the target stays where it was.
+    const int w = options_.scene.width;
+    const int h = options_.scene.height;
+    const synthetic::RobotCameraModel model(options_.robot, w, h);
+    constexpr int kEdgePoints = 64;
+    const double r = options_.target.radius_mm;
+    for (const cv::Point2d& dot : synthetic::targetDots(options_.target, *at_mm)) {
+      for (int i = 0; i < kEdgePoints; ++i) {
+        const double t = 2 * M_PI * i / kEdgePoints;
+        const cv::Point2d p = model.toImage(dot + r * cv::Point2d(std::cos(t), std::sin(t)));
+        if (p.x >= -0.5 && p.y >= -0.5 && p.x <= w - 0.5 && p.y <= h - 0.5) continue;
+        return makeError(SourceErrc::kBadValue,
+                         "target at (" + formatFixed(at_mm->x) + ", " + formatFixed(at_mm->y) +
+                             ") mm would lie outside the image (its edge at pixel (" +
+                             formatFixed(p.x, 1) + ", " + formatFixed(p.y, 1) + "), the image is " +
+                             std::to_string(w) + " x " + std::to_string(h) +
+                             "): not moved; hold it where the camera sees all of it");
+      }
+    }
+  }
   target_at_mm_ = at_mm;
   if (renderer_) renderer_->setTarget(options_.robot, options_.target, target_at_mm_);
   return simulatedRobot();
