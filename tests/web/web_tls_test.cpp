@@ -8,7 +8,11 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <chrono>
 #include <csignal>
+#include <memory>
+#include <thread>
+#include <vector>
 
 #include <openssl/ssl.h>
 
@@ -202,6 +206,83 @@ TEST_CASE("over HTTPS a request not complete by the header timeout is cut but a 
   CHECK(events >= 4);
   // And the page is served as always.
   CHECK(web.client().Get("/api/cameras")->status == 200);
+}
+
+}  // namespace picksight::webtest
+
+namespace picksight::webtest {
+
+TEST_CASE("over HTTPS the page is served while more slow clients than server threads trickle",
+          "[web][tls][security]") {
+  test::TempDir dir;
+  const Certificate cert = makeCertificate(dir, "web");
+  VideoServerProcess server({"--source", "cam0=synthetic:width=320,height=240", "--fps", "5"});
+  auto args = videoServerArgs(server);
+  // 17 pool threads (--max-streams + 16); the slow clients are not cut
+  // for a minute.
+  args.insert(args.end(), {"--tls-cert", cert.cert, "--tls-key", cert.key, "--max-streams", "1",
+                           "--header-timeout", "60"});
+  WebProcess web(args, cert.cert);
+  REQUIRE(!web.cookie.empty());
+  std::signal(SIGPIPE, SIG_IGN);
+  std::unique_ptr<SSL_CTX, decltype(&SSL_CTX_free)> context(SSL_CTX_new(TLS_client_method()),
+                                                            SSL_CTX_free);
+  REQUIRE(context);
+  // 40 clients from two addresses (under the per-address cap), each past
+  // its handshake with its request begun: a server thread reads each (the
+  // request is encrypted: the gate cannot wait for it). On the pool's 17
+  // threads the 18th handshake waited for a thread for the minute.
+  struct Slow {
+    std::unique_ptr<RawSocket> socket;
+    std::unique_ptr<SSL, decltype(&SSL_free)> ssl{nullptr, SSL_free};
+    bool started = false;
+  };
+  std::vector<Slow> slow(40);
+  for (size_t i = 0; i < slow.size(); ++i) {
+    slow[i].socket = std::make_unique<RawSocket>(web.port, "127.0.0." + std::to_string(2 + i % 2));
+    REQUIRE(slow[i].socket->valid());
+    const int fd = slow[i].socket->fd();
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK);
+    slow[i].ssl.reset(SSL_new(context.get()));
+    SSL_set_fd(slow[i].ssl.get(), fd);
+    SSL_set_connect_state(slow[i].ssl.get());
+  }
+  const std::string head = "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  size_t started = 0;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (started < slow.size() && std::chrono::steady_clock::now() < give_up) {
+    for (auto& s : slow) {
+      if (s.started) continue;
+      const int rc = SSL_do_handshake(s.ssl.get());
+      if (rc == 1) {
+        REQUIRE(SSL_write(s.ssl.get(), head.data(), static_cast<int>(head.size())) > 0);
+        s.started = true;
+        ++started;
+        continue;
+      }
+      const int error = SSL_get_error(s.ssl.get(), rc);
+      REQUIRE((error == SSL_ERROR_WANT_READ || error == SSL_ERROR_WANT_WRITE));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  CHECK(started == slow.size());
+  // The page and the API answer while every slow client still holds its
+  // connection.
+  auto client = web.client();
+  client.set_read_timeout(std::chrono::seconds(30));
+  auto page = client.Get("/");
+  REQUIRE(page);
+  CHECK(page->status == 200);
+  auto cameras = client.Get("/api/cameras");
+  REQUIRE(cameras);
+  CHECK(cameras->status == 200);
+  size_t open = 0;
+  for (auto& s : slow) {
+    char buffer[256];
+    const int n = SSL_read(s.ssl.get(), buffer, sizeof buffer);
+    open += n <= 0 && SSL_get_error(s.ssl.get(), n) == SSL_ERROR_WANT_READ;
+  }
+  CHECK(open == slow.size());
 }
 
 }  // namespace picksight::webtest

@@ -15,10 +15,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <condition_variable>
 #include <cstring>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <unordered_map>
 
@@ -169,6 +172,12 @@ class HttpGate::Impl {
     bool cut = false;
   };
   void cutLateServed(Clock::time_point now);
+  // TLS: runs `job` (a connection from its ClientHello on) on a thread of
+  // its own, at most max_waiting at once; false when it did not (the pool's
+  // then). A TLS connection's thread waits for its handshake and request,
+  // up to header_timeout: on the pool's threads, 64 clients trickling
+  // bytes after a handshake held them all and the page waited seconds.
+  bool serveOnOwnThread(const std::function<void()>& job);
   void run();
   void acceptAll();
   void check(int fd);
@@ -191,6 +200,9 @@ class HttpGate::Impl {
   int wake_fd_ = -1;
   std::thread thread_;
   std::unique_ptr<httplib::ThreadPool> pool_;
+  std::mutex own_mutex_;
+  std::condition_variable own_done_;
+  size_t own_threads_ = 0;  // under own_mutex_: TLS connections' own threads
   std::atomic<bool> stopping_{false};
   std::atomic<size_t> waiting_count_{0};
   bool accept_paused_ = false;  // out of descriptors: the gate's thread only
@@ -279,6 +291,8 @@ void HttpGate::Impl::stop() {
 void HttpGate::Impl::join() {
   if (pool_) pool_->shutdown();
   pool_.reset();
+  std::unique_lock<std::mutex> lock(own_mutex_);
+  own_done_.wait(lock, [this] { return own_threads_ == 0; });
 }
 
 void HttpGate::Impl::run() {
@@ -439,7 +453,7 @@ void HttpGate::Impl::check(int fd) {
       served_[key] = Served{watch, w.deadline, w.address};
     }
   }
-  pool_->enqueue([this, fd, address = w.address, watch, key] {
+  auto job = [this, fd, address = w.address, watch, key] {
     serve_(fd);
     if (watch >= 0) {
       {
@@ -449,7 +463,31 @@ void HttpGate::Impl::check(int fd) {
       ::close(watch);  // after the erase: the gate's thread never uses a closed one
     }
     release(address);
-  });
+  };
+  if (options_.tls && serveOnOwnThread(job)) return;
+  pool_->enqueue(std::move(job));
+}
+
+bool HttpGate::Impl::serveOnOwnThread(const std::function<void()>& job) {
+  {
+    std::lock_guard<std::mutex> lock(own_mutex_);
+    if (own_threads_ >= static_cast<size_t>(options_.max_waiting)) return false;
+    ++own_threads_;
+  }
+  const auto done = [this] {
+    std::lock_guard<std::mutex> lock(own_mutex_);
+    if (--own_threads_ == 0) own_done_.notify_all();
+  };
+  try {
+    std::thread([job, done] {
+      job();
+      done();
+    }).detach();
+    return true;
+  } catch (const std::system_error&) {  // no thread to be had: the pool's
+    done();
+    return false;
+  }
 }
 
 HttpGate::Impl::Waiting HttpGate::Impl::forget(int fd) {

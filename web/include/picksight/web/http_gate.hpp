@@ -39,6 +39,8 @@ struct GateOptions {
   // ClientHello) is awaited here; the handshake and the request are then
   // read by the serving thread, held to the same deadline: the gate shuts
   // the socket down at header_timeout unless arrived() was called for it.
+  // That thread is the connection's own (up to max_waiting at once), not
+  // one of the pool's, which slow TLS clients would otherwise all hold.
   // Anything but a TLS handshake record first is refused at once (400).
   bool tls = false;
 };
