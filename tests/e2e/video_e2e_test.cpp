@@ -237,3 +237,30 @@ TEST_CASE("snap saves the next frame and close releases the camera until open re
   CHECK(cv::countNonZero(resumed->image != published->image) == 0);
   CHECK(cam(server, {"list"}).out.find("streaming") != std::string::npos);
 }
+
+TEST_CASE("a file camera follows its image replaced by one of another size", "[e2e][video]") {
+  picksight::test::TempDir dir;
+  const std::string path = dir.file("scene.png");
+  REQUIRE(cv::imwrite(path, cv::Mat(480, 640, CV_8UC1, cv::Scalar(90))));
+  VideoServerProcess server({"--source", "cam0=file:" + path, "--mode", "trigger"});
+  const std::string snap = dir.file("snap.png");
+  REQUIRE(cam(server, {"snap", "cam0", snap}).exit_code == 0);
+  REQUIRE(cv::imread(snap, cv::IMREAD_UNCHANGED).size() == cv::Size(640, 480));
+  CHECK(infoValue(cam(server, {"info", "cam0"}).out, "sensor") == "640x480");
+
+  // Replaced as a person saving another photograph would (renamed over it).
+  for (const cv::Size size : {cv::Size(800, 600), cv::Size(320, 200)}) {
+    const std::string next = dir.file("next.png");
+    REQUIRE(cv::imwrite(next, cv::Mat(size, CV_8UC1, cv::Scalar(120))));
+    std::filesystem::rename(next, path);
+    REQUIRE(cam(server, {"snap", "cam0", snap}).exit_code == 0);
+    CHECK(cv::imread(snap, cv::IMREAD_UNCHANGED).size() == size);
+    // What clients map ROIs and parts through: the new size, no restart.
+    const std::string info = cam(server, {"info", "cam0"}).out;
+    INFO(info);
+    const std::string wh = std::to_string(size.width) + "x" + std::to_string(size.height);
+    CHECK(infoValue(info, "sensor") == wh);
+    CHECK(infoValue(info, "roi") ==
+          "x=0 y=0 width=" + std::to_string(size.width) + " height=" + std::to_string(size.height));
+  }
+}

@@ -295,9 +295,23 @@ void Camera::run() {
     if (!waiting_since_) waiting_since_ = Clock::now();
     grab_sequence_ = sequence;
     grab_waits_pulse_ = mode_ == AcquisitionMode::kHardwareTrigger;
+    const cv::Size known_size = frame_size_;
     lock.unlock();
     Grab grab = grabAndConvert(*triggered, streams, output);
+    // The device's frames changed size (a file: camera's image replaced by
+    // one of another size): what it says of itself is asked again, on this
+    // thread as at open, so that the sensor size everybody maps ROIs and
+    // parts through follows without a restart.
+    std::optional<SourceInfo> resized;
+    if (grab.out && !known_size.empty() && grab.out->sensor_size != known_size)
+      resized = source_->info();
     lock.lock();
+    if (resized) {
+      logInfo("camera ", config_.name, ": frames of ", grab.out->sensor_size.width, "x",
+              grab.out->sensor_size.height, " now (were ", known_size.width, "x", known_size.height,
+              "); sensor ", resized->sensor_width, "x", resized->sensor_height);
+      status_.info = *resized;
+    }
     grab_sequence_.reset();
     status_.driver = grab.counters;
     if (!grab.out) {
