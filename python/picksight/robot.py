@@ -26,6 +26,12 @@ Tolerances = namedtuple("Tolerances", "type name values")
 # mode "FREE" (fps), "SOFTWARE" or "HARDWARE" (line, timeout in s); None where
 # the mode has no such setting.
 CameraMode = namedtuple("CameraMode", "mode fps line timeout")
+# UNDO: the type, whether a model was restored (False: the undone change had
+# created it), the changes still undoable, and the request undone.
+Undone = namedtuple("Undone", "type restored left change")
+# TRYLEARN: the model LEARN would store, the parts of its type and all parts
+# LOCATE ALL then finds on that frame, and LEARN's warnings.
+TriedModel = namedtuple("TriedModel", "model found parts warnings")
 Blob = namedtuple(
     "Blob",
     "x y angle area perimeter roundness holes eccentricity bx by bw bh "
@@ -207,11 +213,41 @@ class RobotClient:
 
     # ------------------------------------------------------ teaching, blobs
 
-    def learn(self, part_type, name=None):
-        """Trains `part_type` from the single part in a fresh frame."""
-        line = f"LEARN {int(part_type)}" + (f" {name}" if name else "")
-        w = self.request(line)
+    @staticmethod
+    def _learn_line(word, part_type, name, at):
+        line = f"{word} {int(part_type)}" + (f" {name}" if name else "")
+        if at is not None:
+            line += " AT " + " ".join(str(int(v)) for v in at)
+        return line
+
+    def learn(self, part_type, name=None, at=None):
+        """Trains `part_type` from the single part in a fresh frame (inside
+        `at` = (x, y, w, h) sensor pixels when given)."""
+        w = self.request(self._learn_line("LEARN", part_type, name, at))
         return Model(int(w[0]), w[1], float(w[2]), int(w[3]), float(w[4]), w[5] == "1")
+
+    def try_learn(self, part_type, name=None, at=None):
+        """What LEARN would store and LOCATE ALL would then find on the same
+        frame, storing nothing (TRYLEARN). Returns a TriedModel."""
+        line = self._learn_line("TRYLEARN", part_type, name, at)
+        if "\n" in line or "\r" in line:
+            raise ValueError("a request is one line")
+        w = self.request(line)
+        text = " ".join(w)
+        warnings = [p[len("warning: "):] for p in text.split(" ; ")[1:] if p.startswith("warning: ")]
+        model = Model(int(w[0]), w[1], float(w[2]), int(w[3]), float(w[4]), w[5] == "1")
+        return TriedModel(model, int(w[6]), int(w[7]), warnings)
+
+    def undo(self):
+        """Takes back the last change to models (LEARN, FORGET, TOLERANCE,
+        GRASP, GRIPPER): the model file as it was. RobotError 37 when there
+        is nothing to undo, 38 when the history entry is damaged or no longer
+        applies. Returns an Undone."""
+        w = self.request("UNDO")
+        text = " ".join(w)
+        parts = text.split(" ; ")
+        change = parts[1][len("undid: "):] if len(parts) > 1 and parts[1].startswith("undid: ") else ""
+        return Undone(int(w[0]), w[1] == "restored", int(w[2]), change)
 
     def models(self):
         def convert(f):

@@ -82,7 +82,10 @@ for path in ./usr/bin/picksight-video-server ./usr/bin/picksight-vision ./usr/bi
   ./usr/lib/tmpfiles.d/picksight.conf ./usr/lib/udev/rules.d/99-picksight-u3v.rules \
   ./etc/picksight/video-server.yaml ./usr/share/doc/picksight/CAMERAS.md \
   ./etc/picksight/vision/cam0.yaml ./usr/share/doc/picksight/README.md \
-  ./usr/share/doc/picksight/copyright; do
+  ./usr/share/doc/picksight/copyright ./usr/lib/python3/dist-packages/picksight/__init__.py \
+  ./usr/lib/python3/dist-packages/picksight/robot.py \
+  ./usr/lib/python3/dist-packages/picksight/picksight_pb2.py \
+  ./usr/lib/python3/dist-packages/picksight/results_pb2.py; do
   awk '{print $6}' "$work/contents" | grep -qxF "$path" || fail "package lacks $path"
 done
 # Only the product: no test, benchmark or fuzzer binary.
@@ -211,6 +214,21 @@ reply="$(/usr/bin/picksight-robot --port "$port" --timeout 30 'LOCATE 1')" ||
 echo "LOCATE 1 -> $reply"
 [[ "$reply" == "OK "* ]] || fail "LOCATE replied '$reply'"
 
+# The packaged Python client with Debian's python3, from no build tree: the
+# installed module, and a request through it (its bytecode, written as root,
+# must go with the package at purge).
+py="$(cd / && env -u PYTHONPATH -u PYTHONDONTWRITEBYTECODE /usr/bin/python3 -c '
+import sys, picksight
+with picksight.RobotClient(port=int(sys.argv[1]), timeout=30) as robot:
+    print(picksight.__file__, robot.request("STATUS")[0].split("=")[0])' "$port" 2>&1)" ||
+  fail "import picksight with Debian's python3: $py"
+[ "$py" = "/usr/lib/python3/dist-packages/picksight/__init__.py frame" ] ||
+  fail "the Python client: '$py'"
+echo "python3: import picksight -> $py"
+# The bytecode python3 wrote there as root, which the purge must take away.
+[ -d /usr/lib/python3/dist-packages/picksight/__pycache__ ] ||
+  fail "python3 left no bytecode beside the client"
+
 for pid in "${pids[@]}"; do kill -TERM "$pid"; done
 for pid in "${pids[@]}"; do wait "$pid" || fail "a service exited with status $? on SIGTERM"; done
 pids=()
@@ -235,7 +253,8 @@ fi
 # Where a package's files go (not the whole disk: container images of the
 # package may be stored under /var/lib).
 stray="$(find /etc /usr/bin /usr/lib/systemd /usr/lib/sysusers.d /usr/lib/tmpfiles.d /usr/lib/udev \
-           /usr/share/doc /var/lib/dpkg/info -name '*picksight*' -print 2>/dev/null
+           /usr/share/doc /var/lib/dpkg/info /usr/lib/python3/dist-packages -name '*picksight*' \
+           -print 2>/dev/null
          find /var/lib -maxdepth 1 -name '*picksight*' -print)"
 [ -n "$stray" ] && { printf '%s\n' "$stray" >&2; fail "files named picksight left after purge"; }
 echo "purged: nothing left; the picksight user stays ($(getent passwd picksight | cut -d: -f1,3,6))"

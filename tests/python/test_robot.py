@@ -122,6 +122,22 @@ def test_tolerances_read_changed_and_refused(cell_factory):
         assert robot.tolerance(1, mirror_symmetric=mirror).values["mirror_symmetric"] == mirror
         assert len(robot.locate(1)) == 1
 
+        # Tried, not stored; then each change taken back, newest first.
+        tried = robot.try_learn(2, "again")
+        assert (tried.model.type, tried.found, tried.parts) == (2, 1, 1), tried
+        assert any(w.startswith("looks like type 1 (part)") for w in tried.warnings), tried
+        assert [m.type for m in robot.models()] == [1]
+        undone = robot.undo()
+        assert undone == (1, True, 2, f"TOLERANCE 1 mirror_symmetric {int(mirror)}"), undone
+        assert robot.tolerance(1) == after
+        assert robot.undo().left == 1
+        assert robot.tolerance(1) == before
+        assert robot.undo() == (1, False, 0, "LEARN 1 part")
+        assert robot.models() == []
+        with pytest.raises(RobotError) as e:
+            robot.undo()
+        assert e.value.code == 37 and "nothing to undo" in e.value.text
+
 
 def test_a_whole_set_up_calibrate_teach_grip_pick(cell_factory, tmp_path):
     scene = Scene(tmp_path)
