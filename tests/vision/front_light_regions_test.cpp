@@ -123,3 +123,47 @@ TEST_CASE("a cast shadow is cut off the part, and does not move it", "[vision][r
     CHECK(cv::contourArea(with.outer) == Approx(cv::contourArea(without.outer)).epsilon(0.006));
   }
 }
+
+namespace {
+// Thirty grey levels between part and belt, the part shaded across its face
+// (up to 15 % lighter on one side, within about ten levels of the belt there)
+// and the belt blotched; `shaded` off: the same contrast, evenly lit, on a
+// plain surface.
+ps::SilhouetteSceneOptions lowContrast(bool shaded) {
+  ps::SilhouetteSceneOptions look;
+  look.part_level = 100;
+  look.background_level = 130;
+  look.uneven_light = false;
+  if (shaded) {
+    look.front.surface = ps::Surface::kBelt;
+    look.front.texture = 0.04;
+    look.front.part_shading = 0.15;
+  }
+  return look;
+}
+}  // namespace
+
+TEST_CASE("a part shaded to within a few levels of its belt is still one whole part",
+          "[vision][regions][front]") {
+  // Each part's edge sets the threshold where it runs: a single ratio to the
+  // belt splits the lighter side of the part into specks and holes. And a
+  // real hole on a blotched belt is not taken for a glint because one pixel
+  // in thousands is ten levels lighter than the belt beside the part.
+  for (const char* name : {"l_shape", "gear", "rectangle", "t_shape", "disc_holes"}) {
+    for (const uint64_t seed : {3U, 11U, 29U}) {
+      CAPTURE(name, seed);
+      const ps::SilhouetteType type = ps::silhouetteFromPartType(name, 200);
+      const cv::Mat even =
+          ps::renderSilhouetteAlone(type, 400, lowContrast(false), seed, nullptr, 30);
+      const cv::Mat shaded =
+          ps::renderSilhouetteAlone(type, 400, lowContrast(true), seed, nullptr, 30);
+      const pv::Region reference = onlyPart(even);
+      const pv::Region part = onlyPart(shaded);
+      CHECK(part.holes == reference.holes);
+      CHECK(part.glints == 0);
+      // The outline (what the shape and boundary tests read) is the part's:
+      // not eaten into on its light side, not grown into the belt's blotches.
+      CHECK(cv::contourArea(part.outer) == Approx(cv::contourArea(reference.outer)).epsilon(0.015));
+    }
+  }
+}

@@ -185,3 +185,25 @@ TEST_CASE("at the edge of its range a bar's angle is one end or the other as doc
   WARN("bar across its taught pose: " << plus << " of " << angles.size() << " frames at +90, "
                                       << angles.size() - plus << " at -90");
 }
+
+TEST_CASE("a bar's region without a model keeps its angle frame after frame",
+          "[vision][regions][symmetry]") {
+  // LOCATE with no model reports regions at their own angle: a bar's two
+  // ends lie at the same distance from its centroid, and which one a pixel
+  // boundary puts farther is noise. The region keeps its axis's own
+  // direction in every frame instead of flipping by half a turn.
+  for (const double angle : {0.0, 17.0, 63.5, 120.0, 151.0}) {
+    CAPTURE(angle);
+    std::vector<double> angles;
+    for (int i = 0; i < 20; ++i) {
+      const cv::Mat grey = frame(kBar, angle, false, 300 + static_cast<uint64_t>(i));
+      const auto regions = findRegions(binarize(grey, {}), {}, grey);
+      REQUIRE(regions.size() == 1);
+      angles.push_back(regions[0].angle_deg);
+    }
+    for (const double a : angles) {
+      CAPTURE(angles);
+      CHECK(std::abs(picksight::signedDeg(a - angles.front())) < kSpreadDeg);
+    }
+  }
+}

@@ -1,10 +1,13 @@
 // Binarization. The adaptive method divides out the illumination: it
 // estimates the lit background at low resolution (a maximum filter wider than
-// any part erases the dark parts, a blur smooths it), finds with Otsu the
-// ratio part/background that separates the two populations, and compares
-// every pixel with that ratio of its local background. All heavy work is at
-// 1/8 resolution; the full-resolution cost is one block mean and one compare
-// against the threshold interpolated on the fly.
+// any part erases the dark parts, a blur smooths it) and finds with Otsu the
+// ratio part/background that separates the two populations. Where parts'
+// edges run, their own steps then set the threshold (each step's middle),
+// and the ratio decides only far from any edge: a part shaded lighter on one
+// side, or lying on a darker blotch of a belt, is split at its own edge
+// however little contrast it has. All heavy work is at 1/8 (the edges at
+// 1/2) resolution; the full-resolution cost is one block mean and one
+// compare against the threshold interpolated on the fly.
 #include "picksight/vision/segmentation/binarize.hpp"
 
 #include <opencv2/core/hal/intrin.hpp>
@@ -29,6 +32,19 @@ constexpr double kMinRatio = 0.25;
 // Noise on an empty field, which Otsu also splits in two, gives about 2.7.
 constexpr double kMinSeparation = 4.0;
 constexpr double kMaxSeparatedRatio = 0.95;
+// How far (pixels, a Gaussian's sigma) an edge's level sets the threshold
+// around it.
+constexpr double kEdgeSpreadPx = 40;
+// A step of this share of the scene's part/background contrast still sets
+// the threshold: a part shaded to within ten levels of its belt has such
+// edges on its light side.
+constexpr double kMinStepShare = 0.3;
+// Far from any edge, the threshold lies this share of the contrast below
+// the middle of part and background.
+constexpr double kOpenShare = 0.25;
+// The weight of that open threshold, as a share of a typical voting cell's
+// once spread: about three sigmas from the nearest edge, it decides.
+constexpr double kPriorShare = 0.03;
 
 // The mean of every `reduce` x `reduce` block, rounded as cv::resize
 // INTER_AREA rounds it (the same image where the blocks tile the frame),
@@ -127,6 +143,185 @@ void compareRow(const uint8_t* grey, const uint16_t* a, const uint16_t* b, int w
   }
 }
 
+// Where a part's edge runs, the threshold that splits it is the grey level
+// halfway up its own step, whatever the light and the part's shading there.
+// A single ratio to the background cannot follow a part shaded lighter on
+// one side, or a surface blotched darker, once the contrast is a few tens of
+// levels; the steps can. So the steps vote: every pixel on a sharp step of
+// at least kMinStepShare of the scene's part/background contrast (`contrast`, a
+// fraction of the background level) adds the level halfway up the step
+// to its cell of the low-resolution grid (the size of
+// `background`, `cell` pixels of `image` a cell). Blotches and wear change
+// by a level or two a pixel and do not vote; noise steps are too small. The
+// sums hold twice the middle levels.
+// Steps whose middle lies above kMaxSeparatedRatio of the background (a
+// glint on a part, a light mark on the surface) do not vote either. The sums
+// are integers, each cell's written by one worker: the result does not
+// depend on the number of threads.
+void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, double contrast,
+               cv::Mat& level_sums, cv::Mat& weights, double* noise) {
+  const int rows = background_f.rows;
+  const int cols = background_f.cols;
+  cv::Mat sums64(rows, cols, CV_64F, cv::Scalar(0));
+  cv::Mat weights64(rows, cols, CV_64F, cv::Scalar(0));
+  // Immerkaer's noise estimate (the mean absolute response to a kernel that
+  // cancels any plane), over the pixels that are not on an edge: sums per
+  // cell row, added in order.
+  std::vector<int64_t> residual_sums(static_cast<size_t>(rows), 0);
+  std::vector<int64_t> residual_counts(static_cast<size_t>(rows), 0);
+  // The step is read this far either side of the pixel, across the edge:
+  // beyond a blurred edge's ramp, within a thin part's width.
+  constexpr double kReach = 2.5;
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    for (int j = range.start; j < range.end; ++j) {
+      std::vector<int64_t> s(static_cast<size_t>(cols), 0);
+      std::vector<int64_t> w(static_cast<size_t>(cols), 0);
+      int64_t residual_sum = 0;
+      int64_t residual_count = 0;
+      const int y_end = j == rows - 1 ? image.rows - 1 : std::min(image.rows - 1, (j + 1) * cell);
+      for (int y = std::max(1, j * cell); y < y_end; ++y) {
+        const uint8_t* up = image.ptr<uint8_t>(y - 1);
+        const uint8_t* mid = image.ptr<uint8_t>(y);
+        const uint8_t* down = image.ptr<uint8_t>(y + 1);
+        const float* back = background_f.ptr<float>(j);
+        for (int x = 1; x + 1 < image.cols; ++x) {
+          const int gx = (up[x + 1] + 2 * mid[x + 1] + down[x + 1]) -
+                         (up[x - 1] + 2 * mid[x - 1] + down[x - 1]);
+          const int gy =
+              (down[x - 1] + 2 * down[x] + down[x + 1]) - (up[x - 1] + 2 * up[x] + up[x + 1]);
+          const int magnitude = std::abs(gx) + std::abs(gy);
+          const int i = std::min(cols - 1, x / cell);
+          const double step = contrast * back[i];
+          // Sobel gives 8 for a ramp of one level a pixel: a step of `step`
+          // over about two pixels gives 4 * step; a quarter of it.
+          if (magnitude < step) {
+            const int residual = (up[x - 1] + up[x + 1] + down[x - 1] + down[x + 1]) -
+                                 2 * (up[x] + down[x] + mid[x - 1] + mid[x + 1]) + 4 * mid[x];
+            residual_sum += std::abs(residual);
+            ++residual_count;
+            continue;
+          }
+          const double norm =
+              std::sqrt(static_cast<double>(gx) * gx + static_cast<double>(gy) * gy);
+          const int dx = static_cast<int>(std::lround(kReach * gx / norm));
+          const int dy = static_cast<int>(std::lround(kReach * gy / norm));
+          const int xl = std::clamp(x - dx, 0, image.cols - 1);
+          const int yl = std::clamp(y - dy, 0, image.rows - 1);
+          const int xh = std::clamp(x + dx, 0, image.cols - 1);
+          const int yh = std::clamp(y + dy, 0, image.rows - 1);
+          const int lo = image.at<uint8_t>(yl, xl);
+          const int hi = image.at<uint8_t>(yh, xh);
+          // The step's middle, read from its two sides: the same wherever on
+          // the ramp this pixel lies.
+          const int middle = lo + hi;  // twice the middle level
+          if (hi - lo < kMinStepShare * step || middle > 2 * kMaxSeparatedRatio * back[i]) continue;
+          // A surface beside a part stays light beyond the edge; the
+          // stripes of wood grain or a ribbed belt fall dark again a few
+          // pixels on, and their steps do not vote.
+          const int xf = std::clamp(x + 2 * dx, 0, image.cols - 1);
+          const int yf = std::clamp(y + 2 * dy, 0, image.rows - 1);
+          if (4 * (image.at<uint8_t>(yf, xf) - lo) < 3 * (hi - lo)) continue;
+          // One vote a pixel, however strong the step: a part's light
+          // side, ten levels from its belt, must not be outvoted by its
+          // dark side's edges a part's width away.
+          s[static_cast<size_t>(i)] += middle;
+          w[static_cast<size_t>(i)] += 1;
+        }
+      }
+      residual_sums[static_cast<size_t>(j)] = residual_sum;
+      residual_counts[static_cast<size_t>(j)] = residual_count;
+      double* so = sums64.ptr<double>(j);
+      double* wo = weights64.ptr<double>(j);
+      for (int i = 0; i < cols; ++i) {
+        so[i] = static_cast<double>(s[static_cast<size_t>(i)]);
+        wo[i] = static_cast<double>(w[static_cast<size_t>(i)]);
+      }
+    }
+  });
+  level_sums = sums64;
+  weights = weights64;
+  int64_t residual_sum = 0;
+  int64_t residual_count = 0;
+  for (size_t j = 0; j < residual_sums.size(); ++j) {
+    residual_sum += residual_sums[j];
+    residual_count += residual_counts[j];
+  }
+  // The kernel's response to white noise of deviation s has mean absolute
+  // value 6 s sqrt(2 / pi).
+  *noise = residual_count > 0 ? static_cast<double>(residual_sum) / residual_count /
+                                    (6 * std::sqrt(2 / 3.14159265358979))
+                              : 0;
+}
+
+// The threshold at low resolution (CV_32F, grey levels): the edges' votes
+// spread over about a quarter of the illumination window (`k` cells), with
+// the global ratio to the background (`fallback`) as a weak prior, so that
+// far from any edge (open surface, the middle of a large part) the global
+// split decides, and near edges their own levels do. Never above
+// kMaxSeparatedRatio of the background: the surface's own blotches stay
+// surface.
+struct GuidedThreshold {
+  cv::Mat level;     // CV_32F, grey levels, the size of the background estimate
+  double noise = 0;  // estimated deviation of a full-resolution pixel's noise and grain
+};
+
+GuidedThreshold edgeGuidedThreshold(const cv::Mat& grey, int reduce, int k,
+                                    const cv::Mat& background_f, double contrast,
+                                    const cv::Mat& fallback) {
+  cv::Mat image;
+  int cell = reduce;
+  double noise_scale = 1;
+  // Half resolution where a cell holds whole half-size pixels: a quarter of
+  // the work, and steps of a sharp edge still a pixel or two wide.
+  if (reduce % 2 == 0 && grey.cols >= 4 && grey.rows >= 4) {
+    cv::resize(grey, image, cv::Size(grey.cols / 2, grey.rows / 2), 0, 0, cv::INTER_AREA);
+    cell = reduce / 2;
+    // Averaging four pixels halves independent noise.
+    noise_scale = 2;
+  } else {
+    image = grey;
+  }
+  cv::Mat sums;
+  cv::Mat weights;
+  GuidedThreshold out;
+  edgeVotes(image, cell, background_f, contrast, sums, weights, &out.noise);
+  out.noise *= noise_scale;
+  std::vector<cv::Point> voting;
+  for (int j = 0; j < weights.rows; ++j) {
+    const double* w = weights.ptr<double>(j);
+    for (int i = 0; i < weights.cols; ++i) {
+      if (w[i] > 0) voting.emplace_back(i, j);
+    }
+  }
+  if (voting.empty()) {
+    out.level = fallback;
+    return out;
+  }
+  // Spread over about 40 pixels (a quarter of the window when that is
+  // smaller): a part's shading and a belt's blotches change over tens of
+  // pixels, and the wide window that keeps a large part whole would average
+  // the light side of a part with its dark side.
+  const double sigma = std::max(1.0, std::min(k / 4.0, kEdgeSpreadPx / reduce));
+  cv::GaussianBlur(sums, sums, cv::Size(0, 0), sigma);
+  cv::GaussianBlur(weights, weights, cv::Size(0, 0), sigma);
+  // The prior (kPriorShare) against what a typical voting cell holds once
+  // spread.
+  std::vector<double> held;
+  held.reserve(voting.size());
+  for (const cv::Point& p : voting) held.push_back(weights.at<double>(p));
+  const auto middle = held.begin() + static_cast<std::ptrdiff_t>(held.size() / 2);
+  std::nth_element(held.begin(), middle, held.end());
+  const double prior = kPriorShare * *middle;
+  cv::Mat fallback64;
+  fallback.convertTo(fallback64, CV_64F);
+  cv::Mat surface = (0.5 * sums + prior * fallback64) / (weights + prior);
+  cv::Mat ceiling64;
+  background_f.convertTo(ceiling64, CV_64F, kMaxSeparatedRatio);
+  surface = cv::min(surface, ceiling64);
+  surface.convertTo(out.level, CV_32F);
+  return out;
+}
+
 cv::Mat adaptive(const cv::Mat& grey, int window) {
   const int reduce = std::min({kReduce, std::max(1, grey.cols / 16), std::max(1, grey.rows / 16)});
   cv::Mat small;
@@ -158,6 +353,7 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
   // sits on the edge of the darker one. Split halfway between the two class
   // means instead, where noise on either side is least likely to cross.
   double k_ratio = kMaxRatio;
+  double contrast = 0;  // part/background, a fraction of the background level
   const int bright = cv::countNonZero(upper);
   if (bright > 0 && bright < upper.rows * upper.cols) {
     cv::Scalar mean_bright;
@@ -170,6 +366,7 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
     const bool separated = mean_bright[0] - mean_dark[0] > kMinSeparation * std::max(spread, 1.0);
     k_ratio = std::clamp(0.5 * (mean_bright[0] + mean_dark[0]) / 200.0, kMinRatio,
                          separated ? kMaxSeparatedRatio : kMaxRatio);
+    contrast = (mean_bright[0] - mean_dark[0]) / 200.0;
   } else {
     k_ratio = std::clamp(otsu / 200.0, kMinRatio, kMaxRatio);
   }
@@ -178,7 +375,33 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
   // only; the vertical interpolation happens inside the compare, so no
   // full-size threshold image is written and read back.
   cv::Mat threshold_small;
-  background.convertTo(threshold_small, CV_16U, 16 * k_ratio);
+  const cv::Mat* compared = &grey;
+  cv::Mat smoothed;
+  if (contrast > 0) {
+    // Far from every edge the surface is open, or the middle of a part
+    // wider than the edges reach: the ratio splits those, but a quarter of
+    // the contrast lower than halfway, since a belt's blotches lie there
+    // and a part's middle lies far below it.
+    const cv::Mat global_threshold = background_f * (k_ratio - kOpenShare * contrast);
+    const GuidedThreshold guided =
+        edgeGuidedThreshold(grey, reduce, k, background_f, contrast, global_threshold);
+    guided.level.convertTo(threshold_small, CV_16U, 16);
+    // Where half the contrast is within six deviations of the noise, single
+    // pixels cross the threshold on both sides of the weaker edges (a part's
+    // light side, a third of the contrast from its belt) and a low-contrast
+    // part breaks into specks: compare the 3x3 mean instead, a third of the
+    // noise. Edges stay where they were (a symmetric mean does not move a
+    // step's middle); the grey levels read for coverage are the frame's own.
+    // Only then: the mean also closes a small blurred hole, or the one-pixel
+    // gap between two parts that touch.
+    const double margin = 0.5 * contrast * cv::mean(background_f)[0];
+    if (6 * guided.noise > margin) {
+      cv::blur(grey, smoothed, cv::Size(3, 3), cv::Point(-1, -1), cv::BORDER_REPLICATE);
+      compared = &smoothed;
+    }
+  } else {
+    background.convertTo(threshold_small, CV_16U, 16 * k_ratio);
+  }
   const cv::Mat rows = widen(threshold_small, grey.cols);
   cv::Mat mask(grey.size(), CV_8UC1);
   const double scale = static_cast<double>(rows.rows) / grey.rows;
@@ -189,8 +412,8 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
       const int y0 = std::min(static_cast<int>(sy), rows.rows - 1);
       const int y1 = std::min(y0 + 1, rows.rows - 1);
       const int w1 = static_cast<int>(std::lround((sy - y0) * 16));
-      compareRow(grey.ptr<uint8_t>(y), rows.ptr<uint16_t>(y0), rows.ptr<uint16_t>(y1), 16 - w1, w1,
-                 mask.ptr<uint8_t>(y), grey.cols);
+      compareRow(compared->ptr<uint8_t>(y), rows.ptr<uint16_t>(y0), rows.ptr<uint16_t>(y1), 16 - w1,
+                 w1, mask.ptr<uint8_t>(y), grey.cols);
     }
   });
   return mask;

@@ -17,6 +17,10 @@
 
 namespace picksight::vision {
 
+// Ends of a region's axis closer than this to the same distance from its
+// centroid (pixels) are a tie (orientationDeg).
+constexpr double kOrientationTiePx = 1.0;
+
 double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
                       const std::vector<cv::Point>& outer) {
   const double theta = 0.5 * std::atan2(2.0 * m.mu11, m.mu20 - m.mu02);
@@ -33,7 +37,11 @@ double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
     backward = std::max(backward, -proj);
   }
   double deg = theta * 180.0 / M_PI;
-  if (backward > forward) deg += 180.0;
+  // theta is in [-90, 90]. Ends within a pixel of each other (a bar, a
+  // rectangle: a half-turn symmetric region) are told apart by noise from
+  // frame to frame, and the region's angle would flip by half a turn; such
+  // a region keeps the direction of theta itself, the same in every frame.
+  if (backward > forward + kOrientationTiePx) deg += 180.0;
   return normalizeDeg(deg);
 }
 
@@ -68,32 +76,47 @@ constexpr double kMaxBandTail = 0.01;
 // beyond it.
 constexpr int kBoxMargin = kMaxBand + 2;
 
-// A hole whose brightest pixel lies beyond the background's level, away from
+// A hole whose brightest pixels lie beyond the background's level, away from
 // the part's, by more than this share of the contrast shows no surface
 // through the part: it is a glint (the lamp reflected by a glossy part), and
 // the part is whole there. A real hole shows the surface under the part, at
 // the background's level give or take its texture and noise, or darker (its
-// rim blurred towards the part's, or in the part's shadow).
+// rim blurred towards the part's, or in the part's shadow). "Brightest" is
+// the hole's 99th percentile, and "beyond" also means by more than
+// kGlintNoise deviations of the surface beside the part: in a large hole
+// on a blotched belt, with only 30 levels of contrast, the very brightest
+// pixel of thousands lies beyond half the contrast by noise alone.
+constexpr double kGlintNoise = 4;
+constexpr double kGlintPercentile = 0.99;
 constexpr double kGlintShare = 0.5;
 
 // The levels just outside (the background) and just inside (the part) a
-// region's outer boundary: the medians of sideSamples. False when either
+// region's outer boundary: the medians of sideSamples, and the deviation of
+// the outside ones (from their median absolute deviation). False when either
 // side has no reading.
+struct SideLevels {
+  double background = 0;
+  double part = 0;
+  double background_spread = 0;
+};
+
 bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
-                double* background, double* part) {
+                SideLevels* levels) {
   std::vector<float> out;
   std::vector<float> in;
   sideSamples(grey, mask, outer, &out, &in);
   if (out.empty() || in.empty()) return false;
-  *background = medianOf(out);
-  *part = medianOf(in);
+  levels->background = medianOf(out);
+  levels->part = medianOf(in);
+  for (float& v : out) v = std::abs(v - static_cast<float>(levels->background));
+  levels->background_spread = 1.4826 * medianOf(out);
   return true;
 }
 
 // Whether the hole traced by `hole` is a glint (kGlintShare), given the
 // levels beside its region.
 bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& hole,
-             double background, double part) {
+             const SideLevels& side) {
   const cv::Rect box = cv::boundingRect(hole);
   cv::Mat inside = cv::Mat::zeros(box.size(), CV_8UC1);
   cv::drawContours(inside, std::vector<std::vector<cv::Point>>{hole}, 0, cv::Scalar(255),
@@ -102,12 +125,25 @@ bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Poi
   cv::Mat free;
   cv::compare(mask(box), 0, free, cv::CMP_EQ);
   cv::bitwise_and(inside, free, inside);
-  if (cv::countNonZero(inside) == 0) return false;
-  double level = 0;
-  cv::minMaxLoc(grey(box), nullptr, &level, nullptr, nullptr, inside);
-  const double contrast = part - background;
-  return (level - background) * contrast < 0 &&
-         std::abs(level - background) > kGlintShare * std::abs(contrast);
+  std::vector<float> levels;
+  const cv::Mat window = grey(box);
+  for (int y = 0; y < inside.rows; ++y) {
+    const uint8_t* in = inside.ptr<uint8_t>(y);
+    const uint8_t* g = window.ptr<uint8_t>(y);
+    for (int x = 0; x < inside.cols; ++x) {
+      if (in[x]) levels.push_back(g[x]);
+    }
+  }
+  if (levels.empty()) return false;
+  // The darker side when parts are light (contrast > 0), else the lighter.
+  const double contrast = side.part - side.background;
+  const auto rank = static_cast<std::ptrdiff_t>(
+      std::floor((contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile) * (levels.size() - 1)));
+  std::nth_element(levels.begin(), levels.begin() + rank, levels.end());
+  const double level = levels[static_cast<size_t>(rank)];
+  const double beyond = std::abs(level - side.background);
+  return (level - side.background) * contrast < 0 && beyond > kGlintShare * std::abs(contrast) &&
+         beyond > kGlintNoise * side.background_spread;
 }
 
 // A least-squares plane z = a + b x + c y through grey levels, and the
@@ -683,11 +719,10 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
                             const std::vector<cv::Vec4i>& hierarchy, int i) {
   std::vector<int> glints;
   if (grey.empty() || hierarchy[i][2] < 0) return glints;
-  double background = 0;
-  double part = 0;
-  if (!sideLevels(grey, mask, contours[i], &background, &part)) return glints;
+  SideLevels side;
+  if (!sideLevels(grey, mask, contours[i], &side)) return glints;
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
-    if (isGlint(grey, mask, contours[h], background, part)) glints.push_back(h);
+    if (isGlint(grey, mask, contours[h], side)) glints.push_back(h);
   }
   return glints;
 }
