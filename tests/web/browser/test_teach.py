@@ -1,6 +1,7 @@
 """The Teach panel cannot lose work, in headless Chromium against a real
 cell: the type defaults to the next free one; a name LEARN would refuse is
-refused in the page; Teach only shows what would be learned and found;
+refused in the page; Teach only shows what would be learned and found
+(the model's outline drawn on the part);
 saving over an existing type asks first, and without the confirmation the
 model file stays byte for byte as it was; confirmed it is replaced; Undo puts
 the file back byte for byte; a part taught again as a second type is
@@ -90,6 +91,12 @@ def test_teach_flow_confirms_replacing_and_undo_restores(cell, browser):
         assert "looks like type 1 (first)" in warnings, warnings
         assert any(line.startswith("TRYLEARN 2 copy") for line in browser.js("return window.picksight.sent"))
         assert model_file(cell, 2) is None  # tried, not stored
+        # Its outline on the part, from the results stream (TRYLEARN's parts).
+        wait_until(lambda: browser.js("""
+            const r = window.picksight.latest[window.picksight.app];
+            const o = document.getElementById('overlay');
+            return r && (r.request_line || '').startsWith('TRYLEARN 2 copy') && o.dataset.parts === '1' &&
+                   o.querySelectorAll('path.outline').length === 1;"""), what="the tried model's outline on the image")
         click(browser, "teach-cancel")
 
         # Over type 1: the preview says what it replaces; Save asks first.
