@@ -87,7 +87,12 @@ Result<std::string> ModelHistory::record(int type, std::string_view change,
                                          const std::optional<std::string>& before,
                                          const std::optional<std::string>& after) {
   std::error_code ec;
-  fs::create_directories(directory_, ec);
+  if (fs::create_directories(directory_, ec)) {
+    // The new undo/ is an entry of the models directory: durable only once
+    // that is synced, or a crash loses the history with it.
+    const fs::path parent = fs::absolute(directory_, ec).parent_path();
+    if (!ec) (void)syncDirectory(parent.string());
+  }
   if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   uint64_t next = 1;
   for (bool damaged : {false, true}) {
