@@ -200,7 +200,7 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
           const double step = contrast * back[i];
           // Sobel gives 8 for a ramp of one level a pixel: a step of `step`
           // over about two pixels gives 4 * step; a quarter of it.
-          if (magnitude < step) {
+          if (magnitude < step || magnitude == 0) {
             const int residual = (up[x - 1] + up[x + 1] + down[x - 1] + down[x + 1]) -
                                  2 * (up[x] + down[x] + mid[x - 1] + mid[x + 1]) + 4 * mid[x];
             residual_sum += std::abs(residual);
