@@ -82,22 +82,18 @@ constexpr int kBoxMargin = kMaxBand + 2;
 // the part is whole there. A real hole shows the surface under the part, at
 // the background's level give or take its texture and noise, or darker (its
 // rim blurred towards the part's, or in the part's shadow). "Brightest" is
-// the hole's 99th percentile, and "beyond" also means by more than
-// kGlintNoise deviations of the surface beside the part: in a large hole
-// on a blotched belt, with only 30 levels of contrast, the very brightest
-// pixel of thousands lies beyond half the contrast by noise alone.
-constexpr double kGlintNoise = 4;
+// the hole's 99th percentile: in a large hole on a blotched belt, with only
+// 30 levels of contrast, the very brightest pixel of thousands lies beyond
+// half the contrast by noise alone.
 constexpr double kGlintPercentile = 0.99;
 constexpr double kGlintShare = 0.5;
 
 // The levels just outside (the background) and just inside (the part) a
-// region's outer boundary: the medians of sideSamples, and the deviation of
-// the outside ones (from their median absolute deviation). False when either
+// region's outer boundary: the medians of sideSamples. False when either
 // side has no reading.
 struct SideLevels {
   double background = 0;
   double part = 0;
-  double background_spread = 0;
 };
 
 bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
@@ -108,8 +104,6 @@ bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::
   if (out.empty() || in.empty()) return false;
   levels->background = medianOf(out);
   levels->part = medianOf(in);
-  for (float& v : out) v = std::abs(v - static_cast<float>(levels->background));
-  levels->background_spread = 1.4826 * medianOf(out);
   return true;
 }
 
@@ -141,9 +135,8 @@ bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Poi
       std::floor((contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile) * (levels.size() - 1)));
   std::nth_element(levels.begin(), levels.begin() + rank, levels.end());
   const double level = levels[static_cast<size_t>(rank)];
-  const double beyond = std::abs(level - side.background);
-  return (level - side.background) * contrast < 0 && beyond > kGlintShare * std::abs(contrast) &&
-         beyond > kGlintNoise * side.background_spread;
+  return (level - side.background) * contrast < 0 &&
+         std::abs(level - side.background) > kGlintShare * std::abs(contrast);
 }
 
 // A least-squares plane z = a + b x + c y through grey levels, and the
