@@ -269,6 +269,18 @@ TEST_CASE("the web's audit file rotates at its cap and skips a damaged line", "[
 
 namespace picksight::web {
 
+TEST_CASE("a teach preview needs an engineer but is not a change", "[web][audit]") {
+  // TRYLEARN learns on a fresh frame and stores nothing: the trail, which
+  // records changes, would fill with previews.
+  CHECK(roleForCommand("TRYLEARN 3 bracket") == Role::kEngineer);
+  CHECK_FALSE(changesCell("TRYLEARN 3 bracket"));
+  CHECK_FALSE(changesCell("trylearn,3"));
+  CHECK(changesCell("LEARN 3 bracket"));
+  CHECK(changesCell("UNDO"));
+  CHECK_FALSE(changesCell("LOCATE 1"));
+  CHECK_FALSE(changesCell("TOLERANCE 4"));
+}
+
 TEST_CASE("a change's read-back line is the read of what it changes", "[web][audit]") {
   CHECK(readBackLine("TOLERANCE 4 area_tolerance 0.3") == "TOLERANCE 4");
   CHECK(readBackLine("grasp 2 add 0 0 0") == "GRASP 2 LIST");

@@ -44,6 +44,11 @@ Role roleForCommand(std::string_view line) {
   return Role::kEngineer;
 }
 
+bool changesCell(std::string_view line) {
+  if (roleForCommand(line) != Role::kEngineer) return false;
+  return words(line)[0] != "TRYLEARN";
+}
+
 std::optional<std::string> readBackLine(std::string_view line) {
   if (roleForCommand(line) != Role::kEngineer) return std::nullopt;
   const auto w = words(line);

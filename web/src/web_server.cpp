@@ -1036,8 +1036,8 @@ void WebServer::Impl::command(ResultFeed& app, const std::string& line, const ht
                               httplib::Response& res) {
   const auto session = sessionOf(req);
   const Role needed = roleForCommand(line);
-  // Reads and LOCATEs are not changes: not recorded.
-  const bool change = needed > Role::kOperator;
+  // Reads, LOCATEs and teach previews are not changes: not recorded.
+  const bool change = changesCell(line);
   AuditRecord record;
   record.action = "command";
   record.target = app.name();

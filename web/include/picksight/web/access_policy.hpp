@@ -15,6 +15,11 @@ namespace picksight::web {
 
 // The role a robot-protocol line sent from the page needs.
 Role roleForCommand(std::string_view line);
+
+// Whether the line changes the cell (models, calibration, camera), so that
+// the audit trail records it: every engineer's line but TRYLEARN, a teach
+// preview that stores nothing (an engineer's, since only engineers teach).
+bool changesCell(std::string_view line);
 // The read-only line whose reply shows what the change `line` changes
 // ("TOLERANCE 3 area_tolerance 0.2" -> "TOLERANCE 3", "GRASP 2 ADD ..." ->
 // "GRASP 2 LIST", "EXPOSURE 900" -> "EXPOSURE"), asked before and after it
