@@ -274,18 +274,17 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
                               : 0;
 }
 
-// The threshold at low resolution (CV_32F, grey levels): the edges' votes
-// spread over about a quarter of the illumination window (`k` cells), with
-// the global ratio to the background (`fallback`) as a weak prior, so that
-// far from any edge (open surface, the middle of a large part) the global
-// split decides, and near edges their own levels do. Never above
-// kMaxSeparatedRatio of the background: the surface's own blotches stay
-// surface.
 struct GuidedThreshold {
   cv::Mat level;     // CV_32F, grey levels, the size of the background estimate
   double noise = 0;  // estimated deviation of a full-resolution pixel's noise and grain
 };
 
+// The threshold at low resolution (CV_32F, grey levels): the edges' votes
+// spread over about kEdgeSpreadPx (less where the illumination window, `k`
+// cells, is narrow), with `fallback` as a weak prior, so that far from any
+// edge (open surface, the middle of a large part) it decides, and near edges
+// their own levels do. Never above kMaxSeparatedRatio of the background: the
+// surface's own blotches stay surface. Also the noise (edgeVotes).
 GuidedThreshold edgeGuidedThreshold(const cv::Mat& grey, int reduce, int k,
                                     const cv::Mat& background_f, double contrast,
                                     const cv::Mat& fallback) {

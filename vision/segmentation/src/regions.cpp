@@ -91,26 +91,21 @@ constexpr double kGlintShare = 0.5;
 // The levels just outside (the background) and just inside (the part) a
 // region's outer boundary: the medians of sideSamples. False when either
 // side has no reading.
-struct SideLevels {
-  double background = 0;
-  double part = 0;
-};
-
 bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
-                SideLevels* levels) {
+                double* background, double* part) {
   std::vector<float> out;
   std::vector<float> in;
   sideSamples(grey, mask, outer, &out, &in);
   if (out.empty() || in.empty()) return false;
-  levels->background = medianOf(out);
-  levels->part = medianOf(in);
+  *background = medianOf(out);
+  *part = medianOf(in);
   return true;
 }
 
 // Whether the hole traced by `hole` is a glint (kGlintShare), given the
 // levels beside its region.
 bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& hole,
-             const SideLevels& side) {
+             double background, double part) {
   const cv::Rect box = cv::boundingRect(hole);
   cv::Mat inside = cv::Mat::zeros(box.size(), CV_8UC1);
   cv::drawContours(inside, std::vector<std::vector<cv::Point>>{hole}, 0, cv::Scalar(255),
@@ -130,13 +125,13 @@ bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Poi
   }
   if (levels.empty()) return false;
   // The darker side when parts are light (contrast > 0), else the lighter.
-  const double contrast = side.part - side.background;
+  const double contrast = part - background;
   const auto rank = static_cast<std::ptrdiff_t>(
       std::floor((contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile) * (levels.size() - 1)));
   std::nth_element(levels.begin(), levels.begin() + rank, levels.end());
   const double level = levels[static_cast<size_t>(rank)];
-  return (level - side.background) * contrast < 0 &&
-         std::abs(level - side.background) > kGlintShare * std::abs(contrast);
+  return (level - background) * contrast < 0 &&
+         std::abs(level - background) > kGlintShare * std::abs(contrast);
 }
 
 // A least-squares plane z = a + b x + c y through grey levels, and the
@@ -712,10 +707,11 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
                             const std::vector<cv::Vec4i>& hierarchy, int i) {
   std::vector<int> glints;
   if (grey.empty() || hierarchy[i][2] < 0) return glints;
-  SideLevels side;
-  if (!sideLevels(grey, mask, contours[i], &side)) return glints;
+  double background = 0;
+  double part = 0;
+  if (!sideLevels(grey, mask, contours[i], &background, &part)) return glints;
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
-    if (isGlint(grey, mask, contours[h], side)) glints.push_back(h);
+    if (isGlint(grey, mask, contours[h], background, part)) glints.push_back(h);
   }
   return glints;
 }
