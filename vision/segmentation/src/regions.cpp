@@ -82,30 +82,36 @@ constexpr int kBoxMargin = kMaxBand + 2;
 // the part is whole there. A real hole shows the surface under the part, at
 // the background's level give or take its texture and noise, or darker (its
 // rim blurred towards the part's, or in the part's shadow). "Brightest" is
-// the hole's 99th percentile: in a large hole on a blotched belt, with only
-// 30 levels of contrast, the very brightest pixel of thousands lies beyond
-// half the contrast by noise alone.
+// the hole's 99th percentile, and "beyond" also means by more than
+// kGlintNoise deviations of the surface beside the part: in a large hole on
+// a blotched belt, with only 30 levels of contrast, the very brightest pixel
+// of thousands lies beyond half the contrast by noise alone, and its 99th
+// percentile close to it.
 constexpr double kGlintPercentile = 0.99;
+constexpr double kGlintNoise = 4;
 constexpr double kGlintShare = 0.5;
 
 // The levels just outside (the background) and just inside (the part) a
-// region's outer boundary: the medians of sideSamples. False when either
+// region's outer boundary: the medians of sideSamples, and the deviation of
+// the outside ones (from their median absolute deviation). False when either
 // side has no reading.
 bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
-                double* background, double* part) {
+                double* background, double* part, double* background_spread) {
   std::vector<float> out;
   std::vector<float> in;
   sideSamples(grey, mask, outer, &out, &in);
   if (out.empty() || in.empty()) return false;
   *background = medianOf(out);
   *part = medianOf(in);
+  for (float& v : out) v = std::abs(v - static_cast<float>(*background));
+  *background_spread = 1.4826 * medianOf(out);
   return true;
 }
 
 // Whether the hole traced by `hole` is a glint (kGlintShare), given the
 // levels beside its region.
 bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& hole,
-             double background, double part) {
+             double background, double part, double background_spread) {
   const cv::Rect box = cv::boundingRect(hole);
   cv::Mat inside = cv::Mat::zeros(box.size(), CV_8UC1);
   cv::drawContours(inside, std::vector<std::vector<cv::Point>>{hole}, 0, cv::Scalar(255),
@@ -130,8 +136,9 @@ bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Poi
       std::floor((contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile) * (levels.size() - 1)));
   std::nth_element(levels.begin(), levels.begin() + rank, levels.end());
   const double level = levels[static_cast<size_t>(rank)];
-  return (level - background) * contrast < 0 &&
-         std::abs(level - background) > kGlintShare * std::abs(contrast);
+  const double beyond = std::abs(level - background);
+  return (level - background) * contrast < 0 && beyond > kGlintShare * std::abs(contrast) &&
+         beyond > kGlintNoise * background_spread;
 }
 
 // A least-squares plane z = a + b x + c y through grey levels, and the
@@ -709,9 +716,10 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
   if (grey.empty() || hierarchy[i][2] < 0) return glints;
   double background = 0;
   double part = 0;
-  if (!sideLevels(grey, mask, contours[i], &background, &part)) return glints;
+  double spread = 0;
+  if (!sideLevels(grey, mask, contours[i], &background, &part, &spread)) return glints;
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
-    if (isGlint(grey, mask, contours[h], background, part)) glints.push_back(h);
+    if (isGlint(grey, mask, contours[h], background, part, spread)) glints.push_back(h);
   }
   return glints;
 }
