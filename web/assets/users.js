@@ -29,13 +29,15 @@
     return b;
   }
 
-  // Sends one change; shows the server's answer; refreshes the list. A
+  // Sends one change; refreshes the list, then shows the server's answer:
+  // once the answer shows, the rows are the new ones (a Delete armed on a
+  // row the refresh then replaced would silently need a third click). A
   // change to the admin's own user ends the admin's session too (the page
   // then asks for a login).
   async function change(what, url, body) {
     const r = await ps.post(url, body);
-    ps.show("users-reply", what, r.ok ? "OK" : "ERROR " + r.body.error);
     if (r.ok || r.status !== 401) await refresh();
+    ps.show("users-reply", what, r.ok ? "OK" : "ERROR " + r.body.error);
     return r;
   }
 
