@@ -104,6 +104,15 @@ Result<std::string> ModelLibrary::recordChange(int type, std::string_view change
   return history_.record(type, change, before, after);
 }
 
+Result<void> ModelLibrary::writeWithUndo(int type, std::string_view change,
+                                         const std::string& text) {
+  auto entry = recordChange(type, change, text);
+  if (!entry) return entry.error();
+  auto written = writeFileAtomically(pathOf(type), text);
+  if (!written) history_.drop(*entry);
+  return written;
+}
+
 Result<void> ModelLibrary::store(const vision::PartModel& model, std::string_view change) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
@@ -116,17 +125,12 @@ Result<void> ModelLibrary::store(const vision::PartModel& model, std::string_vie
   if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   const auto kept = grasps_->find(model.type);
   const std::string text = modelToYaml(model, kept == grasps_->end() ? GraspSetup{} : kept->second);
-  auto entry =
-      recordChange(model.type,
-                   change.empty() ? "LEARN " + std::to_string(model.type) + " " + model.name
-                                  : std::string(change),
-                   text);
-  if (!entry) return entry.error();
-  auto written = writeFileAtomically(pathOf(model.type), text);
-  if (!written) {
-    history_.drop(*entry);
-    return written;
-  }
+  auto written =
+      writeWithUndo(model.type,
+                    change.empty() ? "LEARN " + std::to_string(model.type) + " " + model.name
+                                   : std::string(change),
+                    text);
+  if (!written) return written;
   auto models = std::make_shared<ModelList>(*models_);
   models->erase(std::remove_if(models->begin(), models->end(),
                                [&](const vision::PartModel& m) { return m.type == model.type; }),
@@ -174,14 +178,9 @@ Result<void> ModelLibrary::setGrasp(int type, const GraspSetup& grasp, std::stri
     return makeError(ModelErrc::kUnknownType, "no model for type " + std::to_string(type));
   if (auto valid = validateGrasp(grasp); !valid) return valid.error();
   const std::string text = modelToYaml(*model, grasp);
-  auto entry = recordChange(
+  auto written = writeWithUndo(
       type, change.empty() ? "GRASP " + std::to_string(type) : std::string(change), text);
-  if (!entry) return entry.error();
-  auto written = writeFileAtomically(pathOf(type), text);
-  if (!written) {
-    history_.drop(*entry);
-    return makeError(ModelErrc::kStorage, written.error().message);
-  }
+  if (!written) return makeError(ModelErrc::kStorage, written.error().message);
   auto grasps = std::make_shared<GraspMap>(*grasps_);
   (*grasps)[type] = grasp;
   grasps_ = std::move(grasps);
@@ -204,14 +203,9 @@ Result<vision::PartModel> ModelLibrary::update(
   const auto kept = grasps_->find(type);
   const std::string text =
       modelToYaml(changed, kept == grasps_->end() ? GraspSetup{} : kept->second);
-  auto entry = recordChange(
+  auto written = writeWithUndo(
       type, what.empty() ? "TOLERANCE " + std::to_string(type) : std::string(what), text);
-  if (!entry) return entry.error();
-  auto written = writeFileAtomically(pathOf(type), text);
-  if (!written) {
-    history_.drop(*entry);
-    return makeError(ModelErrc::kStorage, written.error().message);
-  }
+  if (!written) return makeError(ModelErrc::kStorage, written.error().message);
   auto models = std::make_shared<ModelList>(*models_);
   for (auto& m : *models) {
     if (m.type == type) m = changed;

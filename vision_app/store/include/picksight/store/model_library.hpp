@@ -101,6 +101,10 @@ class ModelLibrary {
   // (nullopt: removed) with the file's bytes now; the entry's path.
   Result<std::string> recordChange(int type, std::string_view change,
                                    const std::optional<std::string>& after);
+  // Call with mutex_ held: records the change, then writes `text` as
+  // `type`'s file atomically; a write that fails drops the entry (nothing
+  // changed, so nothing to undo).
+  Result<void> writeWithUndo(int type, std::string_view change, const std::string& text);
 
   const std::string directory_;
   ModelHistory history_;
