@@ -1,9 +1,10 @@
 // WHY against LOCATE on every region of silhouette scenes (separated,
 // touching and overlapping parts, mirrored and rescaled distractors), with
-// models of two minimum hole areas: the region WHY says passes every test
-// of a model is the region LOCATE reports as one whole part of that model,
-// and no other region is; a region WHY calls a whole part drawn other than
-// trained holds no part LOCATE reports.
+// models of two minimum hole areas and under several tolerances (as
+// trained, tight, loose, and each tolerance alone moved): the region WHY
+// says passes every test of a model is the region LOCATE reports as one
+// whole part of that model, and no other region is; a region WHY calls a
+// whole part drawn other than trained holds no part LOCATE reports.
 #include <catch2/catch.hpp>
 
 #include <map>
@@ -14,6 +15,7 @@
 #include "picksight/vision/recognition/recognizer.hpp"
 #include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/recognition/region_judge.hpp"
+#include "picksight/vision/training/part_training.hpp"
 #include "silhouette_support.hpp"
 
 using namespace picksight::vision;
@@ -31,55 +33,87 @@ TEST_CASE("WHY names a passing model exactly where LOCATE reports that model's w
       {"gear", "", 150},
       {"l_shape", "", 160},
   };
-  SilhouetteModels models = trainSilhouettes(specs, look);
-  // Half the models judge holes from 4 px up, as if taught with that
-  // setting: two groups, each seeing the regions its own way.
-  for (size_t i = 0; i < models.models.size(); i += 2) models.models[i].min_hole_area = 4;
-  const auto list = models.list();
+  const SilhouetteModels trained = trainSilhouettes(specs, look);
 
+  // The tolerances TOLERANCE can set, moved together and one at a time:
+  // each moves the bound of another test, so that regions change sides in
+  // WHY and in LOCATE alike (area 0.004, Hu x0.02 and edge 0.7 px each
+  // turn passing regions of these scenes into failing ones; as trained, no
+  // region here fails on its Hu distance or its boundary).
+  struct Setting {
+    const char* name;
+    double area_tolerance;  // 0: as trained
+    double hu_factor;       // times the trained Hu tolerance
+    double verify_percent;  // 0: as trained
+    double edge_tolerance;  // 0: as trained
+  };
+  const std::vector<Setting> settings = {
+      {"as trained", 0, 1, 0, 0},     {"tight", 0.01, 0.1, 97, 1.2}, {"loose", 0.3, 3, 60, 3},
+      {"area 0.004", 0.004, 1, 0, 0}, {"hu x0.02", 0, 0.02, 0, 0},   {"edge 0.7 px", 0, 1, 0, 0.7},
+  };
   std::map<RegionTest, int> verdicts;
   int touching_parts = 0;
-  for (const auto arrangement :
-       {ps::Arrangement::kSeparated, ps::Arrangement::kTouching, ps::Arrangement::kOverlapping}) {
-    for (uint64_t seed = 1; seed <= 2; ++seed) {
-      const ps::SilhouetteScene scene(models.types, models.chiral,
-                                      smallScene(look, seed, 10, 0.3, arrangement));
-      const cv::Mat grey = scene.render(0);
-      // The regions as the cell finds them: the smallest minimum hole area
-      // of the models (0).
-      const auto regions = findRegions(binarize(grey, silhouetteBinarization()), {}, grey);
-      const auto matches = recognizeEachHoleSetting(regions, list);
-      for (const auto& m : matches) touching_parts += m.touching ? 1 : 0;
-      for (size_t i = 0; i < regions.size(); ++i) {
-        const RegionExplanation why = explainRegion(regions[i], list);
-        REQUIRE(why.nearest);
-        verdicts[why.test] += 1;
-        std::vector<const Match*> whole;
-        std::vector<const Match*> in_blob;
-        for (const auto& m : matches) {
-          if (m.region == i) (m.touching ? in_blob : whole).push_back(&m);
-        }
-        INFO(ps::arrangementName(arrangement)
-             << " seed " << seed << " region " << i << " at " << regions[i].centroid.x << ", "
-             << regions[i].centroid.y << ": WHY " << regionTestName(why.test) << " for "
-             << why.nearest->name << ", LOCATE " << whole.size() << " whole part(s), "
-             << in_blob.size() << " in a blob");
-        if (why.test == RegionTest::kPasses) {
-          REQUIRE(whole.size() == 1);
-          CHECK(whole.front()->model == why.nearest);
-          CHECK(in_blob.empty());
-        } else {
-          CHECK(whole.empty());
-        }
-        if (why.test == RegionTest::kScale || why.test == RegionTest::kMirror) {
-          CHECK(in_blob.empty());
+  for (const Setting& setting : settings) {
+    SilhouetteModels models = trained;
+    for (size_t i = 0; i < models.models.size(); ++i) {
+      PartModel& m = models.models[i];
+      // Half the models judge holes from 4 px up, as if taught with that
+      // setting: two groups, each seeing the regions its own way.
+      if (i % 2 == 0) m.min_hole_area = 4;
+      if (setting.area_tolerance > 0) m.body.area_tolerance = setting.area_tolerance;
+      m.body.hu_tolerance *= setting.hu_factor;
+      if (setting.verify_percent > 0) m.verify_percent = setting.verify_percent;
+      if (setting.edge_tolerance > 0) {
+        m.edge_tolerance = setting.edge_tolerance;
+        prepareModel(m);  // the distance map follows the edge tolerance
+      }
+    }
+    const auto list = models.list();
+    for (const auto arrangement :
+         {ps::Arrangement::kSeparated, ps::Arrangement::kTouching, ps::Arrangement::kOverlapping}) {
+      for (uint64_t seed = 1; seed <= 2; ++seed) {
+        const ps::SilhouetteScene scene(models.types, models.chiral,
+                                        smallScene(look, seed, 10, 0.3, arrangement));
+        const cv::Mat grey = scene.render(0);
+        // The regions as the cell finds them: the smallest minimum hole area
+        // of the models (0).
+        const auto regions = findRegions(binarize(grey, silhouetteBinarization()), {}, grey);
+        const auto matches = recognizeEachHoleSetting(regions, list);
+        for (const auto& m : matches) touching_parts += m.touching ? 1 : 0;
+        for (size_t i = 0; i < regions.size(); ++i) {
+          const RegionExplanation why = explainRegion(regions[i], list);
+          REQUIRE(why.nearest);
+          verdicts[why.test] += 1;
+          std::vector<const Match*> whole;
+          std::vector<const Match*> in_blob;
+          for (const auto& m : matches) {
+            if (m.region == i) (m.touching ? in_blob : whole).push_back(&m);
+          }
+          INFO(setting.name << ": " << ps::arrangementName(arrangement) << " seed " << seed
+                            << " region " << i << " at " << regions[i].centroid.x << ", "
+                            << regions[i].centroid.y << ": WHY " << regionTestName(why.test)
+                            << " for " << why.nearest->name << ", LOCATE " << whole.size()
+                            << " whole part(s), " << in_blob.size() << " in a blob");
+          if (why.test == RegionTest::kPasses) {
+            REQUIRE(whole.size() == 1);
+            CHECK(whole.front()->model == why.nearest);
+            CHECK(in_blob.empty());
+          } else {
+            CHECK(whole.empty());
+          }
+          if (why.test == RegionTest::kScale || why.test == RegionTest::kMirror) {
+            CHECK(in_blob.empty());
+          }
         }
       }
     }
   }
-  // Otherwise the comparison would cover little.
+  // Otherwise the comparison would cover little: every test that can fail a
+  // region here fails some.
   CHECK(verdicts[RegionTest::kPasses] >= 10);
   CHECK(verdicts[RegionTest::kMirror] + verdicts[RegionTest::kScale] >= 3);
   CHECK(verdicts[RegionTest::kArea] >= 3);
+  CHECK(verdicts[RegionTest::kHu] >= 3);
+  CHECK(verdicts[RegionTest::kVerify] >= 3);
   CHECK(touching_parts >= 6);
 }
