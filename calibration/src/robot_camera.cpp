@@ -286,7 +286,9 @@ int minimumPoints(Method method) {
   return method == Method::kHomography ? 6 : method == Method::kTilt ? 4 : 3;
 }
 
-Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method method) {
+namespace {
+// Enough finite points for `method`, spread over more than a line.
+Result<void> checkPoints(const std::vector<PointPair>& points, Method method) {
   const size_t need = static_cast<size_t>(minimumPoints(method));
   if (points.size() < need) {
     return makeError(CalibrationErrc::kTooFewPoints,
@@ -312,47 +314,42 @@ Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method
     return makeError(CalibrationErrc::kDegeneratePoints,
                      "the points lie (nearly) on one line: spread them over the work area");
   }
-  const TransformModel outlier_model =
-      method == Method::kSimilarity   ? TransformModel::kSimilarity
-      : method == Method::kHomography ? TransformModel::kHomography
-      : method == Method::kTilt       ? TransformModel::kTilt
-      : method == Method::kBest
-          ? (points.size() >= kHomographyOutlierPoints ? TransformModel::kHomography
-             : points.size() >= kTiltOutlierPoints     ? TransformModel::kTilt
-                                                       : TransformModel::kSimilarity)
-          : TransformModel::kRigid;
-  const auto robust = fits::robustFit(points, outlier_model);
-  if (!robust) {
-    return makeError(CalibrationErrc::kDegeneratePoints,
-                     "no well-spread subset of the points: spread them over the work area");
-  }
-  const std::vector<bool>& use = robust->inliers;
-  const int inliers = static_cast<int>(std::count(use.begin(), use.end(), true));
-  if (inliers < 3) return tooFewAgree();
-  const bool mirrored = robust->transform.mirrored;
-  // Cluster radius for the geometric method: a few times the noise level
-  // (the robust fit's RMS), never below a tenth of a millimetre.
+  return {};
+}
+
+// The model whose robust fit finds the outliers for `method` on `points`.
+TransformModel outlierModel(Method method, size_t points) {
+  return method == Method::kSimilarity   ? TransformModel::kSimilarity
+         : method == Method::kHomography ? TransformModel::kHomography
+         : method == Method::kTilt       ? TransformModel::kTilt
+         : method == Method::kBest
+             ? (points >= kHomographyOutlierPoints ? TransformModel::kHomography
+                : points >= kTiltOutlierPoints     ? TransformModel::kTilt
+                                                   : TransformModel::kSimilarity)
+             : TransformModel::kRigid;
+}
+
+// Cluster radius for the geometric method: a few times the noise level
+// (the robust fit's RMS on its `inliers`), never below a tenth of a
+// millimetre.
+double clusterRadius(const std::vector<PointPair>& points, const fits::RobustFit& robust,
+                     int inliers) {
   double ss = 0;
   for (size_t i = 0; i < points.size(); ++i) {
-    if (!use[i]) continue;
-    const cv::Point2d d = robust->transform.apply(points[i].vision) - points[i].robot;
+    if (!robust.inliers[i]) continue;
+    const cv::Point2d d = robust.transform.apply(points[i].vision) - points[i].robot;
     ss += d.dot(d);
   }
-  const double radius = std::max(0.1, 5 * std::sqrt(ss / inliers));
-  if ((method == Method::kHomography && inliers < kHomographyMinInliers) ||
-      (method == Method::kTilt && inliers < kTiltMinInliers))
-    return tooFewAgree();
-  if (method != Method::kBest) {
-    auto r = evaluate(estimator(method, mirrored, radius), method, points, use);
-    if (!r)
-      return makeError(CalibrationErrc::kDegeneratePoints,
-                       "the inliers do not determine a homography: spread them over the work area");
-    return *r;
-  }
-  // Every model on the same inliers. The rigid model is the least-squares or
-  // the geometric estimate, whichever predicts points left out better (they
-  // have the same parameters). BEST keeps the stiffest model that fits as
-  // well as the most general one, within the noise (see fitsAsWell).
+  return std::max(0.1, 5 * std::sqrt(ss / inliers));
+}
+
+// BEST: every model on the same inliers. The rigid model is the
+// least-squares or the geometric estimate, whichever predicts points left
+// out better (they have the same parameters). BEST keeps the stiffest model
+// that fits as well as the most general one, within the noise (see
+// fitsAsWell).
+CalibrationResult bestModel(const std::vector<PointPair>& points, const std::vector<bool>& use,
+                            int inliers, bool mirrored, double radius) {
   std::optional<CalibrationResult> rigid;
   double rigid_rss = 0;  // the rigid model's least residuals: least squares'
   for (Method m : {Method::kLeastSquares, Method::kGeometric}) {
@@ -388,6 +385,30 @@ Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method
       break;
   }
   return models[kept].first;
+}
+}  // namespace
+
+Result<CalibrationResult> calibrate(const std::vector<PointPair>& points, Method method) {
+  if (auto ok = checkPoints(points, method); !ok) return ok.error();
+  const auto robust = fits::robustFit(points, outlierModel(method, points.size()));
+  if (!robust) {
+    return makeError(CalibrationErrc::kDegeneratePoints,
+                     "no well-spread subset of the points: spread them over the work area");
+  }
+  const std::vector<bool>& use = robust->inliers;
+  const int inliers = static_cast<int>(std::count(use.begin(), use.end(), true));
+  if (inliers < 3) return tooFewAgree();
+  const bool mirrored = robust->transform.mirrored;
+  const double radius = clusterRadius(points, *robust, inliers);
+  if ((method == Method::kHomography && inliers < kHomographyMinInliers) ||
+      (method == Method::kTilt && inliers < kTiltMinInliers))
+    return tooFewAgree();
+  if (method == Method::kBest) return bestModel(points, use, inliers, mirrored, radius);
+  auto r = evaluate(estimator(method, mirrored, radius), method, points, use);
+  if (!r)
+    return makeError(CalibrationErrc::kDegeneratePoints,
+                     "the inliers do not determine a homography: spread them over the work area");
+  return *r;
 }
 
 }  // namespace picksight::calibration

@@ -168,6 +168,56 @@ double profileSpread2(const std::vector<double>& profile) {
   const double mean = swr / sw;
   return std::max(0.0, swr2 / sw - mean * mean);
 }
+// Polarity of the disc about `centre` (+1 bright, -1 dark): a bright disc
+// has its gradient pointing inwards.
+double discPolarity(const cv::Mat& img, cv::Point2d centre, double radius_guess, double w0) {
+  double inside = 0, outside = 0;
+  for (int k = 0; k < 16; ++k) {
+    const double a = 2 * M_PI * k / 16;
+    const cv::Point2d d(std::cos(a), std::sin(a));
+    const double vi =
+        sample(img, centre.x + d.x * (radius_guess - w0), centre.y + d.y * (radius_guess - w0));
+    const double vo =
+        sample(img, centre.x + d.x * (radius_guess + w0), centre.y + d.y * (radius_guess + w0));
+    if (!std::isnan(vi)) inside += vi;
+    if (!std::isnan(vo)) outside += vo;
+  }
+  return inside >= outside ? 1.0 : -1.0;
+}
+
+// The points within four robust deviations (at least 0.05 px) of `fit`.
+std::vector<cv::Point2d> closeToEllipse(const std::vector<cv::Point2d>& pts, const Ellipse& fit) {
+  std::vector<double> dist;
+  for (const auto& p : pts) {
+    const cv::Point2d u = p - fit.c;
+    const double len = cv::norm(u);
+    dist.push_back(len - fit.reach(u / len));
+  }
+  std::vector<double> abs_dist;
+  for (double d : dist) abs_dist.push_back(std::abs(d));
+  const double cut = std::max(0.05, 4 * 1.4826 * median(abs_dist));
+  std::vector<cv::Point2d> kept;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (std::abs(dist[i]) <= cut) kept.push_back(pts[i]);
+  }
+  return kept;
+}
+
+// The centre (image pixels: `offset` added), radii along X and Y, semi-axes
+// and major axis of the fitted ellipse `e`.
+void setAxes(const Ellipse& e, cv::Point2d offset, DiscMeasurement& m) {
+  const cv::Matx22d inv = e.q.inv();
+  m.centre = e.c + offset;
+  m.radius_x = std::sqrt(inv(0, 0));
+  m.radius_y = std::sqrt(inv(1, 1));
+  // Semi-axes from the eigenvalues of the form.
+  const double tr = e.q(0, 0) + e.q(1, 1);
+  const double disc = std::sqrt(std::pow(e.q(0, 0) - e.q(1, 1), 2) + 4 * e.q(0, 1) * e.q(0, 1));
+  m.major = 1.0 / std::sqrt((tr - disc) / 2);
+  m.minor = 1.0 / std::sqrt((tr + disc) / 2);
+  // The major axis is the eigenvector of the smaller eigenvalue.
+  m.axis_deg = 0.5 * std::atan2(-2 * e.q(0, 1), e.q(1, 1) - e.q(0, 0)) * kDegPerRad;
+}
 }  // namespace
 
 Result<DiscMeasurement> measureDisc(const cv::Mat& grey, cv::Point2d centre_guess,
@@ -193,19 +243,7 @@ Result<DiscMeasurement> measureDisc(const cv::Mat& grey, cv::Point2d centre_gues
   Ellipse e{centre_guess - offset, cv::Matx22d(1, 0, 0, 1) * (1.0 / (radius_guess * radius_guess))};
   const double w0 = std::clamp(0.35 * radius_guess, 2.0, 15.0);
   double w = w0;
-  // Polarity: a bright disc has its gradient pointing inwards.
-  double inside = 0, outside = 0;
-  for (int k = 0; k < 16; ++k) {
-    const double a = 2 * M_PI * k / 16;
-    const cv::Point2d d(std::cos(a), std::sin(a));
-    const double vi =
-        sample(img, e.c.x + d.x * (radius_guess - w0), e.c.y + d.y * (radius_guess - w0));
-    const double vo =
-        sample(img, e.c.x + d.x * (radius_guess + w0), e.c.y + d.y * (radius_guess + w0));
-    if (!std::isnan(vi)) inside += vi;
-    if (!std::isnan(vo)) outside += vo;
-  }
-  const double polarity = inside >= outside ? 1.0 : -1.0;
+  const double polarity = discPolarity(img, e.c, radius_guess, w0);
 
   DiscMeasurement m;
   double edge_var = 0;  // of the mean gradient profile, once known
@@ -237,19 +275,7 @@ Result<DiscMeasurement> measureDisc(const cv::Mat& grey, cv::Point2d centre_gues
     auto fit = fitConic(pts, e.c, r_mean);
     if (!fit) return makeError(CalibrationErrc::kBadTarget, "the target's edge is not an ellipse");
     // Points far off the first fit (a nick, a speck on the edge) go; refit.
-    std::vector<double> dist;
-    for (const auto& p : pts) {
-      const cv::Point2d u = p - fit->c;
-      const double len = cv::norm(u);
-      dist.push_back(len - fit->reach(u / len));
-    }
-    std::vector<double> abs_dist;
-    for (double d : dist) abs_dist.push_back(std::abs(d));
-    const double cut = std::max(0.05, 4 * 1.4826 * median(abs_dist));
-    std::vector<cv::Point2d> kept;
-    for (size_t i = 0; i < pts.size(); ++i) {
-      if (std::abs(dist[i]) <= cut) kept.push_back(pts[i]);
-    }
+    const std::vector<cv::Point2d> kept = closeToEllipse(pts, *fit);
     fit = fitConic(kept, e.c, r_mean);
     if (!fit) return makeError(CalibrationErrc::kBadTarget, "the target's edge is not an ellipse");
     e = *fit;
@@ -271,17 +297,7 @@ Result<DiscMeasurement> measureDisc(const cv::Mat& grey, cv::Point2d centre_gues
     // Later rounds search only where the edge's gradient is.
     w = std::clamp(4.0 * std::sqrt(spread2) + 1.0, 1.5, w0);
   }
-  const cv::Matx22d inv = e.q.inv();
-  m.centre = e.c + offset;
-  m.radius_x = std::sqrt(inv(0, 0));
-  m.radius_y = std::sqrt(inv(1, 1));
-  // Semi-axes from the eigenvalues of the form.
-  const double tr = e.q(0, 0) + e.q(1, 1);
-  const double disc = std::sqrt(std::pow(e.q(0, 0) - e.q(1, 1), 2) + 4 * e.q(0, 1) * e.q(0, 1));
-  m.major = 1.0 / std::sqrt((tr - disc) / 2);
-  m.minor = 1.0 / std::sqrt((tr + disc) / 2);
-  // The major axis is the eigenvector of the smaller eigenvalue.
-  m.axis_deg = 0.5 * std::atan2(-2 * e.q(0, 1), e.q(1, 1) - e.q(0, 0)) * kDegPerRad;
+  setAxes(e, offset, m);
   return m;
 }
 
@@ -300,11 +316,11 @@ Result<PixelScale> scaleFromDisc(const DiscMeasurement& disc, double radius_mm) 
   return s;
 }
 
-Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) {
-  if (!(pitch_mm > 0) || !std::isfinite(pitch_mm))
-    return makeError(CalibrationErrc::kBadInput, "the grid pitch must be positive");
-  if (grey.empty() || grey.channels() != 1)
-    return makeError(CalibrationErrc::kBadInput, "the target image must be one grey channel");
+namespace {
+// The dots' centres: the minority class of an Otsu threshold, its regions
+// clear of the border and of about the typical area, each measured as a
+// disc.
+Result<std::vector<cv::Point2d>> dotCentres(const cv::Mat& grey) {
   cv::Mat grey8 = grey;
   if (grey.depth() != CV_8U) cv::normalize(grey, grey8, 0, 255, cv::NORM_MINMAX, CV_8U);
   cv::Mat binary;
@@ -334,11 +350,11 @@ Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) 
     if (!dot) return dot.error();
     centres.push_back(dot->centre);
   }
-  if (centres.size() < 4)
-    return makeError(CalibrationErrc::kBadTarget, "a dot grid needs at least 2 x 2 dots; found " +
-                                                      std::to_string(centres.size()));
-  // The grid's two steps: from the dot nearest the middle, its nearest
-  // neighbour, then the nearest one off that line.
+  return centres;
+}
+
+// The dot nearest the dots' mean.
+cv::Point2d dotNearestMiddle(const std::vector<cv::Point2d>& centres) {
   cv::Point2d mean(0, 0);
   for (const auto& c : centres) mean += c;
   mean *= 1.0 / static_cast<double>(centres.size());
@@ -347,7 +363,13 @@ Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) 
       return cv::norm(a - to) < cv::norm(b - to);
     });
   };
-  const cv::Point2d p0 = nearest(mean);
+  return nearest(mean);
+}
+
+// The grid's two steps from `p0`: its nearest neighbour, then the nearest
+// dot off that line; the one nearer the X axis first.
+Result<std::pair<cv::Point2d, cv::Point2d>> gridSteps(const std::vector<cv::Point2d>& centres,
+                                                      cv::Point2d p0) {
   cv::Point2d u(0, 0), v(0, 0);
   for (const auto& c : centres) {
     const cv::Point2d d = c - p0;
@@ -362,6 +384,26 @@ Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) 
   if (v == cv::Point2d(0, 0))
     return makeError(CalibrationErrc::kBadTarget, "the dots are not a grid (all on one line)");
   if (std::abs(u.x) < std::abs(u.y)) std::swap(u, v);
+  return std::make_pair(u, v);
+}
+}  // namespace
+
+Result<DotGridMeasurement> measureDotGrid(const cv::Mat& grey, double pitch_mm) {
+  if (!(pitch_mm > 0) || !std::isfinite(pitch_mm))
+    return makeError(CalibrationErrc::kBadInput, "the grid pitch must be positive");
+  if (grey.empty() || grey.channels() != 1)
+    return makeError(CalibrationErrc::kBadInput, "the target image must be one grey channel");
+  auto found = dotCentres(grey);
+  if (!found) return found.error();
+  std::vector<cv::Point2d> centres = std::move(*found);
+  if (centres.size() < 4)
+    return makeError(CalibrationErrc::kBadTarget, "a dot grid needs at least 2 x 2 dots; found " +
+                                                      std::to_string(centres.size()));
+  // The grid's two steps from the dot nearest the middle.
+  const cv::Point2d p0 = dotNearestMiddle(centres);
+  const auto steps = gridSteps(centres, p0);
+  if (!steps) return steps.error();
+  const auto [u, v] = *steps;
   const cv::Matx22d to_index = cv::Matx22d(u.x, v.x, u.y, v.y).inv();
   // Grid indices of every dot, then the grid fitted to all of them.
   cv::Mat a(static_cast<int>(centres.size()), 3, CV_64F);
