@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <ostream>
+#include <variant>
 
 #include "picksight/calibration/camera_calibration.hpp"
 #include "picksight/cell/cell_locate.hpp"
@@ -110,18 +111,25 @@ int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 }
 }  // namespace
 
-int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  if (!isOfflineCommand(args)) {
-    err << offlineUsage();
-    return 2;
-  }
-  const std::string command = args[0];
-  if (command == "lens") return runLens(args, out, err);
-  std::vector<std::string> rest;
+namespace {
+// learn, locate or blobs as the command line asks them.
+struct OfflineRequest {
+  std::string command;
   std::vector<std::string> images;
   int type = -1;
   std::string name;
   std::optional<cv::Rect> at;
+  AppOptions options;
+};
+
+// The request in `args` (a command but lens), or the exit status (2) once
+// what is wrong with it is written to `err`.
+std::variant<OfflineRequest, int> parseOfflineRequest(const std::vector<std::string>& args,
+                                                      std::ostream& err) {
+  OfflineRequest r;
+  r.command = args[0];
+  const std::string& command = r.command;
+  std::vector<std::string> rest;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--at") {
@@ -139,13 +147,13 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
         v[k] = static_cast<int>(*n);
         ++i;
       }
-      at = cv::Rect(v[0], v[1], v[2], v[3]);
+      r.at = cv::Rect(v[0], v[1], v[2], v[3]);
       continue;
     }
     if ((a == "--type" || a == "--name") && i + 1 < args.size()) {
       const std::string& v = args[++i];
       if (a == "--name") {
-        name = v;
+        r.name = v;
         continue;
       }
       const auto t = parseType(v);
@@ -154,12 +162,12 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
             << v << "'\n";
         return 2;
       }
-      type = *t;
+      r.type = *t;
     } else if (a.rfind("--", 0) == 0) {
       rest.push_back(a);
       if (i + 1 < args.size()) rest.push_back(args[++i]);
     } else {
-      images.push_back(a);
+      r.images.push_back(a);
     }
   }
   auto options = parseAppArgs(rest, nullptr);
@@ -168,23 +176,71 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
         << offlineUsage();
     return 2;
   }
-  if (at && command != "learn") {
+  if (r.at && command != "learn") {
     err << "picksight-vision " << command << ": --at is an option of learn\n";
     return 2;
   }
-  if (images.empty() || (command == "learn" && (images.size() != 1 || type < 0))) {
+  if (r.images.empty() || (command == "learn" && (r.images.size() != 1 || r.type < 0))) {
     err << offlineUsage();
     return 2;
   }
-  ModelLibrary library(options->data_dir + "/models");
+  r.options = std::move(*options);
+  return r;
+}
+
+// picksight-vision learn on its one image: the model stored as LEARN
+// stores it. The exit status.
+int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string& path,
+                 ModelLibrary& library, std::ostream& out, std::ostream& err) {
+  const std::string name = r.name.empty() ? "type" + std::to_string(r.type) : r.name;
+  if (!validModelName(name)) {
+    err << "picksight-vision learn: name must be 1-32 of A-Z a-z 0-9 _ - .\n";
+    return 2;
+  }
+  // As LEARN does it: the whole image binarized the way LOCATE will see it.
+  const SensorMapping full;
+  const auto learned =
+      learnInImage(grey, full, r.options.vision, library.snapshot(), r.type, name, r.at);
+  if (!learned) {
+    out << errorReply(learned.error()) << "\n";
+    return 1;
+  }
+  std::string change =
+      "picksight-vision learn --type " + std::to_string(r.type) + " --name " + name;
+  if (r.at) {
+    change += " --at " + std::to_string(r.at->x) + " " + std::to_string(r.at->y) + " " +
+              std::to_string(r.at->width) + " " + std::to_string(r.at->height);
+  }
+  auto stored = library.store(learned->model, change + " " + path);
+  if (!stored) {
+    out << errorReply(VisionErrc::kStorageFailed,
+                      "cannot store the model: " + stored.error().message)
+        << "\n";
+    return 1;
+  }
+  out << learnReply(*learned) << "\n";
+  return 0;
+}
+}  // namespace
+
+int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  if (!isOfflineCommand(args)) {
+    err << offlineUsage();
+    return 2;
+  }
+  if (args[0] == "lens") return runLens(args, out, err);
+  auto parsed = parseOfflineRequest(args, err);
+  if (const int* status = std::get_if<int>(&parsed)) return *status;
+  const OfflineRequest& r = std::get<OfflineRequest>(parsed);
+  ModelLibrary library(r.options.data_dir + "/models");
   for (const auto& problem : library.load())
     err << "picksight-vision: model rejected: " << problem << "\n";
-  CellCalibration calibration(options->data_dir + "/calibration.yaml");
+  CellCalibration calibration(r.options.data_dir + "/calibration.yaml");
   if (auto loaded = calibration.load(); !loaded)
     err << "picksight-vision: calibration rejected: " << loaded.error().message << "\n";
 
   int status = 0;
-  for (const auto& path : images) {
+  for (const auto& path : r.images) {
     const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (grey.empty()) {
       out << errorReply(ProtocolErrc::kBadArguments,
@@ -193,40 +249,15 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       status = 1;
       continue;
     }
-    if (command == "learn") {
-      if (name.empty()) name = "type" + std::to_string(type);
-      if (!validModelName(name)) {
-        err << "picksight-vision learn: name must be 1-32 of A-Z a-z 0-9 _ - .\n";
-        return 2;
-      }
-      // As LEARN does it: the whole image binarized the way LOCATE will see it.
-      const SensorMapping full;
-      const auto learned =
-          learnInImage(grey, full, options->vision, library.snapshot(), type, name, at);
-      if (!learned) {
-        out << errorReply(learned.error()) << "\n";
-        return 1;
-      }
-      std::string change =
-          "picksight-vision learn --type " + std::to_string(type) + " --name " + name;
-      if (at) {
-        change += " --at " + std::to_string(at->x) + " " + std::to_string(at->y) + " " +
-                  std::to_string(at->width) + " " + std::to_string(at->height);
-      }
-      auto stored = library.store(learned->model, change + " " + path);
-      if (!stored) {
-        out << errorReply(VisionErrc::kStorageFailed,
-                          "cannot store the model: " + stored.error().message)
-            << "\n";
-        return 1;
-      }
-      out << learnReply(*learned) << "\n";
-    } else if (command == "locate") {
+    if (r.command == "learn") {
+      if (const int learned = learnOffline(r, grey, path, library, out, err); learned != 0)
+        return learned;
+    } else if (r.command == "locate") {
       // The robot's LOCATE path on the image: same frame (calibration of
       // the data dir), same grasps.
       const auto located = locateAndPick(calibration, &library, [&]() -> Result<LocateOutcome> {
-        return locateInFrame(frameFromImage(grey, path, 1), options->vision, library.snapshot(),
-                             type);
+        return locateInFrame(frameFromImage(grey, path, 1), r.options.vision, library.snapshot(),
+                             r.type);
       });
       if (!located) {
         out << errorReply(located.error()) << "\n";
@@ -234,7 +265,7 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       }
       out << locateReply(located->pick) << "\n";
     } else {
-      const auto blobs = blobsInImage(grey, options->vision);
+      const auto blobs = blobsInImage(grey, r.options.vision);
       std::string line = "OK " + std::to_string(blobs.size());
       for (const auto& b : blobs) line += " " + blobSummary(b);
       out << line << "\n";
