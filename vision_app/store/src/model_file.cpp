@@ -74,6 +74,74 @@ vision::Range asRange(const YAML::Node& node, const std::string& key) {
   if (!(p.x <= p.y)) throw FieldError{"range '" + key + "' must be [min, max] with min <= max"};
   return {p.x, p.y};
 }
+// The boundary's loops of primitives, under "loops".
+void writeLoops(YAML::Emitter& out, const std::vector<vision::BoundaryLoop>& loops) {
+  out << YAML::Key << "loops" << YAML::Value << YAML::BeginSeq;
+  for (const auto& loop : loops) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "hole" << YAML::Value << loop.hole;
+    out << YAML::Key << "weight" << YAML::Value << loop.weight;
+    out << YAML::Key << "primitives" << YAML::Value << YAML::BeginSeq;
+    for (const auto& p : loop.primitives) {
+      out << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "kind" << YAML::Value
+          << (p.kind == PrimitiveKind::kLine ? "line" : "arc");
+      point(out, "start", p.start);
+      point(out, "end", p.end);
+      if (p.kind == PrimitiveKind::kArc) {
+        point(out, "centre", p.centre);
+        out << YAML::Key << "radius" << YAML::Value << p.radius;
+        out << YAML::Key << "sweep_deg" << YAML::Value << p.sweep_deg;
+      }
+      out << YAML::Key << "weight" << YAML::Value << p.weight;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
+// The boundary's corners, under "corners".
+void writeCorners(YAML::Emitter& out, const std::vector<vision::Corner>& corners) {
+  out << YAML::Key << "corners" << YAML::Value << YAML::BeginSeq;
+  for (const auto& c : corners) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "class" << YAML::Value << vision::cornerClassName(c.kind);
+    out << YAML::Key << "loop" << YAML::Value << c.loop;
+    out << YAML::Key << "index" << YAML::Value << c.index;
+    point(out, "at", c.at);
+    out << YAML::Key << "direction_in_deg" << YAML::Value << c.direction_in_deg;
+    out << YAML::Key << "direction_out_deg" << YAML::Value << c.direction_out_deg;
+    range(out, "turn_deg", c.turn_deg);
+    out << YAML::Key << "convex" << YAML::Value << c.convex;
+    range(out, "length_in", c.length_in);
+    range(out, "length_out", c.length_out);
+    range(out, "radius_in", c.radius_in);
+    range(out, "radius_out", c.radius_out);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
+// The grasp styles and the gripper's fingers, under "grasp".
+void writeGrasp(YAML::Emitter& out, const GraspSetup& grasp) {
+  out << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "styles" << YAML::Value << YAML::BeginSeq;
+  for (const auto& st : grasp.styles) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << st.x_mm
+        << YAML::Key << "y_mm" << YAML::Value << st.y_mm << YAML::Key << "rz_deg" << YAML::Value
+        << st.rz_deg << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "fingers" << YAML::Value << YAML::BeginSeq;
+  for (const auto& f : grasp.gripper.fingers) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << f.x_mm << YAML::Key
+        << "y_mm" << YAML::Value << f.y_mm << YAML::Key << "width_mm" << YAML::Value << f.width_mm
+        << YAML::Key << "height_mm" << YAML::Value << f.height_mm << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+}
 }  // namespace
 
 std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
@@ -132,65 +200,11 @@ std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   out << YAML::Key << "conformity_px" << YAML::Value << m.conformity;
   out << YAML::Key << "edge_tolerance_px" << YAML::Value << m.edge_tolerance;
   out << YAML::Key << "verify_percent" << YAML::Value << m.verify_percent;
-  out << YAML::Key << "loops" << YAML::Value << YAML::BeginSeq;
-  for (const auto& loop : m.loops) {
-    out << YAML::BeginMap;
-    out << YAML::Key << "hole" << YAML::Value << loop.hole;
-    out << YAML::Key << "weight" << YAML::Value << loop.weight;
-    out << YAML::Key << "primitives" << YAML::Value << YAML::BeginSeq;
-    for (const auto& p : loop.primitives) {
-      out << YAML::Flow << YAML::BeginMap;
-      out << YAML::Key << "kind" << YAML::Value
-          << (p.kind == PrimitiveKind::kLine ? "line" : "arc");
-      point(out, "start", p.start);
-      point(out, "end", p.end);
-      if (p.kind == PrimitiveKind::kArc) {
-        point(out, "centre", p.centre);
-        out << YAML::Key << "radius" << YAML::Value << p.radius;
-        out << YAML::Key << "sweep_deg" << YAML::Value << p.sweep_deg;
-      }
-      out << YAML::Key << "weight" << YAML::Value << p.weight;
-      out << YAML::EndMap;
-    }
-    out << YAML::EndSeq << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::Key << "corners" << YAML::Value << YAML::BeginSeq;
-  for (const auto& c : m.corners) {
-    out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "class" << YAML::Value << vision::cornerClassName(c.kind);
-    out << YAML::Key << "loop" << YAML::Value << c.loop;
-    out << YAML::Key << "index" << YAML::Value << c.index;
-    point(out, "at", c.at);
-    out << YAML::Key << "direction_in_deg" << YAML::Value << c.direction_in_deg;
-    out << YAML::Key << "direction_out_deg" << YAML::Value << c.direction_out_deg;
-    range(out, "turn_deg", c.turn_deg);
-    out << YAML::Key << "convex" << YAML::Value << c.convex;
-    range(out, "length_in", c.length_in);
-    range(out, "length_out", c.length_out);
-    range(out, "radius_in", c.radius_in);
-    range(out, "radius_out", c.radius_out);
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
+  writeLoops(out, m.loops);
+  writeCorners(out, m.corners);
   out << YAML::EndMap;
 
-  out << YAML::Key << "grasp" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "styles" << YAML::Value << YAML::BeginSeq;
-  for (const auto& st : grasp.styles) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << st.x_mm
-        << YAML::Key << "y_mm" << YAML::Value << st.y_mm << YAML::Key << "rz_deg" << YAML::Value
-        << st.rz_deg << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::Key << "fingers" << YAML::Value << YAML::BeginSeq;
-  for (const auto& f : grasp.gripper.fingers) {
-    out << YAML::Flow << YAML::BeginMap << YAML::Key << "x_mm" << YAML::Value << f.x_mm << YAML::Key
-        << "y_mm" << YAML::Value << f.y_mm << YAML::Key << "width_mm" << YAML::Value << f.width_mm
-        << YAML::Key << "height_mm" << YAML::Value << f.height_mm << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::EndMap;
+  writeGrasp(out, grasp);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -229,6 +243,101 @@ Result<PartModel> modelFromYaml(const std::string& text) {
   if (!record) return record.error();
   return std::move(record->model);
 }
+
+namespace {
+// The boundary's loops of primitives (FieldError when one is wrong).
+std::vector<vision::BoundaryLoop> readLoops(const YAML::Node& boundary) {
+  std::vector<vision::BoundaryLoop> loops_out;
+  const YAML::Node loops = need(boundary, "loops");
+  if (!loops.IsSequence()) throw FieldError{"'loops' must be a list"};
+  for (const auto& l : loops) {
+    vision::BoundaryLoop loop;
+    loop.hole = as<bool>(l, "hole");
+    loop.weight = as<double>(l, "weight");
+    const YAML::Node prims = need(l, "primitives");
+    if (!prims.IsSequence()) throw FieldError{"'primitives' must be a list"};
+    for (const auto& p : prims) {
+      Primitive prim;
+      const std::string kind = as<std::string>(p, "kind");
+      if (kind != "line" && kind != "arc")
+        throw FieldError{"primitive kind must be line or arc, got '" + kind + "'"};
+      prim.kind = kind == "line" ? PrimitiveKind::kLine : PrimitiveKind::kArc;
+      prim.start = asPoint(p, "start");
+      prim.end = asPoint(p, "end");
+      if (prim.kind == PrimitiveKind::kArc) {
+        prim.centre = asPoint(p, "centre");
+        prim.radius = as<double>(p, "radius");
+        prim.sweep_deg = as<double>(p, "sweep_deg");
+      }
+      prim.weight = as<double>(p, "weight");
+      loop.primitives.push_back(prim);
+    }
+    loops_out.push_back(std::move(loop));
+  }
+  return loops_out;
+}
+
+// The boundary's corners, each on a primitive of `loops` (FieldError when
+// one is wrong).
+std::vector<vision::Corner> readCorners(const YAML::Node& boundary,
+                                        const std::vector<vision::BoundaryLoop>& loops) {
+  std::vector<vision::Corner> corners_out;
+  const YAML::Node corners = need(boundary, "corners");
+  if (!corners.IsSequence()) throw FieldError{"'corners' must be a list"};
+  for (const auto& c : corners) {
+    vision::Corner corner;
+    const std::string kind = as<std::string>(c, "class");
+    bool known = false;
+    for (auto k : {vision::CornerClass::kLineLine, vision::CornerClass::kLineArc,
+                   vision::CornerClass::kArcLine, vision::CornerClass::kArcArc}) {
+      if (kind == vision::cornerClassName(k)) {
+        corner.kind = k;
+        known = true;
+      }
+    }
+    if (!known) throw FieldError{"unknown corner class '" + kind + "'"};
+    corner.loop = as<int>(c, "loop");
+    corner.index = as<int>(c, "index");
+    if (corner.loop < 0 || static_cast<size_t>(corner.loop) >= loops.size() || corner.index < 0 ||
+        static_cast<size_t>(corner.index) >=
+            loops[static_cast<size_t>(corner.loop)].primitives.size()) {
+      throw FieldError{"a corner refers to a primitive that does not exist"};
+    }
+    corner.at = asPoint(c, "at");
+    corner.direction_in_deg = as<double>(c, "direction_in_deg");
+    corner.direction_out_deg = as<double>(c, "direction_out_deg");
+    corner.turn_deg = asRange(c, "turn_deg");
+    corner.convex = as<bool>(c, "convex");
+    corner.length_in = asRange(c, "length_in");
+    corner.length_out = asRange(c, "length_out");
+    corner.radius_in = asRange(c, "radius_in");
+    corner.radius_out = asRange(c, "radius_out");
+    corners_out.push_back(corner);
+  }
+  return corners_out;
+}
+
+// The grasp set-up of a version 2 file or later (FieldError when wrong).
+GraspSetup readGrasp(const YAML::Node& root) {
+  GraspSetup grasp_out;
+  const YAML::Node grasp = need(root, "grasp");
+  const YAML::Node styles = need(grasp, "styles");
+  const YAML::Node fingers = need(grasp, "fingers");
+  if (!styles.IsSequence() || !fingers.IsSequence())
+    throw FieldError{"'grasp.styles' and 'grasp.fingers' must be lists"};
+  for (const auto& st : styles) {
+    grasp_out.styles.push_back(
+        {as<double>(st, "x_mm"), as<double>(st, "y_mm"), as<double>(st, "rz_deg")});
+  }
+  for (const auto& f : fingers) {
+    grasp_out.gripper.fingers.push_back({as<double>(f, "x_mm"), as<double>(f, "y_mm"),
+                                         as<double>(f, "width_mm"), as<double>(f, "height_mm")});
+  }
+  if (auto valid = validateGrasp(grasp_out); !valid)
+    throw FieldError{"grasp: " + valid.error().message};
+  return grasp_out;
+}
+}  // namespace
 
 Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
   YAML::Node root;
@@ -301,83 +410,9 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
     m.conformity = as<double>(boundary, "conformity_px");
     m.edge_tolerance = as<double>(boundary, "edge_tolerance_px");
     m.verify_percent = as<double>(boundary, "verify_percent");
-    const YAML::Node loops = need(boundary, "loops");
-    if (!loops.IsSequence()) throw FieldError{"'loops' must be a list"};
-    for (const auto& l : loops) {
-      vision::BoundaryLoop loop;
-      loop.hole = as<bool>(l, "hole");
-      loop.weight = as<double>(l, "weight");
-      const YAML::Node prims = need(l, "primitives");
-      if (!prims.IsSequence()) throw FieldError{"'primitives' must be a list"};
-      for (const auto& p : prims) {
-        Primitive prim;
-        const std::string kind = as<std::string>(p, "kind");
-        if (kind != "line" && kind != "arc")
-          throw FieldError{"primitive kind must be line or arc, got '" + kind + "'"};
-        prim.kind = kind == "line" ? PrimitiveKind::kLine : PrimitiveKind::kArc;
-        prim.start = asPoint(p, "start");
-        prim.end = asPoint(p, "end");
-        if (prim.kind == PrimitiveKind::kArc) {
-          prim.centre = asPoint(p, "centre");
-          prim.radius = as<double>(p, "radius");
-          prim.sweep_deg = as<double>(p, "sweep_deg");
-        }
-        prim.weight = as<double>(p, "weight");
-        loop.primitives.push_back(prim);
-      }
-      m.loops.push_back(std::move(loop));
-    }
-    const YAML::Node corners = need(boundary, "corners");
-    if (!corners.IsSequence()) throw FieldError{"'corners' must be a list"};
-    for (const auto& c : corners) {
-      vision::Corner corner;
-      const std::string kind = as<std::string>(c, "class");
-      bool known = false;
-      for (auto k : {vision::CornerClass::kLineLine, vision::CornerClass::kLineArc,
-                     vision::CornerClass::kArcLine, vision::CornerClass::kArcArc}) {
-        if (kind == vision::cornerClassName(k)) {
-          corner.kind = k;
-          known = true;
-        }
-      }
-      if (!known) throw FieldError{"unknown corner class '" + kind + "'"};
-      corner.loop = as<int>(c, "loop");
-      corner.index = as<int>(c, "index");
-      if (corner.loop < 0 || static_cast<size_t>(corner.loop) >= m.loops.size() ||
-          corner.index < 0 ||
-          static_cast<size_t>(corner.index) >=
-              m.loops[static_cast<size_t>(corner.loop)].primitives.size()) {
-        throw FieldError{"a corner refers to a primitive that does not exist"};
-      }
-      corner.at = asPoint(c, "at");
-      corner.direction_in_deg = as<double>(c, "direction_in_deg");
-      corner.direction_out_deg = as<double>(c, "direction_out_deg");
-      corner.turn_deg = asRange(c, "turn_deg");
-      corner.convex = as<bool>(c, "convex");
-      corner.length_in = asRange(c, "length_in");
-      corner.length_out = asRange(c, "length_out");
-      corner.radius_in = asRange(c, "radius_in");
-      corner.radius_out = asRange(c, "radius_out");
-      m.corners.push_back(corner);
-    }
-    if (version >= 2) {
-      const YAML::Node grasp = need(root, "grasp");
-      const YAML::Node styles = need(grasp, "styles");
-      const YAML::Node fingers = need(grasp, "fingers");
-      if (!styles.IsSequence() || !fingers.IsSequence())
-        throw FieldError{"'grasp.styles' and 'grasp.fingers' must be lists"};
-      for (const auto& st : styles) {
-        record.grasp.styles.push_back(
-            {as<double>(st, "x_mm"), as<double>(st, "y_mm"), as<double>(st, "rz_deg")});
-      }
-      for (const auto& f : fingers) {
-        record.grasp.gripper.fingers.push_back({as<double>(f, "x_mm"), as<double>(f, "y_mm"),
-                                                as<double>(f, "width_mm"),
-                                                as<double>(f, "height_mm")});
-      }
-      if (auto valid = validateGrasp(record.grasp); !valid)
-        throw FieldError{"grasp: " + valid.error().message};
-    }
+    m.loops = readLoops(boundary);
+    m.corners = readCorners(boundary, m.loops);
+    if (version >= 2) record.grasp = readGrasp(root);
   } catch (const FieldError& e) {
     return makeError(ModelErrc::kBadFile, e.what);
   } catch (const YAML::Exception& e) {
