@@ -45,6 +45,8 @@ using Ms = std::chrono::duration<double, std::milli>;
 
 // A report this close to a drawn part's centroid is about that part.
 constexpr double kMatchRadiusPx = 12;
+// --list-errors names the parts placed further than this from their truth.
+constexpr double kListOffPx = 0.2;
 // The binarization window for parts up to 350 px (the vision app's --window).
 constexpr int kWindow = 400;
 
@@ -156,6 +158,12 @@ void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pa::L
                                                    o.x * std::sin(a) + o.y * std::cos(a));
     const double pos = std::hypot(p.x - ref.x, p.y - ref.y);
     row.pos2 += pos * pos;
+    // Parts placed well beyond the position goal, to look at.
+    if (list && pos > kListOffPx) {
+      std::printf("    placed %.2f px off (%+.2f %+.2f): %s at %.1f %.1f%s\n", pos, p.x - ref.x,
+                  p.y - ref.y, specs[t.type].name.c_str(), ref.x, ref.y,
+                  t.touching ? ", touching" : "");
+    }
     if (p.symmetry_deg > 0) {
       const double e = picksight::angleDiffDeg(
           p.angle_deg, t.angle_deg - picksight::bench::kTrainAngleDeg, p.symmetry_deg);
@@ -204,7 +212,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--standard-types", standard_types,
                "the 15 types of picksight-bench-silhouettes instead of unseen ones");
-  app.add_flag("--list-errors", list_errors, "print each false report and each part missed");
+  app.add_flag("--list-errors", list_errors,
+               "print each false report, each part missed and each placed over 0.2 px off");
   app.add_flag("--keep-shadows", keep_shadows,
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
                "costs)");

@@ -116,7 +116,9 @@ TEST_CASE("a cast shadow is cut off the part, and does not move it", "[vision][r
     CHECK(cv::norm(kept.centroid - without.centroid) > 1.0);
     CHECK(with.holes == without.holes);
     CHECK(with.area == Approx(without.area).epsilon(0.015));
-    CHECK(cv::norm(with.centroid - without.centroid) < 0.3);
+    // Read against a level too far from the part, the shadow under the
+    // edge reads as part: 0.17-0.28 px off towards it.
+    CHECK(cv::norm(with.centroid - without.centroid) < 0.1);
     // The outline too (the shape the boundary tests read), not only the
     // grey-level moments, which read a thin shadow left in the band as
     // uncovered: a thin shadow left joined makes it 0.8 % larger.

@@ -42,12 +42,16 @@ constexpr int kCutReach = 3;
 // The level outside the part is read this far past the ring it is read in.
 constexpr int kZoneReach = 2;
 // The level just outside the part is read in a ring this far out (pixels),
-// past the edge's blur and within a shadow, averaged with Gaussian weights
-// of this sigma; where they sum to less than kMinOutsideWeight no ring pixel
-// is near.
-constexpr int kNearOut = 2;
-constexpr int kFarOut = 5;
-constexpr double kOutsideSigma = 2.5;
+// averaged with Gaussian weights of this sigma; where they sum to less than
+// kMinOutsideWeight no ring pixel is near. As near as the edge's blur allows:
+// a shadow lightens away from the part (along a flank, its penumbra starts
+// at the edge), and a level read further out is lighter than the shadow
+// under the part's edge, which then reads as part. Read 2-5 px out, parts
+// beside a shadow were 1 % too large and 0.17-0.28 px off towards it; 1-2 px
+// out, 0.02-0.07 px (tests/vision/front_light_regions_test.cpp).
+constexpr int kNearOut = 1;
+constexpr int kFarOut = 2;
+constexpr double kOutsideSigma = 1.5;
 constexpr float kMinOutsideWeight = 0.02f;
 // A ring pixel is in a shadow when darker than the surface by more than
 // this many times the surface's spread (its texture) and kBelowSurface of
