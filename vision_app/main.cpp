@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 
+#include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
 #include "picksight/common/service_notify.hpp"
@@ -48,9 +49,16 @@ int main(int argc, char** argv) {
                          std::make_unique<app::VideoServerCamera>(
                              context, options->frames_endpoint, options->control_endpoint,
                              options->camera, options->vision.frame_timeout, options->curve),
-                         options->vision);
+                         options->vision, options->vision_settings_given);
     // A bad file costs what it holds, never the start.
     for (const auto& problem : cell.load()) logError(problem);
+    if (!options->vision_settings_given.empty()) {
+      std::string keys;
+      for (const auto& k : options->vision_settings_given) keys += (keys.empty() ? "" : ", ") + k;
+      logInfo("vision settings from the command line, over ", options->data_dir,
+              "/vision.json: ", keys, " (a VISION change replaces them until the next start)");
+    }
+    logInfo("vision settings: ", app::visionSettingsText(cell.vision().options()));
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
     // The results stream: subscribers see what each request saw, after
     // its reply; they never slow a robot.

@@ -4,6 +4,7 @@
 
 #include "picksight/calibration/calibration_errors.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/cell/vision_settings.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/protocol/robot_errors.hpp"
@@ -43,6 +44,9 @@ TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]")
   CHECK(robotErrorCode(CellCalibrationErrc::kDamaged) == 45);
   CHECK(robotErrorCode(CellCalibrationErrc::kTooManyPoints) == 46);
   CHECK(robotErrorCode(CellCalibrationErrc::kPointsChanged) == 47);
+  CHECK(robotErrorCode(VisionSettingsErrc::kBadSetting) == 11);
+  CHECK(robotErrorCode(VisionSettingsErrc::kDamaged) == 48);
+  CHECK(robotErrorCode(VisionSettingsErrc::kStorage) == 49);
   CHECK(robotErrorCode(ProtocolErrc::kInternalError) == 99);
 }
 

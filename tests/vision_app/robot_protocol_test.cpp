@@ -129,9 +129,9 @@ TEST_CASE("a read-only port answers reads and refuses every change with ERROR 17
   Fixture f;
   const auto readOnly = [&](const std::string& line) { return f.protocol.handle(line, true); };
   // Reads behave as on a full port (here: no camera, no calibration).
-  for (const char* read :
-       {"PING", "VERSION", "HELP", "STATUS", "MODELS", "LIST", "FRAME", "LOCATE 1", "BLOBS",
-        "RESIDUALS", "EXPOSURE", "ROI", "GRASP 1 LIST", "gripper 1 list", "TOLERANCE 1"}) {
+  for (const char* read : {"PING", "VERSION", "HELP", "STATUS", "MODELS", "LIST", "FRAME",
+                           "LOCATE 1", "BLOBS", "RESIDUALS", "EXPOSURE", "ROI", "GRASP 1 LIST",
+                           "gripper 1 list", "TOLERANCE 1", "VISION", "vision"}) {
     INFO(read);
     CHECK(readOnly(read) == f.protocol.handle(read));
     CHECK(readOnly(read).rfind("ERROR 17 ", 0) != 0);
@@ -141,7 +141,8 @@ TEST_CASE("a read-only port answers reads and refuses every change with ERROR 17
   for (const char* change :
        {"LEARN 1", "FORGET 1", "CALCAM 5", "STORE 1 2", "DELETE 1", "COMPUTE", "EXPOSURE 500",
         "ROI 0 0 8 8", "ROI FULL", "GRASP 1 ADD 0 0 0", "GRASP 1 CLEAR", "GRIPPER 1 CLEAR", "GRASP",
-        "learn", "TOLERANCE 1 verify_percent 90"}) {
+        "learn", "TOLERANCE 1 verify_percent 90", "VISION polarity light", "VISION RESET",
+        "vision bad"}) {
     INFO(change);
     const std::string reply = readOnly(change);
     CHECK(reply.rfind("ERROR 17 ", 0) == 0);

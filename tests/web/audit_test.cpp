@@ -279,6 +279,8 @@ TEST_CASE("a teach preview needs an engineer but is not a change", "[web][audit]
   CHECK(changesCell("UNDO"));
   CHECK_FALSE(changesCell("LOCATE 1"));
   CHECK_FALSE(changesCell("TOLERANCE 4"));
+  CHECK_FALSE(changesCell("VISION"));
+  CHECK(changesCell("VISION polarity light"));
 }
 
 TEST_CASE("a change's read-back line is the read of what it changes", "[web][audit]") {
@@ -287,9 +289,11 @@ TEST_CASE("a change's read-back line is the read of what it changes", "[web][aud
   CHECK(readBackLine("GRIPPER,3,CLEAR") == "GRIPPER 3 LIST");
   CHECK(readBackLine("EXPOSURE 900") == "EXPOSURE");
   CHECK(readBackLine("CAMMODE trigger") == "CAMMODE");
+  CHECK(readBackLine("vision polarity light level 90") == "VISION");
+  CHECK(readBackLine("VISION RESET") == "VISION");
   // Reads, and changes without a cheap read.
   for (const char* line : {"TOLERANCE 4", "GRASP 2 LIST", "EXPOSURE", "LOCATE 1", "LEARN 4",
-                           "CALCAM 5", "TOLERANCE x area_tolerance 1", "FORGET 4"}) {
+                           "CALCAM 5", "TOLERANCE x area_tolerance 1", "FORGET 4", "VISION"}) {
     CAPTURE(line);
     CHECK_FALSE(readBackLine(line));
   }

@@ -97,7 +97,7 @@ TEST_CASE("logins from an address are limited after 5 failures", "[web][users]")
 TEST_CASE("an operator may locate and read but not teach or calibrate", "[web][users]") {
   for (const char* line :
        {"LOCATE 1", "locate all", "WHY", "STATUS", "MODELS", "LIST", "RESIDUALS", "TOLERANCE 3",
-        "GRASP 2 LIST", "GRIPPER 2 list", "EXPOSURE", "ROI", "CAMMODE"}) {
+        "GRASP 2 LIST", "GRIPPER 2 list", "EXPOSURE", "ROI", "CAMMODE", "VISION", "vision"}) {
     CAPTURE(line);
     CHECK(roleForCommand(line) == Role::kOperator);
   }
@@ -105,7 +105,7 @@ TEST_CASE("an operator may locate and read but not teach or calibrate", "[web][u
        {"LEARN 4", "FORGET 4", "TOLERANCE 3 area_tolerance 0.2", "GRASP 2 ADD 0 0 0",
         "GRASP 2 CLEAR", "GRIPPER 2 FINGER 1 2 3 4", "CALCAM 5", "STORE 1 2", "DELETE 3", "COMPUTE",
         "CLEARCAL", "EXPOSURE 1000", "ROI 0 0 8 8", "CAMMODE trigger", "SOMETHINGNEW",
-        "GRASP,2,ADD,0,0,0"}) {
+        "GRASP,2,ADD,0,0,0", "VISION polarity light", "VISION RESET"}) {
     CAPTURE(line);
     CHECK(roleForCommand(line) == Role::kEngineer);
   }

@@ -36,7 +36,8 @@ Role roleForCommand(std::string_view line) {
   const std::string& command = w[0];
   if (reads.count(command) > 0) return Role::kOperator;
   // Reads with these arguments, changes with more.
-  if ((command == "EXPOSURE" || command == "ROI" || command == "CAMMODE") && w.size() == 1)
+  if ((command == "EXPOSURE" || command == "ROI" || command == "CAMMODE" || command == "VISION") &&
+      w.size() == 1)
     return Role::kOperator;
   if (command == "TOLERANCE" && w.size() <= 2) return Role::kOperator;
   if ((command == "GRASP" || command == "GRIPPER") && w.size() == 3 && w[2] == "LIST")
@@ -59,7 +60,8 @@ std::optional<std::string> readBackLine(std::string_view line) {
       return std::nullopt;
     return command == "TOLERANCE" ? command + " " + w[1] : command + " " + w[1] + " LIST";
   }
-  if (command == "EXPOSURE" || command == "ROI" || command == "CAMMODE") return command;
+  if (command == "EXPOSURE" || command == "ROI" || command == "CAMMODE" || command == "VISION")
+    return command;
   return std::nullopt;
 }
 

@@ -207,6 +207,13 @@ Result<AppOptions> finishOptions(AppOptions o, RawOptions& raw) {
     o.setup->listen.bind_address = raw.setup_bind;
     o.setup->label = "setup";
   }
+  // Keys of vision_settings.hpp: given here, they win over vision.json.
+  if (!raw.threshold.empty()) o.vision_settings_given.emplace_back("threshold");
+  if (raw.threshold.rfind("fixed:", 0) == 0) o.vision_settings_given.emplace_back("level");
+  if (!raw.polarity.empty()) o.vision_settings_given.emplace_back("polarity");
+  if (!raw.window.empty()) o.vision_settings_given.emplace_back("window");
+  if (!raw.min_area.empty()) o.vision_settings_given.emplace_back("min_area");
+  if (!raw.min_hole_area.empty()) o.vision_settings_given.emplace_back("min_hole_area");
   if (raw.threshold == "adaptive") {
     o.vision.binarize.method = vision::ThresholdMethod::kAdaptive;
   } else if (raw.threshold == "otsu") {

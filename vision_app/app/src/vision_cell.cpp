@@ -5,12 +5,15 @@
 
 #include "picksight/protocol/calibration_commands.hpp"
 #include "picksight/protocol/model_commands.hpp"
+#include "picksight/protocol/vision_settings_commands.hpp"
 
 namespace picksight::app {
 
 VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera,
-                       VisionOptions options)
-    : models_(data_dir + "/models"),
+                       VisionOptions options, std::vector<std::string> command_line_settings)
+    : settings_file_(data_dir + "/vision.json"),
+      command_line_settings_(std::move(command_line_settings)),
+      models_(data_dir + "/models"),
       calibration_(data_dir + "/calibration.yaml"),
       vision_(std::move(camera), std::move(options), &models_),
       protocol_(vision_),
@@ -19,10 +22,16 @@ VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> 
   addModelCommands(protocol_.table(), vision_);
   addCalibrationCommands(protocol_.table(), vision_, calibration_);
   addCellCommands(protocol_.table(), context_);
+  addVisionSettingsCommands(protocol_.table(), vision_);
 }
 
 std::vector<std::string> VisionCell::load() {
   std::vector<std::string> problems;
+  if (auto ok = vision_.loadSettings(settings_file_, command_line_settings_); !ok)
+    problems.push_back(
+        "vision settings rejected (LOCATE, LEARN and VISION changes refused until repaired, or "
+        "VISION RESET): " +
+        ok.error().message);
   for (auto& p : models_.load()) problems.push_back("model rejected: " + p);
   for (auto& p : models_.checkHistory()) problems.push_back("undo history: " + p);
   if (auto ok = calibration_.load(); !ok)

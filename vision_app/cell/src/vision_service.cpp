@@ -6,9 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/scaled_model_cache.hpp"
+#include "picksight/cell/vision_settings.hpp"
+#include "picksight/common/atomic_file.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision/recognition/recognizer.hpp"
 #include "picksight/vision/recognition/region_explanation.hpp"
@@ -212,8 +215,8 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& ma
 VisionService::VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
                              ModelLibrary* models)
     : camera_(std::move(camera)),
-      options_(std::move(options)),
       models_(models),
+      settings_(std::make_shared<const VisionOptions>(std::move(options))),
       scaled_models_(std::make_unique<ScaledModelCache>()) {}
 
 VisionService::~VisionService() = default;
@@ -239,20 +242,24 @@ Result<LocateOutcome> VisionService::locate(int type) {
       return makeError(VisionErrc::kUnknownType,
                        "no model for type " + std::to_string(type) + " (see MODELS)");
   }
+  const auto settings = requestSettings();
+  if (!settings) return settings.error();
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  return locateInFrame(**frame, options_, models, type, scaled_models_.get());
+  return locateInFrame(**frame, **settings, models, type, scaled_models_.get());
 }
 
 Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
                                           const std::optional<cv::Rect>& at,
                                           std::string_view change) {
   if (!models_) return makeError(VisionErrc::kStorageFailed, "no model library");
+  const auto settings = requestSettings();
+  if (!settings) return settings.error();
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  auto learned = learnInImage((*frame)->image, (*frame)->mapping, options_, models_->snapshot(),
+  auto learned = learnInImage((*frame)->image, (*frame)->mapping, **settings, models_->snapshot(),
                               type, name, at, scaled_models_.get());
   if (!learned) return learned.error();
   auto stored = models_->store(learned->model, change);
@@ -265,11 +272,13 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
 Result<TryLearnOutcome> VisionService::tryLearn(int type, const std::string& name,
                                                 const std::optional<cv::Rect>& at) {
   const auto stored = models_ ? models_->snapshot() : std::make_shared<const ModelList>();
+  const auto settings = requestSettings();
+  if (!settings) return settings.error();
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  auto learned = learnInImage((*frame)->image, (*frame)->mapping, options_, stored, type, name, at,
-                              scaled_models_.get());
+  auto learned = learnInImage((*frame)->image, (*frame)->mapping, **settings, stored, type, name,
+                              at, scaled_models_.get());
   if (!learned) return learned.error();
   auto models = std::make_shared<ModelList>();
   for (const auto& m : *stored) {
@@ -281,7 +290,7 @@ Result<TryLearnOutcome> VisionService::tryLearn(int type, const std::string& nam
   TryLearnOutcome out;
   // No cache: a list that is not the library's would evict the scaled models
   // LOCATE keeps.
-  out.located = locateInFrame(**frame, options_, std::move(models), -1, nullptr);
+  out.located = locateInFrame(**frame, **settings, std::move(models), -1, nullptr);
   for (const auto& p : out.located.parts) out.found += p.type == type ? 1 : 0;
   out.learned = std::move(*learned);
   return out;
@@ -511,6 +520,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     out.model.trained_angle_deg = mapping.directionToSensor(r.angle_deg);
     out.model.min_region_area = options.regions.min_area;
     out.model.min_hole_area = options.regions.min_hole_area;
+    out.model.taught_polarity = options.binarize.polarity;
     out.model.colour = colour;
     out.warnings = learnWarnings(r, grey, mask, mapping, options);
     if (auto alike = lookAlikeWarning(r, *frame_models, type)) out.warnings.push_back(*alike);
@@ -520,11 +530,13 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
 }
 
 Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {
+  const auto settings = requestSettings();
+  if (!settings) return settings.error();
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
   const SensorMapping& mapping = (*frame)->mapping;
-  auto features = blobsInImage(greyImage(**frame), options_);
+  auto features = blobsInImage(greyImage(**frame), **settings);
   for (auto& f : features) {
     f.centroid = mapping.toSensor(f.centroid);
     f.angle_deg = mapping.directionToSensor(f.angle_deg);
@@ -536,10 +548,12 @@ Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {
 }
 
 Result<TargetOutcome> VisionService::target() {
+  const auto settings = requestSettings();
+  if (!settings) return settings.error();
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  auto outcome = targetInImage(greyImage(**frame), (*frame)->mapping, options_);
+  auto outcome = targetInImage(greyImage(**frame), (*frame)->mapping, **settings);
   if (outcome) outcome->frame = *last_frame_;
   return outcome;
 }
@@ -554,6 +568,96 @@ Result<std::pair<cv::Mat, SensorMapping>> VisionService::greyFrame() {
 std::optional<FrameInfo> VisionService::lastFrame() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return last_frame_;
+}
+
+VisionOptions VisionService::options() const {
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  return *settings_;
+}
+
+Error VisionService::settingsBlocked() const {
+  return makeError(VisionSettingsErrc::kDamaged, "the vision settings file is damaged (" +
+                                                     settings_damage_.substr(0, 200) +
+                                                     "): repair it and restart, or VISION RESET");
+}
+
+Result<std::shared_ptr<const VisionOptions>> VisionService::requestSettings() const {
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  if (!settings_damage_.empty()) return settingsBlocked();
+  return settings_;
+}
+
+std::optional<std::string> VisionService::settingsDamage() const {
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  if (settings_damage_.empty()) return std::nullopt;
+  return settings_damage_;
+}
+
+Result<void> VisionService::loadSettings(const std::string& path,
+                                         const std::vector<std::string>& keep) {
+  std::lock_guard<std::mutex> change(change_mutex_);
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  settings_path_ = path;
+  settings_damage_.clear();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec) && !ec) return {};
+  auto text = readFile(path);
+  auto read =
+      text ? parseVisionSettingsJson(*text, *settings_, keep) : Result<VisionOptions>(text.error());
+  if (!read) {
+    settings_damage_ = path + ": " + read.error().message;
+    return makeError(VisionSettingsErrc::kDamaged, settings_damage_);
+  }
+  settings_ = std::make_shared<const VisionOptions>(std::move(*read));
+  return {};
+}
+
+Result<std::pair<VisionOptions, VisionOptions>> VisionService::changeSettings(
+    const std::vector<std::pair<std::string, std::string>>& pairs) {
+  std::lock_guard<std::mutex> change(change_mutex_);
+  std::shared_ptr<const VisionOptions> before;
+  std::string path;
+  {
+    std::lock_guard<std::mutex> lock(settings_mutex_);
+    if (!settings_damage_.empty()) return settingsBlocked();
+    before = settings_;
+    path = settings_path_;
+  }
+  auto after = applyVisionSettings(*before, pairs);
+  if (!after) return after.error();
+  // Written before it is used: a change the file does not hold is not made,
+  // and a restart starts with what the cell last ran with.
+  if (!path.empty()) {
+    if (auto written = writeFileAtomically(path, visionSettingsJson(*after)); !written) {
+      return makeError(VisionSettingsErrc::kStorage,
+                       "cannot write " + path + ": " + written.error().message);
+    }
+  }
+  {
+    std::lock_guard<std::mutex> lock(settings_mutex_);
+    settings_ = std::make_shared<const VisionOptions>(*after);
+  }
+  return std::make_pair(*before, std::move(*after));
+}
+
+Result<VisionOptions> VisionService::resetSettings() {
+  std::lock_guard<std::mutex> change(change_mutex_);
+  std::shared_ptr<const VisionOptions> current;
+  std::string path;
+  {
+    std::lock_guard<std::mutex> lock(settings_mutex_);
+    current = settings_;
+    path = settings_path_;
+  }
+  if (!path.empty()) {
+    if (auto written = writeFileAtomically(path, visionSettingsJson(*current)); !written) {
+      return makeError(VisionSettingsErrc::kStorage,
+                       "cannot write " + path + ": " + written.error().message);
+    }
+  }
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  settings_damage_.clear();
+  return *current;
 }
 
 std::shared_ptr<const Frame> VisionService::lastFramePixels() const {

@@ -6,6 +6,7 @@
 
 #include "picksight/calibration/robot_camera.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/cell/vision_settings.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/store/cell_calibration.hpp"
@@ -59,6 +60,9 @@ const std::pair<std::error_code, int> kTable[] = {
     {CellCalibrationErrc::kDamaged, 45},
     {CellCalibrationErrc::kTooManyPoints, 46},
     {CellCalibrationErrc::kPointsChanged, 47},
+    {VisionSettingsErrc::kBadSetting, 11},
+    {VisionSettingsErrc::kDamaged, 48},
+    {VisionSettingsErrc::kStorage, 49},
     {ProtocolErrc::kInternalError, kInternal},
 };
 

@@ -162,6 +162,11 @@ std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   out << YAML::Key << "regions" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "min_area" << YAML::Value << m.min_region_area;
   out << YAML::Key << "min_hole_area" << YAML::Value << m.min_hole_area;
+  // Optional on reading: files written before it do not say.
+  if (m.taught_polarity) {
+    out << YAML::Key << "polarity" << YAML::Value
+        << (*m.taught_polarity == vision::Polarity::kDarkOnLight ? "dark" : "light");
+  }
   out << YAML::EndMap;
 
   // Optional on reading: a model taught in grey levels has none.
@@ -371,6 +376,13 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
       const YAML::Node regions = root["regions"];
       m.min_region_area = as<double>(regions, "min_area");
       m.min_hole_area = as<double>(regions, "min_hole_area");
+      if (regions["polarity"]) {
+        const auto polarity = as<std::string>(regions, "polarity");
+        if (polarity != "dark" && polarity != "light")
+          throw FieldError{"regions: polarity must be dark or light, got '" + polarity + "'"};
+        m.taught_polarity =
+            polarity == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
+      }
     }
 
     if (root["colour"]) {

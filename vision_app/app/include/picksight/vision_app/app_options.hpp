@@ -29,6 +29,9 @@ struct AppOptions {
   // allow-list as the robot port, on loopback unless --setup-bind says.
   std::optional<RobotServerOptions> setup;
   VisionOptions vision;
+  // The vision settings keys (vision_settings.hpp) the command line or
+  // --config set: they win over <data dir>/vision.json at start.
+  std::vector<std::string> vision_settings_given;
   PlcPortOptions plc;  // off unless --modbus-port is given
   // CURVE keys for the camera link (loaded by parseAppArgs); nullopt: plain.
   std::optional<CurveClientKeys> curve;

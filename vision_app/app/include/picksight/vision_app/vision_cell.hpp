@@ -24,10 +24,12 @@ namespace picksight::app {
 
 class VisionCell {
  public:
-  // Files live in `data_dir` (models/, calibration.yaml); nothing is read
-  // or written before load().
-  VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera,
-             VisionOptions options);
+  // Files live in `data_dir` (models/, calibration.yaml, vision.json);
+  // nothing is read or written before load(). `command_line_settings`: the
+  // vision settings keys (vision_settings.hpp) set on the command line, which
+  // win over vision.json at start.
+  VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera, VisionOptions options,
+             std::vector<std::string> command_line_settings = {});
   VisionCell(const VisionCell&) = delete;
   VisionCell& operator=(const VisionCell&) = delete;
 
@@ -59,6 +61,8 @@ class VisionCell {
   CellContext& context() { return context_; }
 
  private:
+  const std::string settings_file_;
+  const std::vector<std::string> command_line_settings_;
   ModelLibrary models_;
   CellCalibration calibration_;
   VisionService vision_;

@@ -243,15 +243,46 @@ class VisionService {
   // of requests that keep none: kept until the next request.
   std::shared_ptr<const Frame> lastFramePixels() const;
   const std::string& camera() const { return camera_->camera(); }
-  const VisionOptions& options() const { return options_; }
+  // The settings in force (a copy: VISION may change them at any time).
+  VisionOptions options() const;
+
+  // Run-time settings (VISION, vision_settings.hpp), stored in `path`. At
+  // start: the file's settings replace the ones the service was made with,
+  // except `keep` (keys set on the command line, which win); no file: they
+  // stay. A damaged file is an error naming it, and every request that
+  // binarizes (LOCATE, LEARN, TRYLEARN, BLOBS, STORE, CALCAM) and every
+  // change is refused until it is repaired and the app restarted, or
+  // resetSettings().
+  Result<void> loadSettings(const std::string& path, const std::vector<std::string>& keep = {});
+  // Applies (key, value) pairs: checked whole, written to the file
+  // atomically, then in force for the next request (a request reads one
+  // snapshot of them: none sees half a change). Returns the settings before
+  // and after.
+  Result<std::pair<VisionOptions, VisionOptions>> changeSettings(
+      const std::vector<std::pair<std::string, std::string>>& pairs);
+  // Writes the settings in force over a damaged file and lifts the refusal.
+  Result<VisionOptions> resetSettings();
+  // What is wrong with the settings file (nullopt: nothing).
+  std::optional<std::string> settingsDamage() const;
 
  private:
   // Call with mutex_ held.
   Result<std::shared_ptr<const Frame>> freshFrame();
+  // The settings for one request; an error while the file is damaged.
+  Result<std::shared_ptr<const VisionOptions>> requestSettings() const;
+  Error settingsBlocked() const;  // call with settings_mutex_ held
 
   const std::unique_ptr<CameraLink> camera_;
-  const VisionOptions options_;
   ModelLibrary* const models_;
+
+  mutable std::mutex settings_mutex_;  // guards settings_, settings_damage_, settings_path_
+  // Swapped whole by a change, never edited in place.
+  std::shared_ptr<const VisionOptions> settings_;
+  std::string settings_damage_;  // non-empty: the file is damaged (path: why)
+  std::string settings_path_;    // empty: changes are not stored
+  // Serializes changes: each writes the file, then swaps settings_, so the
+  // file and the settings in force agree in the order the changes came.
+  std::mutex change_mutex_;
 
   mutable std::mutex mutex_;  // serializes requests; guards camera_ calls and last_frame_
   std::optional<FrameInfo> last_frame_;

@@ -17,6 +17,7 @@
 
 #include "picksight/vision/models/boundary_model.hpp"
 #include "picksight/vision/models/boundary_verification.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/blob_features.hpp"
 #include "picksight/vision/segmentation/colour_axis.hpp"
 
@@ -71,6 +72,10 @@ struct PartModel {
   // smaller than these were not part of the image it learned from.
   double min_region_area = 0;
   double min_hole_area = 0;
+  // The polarity the cell's settings had when it was taught (its regions
+  // were the dark or the light ones), so that a change of polarity names the
+  // models taught under the other. None: taught before it was recorded.
+  std::optional<Polarity> taught_polarity;
   // Taught in colour: the part's colour and its surface's, when colour told
   // them apart better than grey levels (colourSeparatesBetter). Colour
   // frames are then read projected on this axis. None: grey levels.

@@ -1,0 +1,13 @@
+// Robot protocol command for the vision settings at run time: VISION
+// (docs/PROTOCOL.md).
+#pragma once
+
+#include "picksight/cell/vision_service.hpp"
+#include "picksight/protocol/command_table.hpp"
+
+namespace picksight::app {
+
+// Registers VISION; `vision` (with its model library) outlives `table`.
+void addVisionSettingsCommands(CommandTable& table, VisionService& vision);
+
+}  // namespace picksight::app
