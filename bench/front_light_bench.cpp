@@ -158,11 +158,17 @@ void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pa::L
                                                    o.x * std::sin(a) + o.y * std::cos(a));
     const double pos = std::hypot(p.x - ref.x, p.y - ref.y);
     row.pos2 += pos * pos;
-    // Parts placed well beyond the position goal, to look at.
+    // Parts placed well beyond the position goal, to look at: the error in
+    // the image and on the part (turned back with it; the same there for
+    // every part of a type is the taught model's own error).
     if (list && pos > kListOffPx) {
-      std::printf("    placed %.2f px off (%+.2f %+.2f): %s at %.1f %.1f%s\n", pos, p.x - ref.x,
-                  p.y - ref.y, specs[t.type].name.c_str(), ref.x, ref.y,
-                  t.touching ? ", touching" : "");
+      const cv::Point2d e(p.x - ref.x, p.y - ref.y);
+      const cv::Point2d on_part(e.x * std::cos(a) + e.y * std::sin(a),
+                                -e.x * std::sin(a) + e.y * std::cos(a));
+      std::printf(
+          "    placed %.2f px off (%+.2f %+.2f, on the part %+.2f %+.2f): %s at %.1f %.1f%s\n", pos,
+          e.x, e.y, on_part.x, on_part.y, specs[t.type].name.c_str(), ref.x, ref.y,
+          t.touching ? ", touching" : "");
     }
     if (p.symmetry_deg > 0) {
       const double e = picksight::angleDiffDeg(
