@@ -444,6 +444,12 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
     }
   }
 
+  auto buffer = nextBuffer(timeout);
+  if (!buffer) return buffer.error();
+  return frameFrom(std::move(*buffer));
+}
+
+Result<GObjectPtr<ArvBuffer>> AravisSource::nextBuffer(std::chrono::milliseconds timeout) {
   GObjectPtr<ArvBuffer> buffer(arv_stream_timeout_pop_buffer(
       stream_.get(), static_cast<guint64>(std::max<int64_t>(0, timeout.count())) * 1000));
   if (!buffer) {
@@ -468,7 +474,10 @@ Result<SourceFrame> AravisSource::grab(std::chrono::milliseconds timeout) {
                          : ": stream thread at normal priority (real time needs CAP_SYS_NICE "
                            "or LimitRTPRIO; see docs/CAMERAS.md)");
   }
+  return buffer;
+}
 
+Result<SourceFrame> AravisSource::frameFrom(GObjectPtr<ArvBuffer> buffer) {
   const ArvBufferStatus status = arv_buffer_get_status(buffer.get());
   if (status != ARV_BUFFER_STATUS_SUCCESS) {
     const uint64_t id = arv_buffer_get_frame_id(buffer.get());

@@ -75,6 +75,11 @@ class AravisSource : public Source {
   void retireStream();
   // Gives the buffer the last frame borrowed back to the stream.
   void returnHeldBuffer();
+  // grab()'s two halves: the next buffer within `timeout` (the device
+  // checked when none comes), and the frame that borrows a complete one
+  // (any other goes back to the stream).
+  Result<GObjectPtr<ArvBuffer>> nextBuffer(std::chrono::milliseconds timeout);
+  Result<SourceFrame> frameFrom(GObjectPtr<ArvBuffer> buffer);
   // A real control read: fails when the device is gone.
   Result<void> checkDevice();
   Error lost(const std::string& why) const;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <tuple>
 
@@ -11,6 +12,67 @@
 #include "v4l2_formats.hpp"
 
 namespace picksight::video {
+
+namespace {
+// One pixel format the device offers, at the size it would stream.
+struct Candidate {
+  uint32_t fourcc;
+  bool emulated;  // converted by libv4l2 in software
+  uint32_t width, height;
+  bool exact;
+  double max_fps;  // 0 = unknown
+};
+
+using Ioctl = std::function<int(unsigned long, void*)>;
+
+// The size of `c.fourcc` the device offers nearest the wanted one (by
+// area, then shape), and whether it is the wanted one.
+void sizeNearest(const Ioctl& ioctl, uint32_t want_w, uint32_t want_h, Candidate& c) {
+  double best = std::numeric_limits<double>::max();
+  bool enumerated = false;
+  for (uint32_t k = 0;; ++k) {
+    v4l2_frmsizeenum size{};
+    size.index = k;
+    size.pixel_format = c.fourcc;
+    if (ioctl(VIDIOC_ENUM_FRAMESIZES, &size) < 0) break;
+    enumerated = true;
+    if (size.type == V4L2_FRMSIZE_TYPE_DISCRETE) {
+      const auto w = size.discrete.width, h = size.discrete.height;
+      const double d = std::abs(double(w) * h - double(want_w) * want_h) +
+                       std::abs(double(w) - want_w) + std::abs(double(h) - want_h);
+      if (d < best) {
+        best = d;
+        c.width = w;
+        c.height = h;
+      }
+    } else {
+      // Stepwise or continuous: one range, the driver rounds in S_FMT.
+      const auto& sw = size.stepwise;
+      c.width = std::clamp(want_w, sw.min_width, sw.max_width);
+      c.height = std::clamp(want_h, sw.min_height, sw.max_height);
+      best = (c.width == want_w && c.height == want_h) ? 0 : 1;
+      break;
+    }
+  }
+  c.exact = !enumerated || best == 0;  // a driver that lists no sizes takes what S_FMT gives
+}
+
+// The fastest rate of `c` at its size (0: unknown), to prefer MJPEG when
+// YUYV cannot keep up.
+double fastestRate(const Ioctl& ioctl, const Candidate& c) {
+  double max_fps = 0;
+  v4l2_frmivalenum ival{};
+  ival.pixel_format = c.fourcc;
+  ival.width = c.width;
+  ival.height = c.height;
+  for (ival.index = 0; ioctl(VIDIOC_ENUM_FRAMEINTERVALS, &ival) == 0; ++ival.index) {
+    const auto& f = ival.type == V4L2_FRMIVAL_TYPE_DISCRETE ? ival.discrete : ival.stepwise.min;
+    if (f.numerator > 0) max_fps = std::max(max_fps, double(f.denominator) / f.numerator);
+    if (ival.type != V4L2_FRMIVAL_TYPE_DISCRETE) break;
+  }
+  return max_fps;
+}
+}  // namespace
 
 Result<void> V4l2Source::chooseFormat() {
   v4l2_format current{};
@@ -22,13 +84,7 @@ Result<void> V4l2Source::chooseFormat() {
   const uint32_t want_h =
       size_given ? static_cast<uint32_t>(options_.height) : current.fmt.pix.height;
 
-  struct Candidate {
-    uint32_t fourcc;
-    bool emulated;  // converted by libv4l2 in software
-    uint32_t width, height;
-    bool exact;
-    double max_fps;  // 0 = unknown
-  };
+  const Ioctl ioctl = [this](unsigned long request, void* arg) { return xioctl(request, arg); };
   std::vector<Candidate> candidates;
   formats_.clear();
   for (uint32_t i = 0;; ++i) {
@@ -40,46 +96,10 @@ Result<void> V4l2Source::chooseFormat() {
     if (!findPixelFormat(desc.pixelformat)) continue;
     if (options_.fourcc != 0 && desc.pixelformat != options_.fourcc) continue;
 
-    // The offered size nearest the wanted one (by area, then shape).
     Candidate c{
         desc.pixelformat, (desc.flags & V4L2_FMT_FLAG_EMULATED) != 0, want_w, want_h, false, 0};
-    double best = std::numeric_limits<double>::max();
-    bool enumerated = false;
-    for (uint32_t k = 0;; ++k) {
-      v4l2_frmsizeenum size{};
-      size.index = k;
-      size.pixel_format = desc.pixelformat;
-      if (xioctl(VIDIOC_ENUM_FRAMESIZES, &size) < 0) break;
-      enumerated = true;
-      if (size.type == V4L2_FRMSIZE_TYPE_DISCRETE) {
-        const auto w = size.discrete.width, h = size.discrete.height;
-        const double d = std::abs(double(w) * h - double(want_w) * want_h) +
-                         std::abs(double(w) - want_w) + std::abs(double(h) - want_h);
-        if (d < best) {
-          best = d;
-          c.width = w;
-          c.height = h;
-        }
-      } else {
-        // Stepwise or continuous: one range, the driver rounds in S_FMT.
-        const auto& sw = size.stepwise;
-        c.width = std::clamp(want_w, sw.min_width, sw.max_width);
-        c.height = std::clamp(want_h, sw.min_height, sw.max_height);
-        best = (c.width == want_w && c.height == want_h) ? 0 : 1;
-        break;
-      }
-    }
-    c.exact = !enumerated || best == 0;  // a driver that lists no sizes takes what S_FMT gives
-    // The fastest rate at that size, to prefer MJPEG when YUYV cannot keep up.
-    v4l2_frmivalenum ival{};
-    ival.pixel_format = desc.pixelformat;
-    ival.width = c.width;
-    ival.height = c.height;
-    for (ival.index = 0; xioctl(VIDIOC_ENUM_FRAMEINTERVALS, &ival) == 0; ++ival.index) {
-      const auto& f = ival.type == V4L2_FRMIVAL_TYPE_DISCRETE ? ival.discrete : ival.stepwise.min;
-      if (f.numerator > 0) c.max_fps = std::max(c.max_fps, double(f.denominator) / f.numerator);
-      if (ival.type != V4L2_FRMIVAL_TYPE_DISCRETE) break;
-    }
+    sizeNearest(ioctl, want_w, want_h, c);
+    c.max_fps = fastestRate(ioctl, c);
     candidates.push_back(c);
   }
   if (candidates.empty()) {
