@@ -166,6 +166,9 @@ std::string commandSynopsis(const std::string& command) {
   return synopsis;
 }
 
+// Long because it declares every subcommand and option, in the order
+// --help lists them, beside the checks CLI11 cannot make; split, the help
+// and its options would no longer read side by side.
 Result<CamOptions> parseCommandLine(const std::vector<std::string>& args) {
   CamOptions options;
   CLI::App app(

@@ -281,6 +281,9 @@ int serveWeb(const picksight::StopSignals& stop, Cell& cell, const std::string& 
 
 }  // namespace
 
+// The demo's script top to bottom (options, the two processes, calibrate,
+// pick, the web): long, but read in one go it is the quick start's
+// walk-through; calibrate() and pick() hold the steps' details.
 int main(int argc, char** argv) {
   int requests = 2;
   int parts = 6;

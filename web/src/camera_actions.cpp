@@ -79,6 +79,92 @@ Result<nlohmann::json> parseJsonBody(const std::string& body) {
   return j;
 }
 
+namespace {
+// The size action: a scale, or a width and a height.
+Result<void> sizeAction(proto::SetSizeRequest* size, const nlohmann::json& body) {
+  auto scale = number(body, "scale");
+  if (!scale) return scale.error();
+  if (*scale) {
+    if (**scale <= 0 || **scale > 16) return fieldError("scale", "must be in (0, 16]");
+    size->set_scale(**scale);
+  } else {
+    auto w = pixels(body, "width");
+    if (!w) return w.error();
+    auto h = pixels(body, "height");
+    if (!h) return h.error();
+    size->set_width(*w);
+    size->set_height(*h);
+  }
+  return {};
+}
+
+// The mode action: the mode, the hardware trigger's input, the rate.
+Result<void> modeAction(proto::SetModeRequest* mode, const nlohmann::json& body) {
+  auto name = text(body, "mode", true);
+  if (!name) return name.error();
+  if (*name == "freerun") {
+    mode->set_mode(proto::FREERUN);
+  } else if (*name == "trigger") {
+    mode->set_mode(proto::TRIGGER);
+  } else if (*name == "hardware") {
+    mode->set_mode(proto::HARDWARE_TRIGGER);
+  } else {
+    return fieldError("mode", "must be \"freerun\", \"trigger\" or \"hardware\"");
+  }
+  // The trigger input's settings go with the hardware mode only, as with
+  // picksight-cam; their names and values are the video server's to judge
+  // (it names the camera's choices when it refuses one).
+  for (const char* field : {"line", "activation", "timeout_ms"}) {
+    if (mode->mode() != proto::HARDWARE_TRIGGER && body.contains(field) &&
+        !body.at(field).is_null())
+      return fieldError(field, "goes with the \"hardware\" mode only");
+  }
+  for (const char* field : {"line", "activation"}) {
+    auto value = text(body, field, false);
+    if (!value) return value.error();
+    if (value->size() > kMaxTriggerName) {
+      return fieldError(field, "longer than " + std::to_string(kMaxTriggerName) + " bytes");
+    }
+    if (field[0] == 'l') mode->set_trigger_line(*value);
+    if (field[0] == 'a') mode->set_trigger_activation(*value);
+  }
+  auto timeout = number(body, "timeout_ms");
+  if (!timeout) return timeout.error();
+  if (*timeout) {
+    const double ms = **timeout;
+    if (ms < 1 || ms > kMaxTriggerTimeoutMs || ms != std::floor(ms)) {
+      return fieldError("timeout_ms", "must be a whole number of milliseconds, 1.." +
+                                          std::to_string(kMaxTriggerTimeoutMs));
+    }
+    mode->set_trigger_timeout_ms(static_cast<uint32_t>(ms));
+  }
+  auto fps = number(body, "fps");
+  if (!fps) return fps.error();
+  if (*fps && (**fps < 0 || **fps > 10000)) return fieldError("fps", "must be in 0..10000");
+  mode->set_fps(fps->value_or(0));
+  return {};
+}
+
+// The simulated robot's target: hidden, or placed at x_mm, y_mm.
+Result<void> targetAction(proto::SetTargetRequest* target, const nlohmann::json& body) {
+  auto hide = body.find("hide");
+  if (hide != body.end() && !hide->is_boolean()) return fieldError("hide", "must be true or false");
+  if (hide != body.end() && hide->get<bool>()) {
+    target->set_hide(true);
+  } else {
+    auto x = number(body, "x_mm");
+    if (!x) return x.error();
+    auto y = number(body, "y_mm");
+    if (!y) return y.error();
+    if (!*x || !*y) return fieldError(*x ? "y_mm" : "x_mm", "missing");
+    target->set_x_mm(**x);
+    target->set_y_mm(**y);
+  }
+  return {};
+}
+
+}  // namespace
+
 Result<proto::ControlRequest> cameraAction(const std::string& camera, const std::string& action,
                                            const nlohmann::json& body) {
   proto::ControlRequest request;
@@ -97,64 +183,11 @@ Result<proto::ControlRequest> cameraAction(const std::string& camera, const std:
   } else if (action == "size") {
     auto* size = request.mutable_set_size();
     size->set_camera(camera);
-    auto scale = number(body, "scale");
-    if (!scale) return scale.error();
-    if (*scale) {
-      if (**scale <= 0 || **scale > 16) return fieldError("scale", "must be in (0, 16]");
-      size->set_scale(**scale);
-    } else {
-      auto w = pixels(body, "width");
-      if (!w) return w.error();
-      auto h = pixels(body, "height");
-      if (!h) return h.error();
-      size->set_width(*w);
-      size->set_height(*h);
-    }
+    if (auto ok = sizeAction(size, body); !ok) return ok.error();
   } else if (action == "mode") {
     auto* mode = request.mutable_set_mode();
     mode->set_camera(camera);
-    auto name = text(body, "mode", true);
-    if (!name) return name.error();
-    if (*name == "freerun") {
-      mode->set_mode(proto::FREERUN);
-    } else if (*name == "trigger") {
-      mode->set_mode(proto::TRIGGER);
-    } else if (*name == "hardware") {
-      mode->set_mode(proto::HARDWARE_TRIGGER);
-    } else {
-      return fieldError("mode", "must be \"freerun\", \"trigger\" or \"hardware\"");
-    }
-    // The trigger input's settings go with the hardware mode only, as with
-    // picksight-cam; their names and values are the video server's to judge
-    // (it names the camera's choices when it refuses one).
-    for (const char* field : {"line", "activation", "timeout_ms"}) {
-      if (mode->mode() != proto::HARDWARE_TRIGGER && body.contains(field) &&
-          !body.at(field).is_null())
-        return fieldError(field, "goes with the \"hardware\" mode only");
-    }
-    for (const char* field : {"line", "activation"}) {
-      auto value = text(body, field, false);
-      if (!value) return value.error();
-      if (value->size() > kMaxTriggerName) {
-        return fieldError(field, "longer than " + std::to_string(kMaxTriggerName) + " bytes");
-      }
-      if (field[0] == 'l') mode->set_trigger_line(*value);
-      if (field[0] == 'a') mode->set_trigger_activation(*value);
-    }
-    auto timeout = number(body, "timeout_ms");
-    if (!timeout) return timeout.error();
-    if (*timeout) {
-      const double ms = **timeout;
-      if (ms < 1 || ms > kMaxTriggerTimeoutMs || ms != std::floor(ms)) {
-        return fieldError("timeout_ms", "must be a whole number of milliseconds, 1.." +
-                                            std::to_string(kMaxTriggerTimeoutMs));
-      }
-      mode->set_trigger_timeout_ms(static_cast<uint32_t>(ms));
-    }
-    auto fps = number(body, "fps");
-    if (!fps) return fps.error();
-    if (*fps && (**fps < 0 || **fps > 10000)) return fieldError("fps", "must be in 0..10000");
-    mode->set_fps(fps->value_or(0));
+    if (auto ok = modeAction(mode, body); !ok) return ok.error();
   } else if (action == "feature") {
     auto* feature = request.mutable_set_feature();
     feature->set_camera(camera);
@@ -175,20 +208,7 @@ Result<proto::ControlRequest> cameraAction(const std::string& camera, const std:
   } else if (action == "target") {
     auto* target = request.mutable_set_target();
     target->set_camera(camera);
-    auto hide = body.find("hide");
-    if (hide != body.end() && !hide->is_boolean())
-      return fieldError("hide", "must be true or false");
-    if (hide != body.end() && hide->get<bool>()) {
-      target->set_hide(true);
-    } else {
-      auto x = number(body, "x_mm");
-      if (!x) return x.error();
-      auto y = number(body, "y_mm");
-      if (!y) return y.error();
-      if (!*x || !*y) return fieldError(*x ? "y_mm" : "x_mm", "missing");
-      target->set_x_mm(**x);
-      target->set_y_mm(**y);
-    }
+    if (auto ok = targetAction(target, body); !ok) return ok.error();
   } else {
     return makeError(WebErrc::kNotFound, "no camera action '" + action + "'");
   }

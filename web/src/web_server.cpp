@@ -237,7 +237,10 @@ class WebServer::Impl {
 
  private:
   void routes();
+  // The login, logout and session routes, and the admin's user list.
   void userRoutes();
+  void loginRoutes();
+  void userAdminRoutes();
   // Runs `change` on the users, records it (before: the user's role; after:
   // `after`, or the same role when null) and answers the request; ends the
   // user's sessions when it is done.
@@ -247,6 +250,17 @@ class WebServer::Impl {
   // http_->Post(pattern, handler), telling the gate (with TLS) that the
   // request has arrived whole before the handler runs.
   void post(const std::string& pattern, httplib::Server::Handler handler);
+  // start()'s steps: the HTTPS server (--tls-cert), the users, sessions
+  // and audit trail, the handlers every request meets, and the gate's
+  // listening port.
+  Result<void> startTls();
+  Result<void> openAccounts();
+  void setHandlers();
+  Result<void> listen();
+  // Before any route: the allow-list, the request's facts, the metrics
+  // scraper's way in, then the session and its role (a refusal is
+  // answered and handled here).
+  httplib::Server::HandlerResponse admit(const httplib::Request& req, httplib::Response& res);
   // The plain-HTTP port that redirects to HTTPS (--http-redirect).
   Result<void> startRedirect();
   // Records a change or login of `session` (or of nobody) from the request's
@@ -288,6 +302,25 @@ class WebServer::Impl {
 };
 
 Result<void> WebServer::Impl::start() {
+  if (auto ok = startTls(); !ok) return ok;
+  if (auto ok = openAccounts(); !ok) return ok;
+  cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
+                                             options_.jpeg_quality);
+  for (const auto& app : options_.vision_apps)
+    apps_[app.name] = std::make_unique<ResultFeed>(
+        context_, app, events_, [this, name = app.name](const proto::VisionResult& change) {
+          recordAppChange(name, change);
+        });
+  setHandlers();
+  routes();
+  userRoutes();
+  auditRoutes();
+  if (auto ok = listen(); !ok) return ok;
+  if (options_.redirect) return startRedirect();
+  return {};
+}
+
+Result<void> WebServer::Impl::startTls() {
   if (tls()) {
     for (const auto& file : {options_.tls_cert, options_.tls_key})
       if (auto read = readFile(file); !read) return read.error();
@@ -301,6 +334,10 @@ Result<void> WebServer::Impl::start() {
     SSL_CTX_set_min_proto_version(https->ssl_context(), TLS1_2_VERSION);
     http_ = std::move(https);
   }
+  return {};
+}
+
+Result<void> WebServer::Impl::openAccounts() {
   auto users = UserStore::open(options_.users_file);
   if (!users) return users.error();
   users_.emplace(std::move(*users));
@@ -320,13 +357,10 @@ Result<void> WebServer::Impl::start() {
             ": made 'admin' with the password printed on stdout (an admin changes it in the "
             "page's Users tab)");
   }
-  cameras_ = std::make_unique<CameraMonitor>(context_, options_.video_servers, events_,
-                                             options_.jpeg_quality);
-  for (const auto& app : options_.vision_apps)
-    apps_[app.name] = std::make_unique<ResultFeed>(
-        context_, app, events_, [this, name = app.name](const proto::VisionResult& change) {
-          recordAppChange(name, change);
-        });
+  return {};
+}
+
+void WebServer::Impl::setHandlers() {
   http_->set_payload_max_length(kMaxBodyBytes);
   // A viewer whose socket takes no bytes for this long is dropped: it held
   // one HTTP thread, never a camera or another viewer.
@@ -363,69 +397,72 @@ Result<void> WebServer::Impl::start() {
         sendJson(res, {{"error", statusText(res.status)}}, res.status);
         return httplib::Server::HandlerResponse::Handled;
       }));
-  http_->set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    // httplib calls this once the request's header is read, before its
-    // body: with TLS, the gate's deadline ends here for a request without
-    // a body, in post() after the body for the others.
-    const std::string length = req.get_header_value("Content-Length");
-    if (tls() && (length.empty() || length == "0") && !req.has_header("Transfer-Encoding"))
-      gate_->arrived(req.remote_addr, req.remote_port);
-    const auto refuse = [&](int status, const std::string& message) {
-      refusals_.refused(req.remote_addr, req.method + " " + req.path + ": " + message);
-      sendJson(res, {{"error", message}}, status);
-      return httplib::Server::HandlerResponse::Handled;
-    };
-    if (!peerAllowed(options_.allow, req.remote_addr))
-      return refuse(403, "forbidden: " + req.remote_addr + " is not in the allow-list");
-    RequestFacts facts;
-    facts.method = req.method;
-    facts.host = req.get_header_value("Host");
-    facts.has_origin = req.has_header("Origin");
-    facts.origin = req.get_header_value("Origin");
-    facts.content_type = req.get_header_value("Content-Type");
-    facts.request_header = req.get_header_value(kRequestHeader);
-    if (auto refusal = checkRequest(hosts_, facts))
-      return refuse(refusal->status, refusal->message);
-    if (req.path == "/metrics" && !changesState(req.method)) {
-      // A scraper's way in, besides a login.
-      const std::string authorization = req.get_header_value("Authorization");
-      if (!options_.metrics_token.empty() && !authorization.empty()) {
-        if (bearerMatches(authorization, options_.metrics_token))
-          return httplib::Server::HandlerResponse::Unhandled;
-        return refuse(401, "wrong metrics token (--metrics-token)");
-      }
-      if (options_.metrics_allow_set && peerAllowed(options_.metrics_allow, req.remote_addr))
+  http_->set_pre_routing_handler(
+      [this](const httplib::Request& req, httplib::Response& res) { return admit(req, res); });
+}
+
+httplib::Server::HandlerResponse WebServer::Impl::admit(const httplib::Request& req,
+                                                        httplib::Response& res) {
+  // httplib calls this once the request's header is read, before its
+  // body: with TLS, the gate's deadline ends here for a request without
+  // a body, in post() after the body for the others.
+  const std::string length = req.get_header_value("Content-Length");
+  if (tls() && (length.empty() || length == "0") && !req.has_header("Transfer-Encoding"))
+    gate_->arrived(req.remote_addr, req.remote_port);
+  const auto refuse = [&](int status, const std::string& message) {
+    refusals_.refused(req.remote_addr, req.method + " " + req.path + ": " + message);
+    sendJson(res, {{"error", message}}, status);
+    return httplib::Server::HandlerResponse::Handled;
+  };
+  if (!peerAllowed(options_.allow, req.remote_addr))
+    return refuse(403, "forbidden: " + req.remote_addr + " is not in the allow-list");
+  RequestFacts facts;
+  facts.method = req.method;
+  facts.host = req.get_header_value("Host");
+  facts.has_origin = req.has_header("Origin");
+  facts.origin = req.get_header_value("Origin");
+  facts.content_type = req.get_header_value("Content-Type");
+  facts.request_header = req.get_header_value(kRequestHeader);
+  if (auto refusal = checkRequest(hosts_, facts)) return refuse(refusal->status, refusal->message);
+  if (req.path == "/metrics" && !changesState(req.method)) {
+    // A scraper's way in, besides a login.
+    const std::string authorization = req.get_header_value("Authorization");
+    if (!options_.metrics_token.empty() && !authorization.empty()) {
+      if (bearerMatches(authorization, options_.metrics_token))
         return httplib::Server::HandlerResponse::Unhandled;
+      return refuse(401, "wrong metrics token (--metrics-token)");
     }
-    const auto needed = roleNeeded(req);
-    if (!needed) return httplib::Server::HandlerResponse::Unhandled;
-    const auto session = sessionOf(req);
-    if (!session) {
-      sendJson(res, {{"error", "log in first (POST /api/login)"}}, 401);
-      return httplib::Server::HandlerResponse::Handled;
+    if (options_.metrics_allow_set && peerAllowed(options_.metrics_allow, req.remote_addr))
+      return httplib::Server::HandlerResponse::Unhandled;
+  }
+  const auto needed = roleNeeded(req);
+  if (!needed) return httplib::Server::HandlerResponse::Unhandled;
+  const auto session = sessionOf(req);
+  if (!session) {
+    sendJson(res, {{"error", "log in first (POST /api/login)"}}, 401);
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  if (session->role < *needed) {
+    // A change refused for the role is recorded: who tried what.
+    if (changesState(req.method) && req.path != "/api/logout") {
+      AuditRecord record;
+      record.action = "request";
+      record.target = req.path.substr(0, 128);
+      record.outcome = "refused";
+      record.status = 403;
+      record.reply = std::string("needs the ") + roleName(*needed) + " role";
+      audit(req, session, std::move(record));
     }
-    if (session->role < *needed) {
-      // A change refused for the role is recorded: who tried what.
-      if (changesState(req.method) && req.path != "/api/logout") {
-        AuditRecord record;
-        record.action = "request";
-        record.target = req.path.substr(0, 128);
-        record.outcome = "refused";
-        record.status = 403;
-        record.reply = std::string("needs the ") + roleName(*needed) + " role";
-        audit(req, session, std::move(record));
-      }
-      sendJson(res,
-               {{"error", std::string("this needs the ") + roleName(*needed) + " role; " +
-                              session->user + " is " + roleName(session->role)}},
-               403);
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    return httplib::Server::HandlerResponse::Unhandled;
-  });
-  routes();
-  userRoutes();
-  auditRoutes();
+    sendJson(res,
+             {{"error", std::string("this needs the ") + roleName(*needed) + " role; " +
+                            session->user + " is " + roleName(session->role)}},
+             403);
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  return httplib::Server::HandlerResponse::Unhandled;
+}
+
+Result<void> WebServer::Impl::listen() {
   GateOptions gate;
   gate.header_timeout = options_.header_timeout;
   gate.per_address = options_.per_address;
@@ -450,7 +487,6 @@ Result<void> WebServer::Impl::start() {
             options_.metrics_token.empty() ? "" : " with the --metrics-token bearer token",
             options_.metrics_allow_set ? " from " + options_.metrics_allow.describe() : "");
   gate_->start([this](int fd) { (http_.get()->*processSocketOf())(fd); });
-  if (options_.redirect) return startRedirect();
   return {};
 }
 
@@ -774,6 +810,11 @@ std::optional<Role> WebServer::Impl::roleNeeded(const httplib::Request& req) {
 }
 
 void WebServer::Impl::userRoutes() {
+  loginRoutes();
+  userAdminRoutes();
+}
+
+void WebServer::Impl::loginRoutes() {
   post("/api/login", [this](const httplib::Request& req, httplib::Response& res) {
     if (auto wait = logins_.blocked(req.remote_addr)) {
       res.set_header("Retry-After", std::to_string(wait->count()));
@@ -847,6 +888,9 @@ void WebServer::Impl::userRoutes() {
     if (!session) return sendJson(res, {{"user", nullptr}});
     sendJson(res, {{"user", session->user}, {"role", roleName(session->role)}});
   });
+}
+
+void WebServer::Impl::userAdminRoutes() {
   http_->Get("/api/users", [this](const httplib::Request&, httplib::Response& res) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& u : users_->list())

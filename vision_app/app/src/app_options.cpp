@@ -58,7 +58,9 @@ std::string checkThreshold(const std::string& v) {
 }
 
 // Declares the options on `app`, bound to `o` and `raw`; parseAppArgs and
-// appUsage share it, so the help lists exactly what is parsed.
+// appUsage share it, so the help lists exactly what is parsed. Long because
+// it is one declaration per option, in the order --help lists them; it
+// decides nothing.
 void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
   app.set_help_flag("-h,--help", "print this help");
   app.add_option("--config", raw.config_file,
