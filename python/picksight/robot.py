@@ -19,6 +19,13 @@ Transform = namedtuple("Transform", "dx dy rz rms")
 Residual = namedtuple("Residual", "id dx dy distance")
 Exposure = namedtuple("Exposure", "feature value")
 Roi = namedtuple("Roi", "x y width height")
+# The vision settings (VISION): `values` maps each key of the reply, in its
+# order, to its value (int or float for numbers, str for words: "dark",
+# "adaptive", "auto"), so keys a later vision app adds are kept too;
+# `reteach` the models a change left taught under other settings, as the
+# reply names them ("1 (coin) taught as dark on its surface"); `notes` the
+# reply's other remarks (a damaged settings file).
+VisionSettings = namedtuple("VisionSettings", "values reteach notes")
 # A model's tolerances (TOLERANCE): `values` maps each key of the reply, in
 # its order, to its value (float; bool for mirror_symmetric), so keys a later
 # vision app adds are kept too.
@@ -89,6 +96,26 @@ def _status_value(key, text):
         except ValueError:
             pass
     return text
+
+
+def _vision_settings(words):
+    """VISION's reply words: `key=value`..., then ` ; `-separated remarks."""
+    head, *remarks = " ".join(words).split(" ; ")
+    values = {}
+    for word in head.split():
+        key, sep, text = word.partition("=")
+        if not sep:
+            raise ValueError(f"not a key=value field in the VISION reply: {word!r}")
+        try:
+            values[key] = int(text)
+        except ValueError:
+            try:
+                values[key] = float(text)
+            except ValueError:
+                values[key] = text
+    reteach = [r[len("re-teach: "):] for r in remarks if r.startswith("re-teach: ")]
+    notes = [r for r in remarks if not r.startswith("re-teach: ")]
+    return VisionSettings(values, reteach, notes)
 
 
 class RobotClient:
@@ -280,6 +307,28 @@ class RobotClient:
                 except ValueError:
                     values[key] = text  # a later key that is not a number
         return Tolerances(int(words[0]), words[1], values)
+
+    def vision_settings(self, **changes):
+        """Reads the vision settings in force (VISION), or changes some and
+        reads back the values in force: e.g. vision_settings(polarity="light",
+        min_hole_area=150). Keys: polarity ("dark"/"light"), threshold
+        ("adaptive"/"otsu"/"fixed"), level, window, min_area (a number or
+        "auto"), min_hole_area. The vision app checks every pair before any
+        applies: an unknown key or a value out of its bounds is RobotError
+        code 11 naming the key, and nothing changes; a damaged settings file
+        is code 48. Returns a VisionSettings."""
+        line = "VISION"
+        for key, value in changes.items():
+            text = value if isinstance(value, str) else _number(value)
+            if not text or any(c.isspace() for c in text):
+                raise ValueError(f"{key}: one word, got {value!r}")
+            line += f" {key} {text}"
+        return _vision_settings(self.request(line))
+
+    def vision_settings_reset(self):
+        """VISION RESET: the settings in force written over a damaged
+        settings file, which lifts the refusal of LOCATE and LEARN."""
+        return _vision_settings(self.request("VISION RESET"))
 
     def forget(self, part_type):
         self.request(f"FORGET {int(part_type)}")

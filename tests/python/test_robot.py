@@ -139,6 +139,51 @@ def test_tolerances_read_changed_and_refused(cell_factory):
         assert e.value.code == 37 and "nothing to undo" in e.value.text
 
 
+def test_vision_settings_read_changed_refused_and_models_named(cell_factory, tmp_path):
+    scene = Scene(tmp_path)
+    scene.show([(320, 240, 40)])
+    _, vision = cell_factory("--source", f"cam0=file:{scene.path}", "--mode", "trigger")
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        first = robot.vision_settings()
+        assert first.values == {"polarity": "dark", "threshold": "adaptive", "level": 128,
+                                "window": 0, "min_area": "auto", "min_hole_area": 0.0}
+        assert (first.reteach, first.notes) == ([], [])
+        robot.learn(1, "disc")
+        scene.show([(160, 240, 40), (320, 240, 40), (480, 240, 40)])
+        assert len(robot.locate(1)) == 3
+
+        # Several keys at once; numbers and words as the reply gives them.
+        changed = robot.vision_settings(threshold="fixed", level=100, min_area=300.5)
+        assert changed.values["threshold"] == "fixed" and changed.values["level"] == 100
+        assert changed.values["min_area"] == pytest.approx(300.5)
+        # The model lets regions down to the area it was taught with through.
+        assert changed.reteach == ["1 (disc) keeps regions from 50.000 px"]
+        assert robot.vision_settings().values == changed.values
+        assert len(robot.locate(1)) == 3
+
+        # Dark discs on a light surface taken as light parts: the model,
+        # taught as dark, is named; the discs are no longer found.
+        light = robot.vision_settings(polarity="light")
+        assert light.values["polarity"] == "light"
+        assert light.reteach == ["1 (disc) taught as dark on its surface"]
+        assert robot.locate(1) == []
+        with pytest.raises(RobotError) as e:
+            robot.vision_settings(polarity="dark", level=256)
+        assert e.value.code == 11 and "level must be" in e.value.text
+        with pytest.raises(RobotError) as e:
+            robot.vision_settings(wobble=3)
+        assert e.value.code == 11 and "no key 'wobble'" in e.value.text
+        with pytest.raises(ValueError):
+            robot.vision_settings(polarity="dark light")
+        assert robot.vision_settings().values["polarity"] == "light"
+
+        back = robot.vision_settings(polarity="dark", threshold="adaptive", min_area="auto")
+        assert back.values == dict(first.values, level=100)
+        assert back.reteach == []
+        assert len(robot.locate(1)) == 3
+        assert robot.vision_settings_reset().values == robot.vision_settings().values
+
+
 def test_a_whole_set_up_calibrate_teach_grip_pick(cell_factory, tmp_path):
     scene = Scene(tmp_path)
     _, vision = cell_factory("--source", f"cam0=file:{scene.path}", "--mode", "trigger")

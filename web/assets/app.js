@@ -1,6 +1,6 @@
 // PickSight web HMI core: state, HTTP helpers, the live frame with its
 // sensor-pixel mapping, Server-Sent Events, tabs and the rectangle tool.
-// Panels (overlay.js, camera.js, teach.js, calibrate.js) register on
+// Panels (overlay.js, camera.js, vision.js, teach.js, calibrate.js) register on
 // window.picksight; everything runs on the browser's one thread.
 "use strict";
 
@@ -204,16 +204,22 @@
   // ---- the frame: MJPEG stream, or the binarized image on demand ------------
   let binaryTimer = null;
   ps.binaryWanted = false;
+  // The Vision panel's preview: query parameters (polarity, threshold,
+  // level, window) that replace the app's settings in the binarized image;
+  // null when no preview is shown.
+  ps.previewQuery = null;
   function showFrame() {
     const img = $("frame");
     if (binaryTimer) { clearInterval(binaryTimer); binaryTimer = null; }
     if (!ps.camera) { img.removeAttribute("src"); return; }
     // The server binarizes the frame of the app's camera with the settings
     // of its latest result: none before the app's first vision request.
-    const binary = ps.binaryWanted && ps.app && ps.latest[ps.app];
-    $("live-binary-note").textContent = ps.binaryWanted && !binary ? "after the app's first vision request" : "";
+    const wanted = ps.binaryWanted || ps.previewQuery !== null;
+    const binary = wanted && ps.app && ps.latest[ps.app];
+    $("live-binary-note").textContent = wanted && !binary ? "after the app's first vision request" : "";
     if (binary) {
-      const load = () => { img.src = "/binary/" + encodeURIComponent(ps.app) + ".png?t=" + Date.now(); };
+      const query = ps.previewQuery ? ps.previewQuery + "&" : "";
+      const load = () => { img.src = "/binary/" + encodeURIComponent(ps.app) + ".png?" + query + "t=" + Date.now(); };
       load();
       binaryTimer = setInterval(load, 1000);
     } else {
@@ -375,7 +381,7 @@
       if (!result.app) return;
         const first = !ps.latest[result.app];
       ps.latest[result.app] = result;
-      if (first && result.app === ps.app && ps.binaryWanted) showFrame();
+      if (first && result.app === ps.app && (ps.binaryWanted || ps.previewQuery !== null)) showFrame();
       emit("result", result);
     });
   }

@@ -293,7 +293,9 @@ class WebServer::Impl {
   bool onIdle(const std::function<void()>& job, httplib::Response& res);
   void frameJpeg(const std::string& camera, httplib::Response& res);
   void stream(const std::string& camera, httplib::Response& res);
-  void binary(const std::string& app, httplib::Response& res);
+  // The binarized newest frame of `app`'s camera, with the app's latest
+  // settings or those the query gives (the Vision panel's live preview).
+  void binary(const std::string& app, const httplib::Request& req, httplib::Response& res);
   void events(httplib::Response& res);
   void apps(httplib::Response& res);
   std::string metrics();
@@ -679,7 +681,49 @@ void WebServer::Impl::stream(const std::string& camera, httplib::Response& res) 
       [viewer](bool) {});
 }
 
-void WebServer::Impl::binary(const std::string& name, httplib::Response& res) {
+namespace {
+// The query's binarize settings over `options` (polarity=dark|light,
+// threshold=adaptive|otsu|fixed, level=0-255, window=0|8-16384: VISION's
+// keys and bounds); an error names the parameter and what it accepts.
+Result<void> binarizeQuery(const httplib::Request& req, vision::BinarizeOptions& options) {
+  const auto bad = [](const std::string& key, const std::string& accepts) {
+    return makeError(WebErrc::kBadRequest, key + " must be " + accepts);
+  };
+  if (req.has_param("polarity")) {
+    const std::string v = req.get_param_value("polarity");
+    if (v != "dark" && v != "light") return bad("polarity", "dark or light");
+    options.polarity =
+        v == "dark" ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
+  }
+  if (req.has_param("threshold")) {
+    const std::string v = req.get_param_value("threshold");
+    if (v == "adaptive") {
+      options.method = vision::ThresholdMethod::kAdaptive;
+    } else if (v == "otsu") {
+      options.method = vision::ThresholdMethod::kOtsu;
+    } else if (v == "fixed") {
+      options.method = vision::ThresholdMethod::kFixed;
+    } else {
+      return bad("threshold", "adaptive, otsu or fixed");
+    }
+  }
+  if (req.has_param("level")) {
+    const auto n = parseInt(req.get_param_value("level"));
+    if (!n || *n < 0 || *n > 255) return bad("level", "an integer in [0, 255]");
+    options.fixed_threshold = static_cast<int>(*n);
+  }
+  if (req.has_param("window")) {
+    const auto n = parseInt(req.get_param_value("window"));
+    if (!n || (*n != 0 && (*n < 8 || *n > 16384)))
+      return bad("window", "0 or an integer in [8, 16384]");
+    options.adaptive_window = static_cast<int>(*n);
+  }
+  return {};
+}
+}  // namespace
+
+void WebServer::Impl::binary(const std::string& name, const httplib::Request& req,
+                             httplib::Response& res) {
   ResultFeed* app = appOr404(name, res);
   if (!app) return;
   auto result = app->latest();
@@ -700,6 +744,7 @@ void WebServer::Impl::binary(const std::string& name, httplib::Response& res) {
         b.dark_parts() ? vision::Polarity::kDarkOnLight : vision::Polarity::kLightOnDark;
     options.adaptive_window = static_cast<int>(b.window());
   }
+  if (auto query = binarizeQuery(req, options); !query) return sendError(res, query.error());
   std::vector<unsigned char> png;
   bool encoded = false;
   if (!onIdle(
@@ -995,9 +1040,10 @@ void WebServer::Impl::routes() {
   http_->Get(
       R"(/stream/([^/]+)\.mjpg)",
       [this](const httplib::Request& req, httplib::Response& res) { stream(req.matches[1], res); });
-  http_->Get(
-      R"(/binary/([^/]+)\.png)",
-      [this](const httplib::Request& req, httplib::Response& res) { binary(req.matches[1], res); });
+  http_->Get(R"(/binary/([^/]+)\.png)",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               binary(req.matches[1], req, res);
+             });
   http_->Get("/events", [this](const httplib::Request&, httplib::Response& res) { events(res); });
   http_->Get(R"(/api/results/([^/]+)/latest)", [this](const httplib::Request& req,
                                                       httplib::Response& res) {

@@ -67,10 +67,10 @@ def stdout_lines(process, until="ready", timeout=20.0):
 class Cell:
     """The running processes and their endpoints."""
 
-    def __init__(self, data_dir):
+    def __init__(self, data_dir, source=SOURCE):
         self.processes = []
         self.data_dir = Path(data_dir)  # the vision app's: models/type_<N>.yaml
-        server = self._start([bin_path("picksight-video-server"), "--source", SOURCE,
+        server = self._start([bin_path("picksight-video-server"), "--source", source,
                               "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"])
         lines = stdout_lines(server)
         self.frames, self.control = lines["frames"], lines["control"]
