@@ -17,9 +17,9 @@ using namespace picksight;
 using namespace picksight::app;
 
 TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]") {
-  CHECK(robotErrorCode(VisionErrc::kNoTarget) == 1);
-  CHECK(robotErrorCode(VisionErrc::kSeveralTargets) == 2);
-  CHECK(robotErrorCode(VisionErrc::kNotADisc) == 3);
+  CHECK(robotErrorCode(VisionServiceErrc::kNoTarget) == 1);
+  CHECK(robotErrorCode(VisionServiceErrc::kSeveralTargets) == 2);
+  CHECK(robotErrorCode(VisionServiceErrc::kNotADisc) == 3);
   CHECK(robotErrorCode(ProtocolErrc::kUnknownCommand) == 10);
   CHECK(robotErrorCode(ProtocolErrc::kBadArguments) == 11);
   CHECK(robotErrorCode(ProtocolErrc::kRequestTooLong) == 12);
@@ -32,9 +32,9 @@ TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]")
   CHECK(robotErrorCode(CameraErrc::kUnknownFeature) == 22);
   CHECK(robotErrorCode(vision::PartModelErrc::kNoPart) == 30);
   CHECK(robotErrorCode(vision::PartModelErrc::kSeveralParts) == 31);
-  CHECK(robotErrorCode(VisionErrc::kUnknownType) == 32);
+  CHECK(robotErrorCode(VisionServiceErrc::kUnknownType) == 32);
   CHECK(robotErrorCode(ModelErrc::kUnknownType) == 32);
-  CHECK(robotErrorCode(VisionErrc::kStorageFailed) == 33);
+  CHECK(robotErrorCode(VisionServiceErrc::kStorageFailed) == 33);
   CHECK(robotErrorCode(ModelErrc::kStorage) == 33);
   CHECK(robotErrorCode(CellCalibrationErrc::kNoSuchPoint) == 40);
   CHECK(robotErrorCode(calibration::CalibrationErrc::kTooFewPoints) == 41);

@@ -213,7 +213,7 @@ int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string
   }
   auto stored = library.store(learned->model, change + " " + path);
   if (!stored) {
-    out << errorReply(VisionErrc::kStorageFailed,
+    out << errorReply(VisionServiceErrc::kStorageFailed,
                       "cannot store the model: " + stored.error().message)
         << "\n";
     return 1;

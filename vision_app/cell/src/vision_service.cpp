@@ -20,23 +20,23 @@
 
 namespace picksight::app {
 
-const char* errorName(VisionErrc e) {
+const char* errorName(VisionServiceErrc e) {
   switch (e) {
-    case VisionErrc::kNoTarget:
+    case VisionServiceErrc::kNoTarget:
       return "no target";
-    case VisionErrc::kSeveralTargets:
+    case VisionServiceErrc::kSeveralTargets:
       return "several targets";
-    case VisionErrc::kNotADisc:
+    case VisionServiceErrc::kNotADisc:
       return "not a disc";
-    case VisionErrc::kUnknownType:
+    case VisionServiceErrc::kUnknownType:
       return "unknown type";
-    case VisionErrc::kStorageFailed:
+    case VisionServiceErrc::kStorageFailed:
       return "storage failed";
-    case VisionErrc::kOutsideFrame:
+    case VisionServiceErrc::kOutsideFrame:
       return "outside the frame";
-    case VisionErrc::kNoPartInRectangle:
+    case VisionServiceErrc::kNoPartInRectangle:
       return "no part in the rectangle";
-    case VisionErrc::kSeveralPartsInRectangle:
+    case VisionServiceErrc::kSeveralPartsInRectangle:
       return "several parts in the rectangle";
   }
   return "unknown";
@@ -192,9 +192,9 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& ma
                                     const VisionOptions& options) {
   const auto regions =
       vision::findRegions(vision::binarize(grey, options.binarize), options.regions, grey);
-  if (regions.empty()) return makeError(VisionErrc::kNoTarget, "no target found");
+  if (regions.empty()) return makeError(VisionServiceErrc::kNoTarget, "no target found");
   if (regions.size() > 1) {
-    return makeError(VisionErrc::kSeveralTargets,
+    return makeError(VisionServiceErrc::kSeveralTargets,
                      "more than one target found (" + std::to_string(regions.size()) + " regions)");
   }
   const vision::Region& r = regions.front();
@@ -239,7 +239,7 @@ Result<LocateOutcome> VisionService::locate(int type) {
     bool known = false;
     for (const auto& m : *models) known = known || m.type == type;
     if (!known)
-      return makeError(VisionErrc::kUnknownType,
+      return makeError(VisionServiceErrc::kUnknownType,
                        "no model for type " + std::to_string(type) + " (see MODELS)");
   }
   const auto settings = requestSettings();
@@ -253,7 +253,7 @@ Result<LocateOutcome> VisionService::locate(int type) {
 Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
                                           const std::optional<cv::Rect>& at,
                                           std::string_view change) {
-  if (!models_) return makeError(VisionErrc::kStorageFailed, "no model library");
+  if (!models_) return makeError(VisionServiceErrc::kStorageFailed, "no model library");
   const auto settings = requestSettings();
   if (!settings) return settings.error();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -264,7 +264,7 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
   if (!learned) return learned.error();
   auto stored = models_->store(learned->model, change);
   if (!stored)
-    return makeError(VisionErrc::kStorageFailed,
+    return makeError(VisionServiceErrc::kStorageFailed,
                      "cannot store the model: " + stored.error().message);
   return learned;
 }
@@ -465,7 +465,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     }
   }
   if (rect.empty()) {
-    return makeError(VisionErrc::kOutsideFrame,
+    return makeError(VisionServiceErrc::kOutsideFrame,
                      "LEARN AT " + sensorRectText(*at) +
                          ": the rectangle holds no pixel of the frame (sensor " +
                          sensorRectText(mapping.boxToSensor(cv::Rect({0, 0}, grey.size()))) + ")");
@@ -481,7 +481,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     const auto inside = regionsInside(regions, rect);
     if (inside.empty()) {
       if (!at) return makeError(vision::PartModelErrc::kNoPart, "no part in the frame");
-      return makeError(VisionErrc::kNoPartInRectangle,
+      return makeError(VisionServiceErrc::kNoPartInRectangle,
                        "no part inside LEARN AT " + sensorRectText(*at));
     }
     const LearnRegions seen = sortForLearn(regions, inside);
@@ -495,7 +495,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
                 "around one; offline: learn --at <x> <y> <w> <h>)");
       }
       return makeError(
-          VisionErrc::kSeveralPartsInRectangle,
+          VisionServiceErrc::kSeveralPartsInRectangle,
           count + " inside LEARN AT " + sensorRectText(*at) + ", it needs exactly one");
     }
     const vision::Region& r = regions[seen.part];

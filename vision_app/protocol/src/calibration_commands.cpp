@@ -50,7 +50,7 @@ std::string calcamGrid(const Request& r, VisionService& vision, CellCalibration&
   auto frame = vision.greyFrame();
   if (!frame) return reply(frame.error());
   auto grid = calibration::measureDotGrid(frame->first, (*pitch)[0]);
-  if (!grid) return errorReply(VisionErrc::kNotADisc, grid.error().message);
+  if (!grid) return errorReply(VisionServiceErrc::kNotADisc, grid.error().message);
   // Fitted in sensor pixels, where the vision frame starts.
   const SensorMapping& mapping = frame->second;
   std::vector<cv::Point2d> sensor;
@@ -69,7 +69,7 @@ std::string calcamGrid(const Request& r, VisionService& vision, CellCalibration&
       refit_lens ? std::optional<cv::Size>(frame->first.size()) : std::nullopt);
   if (model && refit_lens && !model->lens && stored)
     model = calibration::fitDotGrid(sensor, grid->indices, (*pitch)[0], stored, std::nullopt);
-  if (!model) return errorReply(VisionErrc::kNotADisc, model.error().message);
+  if (!model) return errorReply(VisionServiceErrc::kNotADisc, model.error().message);
   if (auto ok = calibration.setGridCalibration(model->scale, model->lens); !ok)
     return reply(ok.error());
   return "OK " + formatFixed(model->scale.mm_per_px_x, 6) + " " +
@@ -85,12 +85,12 @@ std::string calcam(const Request& r, VisionService& vision, CellCalibration& cal
   auto target = vision.target();
   if (!target) return reply(target.error());
   if (!looksLikeDisc(target->moments))
-    return errorReply(VisionErrc::kNotADisc,
+    return errorReply(VisionServiceErrc::kNotADisc,
                       "the target is not a disc (check the target and the lighting)");
   auto disc = measuredDisc(*target);
-  if (!disc) return errorReply(VisionErrc::kNotADisc, disc.error().message);
+  if (!disc) return errorReply(VisionServiceErrc::kNotADisc, disc.error().message);
   auto scale = calibration::scaleFromDisc(*disc, (*radius)[0]);
-  if (!scale) return errorReply(VisionErrc::kNotADisc, scale.error().message);
+  if (!scale) return errorReply(VisionServiceErrc::kNotADisc, scale.error().message);
   if (auto ok = calibration.setScale(*scale); !ok) return reply(ok.error());
   return "OK " + formatFixed(scale->mm_per_px_x, 6) + " " + formatFixed(scale->mm_per_px_y, 6);
 }

@@ -71,7 +71,7 @@ std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
     return errorReply(ProtocolErrc::kBadArguments, usage);
   }
   if (!modelExists(cell.vision, *type)) {
-    return errorReply(VisionErrc::kUnknownType,
+    return errorReply(VisionServiceErrc::kUnknownType,
                       "no model for type " + std::to_string(*type) + " (see MODELS, LEARN)");
   }
   ModelLibrary& library = *cell.vision.models();
@@ -110,8 +110,9 @@ std::string editGrasp(const Request& r, CellContext& cell, bool gripper) {
   auto ok = library.setGrasp(*type, setup, r.line);
   if (!ok) {
     if (ok.error().code == ModelErrc::kUnknownType)
-      return errorReply(VisionErrc::kUnknownType, ok.error().message);
-    return errorReply(VisionErrc::kStorageFailed, "cannot store the model: " + ok.error().message);
+      return errorReply(VisionServiceErrc::kUnknownType, ok.error().message);
+    return errorReply(VisionServiceErrc::kStorageFailed,
+                      "cannot store the model: " + ok.error().message);
   }
   const size_t count = gripper ? setup.gripper.fingers.size() : setup.styles.size();
   return "OK " + std::to_string(count);

@@ -257,7 +257,8 @@ std::string tolerance(VisionService& vision, const Request& r) {
     changes.emplace_back(key, *value);
   }
   const auto no_model = [&] {
-    return errorReply(VisionErrc::kUnknownType, "no model for type " + std::to_string(*type));
+    return errorReply(VisionServiceErrc::kUnknownType,
+                      "no model for type " + std::to_string(*type));
   };
   if (!vision.models()) return no_model();
   if (changes.empty()) {
@@ -341,12 +342,13 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
           "FORGET: type must be an integer in [0, 9999], got '" + printable(r.args[0]) + "'");
     }
     if (!vision.models())
-      return errorReply(VisionErrc::kUnknownType, "no model for type " + std::to_string(*type));
+      return errorReply(VisionServiceErrc::kUnknownType,
+                        "no model for type " + std::to_string(*type));
     auto removed = vision.models()->remove(*type, r.line);
     if (!removed) {
       return errorReply(removed.error().code == ModelErrc::kUnknownType
-                            ? VisionErrc::kUnknownType
-                            : VisionErrc::kStorageFailed,
+                            ? VisionServiceErrc::kUnknownType
+                            : VisionServiceErrc::kStorageFailed,
                         removed.error().message);
     }
     return std::string("OK");

@@ -28,9 +28,10 @@ namespace picksight::app {
 
 class ScaledModelCache;
 
-// Why a vision request failed (besides the camera link's CameraErrc and
-// training's vision::PartModelErrc).
-enum class VisionErrc {
+// Why a request VisionService serves failed (besides the camera link's
+// CameraErrc and training's vision::PartModelErrc). Its domain keeps the
+// name "vision" it has always had in messages.
+enum class VisionServiceErrc {
   kNoTarget = 1,             // STORE, CALCAM: no target in the frame
   kSeveralTargets,           // STORE, CALCAM: more than one
   kNotADisc,                 // CALCAM: the target is not a disc
@@ -40,8 +41,8 @@ enum class VisionErrc {
   kNoPartInRectangle,        // LEARN AT: no part inside the rectangle
   kSeveralPartsInRectangle,  // LEARN AT: more than one
 };
-const char* errorName(VisionErrc e);
-PICKSIGHT_ERROR_DOMAIN(VisionErrc, "vision")
+const char* errorName(VisionServiceErrc e);
+PICKSIGHT_ERROR_DOMAIN(VisionServiceErrc, "vision")
 
 struct LocatedPart {
   double x = 0;  // sensor pixels
@@ -206,7 +207,7 @@ class VisionService {
   void stop();
 
   // The parts of `type` (-1: of every trained type) in a frame taken after
-  // this call (every region when no model exists; VisionErrc::kUnknownType
+  // this call (every region when no model exists; VisionServiceErrc::kUnknownType
   // when models exist but none of `type`).
   Result<LocateOutcome> locate(int type);
   // Trains type `type` from the single part in a fresh frame (inside `at`,
@@ -293,4 +294,4 @@ class VisionService {
 
 }  // namespace picksight::app
 
-PICKSIGHT_ERROR_ENUM(picksight::app::VisionErrc)
+PICKSIGHT_ERROR_ENUM(picksight::app::VisionServiceErrc)
