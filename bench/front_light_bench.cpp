@@ -92,6 +92,10 @@ struct Row {
   int angles = 0;
   std::vector<double> locate_ms;
   std::vector<double> plain_ms;
+  // --stages: the vision pass's first two stages alone, on the same image.
+  std::vector<double> binarize_ms;
+  std::vector<double> regions_ms;
+  std::vector<double> uncut_ms;  // the region pass without cutting shadows
 };
 
 // The frame a camera delivers: lossless, or through JPEG.
@@ -193,6 +197,7 @@ int main(int argc, char** argv) {
   int jpeg_quality = 0;
   bool standard_types = false;
   bool list_errors = false;
+  bool stages = false;
   std::string save_frames;
   bool keep_shadows = false;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
@@ -220,6 +225,9 @@ int main(int argc, char** argv) {
                "the 15 types of picksight-bench-silhouettes instead of unseen ones");
   app.add_flag("--list-errors", list_errors,
                "print each false report, each part missed and each placed over 0.2 px off");
+  app.add_flag("--stages", stages,
+               "also time binarization and the region pass alone (medians, ms): where the time "
+               "goes");
   app.add_flag("--keep-shadows", keep_shadows,
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
                "costs)");
@@ -355,6 +363,23 @@ int main(int argc, char** argv) {
                                              sink += picksight::bench::competentOpenCvPass(grey);
                                            }},
                                           {&row.locate_ms, &row.plain_ms});
+          if (stages && !models->empty()) {
+            // As locateInFrame prepares them: the vision image (a colour
+            // frame projected on the taught colours) and the frame's options.
+            const cv::Mat grey = pa::visionImage(frame, *models);
+            const pa::VisionOptions o =
+                pa::frameOptions(options, frame.mapping, grey.size(), *models);
+            cv::Mat mask;
+            row.binarize_ms.push_back(
+                picksight::bench::elapsedMs([&] { mask = pv::binarize(grey, o.binarize); }));
+            std::vector<pv::Region> regions;
+            row.regions_ms.push_back(picksight::bench::elapsedMs(
+                [&] { regions = pv::findRegions(mask, o.regions, grey); }));
+            pv::RegionOptions uncut = o.regions;
+            uncut.cut_shadows = false;
+            row.uncut_ms.push_back(
+                picksight::bench::elapsedMs([&] { regions = pv::findRegions(mask, uncut, grey); }));
+          }
           if (list_errors)
             std::printf("  %s %s scene %d round %d:\n", condition.c_str(), name.c_str(), n, r);
           score(scene.truth(), outcome.parts, type_of_model, reference, list_errors, specs, row);
@@ -389,6 +414,22 @@ int main(int argc, char** argv) {
       "size confusion); position RMS <= 0.05 px (<= 0.1 beside shadows, <= 0.03 clean); angle RMS "
       "<= 0.05 deg; LOCATE median <= 10 ms, p99 <= 20 ms (times here: the vision pass in process, "
       "ms, beside the plain OpenCV pass)\n");
+  if (stages) {
+    std::printf(
+        "\nwhere the time goes (medians, ms): binarize, regions (shadows cut), of which "
+        "cutting shadows (regions less the pass without), the rest of the vision pass "
+        "(recognition, blob search)\n");
+    std::printf("%-13s %-10s %8s %8s %8s %8s %8s\n", "condition", "arrange", "binarize", "regions",
+                "shadows", "rest", "plain");
+    for (const auto& r : rows) {
+      const double b = picksight::bench::nearestRank(r.binarize_ms, 50);
+      const double g = picksight::bench::nearestRank(r.regions_ms, 50);
+      std::printf("%-13s %-10s %8.2f %8.2f %8.2f %8.2f %8.2f\n", r.condition.c_str(),
+                  r.arrangement.c_str(), b, g, g - picksight::bench::nearestRank(r.uncut_ms, 50),
+                  picksight::bench::nearestRank(r.locate_ms, 50) - b - g,
+                  picksight::bench::nearestRank(r.plain_ms, 50));
+    }
+  }
   for (const auto& r : rows) {
     if (r.arrangement == rows.front().arrangement && !r.first_refusal.empty()) {
       std::printf("  %s: LEARN first refused with \"%s\"\n", r.condition.c_str(),

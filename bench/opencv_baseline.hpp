@@ -66,6 +66,13 @@ inline double nearestRank(std::vector<double> samples, double p) {
   return samples[std::min(samples.size(), std::max<size_t>(rank, 1)) - 1];
 }
 
+// The milliseconds `pass` takes, once.
+inline double elapsedMs(const std::function<void()>& pass) {
+  const auto t0 = std::chrono::steady_clock::now();
+  pass();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // Times `passes` on one frame, each into its own list of milliseconds, the
 // one that runs first turning with `turn` (the frame's index): a pass that
 // always ran first would pay for cold caches, or always profit from warm ones.

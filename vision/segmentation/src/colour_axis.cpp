@@ -14,6 +14,8 @@ constexpr double kMinColourDistance = 20;
 // ... or closer than this many times the rim's own spread (its texture and
 // noise).
 constexpr double kMinDistanceOverSpread = 3;
+// Colour axes whose ends are this close (BGR distance) project alike.
+constexpr double kSameAxis = 6;
 // A rectangle narrower than this holds no part with a rim around it.
 constexpr int kMinSide = 8;
 
@@ -45,7 +47,21 @@ cv::Vec3d medianColour(std::vector<cv::Vec3b>& pixels, double* spread) {
 cv::Mat projectOnColourAxes(const cv::Mat& bgr, const std::vector<ColourAxis>& axes) {
   CV_Assert(bgr.type() == CV_8UC3);
   cv::Mat out;
+  // Each projection costs a pass over the frame's three channels (3-4 ms at
+  // 1920x1080), and a cell teaches many types of one colour on one surface:
+  // fifteen such axes cost 50 ms a frame. Axes whose two ends lie within
+  // kSameAxis of an axis already projected give the same levels to within
+  // a few grey levels, and are not projected again.
+  std::vector<const ColourAxis*> distinct;
   for (const auto& axis : axes) {
+    const bool seen = std::any_of(distinct.begin(), distinct.end(), [&](const ColourAxis* a) {
+      return cv::norm(a->part - axis.part) <= kSameAxis &&
+             cv::norm(a->background - axis.background) <= kSameAxis;
+    });
+    if (!seen) distinct.push_back(&axis);
+  }
+  for (const ColourAxis* each : distinct) {
+    const ColourAxis& axis = *each;
     const cv::Vec3d d = axis.background - axis.part;
     const double d2 = d.dot(d);
     if (d2 <= 0) continue;

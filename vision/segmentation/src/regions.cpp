@@ -84,6 +84,7 @@ constexpr double kMaxBandTail = 0.01;
 // better than 8. On a plane and noise it would only add noise (0.0127 px
 // instead of 0.0102 on the clean scenes), hence the test.
 constexpr int kLocalRadiusPx = 8;
+constexpr int kLocalCellPx = 4;
 constexpr float kLocalMinPixels = 6;
 constexpr int kLocalDepthPx = 3;
 constexpr int kDepartureTilePx = 16;
@@ -661,35 +662,61 @@ double departure(const cv::Mat& grey, const RowRuns& ring, Keep&& keep, const cv
 }
 
 // The mean level of the pixels of `ring` that `keep(y, x, level)` within
-// kLocalRadiusPx of each pixel of `grey` (box coordinates) into `levels`
-// (CV_32F), where at least kLocalMinPixels are; a value already set there
-// (>= 0, beside a shadow) is kept, and -1 marks the pixels left to the plane.
+// about kLocalRadiusPx of each pixel of `band` (box coordinates of `grey`),
+// into `levels` (CV_32F over the box, made with -1 everywhere when empty),
+// where at least kLocalMinPixels are near; a value already set there (>= 0,
+// beside a shadow) is kept. The sums are made on a grid of kLocalCellPx
+// cells, summed over the cells around and interpolated between cell centres:
+// the level beside an edge changes over several pixels, and full-size sums
+// over the box cost more than the rest of the region's reading.
 template <class Keep>
-void localLevels(const cv::Mat& grey, const RowRuns& ring, Keep&& keep, cv::Mat* levels) {
-  cv::Mat weight = cv::Mat::zeros(grey.size(), CV_32F);
-  cv::Mat level = cv::Mat::zeros(grey.size(), CV_32F);
+void localLevels(const cv::Mat& grey, const RowRuns& ring, Keep&& keep, const RowRuns& band,
+                 cv::Mat* levels) {
+  const int columns = (grey.cols + kLocalCellPx - 1) / kLocalCellPx;
+  const int rows = (grey.rows + kLocalCellPx - 1) / kLocalCellPx;
+  cv::Mat count = cv::Mat::zeros(rows, columns, CV_32F);
+  cv::Mat sum = cv::Mat::zeros(rows, columns, CV_32F);
   ring.forEachRun([&](int y, int a, int b) {
     const uint8_t* g = grey.ptr<uint8_t>(y);
-    float* w = weight.ptr<float>(y);
-    float* l = level.ptr<float>(y);
+    float* n = count.ptr<float>(y / kLocalCellPx);
+    float* v = sum.ptr<float>(y / kLocalCellPx);
     for (int x = a; x < b; ++x) {
       if (!keep(y, x, g[x])) continue;
-      w[x] = 1;
-      l[x] = g[x];
+      n[x / kLocalCellPx] += 1;
+      v[x / kLocalCellPx] += g[x];
     }
   });
-  const cv::Size window(2 * kLocalRadiusPx + 1, 2 * kLocalRadiusPx + 1);
-  cv::boxFilter(weight, weight, -1, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-  cv::boxFilter(level, level, -1, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  constexpr int kCells = 2 * (kLocalRadiusPx / kLocalCellPx) + 1;
+  cv::boxFilter(count, count, -1, cv::Size(kCells, kCells), cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
+  cv::boxFilter(sum, sum, -1, cv::Size(kCells, kCells), cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
   if (levels->empty()) *levels = cv::Mat(grey.size(), CV_32F, cv::Scalar(-1));
-  for (int y = 0; y < grey.rows; ++y) {
-    const float* w = weight.ptr<float>(y);
-    const float* l = level.ptr<float>(y);
+  band.forEachRun([&](int y, int a, int b) {
     float* o = levels->ptr<float>(y);
-    for (int x = 0; x < grey.cols; ++x) {
-      if (o[x] < 0 && w[x] >= kLocalMinPixels) o[x] = l[x] / w[x];
+    // Between the centres of the cells above and below, left and right.
+    const float fy = std::clamp((y + 0.5f) / kLocalCellPx - 0.5f, 0.0f, rows - 1.0f);
+    const int y0 = static_cast<int>(fy);
+    const int y1 = std::min(y0 + 1, rows - 1);
+    const float wy = fy - y0;
+    const float* n0 = count.ptr<float>(y0);
+    const float* n1 = count.ptr<float>(y1);
+    const float* v0 = sum.ptr<float>(y0);
+    const float* v1 = sum.ptr<float>(y1);
+    for (int x = a; x < b; ++x) {
+      if (o[x] >= 0) continue;
+      const float fx = std::clamp((x + 0.5f) / kLocalCellPx - 0.5f, 0.0f, columns - 1.0f);
+      const int x0 = static_cast<int>(fx);
+      const int x1 = std::min(x0 + 1, columns - 1);
+      const float wx = fx - x0;
+      const auto at = [&](const float* top, const float* bottom) {
+        return (1 - wy) * ((1 - wx) * top[x0] + wx * top[x1]) +
+               wy * ((1 - wx) * bottom[x0] + wx * bottom[x1]);
+      };
+      const float n = at(n0, n1);
+      if (n >= kLocalMinPixels) o[x] = at(v0, v1) / n;
     }
-  }
+  });
 }
 
 // On an uneven surface, reads the band of `kept` again against the levels
@@ -713,8 +740,8 @@ bool readLocally(int reach, const RowRuns& interior, Dilations& dilations, BandP
   const bool surface = departure(pixels->grey, outside, free, r.plane) > kDeparture;
   const bool part = departure(pixels->grey, inside, like_part, r.part) > kDeparture;
   if (!surface && !part) return false;
-  if (surface) localLevels(pixels->grey, outside, free, &pixels->local);
-  if (part) localLevels(pixels->grey, inside, like_part, &pixels->local_part);
+  if (surface) localLevels(pixels->grey, outside, free, kept->band, &pixels->local);
+  if (part) localLevels(pixels->grey, inside, like_part, kept->band, &pixels->local_part);
   BandReading reading = *kept;
   reading.sums = Moments10{};
   interior.forEachRun([&](int y, int a, int b) { reading.sums.addRun(a, b, y); });
