@@ -247,7 +247,9 @@ Result<LocateOutcome> VisionService::locate(int type) {
   std::lock_guard<std::mutex> lock(mutex_);
   auto frame = freshFrame();
   if (!frame) return frame.error();
-  return locateInFrame(**frame, **settings, models, type, scaled_models_.get());
+  auto outcome = locateInFrame(**frame, **settings, models, type, scaled_models_.get());
+  outcome.settings = *settings;
+  return outcome;
 }
 
 Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
@@ -291,6 +293,7 @@ Result<TryLearnOutcome> VisionService::tryLearn(int type, const std::string& nam
   // No cache: a list that is not the library's would evict the scaled models
   // LOCATE keeps.
   out.located = locateInFrame(**frame, **settings, std::move(models), -1, nullptr);
+  out.located.settings = *settings;
   for (const auto& p : out.located.parts) out.found += p.type == type ? 1 : 0;
   out.learned = std::move(*learned);
   return out;

@@ -158,7 +158,9 @@ std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int ty
   auto record = std::make_shared<RequestRecord>();
   record->request = "LOCATE";
   record->asked_type = type;
-  record->options = options;
+  // The settings the location ran with: a VISION change may have come
+  // between it and this record.
+  record->options = located && located->outcome.settings ? *located->outcome.settings : options;
   if (located) {
     record->locate = std::move(located->outcome);
     // Nothing published or explained reads the mask: a connection's last

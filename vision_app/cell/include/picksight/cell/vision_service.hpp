@@ -77,10 +77,16 @@ struct LocateScene {
   std::vector<ScreenedRegion> screened_out;
 };
 
+struct VisionOptions;
+
 struct LocateOutcome {
   FrameInfo frame;
   std::vector<LocatedPart> parts;  // best (or largest) first
   LocateScene scene;
+  // The vision settings it ran with (VisionService: the snapshot it read;
+  // null from locateInFrame alone): what its record publishes, whatever
+  // VISION changed since.
+  std::shared_ptr<const VisionOptions> settings;
 };
 
 // The single calibration target in a frame, in sensor pixels.

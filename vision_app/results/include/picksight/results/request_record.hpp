@@ -86,7 +86,9 @@ class RequestRecord {
 
 // A LOCATE's record (robot port or PLC trigger), the outcome moved in
 // (`located` may be an error); the caller fills in the request line and
-// the client, the reply and the time once they are known.
+// the client, the reply and the time once they are known. Its settings are
+// those the location ran with when it says (LocateOutcome::settings), else
+// `options`.
 std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
                                             const VisionOptions& options);
 
