@@ -115,7 +115,7 @@ def test_vision_panel_previews_and_applies_polarity_without_restart(cell, browse
     assert browser.driver.find_element(By.ID, "vision-level-text").text == "120"
     assert low - high > 0.5
     Select(browser.driver.find_element(By.ID, "vision-threshold")).select_by_value("adaptive")
-    browser.screenshot("vision_panel_preview")
+    browser.screenshot("vision-preview")
 
     # Apply: the app's settings now, stored; the next LOCATE finds the discs
     # and the hint goes away.
@@ -131,7 +131,7 @@ def test_vision_panel_previews_and_applies_polarity_without_restart(cell, browse
     wait_until(lambda: browser.js("return document.getElementById('vision-polarity-hint').hidden"),
                what="the hint gone")
     assert browser.js("return document.getElementById('live-polarity-hint').hidden")
-    browser.screenshot("vision_panel_applied")
+    browser.screenshot("vision-applied")
 
     # A bad value is refused naming the key, the field kept for correcting.
     set_field(browser, "vision-min-hole-area", "-5")
