@@ -151,6 +151,22 @@ TEST_CASE("VISION polarity light finds light parts on a dark table without a res
   CHECK_THAT(file, Catch::Contains("\"format\": \"picksight-vision-settings\""));
   CHECK_THAT(file, Catch::Contains("\"polarity\": \"light\""));
 
+  // The offline tool on the same data dir reads them too, its own options
+  // winning.
+  const auto offline = [&](const std::vector<std::string>& args) {
+    std::vector<std::string> argv = {binPath("picksight-vision"), "locate", "--data-dir",
+                                     cell.data_dir};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.push_back(cell.scene.path);
+    return run(argv);
+  };
+  const auto light_offline = offline({});
+  CHECK(light_offline.exit_code == 0);
+  CHECK(located(light_offline.out) == 6);
+  const auto dark_offline = offline({"--polarity", "dark"});
+  CHECK(dark_offline.exit_code == 0);
+  CHECK(located(dark_offline.out) == 1);
+
   // Stored: a restarted app has it. Several keys at once, in any case.
   cell.restart();
   CHECK(cell.ask("VISION") == kLight);
@@ -268,7 +284,16 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
       CHECK_THAT(refused, Catch::EndsWith("repair it and restart, or VISION RESET"));
     }
     CHECK(readText(cell.settings_file) == damaged[i]);
+    // The offline tool on that data dir refuses too, whatever it is given.
+    const auto offline = run({binPath("picksight-vision"), "locate", "--data-dir", cell.data_dir,
+                              "--polarity", "light", cell.scene.path});
+    CHECK(offline.exit_code == 2);
+    CHECK(offline.out.empty());
   }
+  // A bad value is refused even where the command line overrides it.
+  writeText(cell.settings_file, damaged[1]);
+  cell.restart({"--polarity", "light"});
+  CHECK_THAT(cell.ask("LOCATE ALL"), Catch::StartsWith("ERROR 48 "));
   // Repaired by hand: in force at the next start.
   writeText(cell.settings_file, good);
   cell.restart();

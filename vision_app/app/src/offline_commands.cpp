@@ -11,6 +11,8 @@
 #include "picksight/calibration/camera_calibration.hpp"
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/cell/vision_settings.hpp"
+#include "picksight/common/atomic_file.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/command_table.hpp"
@@ -36,8 +38,9 @@ std::string offlineUsage() {
          "  lens    calibrates the lens from chessboard views (inner corners, square size)\n"
          "          into DATA_DIR/calibration.yaml: 'OK fx fy cx cy rms_px views'; stop the\n"
          "          vision app first, it reads the file at start\n"
-         "Options: --data-dir DIR, --threshold, --polarity, --window, --min-area as in server "
-         "mode.\n";
+         "Options: --data-dir DIR, --threshold, --polarity, --window, --min-area, "
+         "--min-hole-area as in server mode; DATA_DIR/vision.json (VISION) supplies those "
+         "not given.\n";
 }
 
 bool isOfflineCommand(const std::vector<std::string>& args) {
@@ -231,7 +234,23 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   if (args[0] == "lens") return runLens(args, out, err);
   auto parsed = parseOfflineRequest(args, err);
   if (const int* status = std::get_if<int>(&parsed)) return *status;
-  const OfflineRequest& r = std::get<OfflineRequest>(parsed);
+  OfflineRequest& r = std::get<OfflineRequest>(parsed);
+  // The vision settings the data dir's vision app runs with (VISION), the
+  // options given here winning, as at its start; a damaged file is refused.
+  const std::string settings_file = r.options.data_dir + "/vision.json";
+  if (std::error_code ec; std::filesystem::exists(settings_file, ec)) {
+    auto text = readFile(settings_file);
+    auto settings =
+        text ? parseVisionSettingsJson(*text, r.options.vision, r.options.vision_settings_given)
+             : Result<VisionOptions>(text.error());
+    if (!settings) {
+      err << "picksight-vision " << r.command << ": " << settings_file << ": "
+          << settings.error().message
+          << " (repair it, or VISION RESET on the vision app of that data dir)\n";
+      return 2;
+    }
+    r.options.vision = std::move(*settings);
+  }
   ModelLibrary library(r.options.data_dir + "/models");
   for (const auto& problem : library.load())
     err << "picksight-vision: model rejected: " << problem << "\n";

@@ -235,10 +235,10 @@ Result<VisionOptions> parseVisionSettingsJson(const std::string& text, VisionOpt
   if (!j.contains("version") || !j["version"].is_number_integer() || j["version"] != kVersion)
     return damaged("version is not " + std::to_string(kVersion));
   std::vector<std::pair<std::string, std::string>> pairs;
+  std::vector<std::pair<std::string, std::string>> used;  // those `keep` leaves
   for (const auto& [name, value] : j.items()) {
     if (name == "format" || name == "version") continue;
     if (!findKey(name)) return damaged("no key '" + printableText(name) + "'");
-    if (std::find(keep.begin(), keep.end(), name) != keep.end()) continue;
     if (value.is_string()) {
       pairs.emplace_back(name, value.get<std::string>());
     } else if (value.is_number_integer()) {
@@ -248,8 +248,12 @@ Result<VisionOptions> parseVisionSettingsJson(const std::string& text, VisionOpt
     } else {
       return damaged(name + " is neither a string nor a number");
     }
+    if (std::find(keep.begin(), keep.end(), name) == keep.end()) used.push_back(pairs.back());
   }
-  auto applied = applyVisionSettings(std::move(base), pairs);
+  // Every value checked, those the command line overrides too: a file
+  // that is wrong is wrong whatever overrides it today.
+  if (auto all = applyVisionSettings(base, pairs); !all) return damaged(all.error().message);
+  auto applied = applyVisionSettings(std::move(base), used);
   if (!applied) return damaged(applied.error().message);
   return applied;
 }
