@@ -14,12 +14,12 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/frame.hpp"
 #include "picksight/store/model_file.hpp"
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/recognition/recognition_pass.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 
 using namespace picksight;
@@ -184,7 +184,7 @@ TEST_CASE("LOCATE's smallest region follows the taught parts unless the user set
   }
   CHECK(followed.scene.regions.size() == 1);
   CHECK(set.scene.regions.size() >= 13);  // and any speck of the belt itself
-  CHECK(speckAreaFor(*models) == Approx(0.05 * learned->model.body.area));
+  CHECK(vision::speckAreaFor(*models) == Approx(0.05 * learned->model.body.area));
 }
 
 TEST_CASE("a green part on a grey belt of the same brightness is taught and found in colour",

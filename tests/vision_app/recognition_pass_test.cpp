@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "../vision/drawn_parts.hpp"
-#include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/results/request_record.hpp"
+#include "picksight/vision/recognition/recognition_pass.hpp"
 
 using namespace picksight;
 using namespace picksight::app;
@@ -107,12 +107,12 @@ TEST_CASE("the cell's region settings are the smallest of its own and its models
   models[0].min_region_area = 80;
   models[1].min_hole_area = 10;
   models[1].min_region_area = 0;  // an old file: not recorded
-  const auto o = regionOptionsFor(cell, models);
+  const auto o = vision::regionOptionsFor(cell, models);
   CHECK(o.min_hole_area == 10);
   CHECK(o.min_area == 50);
   models[1].min_region_area = 20;
-  CHECK(regionOptionsFor(cell, models).min_area == 20);
-  CHECK(regionOptionsFor(cell, {}).min_hole_area == 30);
+  CHECK(vision::regionOptionsFor(cell, models).min_area == 20);
+  CHECK(vision::regionOptionsFor(cell, {}).min_hole_area == 30);
 }
 
 TEST_CASE("LOCATE of one type does not report a part clearly closer to another type",

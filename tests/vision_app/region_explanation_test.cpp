@@ -16,11 +16,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "../vision/drawn_parts.hpp"
-#include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/frame.hpp"
 #include "picksight/results/request_record.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/recognition/recognition_pass.hpp"
 #include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/training/part_training.hpp"
@@ -120,8 +120,8 @@ TEST_CASE("explanations agree with recognition on every separated region",
     const ps::SilhouetteScene scene(types, chiral, o);
     const cv::Mat grey = scene.render(0);
     const auto regions =
-        pv::findRegions(pv::binarize(grey, binarize), app::regionOptionsFor({}, models), grey);
-    const auto pass = app::recognizeParts(regions, models, -1);
+        pv::findRegions(pv::binarize(grey, binarize), pv::regionOptionsFor({}, models), grey);
+    const auto pass = pv::recognizeParts(regions, models, -1);
     for (size_t i = 0; i < regions.size(); ++i) {
       const pv::Region& region = regions[i];
       const ps::SilhouettePart* drawn = drawnAt(scene, region.centroid);

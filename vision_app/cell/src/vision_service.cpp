@@ -8,11 +8,11 @@
 #include <cmath>
 #include <filesystem>
 
-#include "picksight/cell/recognition_pass.hpp"
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/common/text.hpp"
+#include "picksight/vision/recognition/recognition_pass.hpp"
 #include "picksight/vision/recognition/recognizer.hpp"
 #include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/colour_axis.hpp"
@@ -69,9 +69,9 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
   LocateScene local;
   LocateScene& s = scene ? *scene : local;
   s.mask = vision::binarize(grey, options.binarize);
-  vision::RegionOptions region_options = regionOptionsFor(options.regions, models);
+  vision::RegionOptions region_options = vision::regionOptionsFor(options.regions, models);
   if (options.min_area_follows_models) {
-    region_options.min_area = std::max(region_options.min_area, speckAreaFor(models));
+    region_options.min_area = std::max(region_options.min_area, vision::speckAreaFor(models));
   }
   s.regions = vision::findRegions(s.mask, region_options, grey);
   s.mapping = mapping;
@@ -96,7 +96,7 @@ std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping&
   // LOCATE <type> costs the work of that type's models alone (and a cheap
   // screen across the others); LOCATE ALL lets every model compete for
   // every region, so that a part is reported as the type that explains it best.
-  const RecognitionPass pass = recognizeParts(regions, models, type);
+  const vision::RecognitionPass pass = vision::recognizeParts(regions, models, type);
   for (const auto& out : pass.screened_out)
     s.screened_out.push_back({static_cast<int>(out.region), out.closer->type});
   for (const auto& match : pass.matches) {

@@ -1,6 +1,6 @@
 // Recognition pass: the asked models' recognition (each with its own
 // minimum hole area), and the screen of `LOCATE <type>` across every type.
-#include "picksight/cell/recognition_pass.hpp"
+#include "picksight/vision/recognition/recognition_pass.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "picksight/vision/recognition/region_judge.hpp"
 #include "picksight/vision/segmentation/blob_features.hpp"
 
-namespace picksight::app {
+namespace picksight::vision {
 namespace {
 // A part of the asked type is screened out when another type's model is
 // closer on the Hu distance (each in units of its model's tolerance) by
@@ -19,26 +19,25 @@ namespace {
 constexpr double kCloserFactor = 2.0 / 3;
 constexpr double kCloserMargin = 0.1;
 
-double normalizedHu(const vision::PartModel& m, const vision::HuArray& log_hu) {
-  return vision::huDistance(m.body, log_hu) / std::max(m.body.hu_tolerance, 1e-12);
+double normalizedHu(const PartModel& m, const HuArray& log_hu) {
+  return huDistance(m.body, log_hu) / std::max(m.body.hu_tolerance, 1e-12);
 }
 
 // The screen of one part of the asked type against the other types' models:
 // the closest model of another type whose body tests (judgeBody: holes,
 // area, Hu distance, the recognizer's own) the region passes, when it is
 // clearly closer than the asked one.
-std::optional<ScreenedOut> screen(const vision::Match& match, const vision::Region& region,
-                                  const std::vector<const vision::PartModel*>& others) {
+std::optional<ScreenedOut> screen(const Match& match, const Region& region,
+                                  const std::vector<const PartModel*>& others) {
   // Body tests only: the edge map, which needs a tolerance, is never built.
-  vision::RegionCache cache(region, 0);
+  RegionCache cache(region, 0);
   ScreenedOut out;
   out.region = match.region;
   out.asked = match.model;
   out.asked_distance = normalizedHu(*match.model, cache.logHu());
-  for (const vision::PartModel* m : others) {
-    const vision::Verdict body =
-        vision::judgeBody(cache, *m, vision::holesAtLeast(region, m->min_hole_area));
-    if (body.test != vision::RegionTest::kPasses) continue;
+  for (const PartModel* m : others) {
+    const Verdict body = judgeBody(cache, *m, holesAtLeast(region, m->min_hole_area));
+    if (body.test != RegionTest::kPasses) continue;
     const double d = body.hu_distance / std::max(m->body.hu_tolerance, 1e-12);
     if (d >= kCloserFactor * out.asked_distance || out.asked_distance - d <= kCloserMargin) {
       continue;
@@ -53,9 +52,8 @@ std::optional<ScreenedOut> screen(const vision::Match& match, const vision::Regi
 }
 }  // namespace
 
-vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
-                                       const std::vector<vision::PartModel>& models) {
-  vision::RegionOptions o = cell;
+RegionOptions regionOptionsFor(const RegionOptions& cell, const std::vector<PartModel>& models) {
+  RegionOptions o = cell;
   for (const auto& m : models) {
     o.min_hole_area = std::min(o.min_hole_area, m.min_hole_area);
     if (m.min_region_area > 0) o.min_area = std::min(o.min_area, m.min_region_area);
@@ -63,7 +61,7 @@ vision::RegionOptions regionOptionsFor(const vision::RegionOptions& cell,
   return o;
 }
 
-double speckAreaFor(const std::vector<vision::PartModel>& models) {
+double speckAreaFor(const std::vector<PartModel>& models) {
   // A part half hidden under another, or the smaller of two scaled copies,
   // is still ten times this; the coarse grain of a textured belt is not.
   constexpr double kSpeckShare = 0.05;
@@ -74,20 +72,20 @@ double speckAreaFor(const std::vector<vision::PartModel>& models) {
   return kSpeckShare * smallest;
 }
 
-RecognitionPass recognizeParts(const std::vector<vision::Region>& regions,
-                               const std::vector<vision::PartModel>& models, int type) {
-  std::vector<const vision::PartModel*> asked;
-  std::vector<const vision::PartModel*> others;
+RecognitionPass recognizeParts(const std::vector<Region>& regions,
+                               const std::vector<PartModel>& models, int type) {
+  std::vector<const PartModel*> asked;
+  std::vector<const PartModel*> others;
   for (const auto& m : models) (type < 0 || m.type == type ? asked : others).push_back(&m);
   RecognitionPass pass;
   // Each model judging holes with its own minimum hole area.
-  pass.matches = vision::recognizeEachHoleSetting(regions, asked);
+  pass.matches = recognizeEachHoleSetting(regions, asked);
   if (type < 0 || others.empty()) return pass;
   // A part found by the touching search is screened on its whole region
   // too: a blob of several parts passes no single model's area test, while
   // one whole part of another type, which the asked model's boundary half
   // fits, does.
-  std::vector<vision::Match> kept;
+  std::vector<Match> kept;
   kept.reserve(pass.matches.size());
   for (auto& m : pass.matches) {
     const auto out = screen(m, regions[m.region], others);
@@ -101,4 +99,4 @@ RecognitionPass recognizeParts(const std::vector<vision::Region>& regions,
   return pass;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::vision
