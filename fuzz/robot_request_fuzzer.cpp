@@ -11,8 +11,8 @@
 #include <string>
 #include <string_view>
 
+#include "picksight/app/vision_cell.hpp"
 #include "picksight/protocol/line_framer.hpp"
-#include "picksight/vision_app/vision_cell.hpp"
 
 namespace {
 // Small, so that over-long lines are reached often.

@@ -8,6 +8,10 @@
 #include <iostream>
 #include <memory>
 
+#include "picksight/app/app_options.hpp"
+#include "picksight/app/offline_commands.hpp"
+#include "picksight/app/plc_port.hpp"
+#include "picksight/app/vision_cell.hpp"
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/large_buffers.hpp"
 #include "picksight/common/log.hpp"
@@ -15,10 +19,6 @@
 #include "picksight/common/stop_signals.hpp"
 #include "picksight/link/video_server_camera.hpp"
 #include "picksight/protocol/robot_server.hpp"
-#include "picksight/vision_app/app_options.hpp"
-#include "picksight/vision_app/offline_commands.hpp"
-#include "picksight/vision_app/plc_port.hpp"
-#include "picksight/vision_app/vision_cell.hpp"
 
 int main(int argc, char** argv) {
   using namespace picksight;

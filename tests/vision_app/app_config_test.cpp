@@ -2,8 +2,8 @@
 // overridden by the command line; a bad key or value names the file and key.
 #include <catch2/catch.hpp>
 
+#include "picksight/app/app_options.hpp"
 #include "picksight/common/command_line.hpp"
-#include "picksight/vision_app/app_options.hpp"
 #include "temp_dir.hpp"
 
 using namespace picksight;

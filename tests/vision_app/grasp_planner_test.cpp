@@ -9,10 +9,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "picksight/app/offline_commands.hpp"
+#include "picksight/app/vision_cell.hpp"
 #include "picksight/cell/grasp_planner.hpp"
 #include "picksight/common/text.hpp"
-#include "picksight/vision_app/offline_commands.hpp"
-#include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight;
 using namespace picksight::app;

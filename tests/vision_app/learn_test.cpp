@@ -16,12 +16,12 @@
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
+#include "picksight/app/offline_commands.hpp"
+#include "picksight/app/vision_cell.hpp"
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/model_file.hpp"
-#include "picksight/vision_app/offline_commands.hpp"
-#include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight;
 using namespace picksight::app;

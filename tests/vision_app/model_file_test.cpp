@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "picksight/app/vision_cell.hpp"
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/model_file.hpp"
 #include "picksight/store/model_library.hpp"
 #include "picksight/synthetic/scene.hpp"
-#include "picksight/vision_app/vision_cell.hpp"
 
 using namespace picksight;
 using namespace picksight::app;

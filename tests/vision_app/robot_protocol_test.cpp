@@ -10,7 +10,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "picksight/vision_app/vision_cell.hpp"
+#include "picksight/app/vision_cell.hpp"
 #include "temp_dir.hpp"
 
 using namespace picksight::app;

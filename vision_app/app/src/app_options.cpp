@@ -1,5 +1,5 @@
 // picksight-vision option parsing, with CLI11.
-#include "picksight/vision_app/app_options.hpp"
+#include "picksight/app/app_options.hpp"
 
 #include <CLI/CLI.hpp>
 #include <set>

@@ -1,5 +1,5 @@
 // Offline subcommands over image files.
-#include "picksight/vision_app/offline_commands.hpp"
+#include "picksight/app/offline_commands.hpp"
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -8,6 +8,7 @@
 #include <ostream>
 #include <variant>
 
+#include "picksight/app/app_options.hpp"
 #include "picksight/calibration/camera_calibration.hpp"
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
@@ -19,7 +20,6 @@
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
-#include "picksight/vision_app/app_options.hpp"
 
 namespace picksight::app {
 

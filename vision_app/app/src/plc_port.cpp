@@ -1,5 +1,5 @@
 // PLC port wiring.
-#include "picksight/vision_app/plc_port.hpp"
+#include "picksight/app/plc_port.hpp"
 
 #include "picksight/plc/cell_picker.hpp"
 

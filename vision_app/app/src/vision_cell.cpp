@@ -1,5 +1,5 @@
 // Vision cell wiring.
-#include "picksight/vision_app/vision_cell.hpp"
+#include "picksight/app/vision_cell.hpp"
 
 #include <chrono>
 

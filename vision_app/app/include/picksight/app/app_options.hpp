@@ -5,11 +5,11 @@
 #include <string>
 #include <vector>
 
+#include "picksight/app/plc_port.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/transport/curve_keys.hpp"
-#include "picksight/vision_app/plc_port.hpp"
 
 namespace picksight::app {
 

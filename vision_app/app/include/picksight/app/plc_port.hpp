@@ -7,9 +7,9 @@
 
 #include <cstdint>
 
+#include "picksight/app/vision_cell.hpp"
 #include "picksight/plc/modbus_server.hpp"
 #include "picksight/plc/plc_device.hpp"
-#include "picksight/vision_app/vision_cell.hpp"
 
 namespace picksight::app {
 
