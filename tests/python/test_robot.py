@@ -166,6 +166,9 @@ def test_vision_settings_read_changed_refused_and_models_named(cell_factory, tmp
         light = robot.vision_settings(polarity="light")
         assert light.values["polarity"] == "light"
         assert light.reteach == ["1 (disc) taught as dark on its surface"]
+        # Most of the frame, the light surface, is now taken for part.
+        assert len(light.notes) == 1 and light.notes[0].startswith("hint: "), light.notes
+        assert light.notes[0].endswith("need VISION polarity dark"), light.notes
         assert robot.locate(1) == []
         with pytest.raises(RobotError) as e:
             robot.vision_settings(polarity="dark", level=256)

@@ -81,9 +81,9 @@ double largestBlobArea(const std::string& reply) {
   return area;
 }
 
-const char* const kDefaults =
+const std::string kDefaults =
     "OK polarity=dark threshold=adaptive level=128 window=0 min_area=auto min_hole_area=0.000";
-const char* const kLight =
+const std::string kLight =
     "OK polarity=light threshold=adaptive level=128 window=0 min_area=auto min_hole_area=0.000";
 
 // A file camera in trigger mode showing the table, a vision app on it whose
@@ -135,12 +135,17 @@ TEST_CASE("VISION polarity light finds light parts on a dark table without a res
   // six discs as holes, most of the frame.
   CHECK(located(cell.ask("LOCATE ALL")) == 1);
   CHECK(largestBlobArea(cell.ask("BLOBS")) > 0.5 * 640 * 480);
+  // VISION says so: the table is 69 % of the last frame.
+  const std::string hint =
+      " ; hint: 69 % of the last frame is taken for part, more than the surface: parts lighter "
+      "than their surface need VISION polarity light";
+  CHECK(cell.ask("VISION") == kDefaults + hint);
 
   // The read-only robot port reads the settings and refuses a change.
-  CHECK(cell.askRobot("VISION") == kDefaults);
+  CHECK(cell.askRobot("VISION") == kDefaults + hint);
   CHECK_THAT(cell.askRobot("VISION polarity light"), Catch::StartsWith("ERROR 17 "));
   CHECK_THAT(cell.askRobot("VISION RESET"), Catch::StartsWith("ERROR 17 "));
-  CHECK(cell.ask("VISION") == kDefaults);
+  CHECK(cell.ask("VISION") == kDefaults + hint);
 
   // The next LOCATE after the change sees the discs, on either port.
   CHECK(cell.ask("VISION polarity light") == kLight);
@@ -272,8 +277,7 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
     // Not silently replaced by defaults: every request that binarizes is
     // refused naming the file, and so is a change, which would overwrite it.
     const std::string reply = cell.ask("VISION");
-    CHECK_THAT(reply, Catch::StartsWith(std::string(kDefaults) +
-                                        " ; error: the settings file is damaged (" +
+    CHECK_THAT(reply, Catch::StartsWith(kDefaults + " ; error: the settings file is damaged (" +
                                         cell.settings_file + ": "));
     CHECK_THAT(reply, Catch::Contains(says[i]));
     for (const char* request : {"LOCATE ALL", "BLOBS", "LEARN 1 disc", "VISION polarity light"}) {
@@ -331,7 +335,9 @@ TEST_CASE("A VISION change names the models it leaves taught under other setting
   // fits anything there.
   CHECK(cell.ask("VISION polarity dark") ==
         "OK polarity=dark threshold=fixed level=130 window=0 min_area=auto "
-        "min_hole_area=150.000 ; re-teach: 1 (disc) taught as light on its surface");
+        "min_hole_area=150.000 ; re-teach: 1 (disc) taught as light on its surface ; hint: 69 % "
+        "of the last frame is taken for part, more than the surface: parts lighter than their "
+        "surface need VISION polarity light");
   CHECK(located(cell.ask("LOCATE 1")) == 0);
   // Back to the settings it was taught under: nothing to re-teach.
   CHECK(cell.ask("VISION polarity light threshold adaptive min_hole_area 0") ==
@@ -408,4 +414,29 @@ TEST_CASE("Each LOCATE runs with one whole VISION change and publishes the setti
     ++seen;
   }
   CHECK(seen == kLocates);
+}
+
+TEST_CASE("Coins on a dark table: VISION hints at polarity light, then LOCATE finds all 24",
+          "[vision_app][vision_settings][e2e]") {
+  // The photograph of the issue (tests/data/scenes/coins.png, scikit-image):
+  // 24 light coins on a darker, unevenly lit table.
+  const std::string coins = std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/coins.png";
+  VideoServerProcess server{{"--source", "cam0=file:" + coins, "--mode", "trigger"}};
+  VisionProcess vision(server);
+  LineClient robot = vision.connect();
+  const auto ask = [&](const std::string& request) {
+    auto reply = robot.request(request, 20s);
+    REQUIRE(reply);
+    return *reply;
+  };
+  // Dark parts: pieces of the table, not a coin.
+  CHECK(located(ask("LOCATE ALL")) != 24);
+  const std::string before = ask("VISION");
+  CHECK_THAT(before, Catch::StartsWith(kDefaults + " ; hint: "));
+  CHECK_THAT(before, Catch::EndsWith(" of the last frame is taken for part, more than the "
+                                     "surface: parts lighter than their surface need VISION "
+                                     "polarity light"));
+  CHECK(ask("VISION polarity light") == kLight);
+  CHECK(located(ask("LOCATE ALL")) == 24);
+  CHECK(ask("VISION") == kLight);
 }

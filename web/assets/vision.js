@@ -69,6 +69,7 @@
   async function reload(force) {
     const reply = await ps.command("VISION");
     ps.show("vision-reply", "VISION", reply);
+    showReplyHint(reply);
     const s = settingsOf(reply);
     if (!s) return reply;
     keys.forEach((key, i) => { if (s[key] !== undefined) ps.setField(fields[i], s[key], force); });
@@ -77,6 +78,32 @@
     return reply;
   }
   ps.reloadVision = reload;
+
+  // A button that previews `polarity` in the Vision panel.
+  function tryButton(polarity) {
+    const b = document.createElement("button");
+    b.type = "button";
+    b.className = "try-polarity";
+    b.textContent = "Try polarity " + polarity;
+    b.addEventListener("click", () => {
+      ps.selectTab("vision");
+      ps.setField("vision-polarity", polarity, true, true);
+      schedulePreview();
+    });
+    return b;
+  }
+
+  // VISION's " ; hint: ..." (most of the last frame taken for part), with a
+  // button for the polarity it names.
+  function showReplyHint(reply) {
+    const el = $("vision-hint");
+    const hint = String(reply).split(" ; ").find((part) => part.startsWith("hint: "));
+    el.textContent = "";
+    el.hidden = !hint;
+    if (!hint) return;
+    const polarity = hint.endsWith("polarity light") ? "light" : "dark";
+    el.append(document.createTextNode(hint.slice("hint: ".length) + ". "), tryButton(polarity));
+  }
 
   function showReteach(reply) {
     const list = $("vision-reteach");
@@ -130,16 +157,7 @@
         Math.round(region.area || 0) + " px, " + (region.holes || 0) + " holes): the surface is " +
         "probably taken for a part. Parts " + (dark ? "lighter" : "darker") + " than their surface need polarity " +
         other + ". ";
-      const b = document.createElement("button");
-      b.type = "button";
-      b.className = "try-polarity";
-      b.textContent = "Try polarity " + other;
-      b.addEventListener("click", () => {
-        ps.selectTab("vision");
-        ps.setField("vision-polarity", other, true, true);
-        schedulePreview();
-      });
-      el.append(text, b);
+      el.append(text, tryButton(other));
     }
   }
   ps.surfaceRegion = surfaceRegion;

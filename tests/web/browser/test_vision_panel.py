@@ -93,6 +93,11 @@ def test_vision_panel_previews_and_applies_polarity_without_restart(cell, browse
     assert Select(browser.driver.find_element(By.ID, "vision-polarity")).first_selected_option \
         .get_attribute("value") == "dark"
     assert "Try polarity light" in hint_shown(browser, "vision-polarity-hint")
+    # VISION's own hint: the table, about 70 % of the last frame, taken for part.
+    reply_hint = wait_until(lambda: hint_shown(browser, "vision-hint"), what="VISION's hint")
+    share, _, rest = reply_hint.partition(" % ")
+    assert 60 <= int(share) <= 80 and rest.startswith("of the last frame is taken for part"), reply_hint
+    assert reply_hint.endswith("need VISION polarity light. Try polarity light"), reply_hint
     # The preview: the app's settings, the table white (69 % of the frame).
     dark = preview_where(browser, ["polarity=dark", "threshold=adaptive"], lambda w: w > 0.6,
                          "the dark-parts preview")
@@ -130,6 +135,7 @@ def test_vision_panel_previews_and_applies_polarity_without_restart(cell, browse
     assert located[0] == "6", located
     wait_until(lambda: browser.js("return document.getElementById('vision-polarity-hint').hidden"),
                what="the hint gone")
+    assert browser.js("return document.getElementById('vision-hint').hidden")
     assert browser.js("return document.getElementById('live-polarity-hint').hidden")
     browser.screenshot("vision-applied")
 

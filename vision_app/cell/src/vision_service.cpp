@@ -663,6 +663,16 @@ Result<VisionOptions> VisionService::resetSettings() {
   return *current;
 }
 
+std::optional<double> VisionService::partShareOfLastFrame() const {
+  const auto frame = lastFramePixels();
+  if (!frame || frame->image.empty()) return std::nullopt;
+  const VisionOptions o = options();
+  const cv::Mat grey = greyImage(*frame);
+  VisionOptions scaled = frameOptions(o, frame->mapping, grey.size(), ModelList());
+  const cv::Mat mask = vision::binarize(grey, scaled.binarize);
+  return static_cast<double>(cv::countNonZero(mask)) / static_cast<double>(mask.total());
+}
+
 std::shared_ptr<const Frame> VisionService::lastFramePixels() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return last_pixels_;

@@ -1,6 +1,7 @@
 // VISION: read, change or reset the vision settings while the cell runs.
 #include "picksight/protocol/vision_settings_commands.hpp"
 
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -12,13 +13,29 @@ namespace {
 
 constexpr const char* kUsage = "VISION [RESET | <key> <value> [<key> <value>]...]";
 
+// Over this share of the frame taken for part, the surface most likely is:
+// parts lie apart on a surface larger than they are.
+constexpr double kSurfaceShare = 0.5;
+
+// " ; hint: ..." when the settings in force take most of the last frame for
+// part, naming the other polarity; empty otherwise.
+std::string polarityHint(const VisionService& vision) {
+  const auto share = vision.partShareOfLastFrame();
+  if (!share || *share <= kSurfaceShare) return "";
+  const bool dark = vision.options().binarize.polarity == vision::Polarity::kDarkOnLight;
+  return " ; hint: " + std::to_string(std::lround(100 * *share)) +
+         " % of the last frame is taken for part, more than the surface: parts " +
+         (dark ? "lighter" : "darker") + " than their surface need VISION polarity " +
+         (dark ? "light" : "dark");
+}
+
 std::string settingsReply(const VisionService& vision) {
   std::string reply = "OK " + visionSettingsText(vision.options());
   if (auto damage = vision.settingsDamage()) {
     reply += " ; error: the settings file is damaged (" + damage->substr(0, 200) +
              "), LOCATE and LEARN refused: repair it and restart, or VISION RESET";
   }
-  return reply;
+  return reply + polarityHint(vision);
 }
 
 std::string change(VisionService& vision, const Request& r) {
@@ -36,7 +53,7 @@ std::string change(VisionService& vision, const Request& r) {
     for (const auto& stale : modelsToReteach(before, after, *models))
       reply += " ; re-teach: " + stale;
   }
-  return reply;
+  return reply + polarityHint(vision);
 }
 
 }  // namespace

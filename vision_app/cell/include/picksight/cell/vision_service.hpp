@@ -271,6 +271,11 @@ class VisionService {
   Result<VisionOptions> resetSettings();
   // What is wrong with the settings file (nullopt: nothing).
   std::optional<std::string> settingsDamage() const;
+  // The share of the last request's frame the settings in force binarize
+  // as part (nullopt before any frame): over half, and the surface is
+  // likely taken for the part (the polarity the wrong way round). A
+  // binarization of that frame on the caller's thread; no request waits.
+  std::optional<double> partShareOfLastFrame() const;
 
  private:
   // Call with mutex_ held.
