@@ -4,7 +4,9 @@
 // trained, tight, loose, and each tolerance alone moved): the region WHY
 // says passes every test of a model is the region LOCATE reports as one
 // whole part of that model, and no other region is; a region WHY calls a
-// whole part drawn other than trained holds no part LOCATE reports.
+// whole part drawn other than trained holds no part LOCATE reports; and
+// for LOCATE <type>, WHY says "other type" only of a region LOCATE ALL
+// finds whole as that other type and LOCATE <type> does not.
 #include <catch2/catch.hpp>
 
 #include <map>
@@ -116,4 +118,68 @@ TEST_CASE("WHY names a passing model exactly where LOCATE reports that model's w
   CHECK(verdicts[RegionTest::kHu] >= 3);
   CHECK(verdicts[RegionTest::kVerify] >= 3);
   CHECK(touching_parts >= 6);
+}
+
+TEST_CASE(
+    "WHY for LOCATE <type> says 'other type' only where LOCATE ALL, not LOCATE <type>, "
+    "finds a whole part",
+    "[vision][why]") {
+  const ps::SilhouetteSceneOptions look;
+  const std::vector<SilhouetteSpec> specs = {
+      {"turtle", "shapes/tari1000/obj4_1.png", 170},
+      {"bottle", "shapes/tari1000/obj32_1.png", 190},
+      {"star", "shapes/tari1000/obj2_1.png", 170},
+      {"l_shape", "", 160},
+  };
+  const SilhouetteModels models = trainSilhouettes(specs, look);
+  const auto list = models.list();
+  int other_type = 0;
+  int passes = 0;
+  for (const auto arrangement : {ps::Arrangement::kSeparated, ps::Arrangement::kTouching})
+    for (uint64_t seed = 3; seed <= 4; ++seed) {
+      const ps::SilhouetteScene scene(models.types, models.chiral,
+                                      smallScene(look, seed, 8, 0.3, arrangement));
+      const cv::Mat grey = scene.render(0);
+      const auto regions = findRegions(binarize(grey, silhouetteBinarization()), {}, grey);
+      const auto all_matches = recognizeEachHoleSetting(regions, list);
+      for (const PartModel* asked_model : list) {
+        const int asked = asked_model->type;
+        std::vector<const PartModel*> asked_list;
+        for (const PartModel* m : list)
+          if (m->type == asked) asked_list.push_back(m);
+        const auto asked_matches = recognizeEachHoleSetting(regions, asked_list);
+        const auto wholeAt = [](const std::vector<Match>& matches, size_t region) -> const Match* {
+          for (const auto& m : matches)
+            if (m.region == region && !m.touching) return &m;
+          return nullptr;
+        };
+        for (size_t i = 0; i < regions.size(); ++i) {
+          const RegionExplanation why = explainRegionAsAsked(regions[i], list, asked);
+          const Match* as_asked = wholeAt(asked_matches, i);
+          const Match* among_all = wholeAt(all_matches, i);
+          INFO(ps::arrangementName(arrangement)
+               << " seed " << seed << " LOCATE " << asked << " region " << i << ": WHY "
+               << regionTestName(why.test) << (why.other_type ? " (other type)" : "") << " for "
+               << (why.nearest ? why.nearest->name : std::string("nothing")));
+          REQUIRE(why.nearest);
+          if (why.other_type) {
+            other_type += 1;
+            CHECK(why.test == RegionTest::kPasses);
+            CHECK(why.nearest->type != asked);
+            CHECK(as_asked == nullptr);
+            REQUIRE(among_all != nullptr);
+            CHECK(among_all->model == why.nearest);
+          } else if (why.test == RegionTest::kPasses) {
+            passes += 1;
+            CHECK(why.nearest->type == asked);
+            CHECK(as_asked != nullptr);
+          } else {
+            CHECK(why.nearest->type == asked);
+            CHECK(as_asked == nullptr);
+          }
+        }
+      }
+    }
+  CHECK(other_type >= 10);
+  CHECK(passes >= 6);
 }

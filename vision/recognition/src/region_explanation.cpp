@@ -45,4 +45,19 @@ RegionExplanation explainRegion(const Region& region, const std::vector<const Pa
   return best;
 }
 
+RegionExplanation explainRegionAsAsked(const Region& region,
+                                       const std::vector<const PartModel*>& models,
+                                       int asked_type) {
+  RegionExplanation e = explainRegion(region, models);
+  if (asked_type < 0) return e;
+  if (e.test == RegionTest::kPasses && e.nearest && e.nearest->type != asked_type) {
+    e.other_type = true;
+    return e;
+  }
+  std::vector<const PartModel*> asked;
+  for (const PartModel* m : models)
+    if (m->type == asked_type) asked.push_back(m);
+  return explainRegion(region, asked);
+}
+
 }  // namespace picksight::vision

@@ -86,7 +86,6 @@ void RequestRecord::explain() const {
   std::set<int> offered;
   for (size_t part : pick.parts) offered.insert(locate->parts[part].region);
   const auto all = modelsOf(models, -1);
-  const auto asked = modelsOf(models, asked_type);
   for (size_t i = 0; i < std::min(scene.regions.size(), kMaxResultRegions); ++i) {
     const int index = static_cast<int>(i);
     if (offered.count(index)) continue;
@@ -108,15 +107,13 @@ void RequestRecord::explain() const {
     } else if (all.empty()) {
       r.test = "no model";
     } else {
-      auto e = vision::explainRegion(scene.regions[i], all);
-      if (asked_type >= 0 && e.test == vision::RegionTest::kPasses &&
-          e.nearest->type != asked_type) {
+      const auto e = vision::explainRegionAsAsked(scene.regions[i], all, asked_type);
+      if (e.other_type) {
         r.test = "other type";
         r.nearest_type = e.nearest->type;
         r.nearest_name = e.nearest->name;
         r.measured = r.low = r.high = asked_type;
       } else {
-        if (asked_type >= 0) e = vision::explainRegion(scene.regions[i], asked);
         r.test = vision::regionTestName(e.test);
         r.nearest_type = e.nearest ? e.nearest->type : -1;
         r.nearest_name = e.nearest ? e.nearest->name : "";

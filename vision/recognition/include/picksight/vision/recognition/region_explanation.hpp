@@ -26,6 +26,9 @@ struct RegionExplanation {
   double measured = 0;
   double low = 0;
   double high = 0;
+  // explainRegionAsAsked: the region passes every test of `nearest`, a
+  // model of another type than the one asked.
+  bool other_type = false;
 };
 
 // The model of `models` the region comes nearest to (the one whose tests it
@@ -34,5 +37,13 @@ struct RegionExplanation {
 // fails. `region` is as findRegions found it with the smallest minimum hole
 // area of the models: each model judges it with its own min_hole_area.
 RegionExplanation explainRegion(const Region& region, const std::vector<const PartModel*>& models);
+
+// Why `LOCATE <asked_type>` left the region out (-1: every type, as
+// explainRegion): a region that passes every test of another type's model
+// (the nearest of all `models`) is that type's part (`other_type`);
+// otherwise the nearest of the asked type's models and the first test it
+// fails.
+RegionExplanation explainRegionAsAsked(const Region& region,
+                                       const std::vector<const PartModel*>& models, int asked_type);
 
 }  // namespace picksight::vision
