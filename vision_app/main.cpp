@@ -20,6 +20,9 @@
 #include "picksight/link/video_server_camera.hpp"
 #include "picksight/protocol/robot_server.hpp"
 
+// The cell's wiring in the order it starts and stops (options, cell,
+// results stream, robot, set-up and PLC ports), with the start-up lines an
+// operator reads in the journal: long for those lines, not for decisions.
 int main(int argc, char** argv) {
   using namespace picksight;
   setLogPrefix("vision");
