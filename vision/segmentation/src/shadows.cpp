@@ -141,11 +141,10 @@ struct Levels {
 };
 
 // The part's own light over its box: the plane a + b x + c y through the
-// levels of its pixels deeper than kCoreDepth and not `lighter` (every other
-// row), or its median level, flat, when too few.
-cv::Vec3d partLight(const cv::Mat& g, const cv::Mat& own, const cv::Mat& lighter, const Levels& l) {
-  cv::Mat deep;
-  cv::erode(own, deep, disc(kCoreDepth));
+// levels of its `deep` pixels (deeper than kCoreDepth) not `lighter` (every
+// other row), or its median level, flat, when too few.
+cv::Vec3d partLight(const cv::Mat& g, const cv::Mat& deep, const cv::Mat& lighter,
+                    const Levels& l) {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sg = 0, sxg = 0, syg = 0;
   for (int y = 0; y < g.rows; y += 2) {
     const uint8_t* d = deep.ptr<uint8_t>(y);
@@ -177,14 +176,14 @@ cv::Vec3d partLight(const cv::Mat& g, const cv::Mat& own, const cv::Mat& lighter
 // deeper in the mask than any edge's blur reaches at that level (3 px in,
 // an edge blurred by 2.5 px is 2 % of the way to the surface), on the
 // outline, at a level of their own. 255 there; empty when none.
-cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const Levels& l) {
+// `interior` is `own` eroded by kCoreDepth.
+cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior, const Levels& l) {
   cv::Mat lighter;
   cv::compare(g, l.part + kLighterShare * l.contrast(), lighter, cv::CMP_GT);
   cv::bitwise_and(lighter, own, lighter);
   if (cv::countNonZero(lighter) < kMinShadowPixels) return {};
   cv::Mat core;
-  cv::erode(own, core, disc(kCoreDepth));
-  cv::bitwise_and(core, lighter, core);
+  cv::bitwise_and(interior, lighter, core);
   if (cv::countNonZero(core) < kMinCorePixels) return {};
   cv::Mat shadow;
   cv::dilate(core, shadow, disc(kCoreDepth + 1));
@@ -201,7 +200,7 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const Levels& l) {
   std::vector<int> pixels(static_cast<size_t>(n), 0);
   std::vector<int> on_outline(static_cast<size_t>(n), 0);
   std::vector<double> excess(static_cast<size_t>(n), 0.0);
-  const cv::Vec3d light = partLight(g, own, lighter, l);
+  const cv::Vec3d light = partLight(g, interior, lighter, l);
   for (int y = 0; y < labels.rows; ++y) {
     const int* lab = labels.ptr<int>(y);
     const uint8_t* o = outline.ptr<uint8_t>(y);
@@ -294,7 +293,9 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
   cv::Mat near;
   cv::Mat ring;
   cv::dilate(own, near, disc(kRingInner));
-  cv::dilate(own, ring, disc(kRingOuter));
+  // Two discs in turn make the wider one, at half the cost of its own pass.
+  static_assert(kRingOuter == 2 * kRingInner, "the ring's outer disc is two inner ones");
+  cv::dilate(near, ring, disc(kRingInner));
   cv::bitwise_xor(ring, near, ring);
   cv::Mat free;
   cv::compare(mask(box), 0, free, cv::CMP_EQ);
@@ -306,7 +307,7 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
   // than halfway to the shadow's level.
   cv::Mat removed = cv::Mat::zeros(box.size(), CV_8UC1);
   cv::Mat zone = cv::Mat::zeros(box.size(), CV_8UC1);
-  const cv::Mat layer = thickLayer(g, own, l);
+  const cv::Mat layer = thickLayer(g, own, interior, l);
   if (!layer.empty()) {
     double level = 0;
     levelsOf(g, layer, 1, &level);
