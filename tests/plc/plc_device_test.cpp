@@ -29,7 +29,7 @@ struct FakeCell {
   int last_type = -2;
   Result<PlcResult> next = PlcResult{};
 
-  PlcDevice::Locator locator() {
+  PlcDevice::Picker picker() {
     return [this](int type) -> Result<PlcResult> {
       std::unique_lock<std::mutex> lock(mutex);
       ++calls;
@@ -58,7 +58,7 @@ PlcResult twoParts() {
 struct Port {
   explicit Port(PlcDeviceOptions device_options = {}, ModbusServerOptions server_options = {}) {
     device = std::make_unique<PlcDevice>(
-        device_options, cell.locator(), [] { return kFrameVisionMm; },
+        device_options, cell.picker(), [] { return kFrameVisionMm; },
         [](const Error& e) { return e.code == std::errc::timed_out ? 20 : 99; });
     server_options.listen.bind_address = "127.0.0.1";
     server_options.listen.port = 0;

@@ -34,7 +34,7 @@ PlcResult plcResult(const app::CellLocate& located) {
   return result;
 }
 
-PlcDevice::Locator cellPicker(app::CellContext& cell, app::ResultsPublisher* const& results) {
+PlcDevice::Picker cellPicker(app::CellContext& cell, app::ResultsPublisher* const& results) {
   return [&cell, &results](int type) -> Result<PlcResult> {
     const auto started = std::chrono::steady_clock::now();
     auto located = app::locateAndPick(cell, type);

@@ -41,10 +41,10 @@ std::optional<size_t> aduLength(const uint8_t* data, size_t size) {
   return size >= total ? total : 0;
 }
 
-PlcDevice::PlcDevice(PlcDeviceOptions options, Locator locator, FrameState frame_state,
+PlcDevice::PlcDevice(PlcDeviceOptions options, Picker picker, FrameState frame_state,
                      ErrorCode error_code)
     : options_(options),
-      locator_(std::move(locator)),
+      picker_(std::move(picker)),
       frame_state_(std::move(frame_state)),
       error_code_(std::move(error_code)) {
   // The same image as holding registers (read/write) and input registers
@@ -229,7 +229,7 @@ void PlcDevice::workerLoop() {
     // The LOCATE runs without the registers' lock: the PLC keeps polling.
     Result<PlcResult> result = makeError(std::errc::state_not_recoverable, "not run");
     try {
-      result = locator_(type);
+      result = picker_(type);
     } catch (const std::exception& e) {
       logError("PLC trigger: ", e.what());
     }

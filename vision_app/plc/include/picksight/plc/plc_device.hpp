@@ -53,15 +53,15 @@ std::optional<size_t> aduLength(const uint8_t* data, size_t size);
 
 class PlcDevice {
  public:
-  // Runs a LOCATE of `type` (-1: every type); called on the worker thread.
-  using Locator = std::function<Result<PlcResult>(int type)>;
+  // Picks the parts of `type` (-1: every type) in a fresh frame, as the
+  // cell's LOCATE does (cell_picker); called on the worker thread.
+  using Picker = std::function<Result<PlcResult>(int type)>;
   // The cell's reply frame now (kFrame*); called on handle()'s thread.
   using FrameState = std::function<uint16_t()>;
   // Turns a LOCATE's error into the robot protocol's ERROR code.
   using ErrorCode = std::function<int(const Error&)>;
 
-  PlcDevice(PlcDeviceOptions options, Locator locator, FrameState frame_state,
-            ErrorCode error_code);
+  PlcDevice(PlcDeviceOptions options, Picker picker, FrameState frame_state, ErrorCode error_code);
   ~PlcDevice();
   PlcDevice(const PlcDevice&) = delete;
   PlcDevice& operator=(const PlcDevice&) = delete;
@@ -93,7 +93,7 @@ class PlcDevice {
   void workerLoop();
 
   const PlcDeviceOptions options_;
-  const Locator locator_;
+  const Picker picker_;
   const FrameState frame_state_;
   const ErrorCode error_code_;
   const std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
