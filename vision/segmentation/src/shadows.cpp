@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
@@ -217,19 +216,14 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   // own. Not a shadow: specks of the edge's blur along the outline (each
   // fewer than kMinShadowPixels, though many of them reach it together) or
   // a fringe of it (thinner than kMinLayerThickness: the blurred tip of a
-  // part's light side); a layer thicker than
-  // kMaxLayerThickness for its length on the outline (a glint's halo near the rim, which cut off
-  // from a glossy part took 2 % of it and moved it 1.6 px), nor one the
-  // part's own light explains to within kLighterShare of the contrast (the
-  // lit side of a part shaded across its face, within a few levels of its
+  // part's light side); a layer thicker than kMaxLayerThickness for its
+  // length on the outline (a glint's halo near the rim, which cut off from
+  // a glossy part took 2 % of it and moved it 1.6 px); nor one the part's
+  // own light explains to within kLighterShare of the contrast (the lit
+  // side of a part shaded across its face, within a few levels of its
   // surface at 30 levels of contrast: cut off, 1.7 % of the part and 1.1 px).
   std::vector<char> kept(static_cast<size_t>(n), 0);
   for (size_t k = 1; k < kept.size(); ++k) {
-    std::printf(
-        "layer %zu pixels %d outline %d excess %.1f need %.1f part %.1f surface %.1f spread "
-        "%.1f\n",
-        k, pixels[k], on_outline[k], excess[k] / pixels[k], kLighterShare * l.contrast(), l.part,
-        l.surface, l.part_spread);
     kept[k] = on_outline[k] > 0 && pixels[k] >= kMinShadowPixels &&
                       pixels[k] >= kMinLayerThickness * on_outline[k] &&
                       pixels[k] <= kMaxLayerThickness * on_outline[k] &&
