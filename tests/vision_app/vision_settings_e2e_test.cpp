@@ -266,11 +266,13 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
       "{\"format\": \"picksight-vision-settings\", \"version\": 1, \"polarty\": \"light\"}",
       "{\"format\": \"something else\", \"version\": 1}",
       "[1, 2]",
+      std::string(70000, ' ') + "{}",
   };
-  const char* const says[] = {"not JSON", "polarity must be dark", "no key 'polarty'",
-                              "format is not 'picksight-vision-settings'", "not a JSON object"};
+  const char* const says[] = {"not JSON",          "polarity must be dark",
+                              "no key 'polarty'",  "format is not 'picksight-vision-settings'",
+                              "not a JSON object", "larger than 64 KiB"};
   for (size_t i = 0; i < std::size(damaged); ++i) {
-    INFO(damaged[i]);
+    INFO(damaged[i].substr(0, 100));
     cell.restart();  // the app running writes nothing now: the file is ours
     writeText(cell.settings_file, damaged[i]);
     cell.restart();
@@ -294,6 +296,18 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
     CHECK(offline.exit_code == 2);
     CHECK(offline.out.empty());
   }
+  // A file that cannot be replaced (here a directory in its place): VISION
+  // RESET fails with ERROR 49 and lifts nothing.
+  cell.restart();
+  std::filesystem::remove(cell.settings_file);
+  std::filesystem::create_directories(cell.settings_file + "/in-the-way");
+  cell.restart();
+  CHECK_THAT(cell.ask("VISION RESET"),
+             Catch::StartsWith("ERROR 49 cannot write " + cell.settings_file + ": "));
+  CHECK_THAT(cell.ask("LOCATE ALL"), Catch::StartsWith("ERROR 48 "));
+  CHECK_THAT(cell.ask("VISION polarity light"), Catch::StartsWith("ERROR 48 "));
+  std::filesystem::remove_all(cell.settings_file);
+
   // A bad value is refused even where the command line overrides it.
   writeText(cell.settings_file, damaged[1]);
   cell.restart({"--polarity", "light"});

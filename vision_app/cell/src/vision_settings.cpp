@@ -227,6 +227,9 @@ Result<VisionOptions> parseVisionSettingsJson(const std::string& text, VisionOpt
   const auto damaged = [](const std::string& why) {
     return makeError(VisionSettingsErrc::kDamaged, why);
   };
+  // The file holds six keys: anything this large was not written by VISION.
+  constexpr size_t kMaxFileBytes = 64 * 1024;
+  if (text.size() > kMaxFileBytes) return damaged("larger than 64 KiB");
   const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded()) return damaged("not JSON");
   if (!j.is_object()) return damaged("not a JSON object");
