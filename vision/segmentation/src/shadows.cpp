@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
 
@@ -20,14 +19,12 @@ constexpr double kLighterShare = 0.25;
 // kLighterShare, so that a layer from 4 px thick (the shadow of a part a few
 // millimetres high under a lamp at 45 degrees) shows.
 constexpr int kCoreDepth = 2;
-// A shadow's layer inside the mask is at least and at most this many
-// pixels thick on average (its pixels over its length on the outline): a
-// part's shadow reaches a few pixels past it, an edge's blur about one. (At
-// 2, the front-light benchmark's shadowed parts, separated, were placed
-// 0.12 px off instead of 0.08: thin stretches of shadow along the parts'
-// flanks stayed on them.)
+// A shadow's layer inside the mask is at least this many pixels thick on
+// average (its pixels over its length on the outline), an edge's blur
+// about one. (At 2, the front-light benchmark's shadowed parts, separated,
+// were placed 0.12 px off instead of 0.08: thin stretches of shadow along
+// the parts' flanks stayed on them.)
 constexpr double kMinLayerThickness = 1.5;
-constexpr double kMaxLayerThickness = 12;
 // Fewer pixels than these are noise, or a corner of the blur.
 constexpr int kMinShadowPixels = 30;
 constexpr int kMinCorePixels = 12;
@@ -139,37 +136,6 @@ struct Levels {
   double contrast() const { return surface - part; }
 };
 
-// The part's own light over its box: the plane a + b x + c y through the
-// levels of its `deep` pixels (deeper than kCoreDepth) not `lighter` (every
-// other row), or its median level, flat, when too few.
-cv::Vec3d partLight(const cv::Mat& g, const cv::Mat& deep, const cv::Mat& lighter,
-                    const Levels& l) {
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, sg = 0, sxg = 0, syg = 0;
-  for (int y = 0; y < g.rows; y += 2) {
-    const uint8_t* d = deep.ptr<uint8_t>(y);
-    const uint8_t* li = lighter.ptr<uint8_t>(y);
-    const uint8_t* v = g.ptr<uint8_t>(y);
-    for (int x = 0; x < g.cols; ++x) {
-      if (!d[x] || li[x]) continue;
-      n += 1;
-      sx += x;
-      sy += y;
-      sxx += static_cast<double>(x) * x;
-      sxy += static_cast<double>(x) * y;
-      syy += static_cast<double>(y) * y;
-      sg += v[x];
-      sxg += static_cast<double>(x) * v[x];
-      syg += static_cast<double>(y) * v[x];
-    }
-  }
-  cv::Vec3d plane(l.part, 0, 0);
-  if (n < kMinShadowPixels) return plane;
-  const cv::Matx33d normal(n, sx, sy, sx, sxx, sxy, sy, sxy, syy);
-  cv::Vec3d solution;
-  if (cv::solve(normal, cv::Vec3d(sg, sxg, syg), solution, cv::DECOMP_CHOLESKY)) plane = solution;
-  return plane;
-}
-
 // The thick layer of a shadow inside the mask (see shadows.hpp): pixels
 // lighter than the part by kLighterShare of the contrast around a core
 // deeper in the mask than any edge's blur reaches at that level (3 px in,
@@ -194,40 +160,30 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   cv::bitwise_xor(own, outline, outline);
   cv::Mat labels;
   const int n = cv::connectedComponents(shadow, labels, 8, CV_32S);
-  // Per layer: its pixels, those on the outline, and how much lighter than
-  // the part's own light predicts there they are (summed).
+  // Per layer: its pixels, and those on the outline.
   std::vector<int> pixels(static_cast<size_t>(n), 0);
   std::vector<int> on_outline(static_cast<size_t>(n), 0);
-  std::vector<double> excess(static_cast<size_t>(n), 0.0);
-  const cv::Vec3d light = partLight(g, interior, lighter, l);
   for (int y = 0; y < labels.rows; ++y) {
     const int* lab = labels.ptr<int>(y);
     const uint8_t* o = outline.ptr<uint8_t>(y);
-    const uint8_t* v = g.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) {
       if (lab[x] == 0) continue;
       const auto k = static_cast<size_t>(lab[x]);
       ++pixels[k];
       on_outline[k] += o[x] ? 1 : 0;
-      excess[k] += v[x] - (light[0] + light[1] * x + light[2] * y);
     }
   }
-  // A shadow lies along the outline, a few pixels thick, at a level of its
-  // own. Not a shadow: specks of the edge's blur along the outline (each
-  // fewer than kMinShadowPixels, though many of them reach it together) or
-  // a fringe of it (thinner than kMinLayerThickness: the blurred tip of a
-  // part's light side); a layer thicker than kMaxLayerThickness for its
-  // length on the outline (a glint's halo near the rim, which cut off from
-  // a glossy part took 2 % of it and moved it 1.6 px); nor one the part's
-  // own light explains to within kLighterShare of the contrast (the lit
-  // side of a part shaded across its face, within a few levels of its
-  // surface at 30 levels of contrast: cut off, 1.7 % of the part and 1.1 px).
+  // A shadow lies along the outline, a few pixels thick. Not a shadow:
+  // specks of the edge's blur along the outline (each fewer than
+  // kMinShadowPixels, though many of them reach it together) or a fringe of
+  // it (thinner than kMinLayerThickness: the blurred tips of a part's arms
+  // on its lit side). Counted as one, they took 2 % of a part shaded within
+  // a few levels of its belt and moved it 1.1 px; of a glossy part, beside
+  // its glints, 1.6 px.
   std::vector<char> kept(static_cast<size_t>(n), 0);
   for (size_t k = 1; k < kept.size(); ++k) {
     kept[k] = on_outline[k] > 0 && pixels[k] >= kMinShadowPixels &&
-                      pixels[k] >= kMinLayerThickness * on_outline[k] &&
-                      pixels[k] <= kMaxLayerThickness * on_outline[k] &&
-                      excess[k] / pixels[k] >= kLighterShare * l.contrast()
+                      pixels[k] >= kMinLayerThickness * on_outline[k]
                   ? 1
                   : 0;
   }
