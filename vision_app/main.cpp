@@ -65,12 +65,12 @@ int main(int argc, char** argv) {
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
     // The results stream: subscribers see what each request saw, after
     // its reply; they never slow a robot.
-    std::unique_ptr<app::ResultsPublisher> results;
+    std::unique_ptr<results::ResultsPublisher> results;
     if (options->results_bind != "none") {
-      app::ResultsOptions results_options;
+      results::ResultsOptions results_options;
       results_options.bind = options->results_bind;
       results_options.app = options->name.empty() ? options->camera : options->name;
-      results = std::make_unique<app::ResultsPublisher>(results_options);
+      results = std::make_unique<results::ResultsPublisher>(results_options);
       cell.publishResultsTo(results.get());
     }
     const bool read_only = options->robot_read_only;

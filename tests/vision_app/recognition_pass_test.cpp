@@ -166,7 +166,7 @@ TEST_CASE("LOCATE of one type does not report a part clearly closer to another t
   CHECK(near(notches.parts, 650, 200));
   CHECK(near(notches.parts, 1050, 450));
   // WHY names them as the other type.
-  RequestRecord record;
+  results::RequestRecord record;
   record.request = "LOCATE";
   record.asked_type = 1;
   record.locate = bars;

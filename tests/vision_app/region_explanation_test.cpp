@@ -174,7 +174,7 @@ TEST_CASE("WHY reads the scale of a copy and names a mirror image", "[vision][wh
                                         7);
   const auto outcome = app::locateInFrame(frameFromImage(scene, "cam", 1), {}, models, 1);
   REQUIRE(outcome.parts.size() == 1);
-  app::RequestRecord record;
+  results::RequestRecord record;
   record.request = "LOCATE";
   record.asked_type = 1;
   record.locate = outcome;

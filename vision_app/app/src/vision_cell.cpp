@@ -53,9 +53,9 @@ std::string VisionCell::handle(std::string_view line, bool read_only, Session* s
   std::string reply = protocol_.handle(line, read_only, &s);
   if (s.publishes == Publishes::kRecord && s.record) {
     // Filled in (reply, time) even with no results stream: WHY keeps it.
-    s.after_reply = publishWhenSent(std::move(s.record), s.received, results_);
+    s.after_reply = results::publishWhenSent(std::move(s.record), s.received, results_);
   } else if ((s.publishes == Publishes::kFrame || s.changed) && results_) {
-    auto record = std::make_shared<RequestRecord>();
+    auto record = std::make_shared<results::RequestRecord>();
     record->request = s.command;
     record->request_line = std::string(line);
     record->client = s.client;
@@ -66,7 +66,7 @@ std::string VisionCell::handle(std::string_view line, bool read_only, Session* s
     // A request refused before it took a frame has none of its own.
     auto frame = s.publishes == Publishes::kFrame ? vision_.lastFramePixels() : nullptr;
     if (frame != frame_before) record->frame = std::move(frame);
-    s.after_reply = publishWhenSent(std::move(record), s.received, results_);
+    s.after_reply = results::publishWhenSent(std::move(record), s.received, results_);
   }
   if (!session && s.after_reply) {
     s.after_reply(reply);

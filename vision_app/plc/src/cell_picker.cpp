@@ -34,7 +34,7 @@ PlcResult plcResult(const app::CellLocate& located) {
   return result;
 }
 
-PlcDevice::Picker cellPicker(app::CellContext& cell, app::ResultsPublisher* const& results) {
+PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results) {
   return [&cell, &results](int type) -> Result<PlcResult> {
     const auto started = std::chrono::steady_clock::now();
     auto located = app::locateAndPick(cell, type);
@@ -44,7 +44,7 @@ PlcDevice::Picker cellPicker(app::CellContext& cell, app::ResultsPublisher* cons
       // Queued only: the publisher builds and sends it on its own thread.
       const std::string reply =
           located ? app::locateReply(located->pick) : app::errorReply(located.error());
-      auto record = app::locateRecord(std::move(located), type, cell.vision.options());
+      auto record = results::locateRecord(std::move(located), type, cell.vision.options());
       record->request_line = "PLC TRIGGER " + std::to_string(type);
       record->client = "plc";
       record->reply = reply;

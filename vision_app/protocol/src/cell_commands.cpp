@@ -37,7 +37,7 @@ std::string locate(const Request& r, CellContext& cell) {
   const std::string out = !located ? reply(located.error())
                           : all    ? locateAllReply(*located)
                                    : locateReply(located->pick);
-  auto record = locateRecord(std::move(located), *type, cell.vision.options());
+  auto record = results::locateRecord(std::move(located), *type, cell.vision.options());
   record->request_line = r.line;
   record->client = r.session->client;
   r.session->last_locate = record;

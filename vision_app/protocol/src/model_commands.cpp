@@ -309,7 +309,7 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         // not kept for WHY, which explains the last real LOCATE.
         CellLocate located;
         located.outcome = std::move(tried->located);
-        auto record = locateRecord(std::move(located), -1, vision.options());
+        auto record = results::locateRecord(std::move(located), -1, vision.options());
         record->request = "TRYLEARN";
         record->request_line = r.line;
         record->client = r.session->client;

@@ -9,7 +9,13 @@
 #include "picksight/common/text.hpp"
 #include "picksight/vision/recognition/region_explanation.hpp"
 
-namespace picksight::app {
+namespace picksight::results {
+using app::CellLocate;
+using app::LocatedPart;
+using app::LocateScene;
+using app::ModelList;
+using app::ScreenedRegion;
+using app::VisionOptions;
 namespace {
 
 std::string ofType(int type) { return " of type " + std::to_string(type); }
@@ -170,4 +176,4 @@ std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int ty
   return record;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::results

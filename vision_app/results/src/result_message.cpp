@@ -10,7 +10,15 @@
 
 #include "picksight/grasp/grasp.hpp"
 
-namespace picksight::app {
+namespace picksight::results {
+using app::CoordinateFrame;
+using app::GraspSetup;
+using app::greyImage;
+using app::LocatedPart;
+using app::LocateOutcome;
+using app::LocateScene;
+using app::modelOf;
+using app::partPoseInVisionFrame;
 namespace {
 
 constexpr size_t kMaxOutlinePoints = 512;
@@ -255,4 +263,4 @@ void buildVisionResult(const RequestRecord& record, const std::string& app, uint
   }
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::results

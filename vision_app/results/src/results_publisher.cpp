@@ -15,7 +15,7 @@
 #include "picksight/common/log.hpp"
 #include "result_message.hpp"
 
-namespace picksight::app {
+namespace picksight::results {
 
 struct ResultsPublisher::Impl {
   // XPUB: a PUB socket that also hands over its subscriptions, so that no
@@ -165,4 +165,4 @@ std::function<void(const std::string& reply)> publishWhenSent(
   };
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::results

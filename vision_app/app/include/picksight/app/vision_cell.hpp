@@ -50,9 +50,9 @@ class VisionCell {
 
   // Every vision request publishes its result there from now on (null:
   // none); `results` outlives the cell. Call before serving starts.
-  void publishResultsTo(ResultsPublisher* results) { results_ = results; }
+  void publishResultsTo(results::ResultsPublisher* results) { results_ = results; }
   // Where requests publish (null: nowhere); read at each request.
-  ResultsPublisher* const& results() const { return results_; }
+  results::ResultsPublisher* const& results() const { return results_; }
 
   VisionService& vision() { return vision_; }
   ModelLibrary& models() { return models_; }
@@ -68,7 +68,7 @@ class VisionCell {
   VisionService vision_;
   RobotProtocol protocol_;
   CellContext context_;
-  ResultsPublisher* results_ = nullptr;
+  results::ResultsPublisher* results_ = nullptr;
 };
 
 }  // namespace picksight::app

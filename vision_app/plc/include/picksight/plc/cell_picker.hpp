@@ -19,7 +19,7 @@ PlcResult plcResult(const app::CellLocate& located);
 // The three callbacks of a PlcDevice over `cell` (borrowed; outlives the
 // device). The picker publishes each trigger's record on `results` when it
 // is set (read at each trigger; the pointer outlives the device).
-PlcDevice::Picker cellPicker(app::CellContext& cell, app::ResultsPublisher* const& results);
+PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results);
 PlcDevice::FrameState cellFrameState(const app::CellCalibration& calibration);
 int robotErrorCodeOf(const Error& error);
 

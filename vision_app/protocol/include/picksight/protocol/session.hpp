@@ -31,7 +31,7 @@ struct Session {
   // line has been sent, so that nothing it does delays the robot.
   std::function<void(const std::string& reply)> after_reply;
   // The last LOCATE on this connection (null before any), for WHY.
-  std::shared_ptr<const RequestRecord> last_locate;
+  std::shared_ptr<const results::RequestRecord> last_locate;
   // Of the current request, set by CommandTable::dispatch from its entry
   // (empty, kNothing for a line no entry took): the command word and what
   // it publishes; and the record its handler leaves (Publishes::kRecord).
@@ -40,7 +40,7 @@ struct Session {
   // Whether the current request changed the cell (answered OK): published
   // for the web's audit trail.
   bool changed = false;
-  std::shared_ptr<RequestRecord> record;
+  std::shared_ptr<results::RequestRecord> record;
 };
 
 }  // namespace picksight::app

@@ -22,7 +22,7 @@
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
 
-namespace picksight::app {
+namespace picksight::results {
 
 // Why one region was not reported as a part of the asked type (see
 // Rejection in proto/results.proto; sensor pixels).
@@ -57,15 +57,15 @@ class RequestRecord {
 
   // LOCATE: its outcome and what the grasps were chosen with (none when
   // the request failed before a frame).
-  std::optional<LocateOutcome> locate;
-  CellPick pick;
-  std::shared_ptr<const GraspMap> grasps;
-  std::optional<CellGeometry> geometry;
+  std::optional<app::LocateOutcome> locate;
+  app::CellPick pick;
+  std::shared_ptr<const app::GraspMap> grasps;
+  std::optional<app::CellGeometry> geometry;
 
   // Other requests: the frame they worked on (regions are found from it by
   // the publisher) and the settings to find them with.
   std::shared_ptr<const Frame> frame;
-  VisionOptions options;
+  app::VisionOptions options;
 
   // The frame the request worked on, if any.
   std::optional<FrameInfo> frameInfo() const;
@@ -89,7 +89,7 @@ class RequestRecord {
 // the client, the reply and the time once they are known. Its settings are
 // those the location ran with when it says (LocateOutcome::settings), else
 // `options`.
-std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
-                                            const VisionOptions& options);
+std::shared_ptr<RequestRecord> locateRecord(Result<app::CellLocate>&& located, int type,
+                                            const app::VisionOptions& options);
 
-}  // namespace picksight::app
+}  // namespace picksight::results

@@ -23,7 +23,7 @@
 
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::results {
 
 struct ResultsOptions {
   std::string bind = "tcp://127.0.0.1:*";  // "none": no results stream
@@ -61,4 +61,4 @@ std::function<void(const std::string& reply)> publishWhenSent(
     std::shared_ptr<RequestRecord> record, std::chrono::steady_clock::time_point received,
     ResultsPublisher* results);
 
-}  // namespace picksight::app
+}  // namespace picksight::results
