@@ -146,12 +146,12 @@ int main(int argc, char** argv) {
   if (!frames || !control_endpoint) return 1;
 
   // The vision app's trigger path, with stamps: the same calls as
-  // VideoServerCamera::freshFrame, then its vision pass.
+  // picksight::link::VideoServerCamera::freshFrame, then its vision pass.
   PathSamples s;
   int failures = 0;
   {
     zmq::context_t context;
-    picksight::app::FrameFeed feed(context, *frames, "cam0");
+    picksight::link::FrameFeed feed(context, *frames, "cam0");
     picksight::ControlClient control(context, *control_endpoint, 2000ms);
     feed.start();
     picksight::proto::ControlRequest trigger;

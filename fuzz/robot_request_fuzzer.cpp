@@ -33,7 +33,7 @@ picksight::app::VisionCell& cell() {
     return true;
   }();
   (void)made;
-  static picksight::app::VisionCell instance(dir, std::make_unique<picksight::app::NoCamera>(),
+  static picksight::app::VisionCell instance(dir, std::make_unique<picksight::link::NoCamera>(),
                                              picksight::app::VisionOptions{});
   static const bool loaded = (instance.load(), true);
   (void)loaded;

@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   try {
     zmq::context_t context;
     app::VisionCell cell(options->data_dir,
-                         std::make_unique<app::VideoServerCamera>(
+                         std::make_unique<picksight::link::VideoServerCamera>(
                              context, options->frames_endpoint, options->control_endpoint,
                              options->camera, options->vision.frame_timeout, options->curve),
                          options->vision, options->vision_settings_given);

@@ -61,13 +61,13 @@ bool posesAre(const std::string& reply, const std::vector<cv::Point3d>& expected
 
 struct Cell {
   std::string dir;
-  StillCamera* camera = nullptr;  // owned by the cell
+  picksight::link::StillCamera* camera = nullptr;  // owned by the cell
   std::unique_ptr<VisionCell> cell;
   Cell() {
     char d[] = "/tmp/picksight-cell-test-XXXXXX";
     REQUIRE(::mkdtemp(d) != nullptr);
     dir = d;
-    auto still = std::make_unique<StillCamera>();
+    auto still = std::make_unique<picksight::link::StillCamera>();
     camera = still.get();
     cell = std::make_unique<VisionCell>(dir, std::move(still), VisionOptions{});
     REQUIRE(cell->load().empty());
@@ -119,7 +119,7 @@ TEST_CASE("the first grasp whose fingers are clear wins and a blocked part is no
   CHECK(posesAre(cell.ask(Scene(blocked).bar({480, 120}), "LOCATE 1"), {{480, -120, 0}}));
 
   // Grasps persist with the model, and reload with it.
-  VisionCell again(cell.dir, std::make_unique<NoCamera>(), VisionOptions{});
+  VisionCell again(cell.dir, std::make_unique<picksight::link::NoCamera>(), VisionOptions{});
   CHECK(again.load().empty());
   CHECK(again.handle("GRASP 1 LIST") == "OK 2 0.000 0.000 0.000 0.000 0.000 90.000");
   CHECK(cell.cell->handle("GRIPPER 1 CLEAR") == "OK 0");
@@ -176,7 +176,7 @@ TEST_CASE("the lens subcommand stores the chessboard lens model the cell then us
   CHECK(parseDouble(w[1]).value_or(0) == Approx(535.916).epsilon(0.01));
   CHECK(parseDouble(w[3]).value_or(0) == Approx(342.283).margin(3));
   CHECK(parseDouble(w[4]).value_or(0) == Approx(235.571).margin(3));
-  VisionCell reloaded(cell.dir, std::make_unique<NoCamera>(), VisionOptions{});
+  VisionCell reloaded(cell.dir, std::make_unique<picksight::link::NoCamera>(), VisionOptions{});
   CHECK(reloaded.load().empty());
   CHECK(reloaded.handle("STATUS").find(" lens=1 ") != std::string::npos);
   CHECK(reloaded.calibration().geometry()->vision.calibrated() == false);  // no scale yet

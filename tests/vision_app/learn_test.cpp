@@ -66,13 +66,13 @@ const LocatedPart& nearest(const std::vector<LocatedPart>& parts, double x, doub
 
 struct StillCell {
   std::string dir;
-  StillCamera* camera = nullptr;  // owned by the cell
+  picksight::link::StillCamera* camera = nullptr;  // owned by the cell
   std::unique_ptr<VisionCell> cell;
   explicit StillCell(const cv::Mat& image, VisionOptions options = {}) {
     char d[] = "/tmp/picksight-learn-test-XXXXXX";
     REQUIRE(::mkdtemp(d) != nullptr);
     dir = d;
-    auto still = std::make_unique<StillCamera>(image);
+    auto still = std::make_unique<picksight::link::StillCamera>(image);
     camera = still.get();
     cell = std::make_unique<VisionCell>(dir, std::move(still), std::move(options));
     REQUIRE(cell->load().empty());

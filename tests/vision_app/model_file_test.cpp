@@ -200,7 +200,7 @@ TEST_CASE("the library stores, reloads, forgets, and skips bad files by name",
 TEST_CASE("model commands check their arguments before touching the camera",
           "[vision_app][protocol]") {
   TempDir dir;
-  VisionCell protocol{dir.path, std::make_unique<NoCamera>(), VisionOptions{}};
+  VisionCell protocol{dir.path, std::make_unique<picksight::link::NoCamera>(), VisionOptions{}};
   ModelLibrary& library = protocol.models();
   CHECK(protocol.handle("MODELS") == "OK 0");
   CHECK(protocol.handle("MODELS 1").rfind("ERROR 11 ", 0) == 0);

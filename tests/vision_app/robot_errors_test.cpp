@@ -25,11 +25,11 @@ TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]")
   CHECK(robotErrorCode(ProtocolErrc::kRequestTooLong) == 12);
   CHECK(robotErrorCode(ProtocolErrc::kTooManyConnections) == 13);
   CHECK(robotErrorCode(ProtocolErrc::kEmptyRequest) == 14);
-  CHECK(robotErrorCode(CameraErrc::kNoFrame) == 20);
-  CHECK(robotErrorCode(CameraErrc::kNoVideoServer) == 21);
+  CHECK(robotErrorCode(picksight::link::CameraErrc::kNoFrame) == 20);
+  CHECK(robotErrorCode(picksight::link::CameraErrc::kNoVideoServer) == 21);
   CHECK(robotErrorCode(ControlErrc::kNoReply) == 21);
-  CHECK(robotErrorCode(CameraErrc::kCameraRefused) == 22);
-  CHECK(robotErrorCode(CameraErrc::kUnknownFeature) == 22);
+  CHECK(robotErrorCode(picksight::link::CameraErrc::kCameraRefused) == 22);
+  CHECK(robotErrorCode(picksight::link::CameraErrc::kUnknownFeature) == 22);
   CHECK(robotErrorCode(vision::PartModelErrc::kNoPart) == 30);
   CHECK(robotErrorCode(vision::PartModelErrc::kSeveralParts) == 31);
   CHECK(robotErrorCode(VisionServiceErrc::kUnknownType) == 32);

@@ -21,7 +21,8 @@ namespace {
 // concurrent runs never share models or calibrations.
 struct Fixture {
   picksight::test::TempDir dir;
-  VisionCell protocol{dir.path().string(), std::make_unique<NoCamera>(), VisionOptions{}};
+  VisionCell protocol{dir.path().string(), std::make_unique<picksight::link::NoCamera>(),
+                      VisionOptions{}};
 };
 }  // namespace
 

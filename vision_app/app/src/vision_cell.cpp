@@ -9,7 +9,7 @@
 
 namespace picksight::app {
 
-VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera,
+VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,
                        VisionOptions options, std::vector<std::string> command_line_settings)
     : settings_file_(data_dir + "/vision.json"),
       command_line_settings_(std::move(command_line_settings)),

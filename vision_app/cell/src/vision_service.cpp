@@ -212,7 +212,7 @@ Result<TargetOutcome> targetInImage(const cv::Mat& grey, const SensorMapping& ma
   return t;
 }
 
-VisionService::VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
+VisionService::VisionService(std::unique_ptr<link::CameraLink> camera, VisionOptions options,
                              ModelLibrary* models)
     : camera_(std::move(camera)),
       models_(models),

@@ -1,7 +1,7 @@
 // Camera links without a video server: a still image, or none.
 #include "picksight/link/camera_link.hpp"
 
-namespace picksight::app {
+namespace picksight::link {
 
 const char* errorName(CameraErrc e) {
   switch (e) {
@@ -75,4 +75,4 @@ Result<void> NoCamera::setRoi(const cv::Rect&) {
   return makeError(CameraErrc::kNoVideoServer, "no video server");
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::link

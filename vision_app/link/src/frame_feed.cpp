@@ -3,7 +3,7 @@
 
 #include "picksight/common/log.hpp"
 
-namespace picksight::app {
+namespace picksight::link {
 
 FrameFeed::FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
                      std::optional<CurveClientKeys> curve)
@@ -61,4 +61,4 @@ std::shared_ptr<const Frame> FrameFeed::waitFor(uint64_t sequence, uint64_t afte
   return fresh() ? latest_ : nullptr;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::link

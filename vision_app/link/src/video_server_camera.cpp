@@ -5,7 +5,7 @@
 
 #include "picksight/common/clock.hpp"
 
-namespace picksight::app {
+namespace picksight::link {
 
 VideoServerCamera::VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
                                      const std::string& control_endpoint, std::string camera,
@@ -172,4 +172,4 @@ Result<void> VideoServerCamera::setRoi(const cv::Rect& roi) {
   return {};
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::link

@@ -168,26 +168,27 @@ std::string exposure(const Request& r, CellContext& cell) {
   // refuses the value explains why better than the names it does not know.
   std::string why;
   for (const auto& name : exposureFeatureNames()) {
-    auto answer = cell.vision.withCamera([&](CameraLink& camera) {
+    auto answer = cell.vision.withCamera([&](link::CameraLink& camera) {
       return value ? camera.setFeature(name, formatFixed(*value, 3)) : camera.feature(name);
     });
     if (answer) return "OK " + name + " " + printable(*answer, 64);
     const std::error_code code = answer.error().code;
-    if (code == CameraErrc::kNoVideoServer)
-      return errorReply(CameraErrc::kNoVideoServer, "video server: " + answer.error().message);
-    if (code != CameraErrc::kUnknownFeature || why.empty())
+    if (code == link::CameraErrc::kNoVideoServer)
+      return errorReply(link::CameraErrc::kNoVideoServer,
+                        "video server: " + answer.error().message);
+    if (code != link::CameraErrc::kUnknownFeature || why.empty())
       why = printable(answer.error().message, 120);
-    if (code != CameraErrc::kUnknownFeature) break;
+    if (code != link::CameraErrc::kUnknownFeature) break;
   }
-  return errorReply(CameraErrc::kCameraRefused, "EXPOSURE: " + why);
+  return errorReply(link::CameraErrc::kCameraRefused, "EXPOSURE: " + why);
 }
 
 std::string roi(const Request& r, CellContext& cell) {
   const std::string usage = "usage: ROI <x> <y> <width> <height> | ROI FULL | ROI";
   if (r.args.empty()) {
-    auto answer = cell.vision.withCamera([](CameraLink& camera) { return camera.roi(); });
+    auto answer = cell.vision.withCamera([](link::CameraLink& camera) { return camera.roi(); });
     if (!answer)
-      return errorReply(CameraErrc::kCameraRefused,
+      return errorReply(link::CameraErrc::kCameraRefused,
                         "ROI: " + printable(answer.error().message, 120));
     return "OK " + std::to_string(answer->x) + " " + std::to_string(answer->y) + " " +
            std::to_string(answer->width) + " " + std::to_string(answer->height);
@@ -205,23 +206,24 @@ std::string roi(const Request& r, CellContext& cell) {
   } else if (r.args.size() != 1 || toUpper(r.args[0]) != "FULL") {
     return errorReply(ProtocolErrc::kBadArguments, usage);
   }
-  auto answer = cell.vision.withCamera([&](CameraLink& camera) { return camera.setRoi(wanted); });
+  auto answer =
+      cell.vision.withCamera([&](link::CameraLink& camera) { return camera.setRoi(wanted); });
   if (!answer) {
-    const CameraErrc code = answer.error().code == CameraErrc::kNoVideoServer
-                                ? CameraErrc::kNoVideoServer
-                                : CameraErrc::kCameraRefused;
+    const link::CameraErrc code = answer.error().code == link::CameraErrc::kNoVideoServer
+                                      ? link::CameraErrc::kNoVideoServer
+                                      : link::CameraErrc::kCameraRefused;
     return errorReply(code, "ROI: " + printable(answer.error().message, 120));
   }
   return std::string("OK");
 }
 
-std::string cameraModeReply(const CameraModeSettings& m) {
+std::string cameraModeReply(const link::CameraModeSettings& m) {
   switch (m.mode) {
-    case CameraMode::kSoftwareTrigger:
+    case link::CameraMode::kSoftwareTrigger:
       return "OK SOFTWARE";
-    case CameraMode::kHardwareTrigger:
+    case link::CameraMode::kHardwareTrigger:
       return "OK HARDWARE " + printable(m.line, 32) + " " + std::to_string(m.timeout.count());
-    case CameraMode::kFreeRun:
+    case link::CameraMode::kFreeRun:
       break;
   }
   return "OK FREE " + formatFixed(m.fps, 3);
@@ -232,12 +234,12 @@ std::string cameraModeReply(const CameraModeSettings& m) {
 std::string cameraMode(const Request& r, CellContext& cell) {
   const std::string usage =
       "usage: CAMMODE [FREE [<fps>] | SOFTWARE | HARDWARE [<line> [<timeout_ms>]]]";
-  std::optional<CameraModeSettings> wanted;
+  std::optional<link::CameraModeSettings> wanted;
   if (!r.args.empty()) {
-    CameraModeSettings m;
+    link::CameraModeSettings m;
     const std::string kind = toUpper(r.args[0]);
     if (kind == "FREE" && r.args.size() <= 2) {
-      m.mode = CameraMode::kFreeRun;
+      m.mode = link::CameraMode::kFreeRun;
       if (r.args.size() == 2) {
         const auto fps = parseDouble(r.args[1]);
         if (!fps || !(*fps > 0 && *fps <= 1000))
@@ -247,9 +249,9 @@ std::string cameraMode(const Request& r, CellContext& cell) {
         m.fps = *fps;
       }
     } else if (kind == "SOFTWARE" && r.args.size() == 1) {
-      m.mode = CameraMode::kSoftwareTrigger;
+      m.mode = link::CameraMode::kSoftwareTrigger;
     } else if (kind == "HARDWARE" && r.args.size() <= 3) {
-      m.mode = CameraMode::kHardwareTrigger;
+      m.mode = link::CameraMode::kHardwareTrigger;
       if (r.args.size() >= 2) {
         const std::string& line = r.args[1];
         const bool name_ok = line.size() <= 32 && std::all_of(line.begin(), line.end(), [](char c) {
@@ -274,16 +276,17 @@ std::string cameraMode(const Request& r, CellContext& cell) {
     }
     wanted = m;
   }
-  auto answer = cell.vision.withCamera([&](CameraLink& camera) -> Result<CameraModeSettings> {
-    if (wanted) {
-      if (auto set = camera.setMode(*wanted); !set) return set.error();
-    }
-    return camera.mode();
-  });
+  auto answer =
+      cell.vision.withCamera([&](link::CameraLink& camera) -> Result<link::CameraModeSettings> {
+        if (wanted) {
+          if (auto set = camera.setMode(*wanted); !set) return set.error();
+        }
+        return camera.mode();
+      });
   if (!answer) {
-    const CameraErrc code = answer.error().code == CameraErrc::kNoVideoServer
-                                ? CameraErrc::kNoVideoServer
-                                : CameraErrc::kCameraRefused;
+    const link::CameraErrc code = answer.error().code == link::CameraErrc::kNoVideoServer
+                                      ? link::CameraErrc::kNoVideoServer
+                                      : link::CameraErrc::kCameraRefused;
     return errorReply(code, "CAMMODE: " + printable(answer.error().message, 160));
   }
   return cameraModeReply(*answer);

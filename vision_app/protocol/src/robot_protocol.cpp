@@ -29,7 +29,7 @@ std::string RobotProtocol::frame(const Request& request) {
   if (!request.args.empty())
     return errorReply(ProtocolErrc::kBadArguments, "FRAME takes no arguments");
   const auto f = vision_.lastFrame();
-  if (!f) return errorReply(CameraErrc::kNoFrame, "no frame used yet");
+  if (!f) return errorReply(link::CameraErrc::kNoFrame, "no frame used yet");
   return "OK " + f->camera + " " + std::to_string(f->sequence) + " " +
          std::to_string(f->host_timestamp_ns) + " " + std::to_string(f->width) + " " +
          std::to_string(f->height) + " " + (f->triggered ? "1" : "0");

@@ -28,8 +28,8 @@ class VisionCell {
   // nothing is read or written before load(). `command_line_settings`: the
   // vision settings keys (vision_settings.hpp) set on the command line, which
   // win over vision.json at start.
-  VisionCell(const std::string& data_dir, std::unique_ptr<CameraLink> camera, VisionOptions options,
-             std::vector<std::string> command_line_settings = {});
+  VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,
+             VisionOptions options, std::vector<std::string> command_line_settings = {});
   VisionCell(const VisionCell&) = delete;
   VisionCell& operator=(const VisionCell&) = delete;
 

@@ -29,7 +29,7 @@ namespace picksight::app {
 class ScaledModelCache;
 
 // Why a request VisionService serves failed (besides the camera link's
-// CameraErrc and training's vision::PartModelErrc). Its domain keeps the
+// link::CameraErrc and training's vision::PartModelErrc). Its domain keeps the
 // name "vision" it has always had in messages.
 enum class VisionServiceErrc {
   kNoTarget = 1,             // STORE, CALCAM: no target in the frame
@@ -205,7 +205,7 @@ std::vector<vision::BlobFeatures> blobsInImage(const cv::Mat& grey, const Vision
 class VisionService {
  public:
   // `models` (borrowed, may be null: no recognition) outlives the service.
-  VisionService(std::unique_ptr<CameraLink> camera, VisionOptions options,
+  VisionService(std::unique_ptr<link::CameraLink> camera, VisionOptions options,
                 ModelLibrary* models = nullptr);
   ~VisionService();
 
@@ -235,7 +235,7 @@ class VisionService {
   // to sensor pixels, for measurements that need the whole image (a grid of
   // calibration dots).
   Result<std::pair<cv::Mat, SensorMapping>> greyFrame();
-  // Runs `fn(CameraLink&)` between requests (camera settings: they share
+  // Runs `fn(link::CameraLink&)` between requests (camera settings: they share
   // the link's control socket with the triggers) and returns its result.
   template <typename Fn>
   auto withCamera(Fn&& fn) {
@@ -284,7 +284,7 @@ class VisionService {
   Result<std::shared_ptr<const VisionOptions>> requestSettings() const;
   Error settingsBlocked() const;  // call with settings_mutex_ held
 
-  const std::unique_ptr<CameraLink> camera_;
+  const std::unique_ptr<link::CameraLink> camera_;
   ModelLibrary* const models_;
 
   mutable std::mutex settings_mutex_;  // guards settings_, settings_damage_, settings_path_

@@ -21,7 +21,7 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/common/result.hpp"
 
-namespace picksight::app {
+namespace picksight::link {
 
 // Why a camera link failed.
 enum class CameraErrc {
@@ -113,6 +113,6 @@ class NoCamera : public CameraLink {
   const std::string camera_ = "none";
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::link
 
-PICKSIGHT_ERROR_ENUM(picksight::app::CameraErrc)
+PICKSIGHT_ERROR_ENUM(picksight::link::CameraErrc)

@@ -15,7 +15,7 @@
 
 #include "picksight/transport/frame_message.hpp"
 
-namespace picksight::app {
+namespace picksight::link {
 
 class FrameFeed {
  public:
@@ -51,4 +51,4 @@ class FrameFeed {
   std::shared_ptr<const Frame> latest_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::link

@@ -19,7 +19,7 @@
 #include "picksight/link/frame_feed.hpp"
 #include "picksight/transport/control_client.hpp"
 
-namespace picksight::app {
+namespace picksight::link {
 
 class VideoServerCamera : public CameraLink {
  public:
@@ -52,4 +52,4 @@ class VideoServerCamera : public CameraLink {
   ControlClient control_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::link
