@@ -149,6 +149,22 @@ void compareRow(const uint8_t* grey, const uint16_t* a, const uint16_t* b, int w
   }
 }
 
+// Immerkaer's noise response (the absolute response to a kernel that
+// cancels any plane) of row `mid`, between rows `up` and `down`, added to
+// `sum` and counted in `count` over the pixels whose Sobel magnitude (`gxs`,
+// `gys`) is under `least` (not on an edge).
+void addRowNoise(const uint8_t* up, const uint8_t* mid, const uint8_t* down, const int16_t* gxs,
+                 const int16_t* gys, const std::vector<int>& least, int64_t* sum, int64_t* count) {
+  const int width = static_cast<int>(least.size());
+  for (int x = 1; x + 1 < width; ++x) {
+    if (std::abs(gxs[x]) + std::abs(gys[x]) >= least[static_cast<size_t>(x)]) continue;
+    const int residual = (up[x - 1] + up[x + 1] + down[x - 1] + down[x + 1]) -
+                         2 * (up[x] + down[x] + mid[x - 1] + mid[x + 1]) + 4 * mid[x];
+    *sum += std::abs(residual);
+    ++*count;
+  }
+}
+
 // Where a part's edge runs, the threshold that splits it is the grey level
 // halfway up its own step, whatever the light and the part's shading there.
 // A single ratio to the background cannot follow a part shaded lighter on
@@ -208,13 +224,7 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
         const int16_t* gys = gradient_y.ptr<int16_t>(y);
         // The noise, off the edges, from every fourth row: plenty of pixels.
         if (y % 4 == 0) {
-          for (int x = 1; x + 1 < width; ++x) {
-            if (std::abs(gxs[x]) + std::abs(gys[x]) >= least[static_cast<size_t>(x)]) continue;
-            const int residual = (up[x - 1] + up[x + 1] + down[x - 1] + down[x + 1]) -
-                                 2 * (up[x] + down[x] + mid[x - 1] + mid[x + 1]) + 4 * mid[x];
-            residual_sum += std::abs(residual);
-            ++residual_count;
-          }
+          addRowNoise(up, mid, down, gxs, gys, least, &residual_sum, &residual_count);
         }
         for (int x = 1; x + 1 < width; ++x) {
           const int gx = gxs[x];
@@ -337,6 +347,50 @@ GuidedThreshold edgeGuidedThreshold(const cv::Mat& grey, int reduce, int k,
   return out;
 }
 
+// How the ratio of the image to its background splits (see adaptive).
+struct RatioSplit {
+  double k_ratio = kMaxRatio;  // the ratio parts lie below
+  // Part/background, a fraction of the background level, where the edges
+  // set the threshold; 0 where the ratio alone does.
+  double contrast = 0;
+};
+
+// The split of the ratio image (200 = the background's level) of `small_f`
+// to `background_f`, both at low resolution.
+RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
+  cv::Mat ratio;
+  cv::divide(small_f, cv::max(background_f, 1.0f), ratio, 200.0);
+  cv::Mat ratio8;
+  ratio.convertTo(ratio8, CV_8U);
+  cv::Mat upper;
+  const double otsu = cv::threshold(ratio8, upper, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  // Otsu's level is the first of a flat optimum: with two clean populations it
+  // sits on the edge of the darker one. Split halfway between the two class
+  // means instead, where noise on either side is least likely to cross.
+  RatioSplit split;
+  const int bright = cv::countNonZero(upper);
+  if (bright > 0 && bright < upper.rows * upper.cols) {
+    cv::Scalar mean_bright;
+    cv::Scalar sd_bright;
+    cv::Scalar mean_dark;
+    cv::Scalar sd_dark;
+    cv::meanStdDev(ratio8, mean_bright, sd_bright, upper);
+    cv::meanStdDev(ratio8, mean_dark, sd_dark, ~upper);
+    const double spread = std::sqrt(0.5 * (sd_bright[0] * sd_bright[0] + sd_dark[0] * sd_dark[0]));
+    const bool separated = mean_bright[0] - mean_dark[0] > kMinSeparation * std::max(spread, 1.0);
+    split.k_ratio = std::clamp(0.5 * (mean_bright[0] + mean_dark[0]) / 200.0, kMinRatio,
+                               separated ? kMaxSeparatedRatio : kMaxRatio);
+    // An even surface (its spread a small share of the contrast: a back
+    // light, a plain tray) is split exactly by the ratio, at no further cost.
+    if (sd_bright[0] > kEvenSurface * (mean_bright[0] - mean_dark[0])) {
+      split.contrast = (mean_bright[0] - mean_dark[0]) / 200.0;
+    }
+  } else {
+    split.k_ratio = std::clamp(otsu / 200.0, kMinRatio, kMaxRatio);
+  }
+  return split;
+}
+
 cv::Mat adaptive(const cv::Mat& grey, int window) {
   const int reduce = std::min({kReduce, std::max(1, grey.cols / 16), std::max(1, grey.rows / 16)});
   cv::Mat small;
@@ -353,44 +407,13 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
              cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
   cv::blur(background, background, cv::Size(k, k), cv::Point(-1, -1), cv::BORDER_REPLICATE);
 
-  // Ratio image at low resolution, 200 = background level.
   cv::Mat small_f;
   cv::Mat background_f;
   small.convertTo(small_f, CV_32F);
   background.convertTo(background_f, CV_32F);
-  cv::Mat ratio;
-  cv::divide(small_f, cv::max(background_f, 1.0f), ratio, 200.0);
-  cv::Mat ratio8;
-  ratio.convertTo(ratio8, CV_8U);
-  cv::Mat upper;
-  const double otsu = cv::threshold(ratio8, upper, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
-  // Otsu's level is the first of a flat optimum: with two clean populations it
-  // sits on the edge of the darker one. Split halfway between the two class
-  // means instead, where noise on either side is least likely to cross.
-  double k_ratio = kMaxRatio;
-  // Part/background, a fraction of the background level, where the edges
-  // set the threshold; 0 where the ratio alone does.
-  double contrast = 0;
-  const int bright = cv::countNonZero(upper);
-  if (bright > 0 && bright < upper.rows * upper.cols) {
-    cv::Scalar mean_bright;
-    cv::Scalar sd_bright;
-    cv::Scalar mean_dark;
-    cv::Scalar sd_dark;
-    cv::meanStdDev(ratio8, mean_bright, sd_bright, upper);
-    cv::meanStdDev(ratio8, mean_dark, sd_dark, ~upper);
-    const double spread = std::sqrt(0.5 * (sd_bright[0] * sd_bright[0] + sd_dark[0] * sd_dark[0]));
-    const bool separated = mean_bright[0] - mean_dark[0] > kMinSeparation * std::max(spread, 1.0);
-    k_ratio = std::clamp(0.5 * (mean_bright[0] + mean_dark[0]) / 200.0, kMinRatio,
-                         separated ? kMaxSeparatedRatio : kMaxRatio);
-    // An even surface (its spread a small share of the contrast: a back
-    // light, a plain tray) is split exactly by the ratio, at no further cost.
-    if (sd_bright[0] > kEvenSurface * (mean_bright[0] - mean_dark[0])) {
-      contrast = (mean_bright[0] - mean_dark[0]) / 200.0;
-    }
-  } else {
-    k_ratio = std::clamp(otsu / 200.0, kMinRatio, kMaxRatio);
-  }
+  const RatioSplit split = splitRatio(small_f, background_f);
+  const double k_ratio = split.k_ratio;
+  const double contrast = split.contrast;
 
   // The threshold in 1/16 grey levels, widened to full width at low height
   // only; the vertical interpolation happens inside the compare, so no
