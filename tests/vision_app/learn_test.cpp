@@ -471,6 +471,10 @@ TEST_CASE("offline learn --at learns the one part inside a rectangle as LEARN AT
   REQUIRE(fields.size() >= 4);
   CHECK(*parseDouble(fields[3]) == Approx(M_PI * 110 * 110).epsilon(0.01));
   CHECK(std::filesystem::exists(cell.dir + "/offline/models/type_4.yaml"));
+  // Its teach image beside it, the 1280 x 960 image shrunk to fit 1024.
+  const cv::Mat taught = cv::imread(cell.dir + "/offline/models/type_4.png", cv::IMREAD_UNCHANGED);
+  CHECK(taught.cols == 1024);
+  CHECK(taught.rows == 768);
   std::string err;
   std::tie(status, out) = run({"--at", "1", "2", "x", "4"}, &err);
   CHECK(status == 2);

@@ -13,6 +13,9 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
 #include "scene_file.hpp"
@@ -151,6 +154,65 @@ TEST_CASE("UNDO restores a forgotten model with its grasps and takes back TOLERA
   CHECK(cell.ask("GRIPPER 1 LIST") == "OK 0");
   CHECK_THAT(cell.ask("UNDO"), Catch::StartsWith("OK 1 restored 1 ; undid: GRASP 1 ADD 1 2 30"));
   CHECK(cell.ask("GRASP 1 LIST") == "OK 0");
+}
+
+// The teach image beside a model: what the camera showed when it was taught.
+cv::Mat teachImage(const UndoCell& cell, int type = 1) {
+  return cv::imread(cell.data_dir + "/models/type_" + std::to_string(type) + ".png",
+                    cv::IMREAD_UNCHANGED);
+}
+
+bool same(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
+}
+
+TEST_CASE("LEARN stores its teach image beside the model and FORGET and UNDO follow it",
+          "[vision_app][undo][e2e]") {
+  UndoCell cell;  // the plate learned as type 1
+  const std::string png = cell.data_dir + "/models/type_1.png";
+  const cv::Mat plate = scene(kPlate);
+  REQUIRE(fs::exists(png));
+  CHECK(same(teachImage(cell), plate));
+  const std::string plate_png = contents(png);
+
+  // Taught again from the bar: its image replaces the plate's.
+  cell.scene.show(scene(kBar));
+  REQUIRE(cell.ask("LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);
+  CHECK(same(teachImage(cell), scene(kBar)));
+  // A change that is not a teach leaves the image alone, and so does its UNDO.
+  const std::string bar_png = contents(png);
+  REQUIRE(cell.ask("TOLERANCE 1 area_tolerance 0.2").rfind("OK 1 bar", 0) == 0);
+  CHECK(contents(png) == bar_png);
+  REQUIRE(cell.ask("UNDO").rfind("OK 1 restored 2 ; undid: TOLERANCE", 0) == 0);
+  CHECK(contents(png) == bar_png);
+  // UNDO of the second LEARN: the plate's image again, byte for byte.
+  REQUIRE(cell.ask("UNDO").rfind("OK 1 restored 1 ; undid: LEARN 1 bar", 0) == 0);
+  CHECK(contents(png) == plate_png);
+
+  REQUIRE(cell.ask("FORGET 1") == "OK");
+  CHECK_FALSE(fs::exists(png));
+  REQUIRE(cell.ask("UNDO").rfind("OK 1 restored 1 ; undid: FORGET 1", 0) == 0);
+  CHECK(contents(png) == plate_png);
+  // Back past the first LEARN: no model, no image.
+  REQUIRE(cell.ask("UNDO").rfind("OK 1 removed 0 ; undid: LEARN 1 plate", 0) == 0);
+  CHECK_FALSE(fs::exists(png));
+  CHECK(entries(cell.undoDir(), ".png") == 0);
+}
+
+TEST_CASE("A teach image is bounded and its undo copies go with the history's entries",
+          "[vision_app][undo][e2e]") {
+  UndoCell cell;
+  // A large frame is stored shrunk to 1024 pixels on its longer side.
+  cell.scene.show(test::drawParts(2400, 1200, {{kPlate, 1200, 600, 0}}, 11));
+  REQUIRE(cell.ask("LEARN 2 large").rfind("OK 2 large ", 0) == 0);
+  const cv::Mat large = teachImage(cell, 2);
+  CHECK(large.cols == 1024);
+  CHECK(large.rows == 512);
+
+  // 34 more teaches: the history keeps 32 entries, and as many images.
+  for (int i = 0; i < 34; ++i) REQUIRE(cell.ask("LEARN 2 large").rfind("OK 2 large ", 0) == 0);
+  CHECK(entries(cell.undoDir(), ".undo") == 32);
+  CHECK(entries(cell.undoDir(), ".png") == 32);
 }
 
 TEST_CASE("UNDO's history survives a restart and is bounded to 32 changes",

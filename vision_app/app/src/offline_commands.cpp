@@ -214,7 +214,7 @@ int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string
     change += " --at " + std::to_string(r.at->x) + " " + std::to_string(r.at->y) + " " +
               std::to_string(r.at->width) + " " + std::to_string(r.at->height);
   }
-  auto stored = library.store(learned->model, change + " " + path);
+  auto stored = library.store(learned->model, change + " " + path, teachImagePng(grey));
   if (!stored) {
     out << errorReply(VisionServiceErrc::kStorageFailed,
                       "cannot store the model: " + stored.error().message)

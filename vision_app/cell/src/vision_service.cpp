@@ -2,6 +2,7 @@
 // sensor pixels; training and blob features on the same frames.
 #include "picksight/cell/vision_service.hpp"
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -264,11 +265,26 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
   auto learned = learnInImage((*frame)->image, (*frame)->mapping, **settings, models_->snapshot(),
                               type, name, at, scaled_models_.get());
   if (!learned) return learned.error();
-  auto stored = models_->store(learned->model, change);
+  auto stored = models_->store(learned->model, change, teachImagePng((*frame)->image));
   if (!stored)
     return makeError(VisionServiceErrc::kStorageFailed,
                      "cannot store the model: " + stored.error().message);
   return learned;
+}
+
+std::optional<std::string> teachImagePng(const cv::Mat& frame) {
+  if (frame.empty()) return std::nullopt;
+  cv::Mat image = frame;
+  const double shrink =
+      std::min(1.0, static_cast<double>(kTeachImageMaxSide) / std::max(frame.cols, frame.rows));
+  if (shrink < 1.0) {
+    const cv::Size size(std::max(1, static_cast<int>(frame.cols * shrink)),
+                        std::max(1, static_cast<int>(frame.rows * shrink)));
+    cv::resize(frame, image, size, 0, 0, cv::INTER_AREA);
+  }
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", image, png)) return std::nullopt;
+  return std::string(png.begin(), png.end());
 }
 
 Result<TryLearnOutcome> VisionService::tryLearn(int type, const std::string& name,

@@ -117,20 +117,27 @@ Result<std::string> ModelHistory::record(int type, std::string_view change,
   // Bounded: the oldest entries (and set-aside ones) beyond the depth go.
   for (bool damaged : {false, true}) {
     auto paths = list(damaged);
-    for (size_t i = 0; i + kUndoDepth < paths.size(); ++i) fs::remove(paths[i], ec);
+    for (size_t i = 0; i + kUndoDepth < paths.size(); ++i) {
+      fs::remove(paths[i], ec);
+      fs::remove(teachImageBeside(paths[i]), ec);
+    }
   }
   return path;
 }
 
+std::string teachImageBeside(const std::string& entry_path) { return entry_path + ".png"; }
+
 void ModelHistory::drop(const std::string& path) {
   std::error_code ec;
   fs::remove(path, ec);
+  fs::remove(teachImageBeside(path), ec);
   (void)syncDirectory(directory_);
 }
 
 std::string ModelHistory::setAside(const std::string& path) {
   const std::string aside = path + ".damaged";
   std::error_code ec;
+  fs::remove(teachImageBeside(path), ec);  // an image is only put back with its entry
   fs::rename(path, aside, ec);
   if (ec) fs::remove(path, ec);  // out of UNDO's way at least
   (void)syncDirectory(directory_);

@@ -23,6 +23,28 @@ std::string ModelLibrary::pathOf(int type) const {
   return directory_ + "/type_" + std::to_string(type) + ".yaml";
 }
 
+std::string ModelLibrary::teachImagePathOf(int type) const {
+  return directory_ + "/type_" + std::to_string(type) + ".png";
+}
+
+Result<void> ModelLibrary::keepTeachImage(int type, const std::string& entry) {
+  const std::string image = teachImagePathOf(type);
+  std::error_code ec;
+  std::string bytes;
+  if (fs::exists(image, ec)) {
+    auto read = readFile(image);
+    if (!read)
+      return makeError(ModelErrc::kStorage,
+                       "cannot keep the teach image for UNDO: " + read.error().message);
+    bytes = std::move(*read);
+  }
+  auto kept = writeFileAtomically(teachImageBeside(entry), bytes);
+  if (!kept)
+    return makeError(ModelErrc::kStorage,
+                     "cannot keep the teach image for UNDO: " + kept.error().message);
+  return {};
+}
+
 std::vector<std::string> ModelLibrary::load() {
   std::vector<std::string> problems;
   // Left by a write that a crash interrupted; this process owns the directory.
@@ -113,7 +135,8 @@ Result<void> ModelLibrary::writeWithUndo(int type, std::string_view change,
   return written;
 }
 
-Result<void> ModelLibrary::store(const vision::PartModel& model, std::string_view change) {
+Result<void> ModelLibrary::store(const vision::PartModel& model, std::string_view change,
+                                 const std::optional<std::string>& teach_png) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::error_code ec;
   if (fs::create_directories(directory_, ec)) {
@@ -125,12 +148,28 @@ Result<void> ModelLibrary::store(const vision::PartModel& model, std::string_vie
   if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   const auto kept = grasps_->find(model.type);
   const std::string text = modelToYaml(model, kept == grasps_->end() ? GraspSetup{} : kept->second);
-  auto written =
-      writeWithUndo(model.type,
-                    change.empty() ? "LEARN " + std::to_string(model.type) + " " + model.name
-                                   : std::string(change),
-                    text);
-  if (!written) return written;
+  auto entry =
+      recordChange(model.type,
+                   change.empty() ? "LEARN " + std::to_string(model.type) + " " + model.name
+                                  : std::string(change),
+                   text);
+  if (!entry) return entry.error();
+  if (auto kept = keepTeachImage(model.type, *entry); !kept) {
+    history_.drop(*entry);
+    return kept;
+  }
+  if (auto written = writeFileAtomically(pathOf(model.type), text); !written) {
+    history_.drop(*entry);
+    return written;
+  }
+  // The model is stored; its image follows (an old one would show another
+  // model, so it goes whatever happens).
+  const std::string image = teachImagePathOf(model.type);
+  fs::remove(image, ec);
+  if (teach_png) {
+    if (auto saved = writeFileAtomically(image, *teach_png); !saved)
+      logWarning(image, ": the teach image was not written: ", saved.error().message);
+  }
   auto models = std::make_shared<ModelList>(*models_);
   models->erase(std::remove_if(models->begin(), models->end(),
                                [&](const vision::PartModel& m) { return m.type == model.type; }),
@@ -151,12 +190,17 @@ Result<void> ModelLibrary::remove(int type, std::string_view change) {
   auto entry = recordChange(
       type, change.empty() ? "FORGET " + std::to_string(type) : std::string(change), std::nullopt);
   if (!entry) return entry.error();
+  if (auto kept = keepTeachImage(type, *entry); !kept) {
+    history_.drop(*entry);
+    return kept;
+  }
   std::error_code ec;
   fs::remove(pathOf(type), ec);
   if (ec) {
     history_.drop(*entry);
     return makeError(ModelErrc::kStorage, pathOf(type) + ": " + ec.message());
   }
+  fs::remove(teachImagePathOf(type), ec);
   // Without this a crash can bring the forgotten model back at restart.
   (void)syncDirectory(directory_);
   auto models = std::make_shared<ModelList>(*models_);
@@ -265,6 +309,19 @@ Result<UndoOutcome> ModelLibrary::undo() {
     fs::remove(path, ec);
     if (ec) return makeError(ModelErrc::kStorage, path + ": " + ec.message());
     (void)syncDirectory(directory_);
+  }
+  // The teach image as it was before that change, when the change touched
+  // it (LEARN, FORGET): kept beside the entry, empty for none.
+  const std::string beside = teachImageBeside(*newest);
+  if (fs::exists(beside, ec)) {
+    const std::string image = teachImagePathOf(entry->type);
+    auto old_image = readFile(beside);
+    if (old_image && !old_image->empty()) {
+      if (auto put = writeFileAtomically(image, *old_image); !put)
+        logWarning(image, ": the teach image was not put back: ", put.error().message);
+    } else {
+      fs::remove(image, ec);
+    }
   }
   history_.drop(*newest);
   const int type = entry->type;

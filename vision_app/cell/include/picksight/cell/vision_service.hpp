@@ -151,6 +151,13 @@ struct LearnOutcome {
   std::vector<std::string> notes;
 };
 
+// The teach image LEARN stores beside a model: the frame it was taught on,
+// shrunk to fit kTeachImageMaxSide pixels each way (so that a model's image
+// stays a few MB at most whatever the camera), as PNG bytes; nullopt if it
+// cannot be encoded.
+constexpr int kTeachImageMaxSide = 1024;
+std::optional<std::string> teachImagePng(const cv::Mat& frame);
+
 // A LEARN tried without storing (TRYLEARN): the model it would store, and
 // LOCATE ALL on the same frame with that model in place of the type's.
 struct TryLearnOutcome {

@@ -36,6 +36,11 @@ struct UndoEntry {
   std::string after_sha256;
 };
 
+// The teach image a change replaced or removed is kept beside its entry,
+// as <entry>.png (empty: the type had none), and goes with the entry
+// (drop(), setAside(), the oldest dropped); see ModelLibrary.
+std::string teachImageBeside(const std::string& entry_path);
+
 // SHA-256 of `bytes`, lower-case hex.
 std::string sha256Hex(std::string_view bytes);
 

@@ -55,10 +55,17 @@ class ModelLibrary {
   // is made that UNDO could not take back.
 
   // Adds or replaces the model of model.type: the file first, then memory.
-  // A replaced model keeps its grasp styles and gripper.
-  Result<void> store(const vision::PartModel& model, std::string_view change = {});
-  // Removes the model of `type` (file and memory); ModelErrc::kUnknownType
-  // if there is none.
+  // A replaced model keeps its grasp styles and gripper. `teach_png`: the
+  // image the model was taught on (PNG bytes), written atomically beside
+  // the model file as type_<n>.png after it; without one, an older type's
+  // image is removed (it would show another model). The image a change
+  // replaces is kept with its undo entry, so undo() puts it back. A teach
+  // image that cannot be written is logged and leaves the type without one
+  // (the model, the part that matters, is stored).
+  Result<void> store(const vision::PartModel& model, std::string_view change = {},
+                     const std::optional<std::string>& teach_png = std::nullopt);
+  // Removes the model of `type` (file, teach image and memory);
+  // ModelErrc::kUnknownType if there is none.
   Result<void> remove(int type, std::string_view change = {});
   // Replaces the grasp styles and gripper of `type`, written with its model;
   // ModelErrc::kUnknownType if there is no model of `type`.
@@ -95,6 +102,8 @@ class ModelLibrary {
   GraspSetup graspOf(int type) const;
   const std::string& directory() const { return directory_; }
   std::string pathOf(int type) const;
+  // Where `type`'s teach image is (type_<n>.png beside its model file).
+  std::string teachImagePathOf(int type) const;
 
  private:
   // Call with mutex_ held: records the change of `type`'s file to `after`
@@ -105,6 +114,9 @@ class ModelLibrary {
   // `type`'s file atomically; a write that fails drops the entry (nothing
   // changed, so nothing to undo).
   Result<void> writeWithUndo(int type, std::string_view change, const std::string& text);
+  // Call with mutex_ held: keeps `type`'s teach image as it is now (empty:
+  // none) beside the history entry `entry`, for undo().
+  Result<void> keepTeachImage(int type, const std::string& entry);
 
   const std::string directory_;
   ModelHistory history_;
