@@ -181,6 +181,25 @@ cv::Mat addNoise(const cv::Mat& clean, double sigma, uint64_t seed) {
   noisy.convertTo(out, CV_8U);
   return out;
 }
+// Whether any outline pixel of `b` placed at `at_b` lies on `a` placed at
+// `at_a` grown by kContactReach (supersampled pixels).
+bool withinReach(const Posed& a, cv::Point at_a, const Posed& b, cv::Point at_b) {
+  const cv::Point shift = at_b - at_a;
+  for (const auto& p : b.outline) {
+    const cv::Point q = p + shift;
+    for (int dy = -kContactReach; dy <= kContactReach; ++dy) {
+      for (int dx = -kContactReach; dx <= kContactReach; ++dx) {
+        const cv::Point r(q.x + dx, q.y + dy);
+        if (r.x >= 0 && r.y >= 0 && r.x < a.mask.cols && r.y < a.mask.rows &&
+            a.mask.at<uchar>(r) != 0) {
+          return true;
+        }
+      }
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 SilhouetteType silhouetteFromDrawing(const std::string& name, const cv::Mat& drawing,
@@ -246,6 +265,11 @@ const char* arrangementName(Arrangement a) {
   return "?";
 }
 
+// One pass over the random stream, part after part: the order of its draws
+// is what makes a seed the same scene (the benchmarks' scenes, and the
+// digests the tests keep of them), so the placing steps stay in this one
+// constructor (the geometry is in the helpers above: pose, footprintOf,
+// withinReach, hiddenOutline, stamp).
 SilhouetteScene::SilhouetteScene(const std::vector<SilhouetteType>& types,
                                  const std::vector<bool>& chiral,
                                  const SilhouetteSceneOptions& options)
@@ -321,20 +345,7 @@ SilhouetteScene::SilhouetteScene(const std::vector<SilhouetteType>& types,
           at_b = cv::Point(static_cast<int>(std::lround(cb.x - pb.centroid.x)),
                            static_cast<int>(std::lround(cb.y - pb.centroid.y)));
           if (o.arrangement == Arrangement::kTouching) {
-            // Within reach: any outline pixel of b on a grown by kContactReach.
-            bool near = false;
-            const cv::Point shift = at_b - at_a;
-            for (const auto& p : pb.outline) {
-              const cv::Point q = p + shift;
-              for (int dy = -kContactReach; dy <= kContactReach && !near; ++dy) {
-                for (int dx = -kContactReach; dx <= kContactReach && !near; ++dx) {
-                  const cv::Point r(q.x + dx, q.y + dy);
-                  near = r.x >= 0 && r.y >= 0 && r.x < pa.mask.cols && r.y < pa.mask.rows &&
-                         pa.mask.at<uchar>(r) != 0;
-                }
-              }
-              if (near) break;
-            }
+            const bool near = withinReach(pa, at_a, pb, at_b);
             if (near && step > 1) {
               dist += step;
               step = 1;
