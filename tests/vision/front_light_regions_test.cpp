@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -146,6 +147,20 @@ ps::SilhouetteSceneOptions lowContrast(bool shaded) {
 }
 }  // namespace
 
+namespace {
+// The one part of this repository's type `name` (200 px), turned
+// `turn_deg`, rendered alone with noise `seed` under `plain` and under
+// `uneven`, each read as its only region.
+std::pair<pv::Region, pv::Region> readUnder(const char* name, uint64_t seed,
+                                            const ps::SilhouetteSceneOptions& plain,
+                                            const ps::SilhouetteSceneOptions& uneven,
+                                            double turn_deg) {
+  const ps::SilhouetteType type = ps::silhouetteFromPartType(name, 200);
+  return {onlyPart(ps::renderSilhouetteAlone(type, 400, plain, seed, nullptr, turn_deg)),
+          onlyPart(ps::renderSilhouetteAlone(type, 400, uneven, seed, nullptr, turn_deg))};
+}
+}  // namespace
+
 TEST_CASE("a part shaded to within a few levels of its belt is still one whole part",
           "[vision][regions][front]") {
   // Each part's edge sets the threshold where it runs: a single ratio to the
@@ -155,13 +170,8 @@ TEST_CASE("a part shaded to within a few levels of its belt is still one whole p
   for (const char* name : {"l_shape", "gear", "rectangle", "t_shape", "disc_holes"}) {
     for (const uint64_t seed : {3U, 11U, 29U}) {
       CAPTURE(name, seed);
-      const ps::SilhouetteType type = ps::silhouetteFromPartType(name, 200);
-      const cv::Mat even =
-          ps::renderSilhouetteAlone(type, 400, lowContrast(false), seed, nullptr, 30);
-      const cv::Mat shaded =
-          ps::renderSilhouetteAlone(type, 400, lowContrast(true), seed, nullptr, 30);
-      const pv::Region reference = onlyPart(even);
-      const pv::Region part = onlyPart(shaded);
+      const auto [reference, part] =
+          readUnder(name, seed, lowContrast(false), lowContrast(true), 30);
       CHECK(part.holes == reference.holes);
       CHECK(part.glints == 0);
       // The outline (what the shape and boundary tests read) is the part's:
@@ -196,7 +206,8 @@ TEST_CASE("a real hole on a grainy belt is not a glint", "[vision][regions][fron
 
 namespace {
 // Dark parts on a blotched belt, shaded across their face (a curved or tilted
-// face under a lamp), in a vignetted light; `textured` off: the same part on a plain surface.
+// face under a lamp), in a vignetted light; `textured` off: the same part on
+// a plain surface.
 ps::SilhouetteSceneOptions blotchedBelt(bool textured) {
   ps::SilhouetteSceneOptions look;
   look.uneven_light = false;
@@ -221,13 +232,8 @@ TEST_CASE("a shaded part on a blotched belt is placed where it lies", "[vision][
   for (const char* name : {"l_shape", "gear", "rectangle", "t_shape", "disc_holes"}) {
     for (const uint64_t seed : {5U, 17U, 41U}) {
       CAPTURE(name, seed);
-      const ps::SilhouetteType type = ps::silhouetteFromPartType(name, 200);
-      const cv::Mat plain =
-          ps::renderSilhouetteAlone(type, 400, blotchedBelt(false), seed, nullptr, 50);
-      const cv::Mat belt =
-          ps::renderSilhouetteAlone(type, 400, blotchedBelt(true), seed, nullptr, 50);
-      const pv::Region reference = onlyPart(plain);
-      const pv::Region part = onlyPart(belt);
+      const auto [reference, part] =
+          readUnder(name, seed, blotchedBelt(false), blotchedBelt(true), 50);
       const double off = cv::norm(part.centroid - reference.centroid);
       CAPTURE(off);
       CHECK(off < 0.08);
