@@ -78,7 +78,8 @@ bool levelsOf(const cv::Mat& grey, const cv::Mat& where, int min_count, double* 
               double* spread = nullptr) {
   // Four counts per level, without a branch per pixel (a mask's pixels set
   // and unset alternate unpredictably at its edge), summed after: this
-  // count was a fifth of a shadow's cut.
+  // count took 95 M of the 1.2 G instructions of the shadow cuts of a
+  // front-lit frame (callgrind), 76 M so.
   std::array<std::array<int, 256>, 4> partial{};
   for (int y = 0; y < grey.rows; ++y) {
     const uint8_t* g = grey.ptr<uint8_t>(y);
@@ -243,7 +244,10 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
   cv::Mat near;
   cv::Mat ring;
   cv::dilate(own, near, disc(kRingInner));
-  // Two discs in turn make the wider one, at half the cost of its own pass.
+  // The inner disc twice makes about the outer one (40 pixels of a 220 px
+  // box differ, at the ring's rim), and costs one pass with a 7x7 kernel
+  // beside `near`'s (about 45 us on such a box) instead of one with 13x13
+  // (about 140 us).
   static_assert(kRingOuter == 2 * kRingInner, "the ring's outer disc is two inner ones");
   cv::dilate(near, ring, disc(kRingInner));
   cv::bitwise_xor(ring, near, ring);
