@@ -81,10 +81,10 @@ constexpr double kMaxBandTail = 0.01;
 // placed parts on a textured belt 0.041 px off instead of 0.13 (their
 // angle 0.031 degrees off instead of 0.22), beside cast shadows 0.082
 // instead of 0.24, glossy 0.11 instead of 0.27, at 30 levels of contrast
-// 0.21 instead of 0.76, on brushed metal 0.051 instead of 0.088. (A radius
-// of 3 px did worse than 8 on the belt, 12 px no better.) On a plane and
-// noise it would only add noise (0.0127 px instead of 0.0102 on the clean
-// scenes), hence the test.
+// 0.21 instead of 0.76, on brushed metal 0.051 instead of 0.088. (By the
+// angle on the belt, a radius of 3 px did worse than 8, 12 px no better.)
+// On a plane and noise it would only add noise (the clean scenes' angle
+// RMS 0.0127 degrees instead of 0.0102), hence the test.
 constexpr int kLocalRadiusPx = 8;
 constexpr int kLocalCellPx = 4;
 constexpr float kLocalMinPixels = 6;
