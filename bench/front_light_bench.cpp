@@ -31,6 +31,7 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
+#include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 #include "silhouette_types.hpp"
@@ -114,9 +115,31 @@ picksight::Frame frameOf(const cv::Mat& image) {
   return f;
 }
 
-void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pa::LocatedPart>& parts,
+// What WHY would say of the region under `at` in `outcome`: the model it
+// comes nearest to and the first test it fails ("passes" for a blob whose
+// search found nothing there), or that no region lies there.
+std::string whyMissed(const pa::LocateOutcome& outcome, cv::Point2d at) {
+  const auto& regions = outcome.scene.regions;
+  for (size_t k = 0; k < regions.size(); ++k) {
+    if (cv::pointPolygonTest(regions[k].outer, at, false) < 0) continue;
+    std::vector<const pv::PartModel*> models;
+    if (outcome.scene.models) {
+      for (const auto& m : *outcome.scene.models) models.push_back(&m);
+    }
+    const pv::RegionExplanation e = pv::explainRegion(regions[k], models);
+    char text[256];
+    std::snprintf(text, sizeof text, "region %zu (%.0f px), nearest %s, %s %.3f in %.3f..%.3f", k,
+                  regions[k].area, e.nearest ? e.nearest->name.c_str() : "-",
+                  pv::regionTestName(e.test), e.measured, e.low, e.high);
+    return text;
+  }
+  return "in no region";
+}
+
+void score(const std::vector<ps::SilhouettePart>& truth, const pa::LocateOutcome& outcome,
            const std::vector<int>& type_of_model, const std::vector<cv::Point2d>& reference,
            bool list, const std::vector<TypeSpec>& specs, Row& row) {
+  const std::vector<pa::LocatedPart>& parts = outcome.parts;
   std::vector<bool> claimed(truth.size(), false);
   for (const auto& t : truth) row.truths += t.kind == ps::PartKind::kTrue ? 1 : 0;
   for (const auto& p : parts) {
@@ -184,8 +207,9 @@ void score(const std::vector<ps::SilhouettePart>& truth, const std::vector<pa::L
   if (!list) return;
   for (size_t i = 0; i < truth.size(); ++i) {
     if (truth[i].kind != ps::PartKind::kTrue || claimed[i]) continue;
-    std::printf("    missed: %s at %.1f %.1f%s\n", specs[truth[i].type].name.c_str(),
-                truth[i].centre.x, truth[i].centre.y, truth[i].touching ? ", touching" : "");
+    std::printf("    missed: %s at %.1f %.1f%s: %s\n", specs[truth[i].type].name.c_str(),
+                truth[i].centre.x, truth[i].centre.y, truth[i].touching ? ", touching" : "",
+                whyMissed(outcome, truth[i].centre).c_str());
   }
 }
 
@@ -382,7 +406,7 @@ int main(int argc, char** argv) {
           }
           if (list_errors)
             std::printf("  %s %s scene %d round %d:\n", condition.c_str(), name.c_str(), n, r);
-          score(scene.truth(), outcome.parts, type_of_model, reference, list_errors, specs, row);
+          score(scene.truth(), outcome, type_of_model, reference, list_errors, specs, row);
           if (sink == 0) std::printf("!");
         }
       }
