@@ -36,6 +36,23 @@ SOURCE = (f"{CAMERA}=synthetic:width=640,height=480,parts=4,types=l_shape,size=9
           "mm_per_px=0.25,rz=178.7,dx=330.5,dy=-612.25,target_radius=5")
 
 
+# A JavaScript function for browser.js scripts: the page's frame image drawn
+# on a canvas, {img, width, height, data} (RGBA bytes), or null while it has
+# not loaded.
+FRAME_PIXELS_JS = """
+    function framePixels() {
+        const img = document.getElementById('frame');
+        if (!img.complete || !img.naturalWidth) return null;
+        const c = document.createElement('canvas');
+        c.width = img.naturalWidth; c.height = img.naturalHeight;
+        const g = c.getContext('2d');
+        g.drawImage(img, 0, 0);
+        return {img: img, width: c.width, height: c.height,
+                data: g.getImageData(0, 0, c.width, c.height).data};
+    }
+"""
+
+
 def wait_until(condition, timeout=30.0, what="condition", interval=0.05):
     """Polls `condition` until it returns something truthy; that value."""
     deadline = time.monotonic() + timeout

@@ -8,7 +8,7 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select
 
-from conftest import APP, CAMERA, wait_until
+from conftest import APP, CAMERA, FRAME_PIXELS_JS, wait_until
 
 # The overlay is drawn in CSS pixels; the reply has 3 decimals.
 TOLERANCE_PX = 1.5
@@ -137,16 +137,11 @@ def page_sequence(browser):
 
 def frame_hash(browser):
     """A checksum of the displayed image's pixels (drawn on a canvas)."""
-    return browser.js("""
-        const img = document.getElementById('frame');
-        if (!img.naturalWidth) return null;
-        const c = document.createElement('canvas');
-        c.width = img.naturalWidth; c.height = img.naturalHeight;
-        const g = c.getContext('2d');
-        g.drawImage(img, 0, 0);
-        const d = g.getImageData(0, 0, c.width, c.height).data;
+    return browser.js(FRAME_PIXELS_JS + """
+        const f = framePixels();
+        if (!f) return null;
         let h = 0;
-        for (let i = 0; i < d.length; i += 7) h = (h * 31 + d[i]) | 0;
+        for (let i = 0; i < f.data.length; i += 7) h = (h * 31 + f.data[i]) | 0;
         return h;""")
 
 

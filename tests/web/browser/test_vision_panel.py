@@ -11,7 +11,7 @@ from PIL import Image
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
-from conftest import APP, CAMERA, Cell, wait_until
+from conftest import APP, CAMERA, FRAME_PIXELS_JS, Cell, wait_until
 from test_page import click, ok_fields, select_tab
 
 # Six light discs (radius 40 px) on a dark table 30 px inside a light rim:
@@ -44,17 +44,12 @@ def cell(tmp_path_factory):
 def binarized(browser):
     """The image element's pixels when it shows a binarized frame: its
     query and the share of white (part) pixels; None before it has one."""
-    return browser.js("""
-        const img = document.getElementById('frame');
-        if (!img.complete || !img.naturalWidth || !img.currentSrc.includes('/binary/')) return null;
-        const c = document.createElement('canvas');
-        c.width = img.naturalWidth; c.height = img.naturalHeight;
-        const g = c.getContext('2d');
-        g.drawImage(img, 0, 0);
-        const d = g.getImageData(0, 0, c.width, c.height).data;
+    return browser.js(FRAME_PIXELS_JS + """
+        const f = framePixels();
+        if (!f || !f.img.currentSrc.includes('/binary/')) return null;
         let white = 0;
-        for (let i = 0; i < d.length; i += 4) if (d[i] > 127) white++;
-        return {src: img.currentSrc, white: white / (c.width * c.height)};""")
+        for (let i = 0; i < f.data.length; i += 4) if (f.data[i] > 127) white++;
+        return {src: f.img.currentSrc, white: white / (f.width * f.height)};""")
 
 
 def preview_where(browser, query, accept, what):
