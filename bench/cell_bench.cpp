@@ -43,7 +43,7 @@ picksight::synthetic::SceneOptions scene(int width, int height, int parts, uint6
 // Models, grasps and a calibration written as a cell set up through the
 // protocol would have them.
 bool prepareDataDir(const std::string& dir) {
-  picksight::app::ModelLibrary library(dir + "/models");
+  picksight::store::ModelLibrary library(dir + "/models");
   int type = 1;
   for (const auto& name : kTypes) {
     const picksight::synthetic::SceneRenderer one(scene(400, 400, 1, 1000 + type, {name}));
@@ -53,13 +53,13 @@ bool prepareDataDir(const std::string& dir) {
                    (trained ? "cannot store" : trained.error().message.c_str()));
       return false;
     }
-    picksight::app::GraspSetup grasp;
+    picksight::store::GraspSetup grasp;
     grasp.styles = {{0, 0, 0}, {0, 0, 90}};
     grasp.gripper.fingers = {{0, 8, 2, 1.5}, {0, -8, 2, 1.5}};
     if (!library.setGrasp(type, grasp)) return false;
     ++type;
   }
-  picksight::app::CellCalibration calibration(dir + "/calibration.yaml");
+  picksight::store::CellCalibration calibration(dir + "/calibration.yaml");
   if (!calibration.setScale({0.1, 0.1, 0})) return false;
   const picksight::calibration::RigidTransform truth{350, -80, 30, false};
   for (const cv::Point2d v : {cv::Point2d(10, -10), cv::Point2d(180, -15), cv::Point2d(170, -100),
@@ -93,8 +93,8 @@ void digest(uint64_t& hash, const std::string& text) {
 // Where a request's vision time goes, in process on the camera's scene: the
 // other engineer's recognition, and this cell's grasp selection.
 Breakdown breakdown(const std::string& data_dir, int width, int height, int parts) {
-  picksight::app::ModelLibrary library(data_dir + "/models");
-  picksight::app::CellCalibration calibration(data_dir + "/calibration.yaml");
+  picksight::store::ModelLibrary library(data_dir + "/models");
+  picksight::store::CellCalibration calibration(data_dir + "/calibration.yaml");
   if (!library.load().empty() || !calibration.load() || !calibration.geometry()) return {};
   const picksight::synthetic::SceneRenderer renderer(scene(width, height, parts, 5, kTypes));
   const picksight::Frame frame = picksight::frameFromImage(renderer.render(1), "cam0", 1);

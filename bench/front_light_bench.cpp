@@ -282,7 +282,7 @@ int main(int argc, char** argv) {
     }
     // Teach every type as a user would: LEARN on an image of the part alone
     // under the same light; when LEARN refuses, LEARN ... AT a box around it.
-    auto models = std::make_shared<pa::ModelList>();
+    auto models = std::make_shared<picksight::store::ModelList>();
     std::vector<int> type_of_model;
     std::vector<bool> chiral(types.size(), true);
     std::vector<cv::Point2d> reference(types.size());
@@ -345,7 +345,7 @@ int main(int argc, char** argv) {
       reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
                       offset.x * std::sin(back) + offset.y * std::cos(back)};
       chiral[i] = !learned->model.body.mirror_symmetric;
-      auto next = std::make_shared<pa::ModelList>(*models);
+      auto next = std::make_shared<picksight::store::ModelList>(*models);
       next->push_back(std::move(learned->model));
       models = next;
       type_of_model.resize(static_cast<size_t>(models->back().type) + 1, -1);

@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   const ps::SilhouetteSceneOptions look;
   pv::TrainOptions train;
   train.binarize.adaptive_window = kWindow;
-  picksight::app::ModelLibrary library(cell_dir + "/models");
+  picksight::store::ModelLibrary library(cell_dir + "/models");
   std::vector<bool> chiral;
   for (size_t i = 0; i < types.size(); ++i) {
     const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;

@@ -14,8 +14,8 @@
 #include "picksight/store/cell_calibration.hpp"
 
 using namespace picksight::calibration;
-using picksight::app::CellCalibration;
-using picksight::app::CoordinateFrame;
+using picksight::store::CellCalibration;
+using picksight::store::CoordinateFrame;
 using picksight::test::TempDir;
 
 namespace {

@@ -97,7 +97,7 @@ TEST_CASE("an atomic write syncs the new file then renames it then syncs the dir
 TEST_CASE("forgetting a model syncs its directory after the file is removed", "[common]") {
   TempDir dir;
   const std::string models = (dir.path() / "models").string();
-  picksight::app::ModelLibrary library(models);
+  picksight::store::ModelLibrary library(models);
   picksight::vision::PartModel model;
   model.type = 3;
   model.name = "plate";

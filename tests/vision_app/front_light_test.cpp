@@ -24,6 +24,7 @@
 
 using namespace picksight;
 using namespace picksight::app;
+using namespace picksight::store;
 namespace ps = picksight::synthetic;
 namespace pv = picksight::vision;
 

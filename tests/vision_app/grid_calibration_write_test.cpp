@@ -15,6 +15,7 @@
 
 using namespace picksight;
 using namespace picksight::app;
+using namespace picksight::store;
 
 namespace {
 calibration::PixelScale gridScale(double mm_per_px) {

@@ -166,7 +166,7 @@ TEST_CASE("WHY reads the scale of a copy and names a mirror image", "[vision][wh
       test::centred(ps::Shape{{{{0, 0}, {160, 0}, {160, 50}, {50, 50}, {50, 110}, {0, 110}}}});
   auto trained = pv::trainModel(test::drawParts(640, 480, {{l_shape, 320, 240, 0}}, 3), 1, "ell");
   REQUIRE(trained.ok());
-  const auto models = std::make_shared<const app::ModelList>(app::ModelList{trained.value()});
+  const auto models = std::make_shared<const store::ModelList>(store::ModelList{trained.value()});
   const cv::Mat scene = test::drawParts(1280, 720,
                                         {{l_shape, 250, 250, 30},
                                          {test::scaled(l_shape, 1.25), 700, 250, 100},

@@ -23,6 +23,10 @@
 
 namespace picksight::app {
 
+using store::CellCalibration;
+using store::CellCalibrationErrc;
+using store::ModelLibrary;
+
 std::string offlineUsage() {
   return "usage: picksight-vision learn --type N [--name NAME] [--at X Y W H] [options] IMAGE\n"
          "       picksight-vision locate [--type N] [options] IMAGE...\n"

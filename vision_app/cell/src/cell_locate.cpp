@@ -3,6 +3,10 @@
 
 namespace picksight::app {
 
+using store::CellCalibration;
+using store::GraspMap;
+using store::ModelLibrary;
+
 Result<CellLocate> locateAndPick(const CellCalibration& calibration, const ModelLibrary* models,
                                  const std::function<Result<LocateOutcome>()>& locate) {
   if (auto geometry = calibration.geometry(); !geometry) return geometry.error();

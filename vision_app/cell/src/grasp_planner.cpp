@@ -10,6 +10,10 @@
 #include "picksight/common/angles.hpp"
 
 namespace picksight::app {
+
+using store::CellGeometry;
+using store::GraspMap;
+
 namespace {
 // Footprint margin (frame pixels) around a placed model: covers its
 // anti-aliased edge and a small pose error, so that a part never blocks

@@ -8,6 +8,8 @@
 
 namespace picksight::app {
 
+using store::ModelList;
+
 std::shared_ptr<const ModelList> ScaledModelCache::forFrame(std::shared_ptr<const ModelList> models,
                                                             const SensorMapping& mapping) {
   if (!models || models->empty() || !isResized(mapping)) return modelsForFrame(models, mapping);

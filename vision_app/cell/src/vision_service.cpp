@@ -21,6 +21,9 @@
 
 namespace picksight::app {
 
+using store::ModelLibrary;
+using store::ModelList;
+
 const char* errorName(VisionServiceErrc e) {
   switch (e) {
     case VisionServiceErrc::kNoTarget:

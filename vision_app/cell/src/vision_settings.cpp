@@ -13,6 +13,8 @@
 
 namespace picksight::app {
 
+using store::ModelList;
+
 const char* errorName(VisionSettingsErrc e) {
   switch (e) {
     case VisionSettingsErrc::kBadSetting:

@@ -9,13 +9,13 @@
 
 namespace picksight::plc {
 
-uint16_t frameCode(app::CoordinateFrame frame) {
+uint16_t frameCode(store::CoordinateFrame frame) {
   switch (frame) {
-    case app::CoordinateFrame::kVisionPixels:
+    case store::CoordinateFrame::kVisionPixels:
       return kFrameVisionPixels;
-    case app::CoordinateFrame::kVisionMm:
+    case store::CoordinateFrame::kVisionMm:
       return kFrameVisionMm;
-    case app::CoordinateFrame::kRobot:
+    case store::CoordinateFrame::kRobot:
       return kFrameRobot;
   }
   return kFrameVisionPixels;
@@ -57,7 +57,7 @@ PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* 
   };
 }
 
-PlcDevice::FrameState cellFrameState(const app::CellCalibration& calibration) {
+PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration) {
   return [&calibration] {
     const auto geometry = calibration.geometry();
     return geometry ? frameCode(geometry->frame()) : kFrameDamaged;

@@ -9,6 +9,10 @@
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
+
+using store::CellCalibration;
+using store::CellCalibrationErrc;
+
 namespace {
 // A disc's area equals that of its equal-moment ellipse; a square's is 4.7%
 // smaller, so 3% tells a disc from the usual wrong targets.

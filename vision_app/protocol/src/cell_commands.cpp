@@ -9,6 +9,14 @@
 #include "picksight/results/request_record.hpp"
 
 namespace picksight::app {
+
+using store::frameName;
+using store::GraspSetup;
+using store::ModelErrc;
+using store::ModelLibrary;
+using store::ModelList;
+using store::validateGrasp;
+
 namespace {
 std::string reply(const Error& e) { return errorReply(e); }
 

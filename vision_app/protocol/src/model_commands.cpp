@@ -12,6 +12,10 @@
 
 namespace picksight::app {
 
+using store::ModelErrc;
+using store::ModelList;
+using store::UndoOutcome;
+
 bool validModelName(std::string_view name) {
   if (name.empty() || name.size() > 32) return false;
   for (char c : name) {

@@ -14,6 +14,10 @@
 #include "picksight/transport/control_client.hpp"
 
 namespace picksight::app {
+
+using store::CellCalibrationErrc;
+using store::ModelErrc;
+
 namespace {
 
 using calibration::CalibrationErrc;

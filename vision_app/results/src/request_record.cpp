@@ -13,9 +13,9 @@ namespace picksight::results {
 using app::CellLocate;
 using app::LocatedPart;
 using app::LocateScene;
-using app::ModelList;
 using app::ScreenedRegion;
 using app::VisionOptions;
+using store::ModelList;
 namespace {
 
 std::string ofType(int type) { return " of type " + std::to_string(type); }

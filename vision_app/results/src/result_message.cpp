@@ -11,14 +11,14 @@
 #include "picksight/grasp/grasp.hpp"
 
 namespace picksight::results {
-using app::CoordinateFrame;
-using app::GraspSetup;
 using app::greyImage;
 using app::LocatedPart;
 using app::LocateOutcome;
 using app::LocateScene;
 using app::modelOf;
 using app::partPoseInVisionFrame;
+using store::CoordinateFrame;
+using store::GraspSetup;
 namespace {
 
 constexpr size_t kMaxOutlinePoints = 512;

@@ -10,7 +10,7 @@
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/common/log.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 
 const char* errorName(CellCalibrationErrc e) {
   switch (e) {
@@ -272,4 +272,4 @@ Result<calibration::CalibrationResult> CellCalibration::compute(calibration::Met
   return result;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::store

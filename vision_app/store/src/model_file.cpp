@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-namespace picksight::app {
+namespace picksight::store {
 
 const char* errorName(ModelErrc e) {
   switch (e) {
@@ -442,4 +442,4 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
   return record;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::store

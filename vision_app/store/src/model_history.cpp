@@ -13,7 +13,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/store/model_file.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 namespace fs = std::filesystem;
 namespace {
 
@@ -211,4 +211,4 @@ std::vector<std::string> ModelHistory::check() const {
   return problems;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::store

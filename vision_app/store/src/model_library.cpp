@@ -10,7 +10,7 @@
 #include "picksight/common/log.hpp"
 #include "picksight/store/model_file.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 namespace fs = std::filesystem;
 
 ModelLibrary::ModelLibrary(std::string directory)
@@ -374,4 +374,4 @@ GraspSetup ModelLibrary::graspOf(int type) const {
   return it == all->end() ? GraspSetup{} : it->second;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::store

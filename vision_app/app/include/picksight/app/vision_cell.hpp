@@ -55,16 +55,16 @@ class VisionCell {
   results::ResultsPublisher* const& results() const { return results_; }
 
   VisionService& vision() { return vision_; }
-  ModelLibrary& models() { return models_; }
-  CellCalibration& calibration() { return calibration_; }
+  store::ModelLibrary& models() { return models_; }
+  store::CellCalibration& calibration() { return calibration_; }
   const CellContext& context() const { return context_; }
   CellContext& context() { return context_; }
 
  private:
   const std::string settings_file_;
   const std::vector<std::string> command_line_settings_;
-  ModelLibrary models_;
-  CellCalibration calibration_;
+  store::ModelLibrary models_;
+  store::CellCalibration calibration_;
   VisionService vision_;
   RobotProtocol protocol_;
   CellContext context_;

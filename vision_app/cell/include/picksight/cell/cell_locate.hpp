@@ -27,17 +27,17 @@ struct CellLocate {
   LocateOutcome outcome;
   CellPick pick;
   // What the grasps were chosen with, for the results stream.
-  std::shared_ptr<const GraspMap> grasps;
-  std::optional<CellGeometry> geometry;
+  std::shared_ptr<const store::GraspMap> grasps;
+  std::optional<store::CellGeometry> geometry;
 };
 
 // What a cell's requests share: its vision service and calibration
 // (borrowed), the LOCATE figures STATUS reports, and the lock GRASP and
 // GRIPPER edits take. Owned by VisionCell.
 struct CellContext {
-  CellContext(VisionService& v, CellCalibration& c) : vision(v), calibration(c) {}
+  CellContext(VisionService& v, store::CellCalibration& c) : vision(v), calibration(c) {}
   VisionService& vision;
-  CellCalibration& calibration;
+  store::CellCalibration& calibration;
   // LOCATE figures for STATUS.
   std::atomic<uint64_t> locates{0};
   std::atomic<uint64_t> last_offered{0};
@@ -51,7 +51,8 @@ struct CellContext {
 // checked before `locate` runs (a damaged file is an error, never a silent
 // change of frame) and read again after it (a CLEARCAL or a COMPUTE may
 // have come meanwhile).
-Result<CellLocate> locateAndPick(const CellCalibration& calibration, const ModelLibrary* models,
+Result<CellLocate> locateAndPick(const store::CellCalibration& calibration,
+                                 const store::ModelLibrary* models,
                                  const std::function<Result<LocateOutcome>()>& locate);
 
 // LOCATE of `type` (-1: every trained type) on a fresh frame of the cell's

@@ -18,7 +18,7 @@ struct CellPick {
   std::vector<size_t> parts;       // for each pose, its part in the outcome's parts
   std::vector<int> styles;         // for each pose, its grasp style (-1: the part's own pose)
   size_t skipped = 0;              // parts with no free grasp, not offered
-  CoordinateFrame frame = CoordinateFrame::kVisionPixels;
+  store::CoordinateFrame frame = store::CoordinateFrame::kVisionPixels;
 };
 
 // The scene's model of `type` (null: none, or a region's type -1).
@@ -37,13 +37,13 @@ grasp::Pose partPoseInVisionFrame(const LocatedPart& part, const calibration::Vi
 // (-180, 180]: the same part in the same place gives the same number, never
 // one 360 apart. A region's (no model) is in [0, 360).
 grasp::Pose replyPose(const LocatedPart& part, const grasp::Pose& pose,
-                      const grasp::GraspStyle& style, const CellGeometry& geometry);
+                      const grasp::GraspStyle& style, const store::CellGeometry& geometry);
 
 // The grasp poses of the parts of `outcome`. Obstacles are the scene's
 // mask without the part's own pixels (for a part found touching others,
 // without its placed model's footprint). A part of a type with no
 // grasp styles is grasped at its own pose, checked against the fingers.
-CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
-                   const CellGeometry& geometry);
+CellPick pickPoses(const LocateOutcome& outcome, const store::GraspMap& grasps,
+                   const store::CellGeometry& geometry);
 
 }  // namespace picksight::app

@@ -24,16 +24,16 @@ namespace picksight::app {
 class ScaledModelCache {
  public:
   // modelsForFrame(models, mapping), built once per (models, scale).
-  std::shared_ptr<const ModelList> forFrame(std::shared_ptr<const ModelList> models,
-                                            const SensorMapping& mapping);
+  std::shared_ptr<const store::ModelList> forFrame(std::shared_ptr<const store::ModelList> models,
+                                                   const SensorMapping& mapping);
   // Scaled lists built so far (each miss builds one).
   uint64_t builds() const;
 
  private:
   struct Entry {
-    std::shared_ptr<const ModelList> source;
+    std::shared_ptr<const store::ModelList> source;
     double scale = 1;
-    std::shared_ptr<const ModelList> scaled;
+    std::shared_ptr<const store::ModelList> scaled;
   };
   // Scales kept per generation: a camera going back and forth between a
   // few sizes keeps them all.

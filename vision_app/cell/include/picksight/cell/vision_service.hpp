@@ -73,7 +73,7 @@ struct LocateScene {
   cv::Mat mask;  // CV_8UC1, non-zero = part
   std::vector<vision::Region> regions;
   SensorMapping mapping;
-  std::shared_ptr<const ModelList> models;  // the models the parts refer to
+  std::shared_ptr<const store::ModelList> models;  // the models the parts refer to
   std::vector<ScreenedRegion> screened_out;
 };
 
@@ -121,7 +121,7 @@ cv::Mat greyImage(const Frame& frame);
 // The image the vision pass reads from a frame: a colour frame projected on
 // the colour axes of the models taught in colour (vision/segmentation/colour_axis.hpp),
 // or its grey levels when none was; a grey frame as it is.
-cv::Mat visionImage(const Frame& frame, const ModelList& models);
+cv::Mat visionImage(const Frame& frame, const store::ModelList& models);
 
 // Frame pixels per sensor pixel along no particular axis (the geometric
 // mean of the two scales), and whether that is a resize at all.
@@ -131,8 +131,8 @@ bool isResized(const SensorMapping& mapping);
 // Models are in sensor pixels; a resized frame sees them scaled. The same
 // list when the frame is not resized, else a scaled copy (frame pixels),
 // built anew on each call (ScaledModelCache keeps them).
-std::shared_ptr<const ModelList> modelsForFrame(std::shared_ptr<const ModelList> models,
-                                                const SensorMapping& mapping);
+std::shared_ptr<const store::ModelList> modelsForFrame(
+    std::shared_ptr<const store::ModelList> models, const SensorMapping& mapping);
 
 // The settings of one frame's vision pass on an `image` of that size: the
 // cell's areas and adaptive window are in sensor pixels and follow a resize,
@@ -140,7 +140,7 @@ std::shared_ptr<const ModelList> modelsForFrame(std::shared_ptr<const ModelList>
 // (frame pixels, see modelsForFrame), or that part's middle would break into
 // phantom holes.
 VisionOptions frameOptions(const VisionOptions& options, const SensorMapping& mapping,
-                           cv::Size image, const ModelList& frame_models);
+                           cv::Size image, const store::ModelList& frame_models);
 
 // A model trained by LEARN, in sensor pixels, and what looks suspicious
 // about it (phrases for the reply, e.g. "12 holes smaller than 60 px").
@@ -178,7 +178,7 @@ struct TryLearnOutcome {
 // null) keeps the models scaled for a resized frame.
 Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& mapping,
                                   const VisionOptions& options,
-                                  std::shared_ptr<const ModelList> models, int type,
+                                  std::shared_ptr<const store::ModelList> models, int type,
                                   const std::string& name, const std::optional<cv::Rect>& at,
                                   ScaledModelCache* cache = nullptr);
 
@@ -189,7 +189,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
 // null: the models are scaled anew) keeps the models scaled for a resized
 // frame from one call to the next.
 LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
-                            std::shared_ptr<const ModelList> models, int type,
+                            std::shared_ptr<const store::ModelList> models, int type,
                             ScaledModelCache* cache = nullptr);
 
 // Finds parts in a grey image: with `models` non-empty, the recognized parts
@@ -199,7 +199,7 @@ LocateOutcome locateInFrame(const Frame& frame, const VisionOptions& options,
 // minimum hole area; with none, every region, largest first.
 // With `scene`, also keeps the mask and regions there.
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
-                                       const VisionOptions& options, const ModelList& models,
+                                       const VisionOptions& options, const store::ModelList& models,
                                        int type, LocateScene* scene = nullptr);
 
 // The single region of a grey image as a calibration target.
@@ -213,7 +213,7 @@ class VisionService {
  public:
   // `models` (borrowed, may be null: no recognition) outlives the service.
   VisionService(std::unique_ptr<link::CameraLink> camera, VisionOptions options,
-                ModelLibrary* models = nullptr);
+                store::ModelLibrary* models = nullptr);
   ~VisionService();
 
   void start();
@@ -250,7 +250,7 @@ class VisionService {
     return fn(*camera_);
   }
   uint64_t framesReceived() const { return camera_->framesReceived(); }
-  ModelLibrary* models() const { return models_; }
+  store::ModelLibrary* models() const { return models_; }
   // The frame the last request worked on.
   std::optional<FrameInfo> lastFrame() const;
   // That frame itself (null before any), for the results stream's regions
@@ -292,7 +292,7 @@ class VisionService {
   Error settingsBlocked() const;  // call with settings_mutex_ held
 
   const std::unique_ptr<link::CameraLink> camera_;
-  ModelLibrary* const models_;
+  store::ModelLibrary* const models_;
 
   mutable std::mutex settings_mutex_;  // guards settings_, settings_damage_, settings_path_
   // Swapped whole by a change, never edited in place.

@@ -53,7 +53,7 @@ Result<VisionOptions> parseVisionSettingsJson(const std::string& text, VisionOpt
 // alone: they match the parts' outlines, which the area tolerance and the
 // boundary check follow. Empty: nothing needs a re-teach.
 std::vector<std::string> modelsToReteach(const VisionOptions& before, const VisionOptions& after,
-                                         const ModelList& models);
+                                         const store::ModelList& models);
 
 }  // namespace picksight::app
 

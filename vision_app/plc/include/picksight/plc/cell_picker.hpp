@@ -10,7 +10,7 @@
 
 namespace picksight::plc {
 
-uint16_t frameCode(app::CoordinateFrame frame);  // kFrame*
+uint16_t frameCode(store::CoordinateFrame frame);  // kFrame*
 
 // A LOCATE's poses as the PLC registers hold them: each pose with its
 // part's type and score.
@@ -20,7 +20,7 @@ PlcResult plcResult(const app::CellLocate& located);
 // device). The picker publishes each trigger's record on `results` when it
 // is set (read at each trigger; the pointer outlives the device).
 PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results);
-PlcDevice::FrameState cellFrameState(const app::CellCalibration& calibration);
+PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration);
 int robotErrorCodeOf(const Error& error);
 
 }  // namespace picksight::plc

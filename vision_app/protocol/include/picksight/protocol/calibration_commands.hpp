@@ -10,6 +10,6 @@ namespace picksight::app {
 
 // Registers the commands; `vision` and `calibration` outlive `table`.
 void addCalibrationCommands(CommandTable& table, VisionService& vision,
-                            CellCalibration& calibration);
+                            store::CellCalibration& calibration);
 
 }  // namespace picksight::app

@@ -25,7 +25,7 @@ std::string toleranceReply(const vision::PartModel& model);
 std::string tryLearnReply(const TryLearnOutcome& tried);
 // UNDO's reply: "OK <type> restored|removed <changes left> ; undid: <request>
 // ; type <type> is <model summary> again" (or "has no model again").
-std::string undoReply(const UndoOutcome& undone);
+std::string undoReply(const store::UndoOutcome& undone);
 // The reply fields of one region's features (see BLOBS).
 std::string blobSummary(const vision::BlobFeatures& blob);
 

@@ -59,8 +59,8 @@ class RequestRecord {
   // the request failed before a frame).
   std::optional<app::LocateOutcome> locate;
   app::CellPick pick;
-  std::shared_ptr<const app::GraspMap> grasps;
-  std::optional<app::CellGeometry> geometry;
+  std::shared_ptr<const store::GraspMap> grasps;
+  std::optional<store::CellGeometry> geometry;
 
   // Other requests: the frame they worked on (regions are found from it by
   // the publisher) and the settings to find them with.

@@ -23,7 +23,7 @@
 #include "picksight/common/result.hpp"
 #include "picksight/grasp/grasp.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 
 // Why a change to the cell's calibration failed. (COMPUTE's own failures
 // are calibration::CalibrationErrc, passed on as they are.)
@@ -128,6 +128,6 @@ class CellCalibration {
   uint64_t revision_ = 0;  // counts changes to the points and the scale
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::store
 
-PICKSIGHT_ERROR_ENUM(picksight::app::CellCalibrationErrc)
+PICKSIGHT_ERROR_ENUM(picksight::store::CellCalibrationErrc)

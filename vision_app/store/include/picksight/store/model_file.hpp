@@ -11,7 +11,7 @@
 #include "picksight/vision/models/part_model.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 
 // Why a model could not be read, stored or removed.
 enum class ModelErrc {
@@ -57,6 +57,6 @@ Result<vision::PartModel> modelFromYaml(const std::string& text);
 // ModelErrc::kInvalidModel says what is wrong.
 Result<void> validateGrasp(const GraspSetup& grasp);
 
-}  // namespace picksight::app
+}  // namespace picksight::store
 
-PICKSIGHT_ERROR_ENUM(picksight::app::ModelErrc)
+PICKSIGHT_ERROR_ENUM(picksight::store::ModelErrc)

@@ -21,7 +21,7 @@
 
 #include "picksight/common/result.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 
 // How many changes UNDO can walk back.
 constexpr size_t kUndoDepth = 32;
@@ -78,4 +78,4 @@ class ModelHistory {
   const std::string directory_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::store

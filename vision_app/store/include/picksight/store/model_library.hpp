@@ -21,7 +21,7 @@
 #include "picksight/store/model_history.hpp"
 #include "picksight/vision/models/part_model.hpp"
 
-namespace picksight::app {
+namespace picksight::store {
 
 using ModelList = std::vector<vision::PartModel>;
 using GraspMap = std::map<int, GraspSetup>;  // by type; a type without grasps may be absent
@@ -125,4 +125,4 @@ class ModelLibrary {
   std::shared_ptr<const GraspMap> grasps_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::store
