@@ -16,7 +16,6 @@
 #include "temp_dir.hpp"
 
 using namespace picksight;
-using namespace picksight::app;
 using namespace picksight::store;
 
 namespace {

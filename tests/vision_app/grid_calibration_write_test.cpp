@@ -14,7 +14,6 @@
 #include "temp_dir.hpp"
 
 using namespace picksight;
-using namespace picksight::app;
 using namespace picksight::store;
 
 namespace {
