@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <filesystem>
 
@@ -331,6 +332,15 @@ constexpr double kSmallPartFactor = 10;
 // there. A second part of the same type, or a half-size one, is far above
 // it. (On a worn belt, stains reach 12 % of a 200 px part's area.)
 constexpr double kSpeckShare = 0.15;
+// ... and regions of any size whose level stands off the surface around them
+// by under this share of the part's: a blotch of the belt that the adaptive
+// threshold took (a glossy belt at 85 on 150 gave stains of 15 % of the
+// part's area, a fifth as deep as it). A second part stands off as deep.
+constexpr double kStainDepthShare = 0.4;
+// The ring around a region its surface level is read on (pixels out, past
+// the edge's blur).
+constexpr int kRingInner = 2;
+constexpr int kRingOuter = 6;
 // An evenly lit part has next to none of its outline beside a shadow or
 // uneven light (vision::unevenEdgeShare): under this share, on a plain or a
 // textured belt, for the t-shaped part of the tests; a soft shadow 8 px
@@ -345,16 +355,42 @@ struct LearnRegions {
   std::vector<size_t> others;
 };
 
+// How far region `r`'s level stands off the surface around it: the mean of
+// its pixels (an edge's blur left out) against that of a ring a few pixels
+// out, over pixels of no region of `mask`. 0 where either is not seen.
+double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask) {
+  const cv::Rect box =
+      (r.bbox + cv::Size(2 * kRingOuter, 2 * kRingOuter) - cv::Point(kRingOuter, kRingOuter)) &
+      cv::Rect({0, 0}, grey.size());
+  cv::Mat own = cv::Mat::zeros(box.size(), CV_8U);
+  cv::drawContours(own, std::vector<std::vector<cv::Point>>{r.outer}, 0, cv::Scalar(255),
+                   cv::FILLED, cv::LINE_8, cv::noArray(), INT_MAX, -box.tl());
+  const auto disc = [](int radius) {
+    return cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * radius + 1, 2 * radius + 1});
+  };
+  cv::Mat core, near, far;
+  cv::erode(own, core, disc(1));
+  cv::dilate(own, near, disc(kRingInner));
+  cv::dilate(own, far, disc(kRingOuter));
+  const cv::Mat ring = far & ~near & (mask(box) == 0);
+  if (cv::countNonZero(core) == 0 || cv::countNonZero(ring) == 0) return 0;
+  return std::abs(cv::mean(grey(box), core)[0] - cv::mean(grey(box), ring)[0]);
+}
+
 LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
-                          const std::vector<size_t>& inside) {
+                          const std::vector<size_t>& inside, const cv::Mat& grey,
+                          const cv::Mat& mask) {
   LearnRegions out;
   out.part = inside.front();
   for (const size_t i : inside) {
     if (regions[i].area > regions[out.part].area) out.part = i;
   }
+  const double part_depth = depthOf(regions[out.part], grey, mask);
   for (const size_t i : inside) {
     if (i == out.part) continue;
-    (regions[i].area < kSpeckShare * regions[out.part].area ? out.specks : out.others).push_back(i);
+    const bool speck = regions[i].area < kSpeckShare * regions[out.part].area ||
+                       depthOf(regions[i], grey, mask) < kStainDepthShare * part_depth;
+    (speck ? out.specks : out.others).push_back(i);
   }
   return out;
 }
@@ -506,7 +542,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
       return makeError(VisionServiceErrc::kNoPartInRectangle,
                        "no part inside LEARN AT " + sensorRectText(*at));
     }
-    const LearnRegions seen = sortForLearn(regions, inside);
+    const LearnRegions seen = sortForLearn(regions, inside, grey, mask);
     if (!seen.others.empty()) {
       const std::string count = std::to_string(seen.others.size() + 1) + " parts";
       if (!at) {
