@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "picksight/protocol/calibration_commands.hpp"
+#include "picksight/protocol/job_commands.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/protocol/vision_settings_commands.hpp"
 
@@ -17,12 +18,14 @@ VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<link::Camera
       calibration_(data_dir + "/calibration.yaml"),
       vision_(std::move(camera), std::move(options), &models_),
       protocol_(vision_),
-      context_(vision_, calibration_) {
+      context_(vision_, calibration_),
+      jobs_(data_dir + "/jobs", context_, models_) {
   // What each command publishes is in its table entry (Publishes).
   addModelCommands(protocol_.table(), vision_);
   addCalibrationCommands(protocol_.table(), vision_, calibration_);
   addCellCommands(protocol_.table(), context_);
   addVisionSettingsCommands(protocol_.table(), vision_);
+  protocol::addJobCommands(protocol_.table(), jobs_);
 }
 
 std::vector<std::string> VisionCell::load() {
@@ -32,6 +35,7 @@ std::vector<std::string> VisionCell::load() {
         "vision settings rejected (LOCATE, LEARN and VISION changes refused until repaired, or "
         "VISION RESET): " +
         ok.error().message);
+  for (auto& p : jobs_.clean()) problems.push_back("jobs: " + p);
   for (auto& p : models_.load()) problems.push_back("model rejected: " + p);
   for (auto& p : models_.checkHistory()) problems.push_back("undo history: " + p);
   if (auto ok = calibration_.load(); !ok)

@@ -7,6 +7,31 @@ using store::CellCalibration;
 using store::GraspMap;
 using store::ModelLibrary;
 
+void JobSwitchGate::lockShared() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return !switching_ && waiting_switches_ == 0; });
+  ++readers_;
+}
+
+void JobSwitchGate::unlockShared() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (--readers_ == 0) changed_.notify_all();
+}
+
+void JobSwitchGate::lock() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  ++waiting_switches_;
+  changed_.wait(lock, [this] { return !switching_ && readers_ == 0; });
+  --waiting_switches_;
+  switching_ = true;
+}
+
+void JobSwitchGate::unlock() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  switching_ = false;
+  changed_.notify_all();
+}
+
 Result<CellLocate> locateAndPick(const CellCalibration& calibration, const ModelLibrary* models,
                                  const std::function<Result<LocateOutcome>()>& locate) {
   if (auto geometry = calibration.geometry(); !geometry) return geometry.error();
@@ -25,6 +50,7 @@ Result<CellLocate> locateAndPick(const CellCalibration& calibration, const Model
 }
 
 Result<CellLocate> locateAndPick(CellContext& cell, int type) {
+  const OneJob one_job(cell.job_switch);
   auto located = locateAndPick(cell.calibration, cell.vision.models(),
                                [&] { return cell.vision.locate(type); });
   if (!located) return located;

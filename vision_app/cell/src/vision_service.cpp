@@ -698,6 +698,34 @@ Result<std::pair<VisionOptions, VisionOptions>> VisionService::changeSettings(
   return std::make_pair(*before, std::move(*after));
 }
 
+Result<void> VisionService::adoptSettings(const VisionOptions& options, const std::string& staged) {
+  std::lock_guard<std::mutex> change(change_mutex_);
+  std::string path;
+  {
+    std::lock_guard<std::mutex> lock(settings_mutex_);
+    path = settings_path_;
+  }
+  std::error_code ec;
+  if (!path.empty()) {
+    std::filesystem::rename(staged, path, ec);
+    if (ec)
+      return makeError(VisionSettingsErrc::kStorage, "cannot write " + path + ": " + ec.message());
+    const std::string directory = std::filesystem::path(path).parent_path().string();
+    (void)syncDirectory(directory.empty() ? "." : directory);
+  } else {
+    std::filesystem::remove(staged, ec);
+  }
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  settings_ = std::make_shared<const VisionOptions>(options);
+  settings_damage_.clear();
+  return {};
+}
+
+std::string VisionService::settingsPath() const {
+  std::lock_guard<std::mutex> lock(settings_mutex_);
+  return settings_path_;
+}
+
 Result<VisionOptions> VisionService::resetSettings() {
   std::lock_guard<std::mutex> change(change_mutex_);
   std::shared_ptr<const VisionOptions> current;

@@ -26,6 +26,57 @@ Result<void> CameraLink::setMode(const CameraModeSettings&) {
   return makeError(CameraErrc::kCameraRefused, "camera " + camera() + " has no acquisition modes");
 }
 
+Result<CameraOutput> CameraLink::output() {
+  return makeError(CameraErrc::kCameraRefused, "camera " + camera() + " has no output settings");
+}
+Result<void> CameraLink::setOutput(const CameraOutput&) {
+  return makeError(CameraErrc::kCameraRefused, "camera " + camera() + " has no output settings");
+}
+
+namespace {
+// A part of the camera's settings it does not have, as opposed to a link
+// that has none at all.
+bool lacks(const Error& e) {
+  return e.code == CameraErrc::kCameraRefused || e.code == CameraErrc::kUnknownFeature;
+}
+}  // namespace
+
+Result<CameraSetup> CameraLink::setup(const std::vector<std::string>& feature_names) {
+  CameraSetup out;
+  auto roi_now = roi();
+  if (!roi_now && !lacks(roi_now.error())) return roi_now.error();
+  if (roi_now) out.roi = *roi_now;
+  auto output_now = output();
+  if (!output_now && !lacks(output_now.error())) return output_now.error();
+  if (output_now) out.output = *output_now;
+  auto mode_now = mode();
+  if (!mode_now && !lacks(mode_now.error())) return mode_now.error();
+  if (mode_now) out.mode = *mode_now;
+  for (const auto& name : feature_names) {
+    auto value = feature(name);
+    // A feature the camera does not know may come back as any refusal.
+    if (!value && value.error().code == CameraErrc::kNoVideoServer) return value.error();
+    if (value) out.features.emplace_back(name, *value);
+  }
+  return out;
+}
+
+Result<void> CameraLink::applySetup(const CameraSetup& s) {
+  if (s.roi) {
+    if (auto ok = setRoi(*s.roi); !ok) return ok;
+  }
+  if (s.output) {
+    if (auto ok = setOutput(*s.output); !ok) return ok;
+  }
+  if (s.mode) {
+    if (auto ok = setMode(*s.mode); !ok) return ok;
+  }
+  for (const auto& [name, value] : s.features) {
+    if (auto ok = setFeature(name, value); !ok) return ok.error();
+  }
+  return {};
+}
+
 // The still image is copied once here, so the caller may reuse its own.
 StillCamera::StillCamera(const cv::Mat& image, std::string camera)
     : camera_(std::move(camera)), image_(image.clone()) {}

@@ -172,4 +172,42 @@ Result<void> VideoServerCamera::setRoi(const cv::Rect& roi) {
   return {};
 }
 
+Result<CameraOutput> VideoServerCamera::output() {
+  proto::ControlRequest request;
+  request.mutable_describe_camera()->set_camera(camera_);
+  auto reply = call(request);
+  if (!reply) return reply.error();
+  const auto& d = reply->describe_camera();
+  CameraOutput out;
+  out.width = d.output_width();
+  out.height = d.output_height();
+  out.pixel_format = d.pixel_format() == proto::BGR8    ? "bgr8"
+                     : d.pixel_format() == proto::MONO8 ? "mono8"
+                                                        : "";
+  return out;
+}
+
+Result<void> VideoServerCamera::setOutput(const CameraOutput& output) {
+  proto::ControlRequest size;
+  auto* set = size.mutable_set_size();
+  set->set_camera(camera_);
+  set->set_width(output.width);
+  set->set_height(output.height);
+  if (auto reply = call(size); !reply) return reply.error();
+  if (output.pixel_format.empty()) return {};
+  proto::ControlRequest format;
+  auto* f = format.mutable_set_format();
+  f->set_camera(camera_);
+  if (output.pixel_format == "mono8") {
+    f->set_pixel_format(proto::MONO8);
+  } else if (output.pixel_format == "bgr8") {
+    f->set_pixel_format(proto::BGR8);
+  } else {
+    return makeError(CameraErrc::kCameraRefused,
+                     "pixel format " + output.pixel_format + " unknown (mono8, bgr8)");
+  }
+  if (auto reply = call(format); !reply) return reply.error();
+  return {};
+}
+
 }  // namespace picksight::link

@@ -7,6 +7,7 @@
 #include "picksight/calibration/robot_camera.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/cell/vision_settings.hpp"
+#include "picksight/jobs/job_file.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/store/cell_calibration.hpp"
@@ -67,6 +68,11 @@ const std::pair<std::error_code, int> kTable[] = {
     {VisionSettingsErrc::kBadSetting, 11},
     {VisionSettingsErrc::kDamaged, 48},
     {VisionSettingsErrc::kStorage, 49},
+    {jobs::JobErrc::kNoSuchJob, 50},
+    {jobs::JobErrc::kDamaged, 51},
+    {jobs::JobErrc::kStorage, 52},
+    {jobs::JobErrc::kTooLarge, 53},
+    {jobs::JobErrc::kBadName, 54},
     {ProtocolErrc::kInternalError, kInternal},
 };
 

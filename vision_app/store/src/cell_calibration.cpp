@@ -113,6 +113,46 @@ grasp::Pose CellGeometry::toReply(const grasp::Pose& p) const {
 CellCalibration::CellCalibration(std::string path, Fit fit)
     : fit_(std::move(fit)), store_(std::move(path)) {}
 
+Result<void> CellCalibration::check(const std::string& staged) {
+  calibration::CalibrationStore store(staged);
+  if (auto ok = store.load(); !ok)
+    return makeError(CellCalibrationErrc::kDamaged, ok.error().message);
+  if (const std::string why = unusable(store); !why.empty())
+    return makeError(CellCalibrationErrc::kDamaged, staged + ": " + why);
+  return {};
+}
+
+Result<void> CellCalibration::adopt(const std::optional<std::string>& staged) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string path = store_.path();
+  std::error_code ec;
+  if (staged) {
+    std::filesystem::rename(*staged, path, ec);
+  } else {
+    std::filesystem::remove(path, ec);
+  }
+  if (ec) return makeError(CellCalibrationErrc::kCalibrationStorage, path + ": " + ec.message());
+  const std::string directory = std::filesystem::path(path).parent_path().string();
+  (void)syncDirectory(directory.empty() ? "." : directory);
+  ++revision_;
+  calibration::CalibrationStore fresh(path);
+  auto ok = fresh.load();
+  damaged_ = ok ? std::string() : ok.error().message;
+  store_ = std::move(fresh);
+  if (!ok) return makeError(CellCalibrationErrc::kDamaged, damaged_);
+  return {};
+}
+
+Result<std::optional<std::string>> CellCalibration::fileText() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!damaged_.empty()) return blocked();
+  std::error_code ec;
+  if (!std::filesystem::exists(store_.path(), ec)) return std::optional<std::string>();
+  auto text = readFile(store_.path());
+  if (!text) return makeError(CellCalibrationErrc::kCalibrationStorage, text.error().message);
+  return std::optional<std::string>(std::move(*text));
+}
+
 Result<void> CellCalibration::load() {
   std::lock_guard<std::mutex> lock(mutex_);
   ++revision_;

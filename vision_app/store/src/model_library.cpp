@@ -1,7 +1,14 @@
 // Model library on disk.
 #include "picksight/store/model_library.hpp"
 
+#include <fcntl.h>
+#include <linux/fs.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <utility>
@@ -356,6 +363,49 @@ size_t ModelLibrary::undoDepth() const {
 std::vector<std::string> ModelLibrary::checkHistory() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return history_.check();
+}
+
+Result<std::vector<StoredModelFiles>> ModelLibrary::files() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<StoredModelFiles> out;
+  for (const auto& model : *models_) {
+    StoredModelFiles f;
+    f.type = model.type;
+    auto yaml = readFile(pathOf(model.type));
+    if (!yaml) return makeError(ModelErrc::kStorage, yaml.error().message);
+    f.yaml = std::move(*yaml);
+    std::error_code ec;
+    if (fs::exists(teachImagePathOf(model.type), ec)) {
+      auto png = readFile(teachImagePathOf(model.type));
+      if (!png) return makeError(ModelErrc::kStorage, png.error().message);
+      f.teach_png = std::move(*png);
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+Result<void> ModelLibrary::adoptDirectory(const std::string& staged, ModelList models,
+                                          GraspMap grasps) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::error_code ec;
+  if (fs::exists(directory_, ec)) {
+    // One rename for both directories: never a moment without a whole one.
+    if (::syscall(SYS_renameat2, AT_FDCWD, staged.c_str(), AT_FDCWD, directory_.c_str(),
+                  RENAME_EXCHANGE) != 0)
+      return makeError(ModelErrc::kStorage, "cannot put " + staged + " in place of " + directory_ +
+                                                ": " + std::strerror(errno));
+  } else {
+    fs::rename(staged, directory_, ec);
+    if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
+  }
+  const fs::path parent = fs::absolute(directory_, ec).parent_path();
+  if (!ec) (void)syncDirectory(parent.string());
+  std::sort(models.begin(), models.end(),
+            [](const vision::PartModel& a, const vision::PartModel& b) { return a.type < b.type; });
+  models_ = std::make_shared<const ModelList>(std::move(models));
+  grasps_ = std::make_shared<const GraspMap>(std::move(grasps));
+  return {};
 }
 
 std::shared_ptr<const ModelList> ModelLibrary::snapshot() const {

@@ -13,6 +13,7 @@
 
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/jobs/job_switch.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"
@@ -24,7 +25,7 @@ namespace picksight::app {
 
 class VisionCell {
  public:
-  // Files live in `data_dir` (models/, calibration.yaml, vision.json);
+  // Files live in `data_dir` (models/, calibration.yaml, vision.json, jobs/);
   // nothing is read or written before load(). `command_line_settings`: the
   // vision settings keys (vision_settings.hpp) set on the command line, which
   // win over vision.json at start.
@@ -57,6 +58,7 @@ class VisionCell {
   VisionService& vision() { return vision_; }
   store::ModelLibrary& models() { return models_; }
   store::CellCalibration& calibration() { return calibration_; }
+  jobs::JobSwitch& jobs() { return jobs_; }
   const CellContext& context() const { return context_; }
   CellContext& context() { return context_; }
 
@@ -68,6 +70,7 @@ class VisionCell {
   VisionService vision_;
   RobotProtocol protocol_;
   CellContext context_;
+  jobs::JobSwitch jobs_;
   results::ResultsPublisher* results_ = nullptr;
 };
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -31,6 +32,36 @@ struct CellLocate {
   std::optional<store::CellGeometry> geometry;
 };
 
+// Many LOCATEs at once, or one job switch alone. Unlike std::shared_mutex
+// (glibc's prefers readers), a switch that waits holds back new LOCATEs:
+// robots that LOCATE without pause never keep a JOB LOAD waiting.
+class JobSwitchGate {
+ public:
+  void lockShared();
+  void unlockShared();
+  void lock();
+  void unlock();
+
+ private:
+  std::mutex mutex_;  // guards the three below
+  std::condition_variable changed_;
+  int readers_ = 0;
+  int waiting_switches_ = 0;
+  bool switching_ = false;
+};
+
+// RAII: a LOCATE's shared hold of the gate.
+class OneJob {
+ public:
+  explicit OneJob(JobSwitchGate& gate) : gate_(gate) { gate_.lockShared(); }
+  ~OneJob() { gate_.unlockShared(); }
+  OneJob(const OneJob&) = delete;
+  OneJob& operator=(const OneJob&) = delete;
+
+ private:
+  JobSwitchGate& gate_;
+};
+
 // What a cell's requests share: its vision service and calibration
 // (borrowed), the LOCATE figures STATUS reports, and the lock GRASP and
 // GRIPPER edits take. Owned by VisionCell.
@@ -44,6 +75,11 @@ struct CellContext {
   std::atomic<uint64_t> last_skipped{0};  // parts with no free grasp in the last LOCATE
   std::atomic<uint64_t> skipped_total{0};
   std::mutex grasp_edits;  // serializes GRASP/GRIPPER read-modify-writes
+  // A LOCATE holds it shared from its first read of the models to its last
+  // of the calibration; JOB LOAD holds it alone while it puts a job's
+  // camera settings, models, vision settings and calibration in force, so
+  // that no LOCATE sees half of one job and half of another.
+  JobSwitchGate job_switch;
 };
 
 // The parts `locate` finds, picked with the grasps of `models` (none when

@@ -274,6 +274,12 @@ class VisionService {
   // and after.
   Result<std::pair<VisionOptions, VisionOptions>> changeSettings(
       const std::vector<std::pair<std::string, std::string>>& pairs);
+  // JOB LOAD: `options` in force, their file `staged` (written and synced
+  // by the caller beside the settings file) renamed over it; a damaged
+  // file's refusal is lifted.
+  Result<void> adoptSettings(const VisionOptions& options, const std::string& staged);
+  // The settings file's path (empty: changes are not stored).
+  std::string settingsPath() const;
   // Writes the settings in force over a damaged file and lifts the refusal.
   Result<VisionOptions> resetSettings();
   // What is wrong with the settings file (nullopt: nothing).

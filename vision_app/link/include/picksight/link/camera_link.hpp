@@ -14,7 +14,10 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -49,6 +52,24 @@ struct CameraModeSettings {
 const char* errorName(CameraErrc e);
 PICKSIGHT_ERROR_DOMAIN(CameraErrc, "camera link")
 
+// What the camera delivers after its ROI: the output size (0 x 0: the
+// ROI's) and the pixel format ("mono8", "bgr8"; empty: the camera's own).
+struct CameraOutput {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::string pixel_format;
+};
+
+// Every camera setting a job keeps (jobs/job_file.hpp): the ROI, the
+// output, the acquisition mode and named features (exposure, gain). Each
+// part the camera does not have is absent.
+struct CameraSetup {
+  std::optional<cv::Rect> roi;
+  std::optional<CameraOutput> output;
+  std::optional<CameraModeSettings> mode;
+  std::vector<std::pair<std::string, std::string>> features;  // name, value as read
+};
+
 class CameraLink {
  public:
   virtual ~CameraLink() = default;
@@ -69,6 +90,19 @@ class CameraLink {
   // The acquisition mode; links without modes refuse (kCameraRefused).
   virtual Result<CameraModeSettings> mode();
   virtual Result<void> setMode(const CameraModeSettings& mode);
+  // The output size and format; links without them refuse (kCameraRefused).
+  virtual Result<CameraOutput> output();
+  virtual Result<void> setOutput(const CameraOutput& output);
+
+  // Reads every setting of a CameraSetup, the features those of
+  // `feature_names` the camera has. kNoVideoServer when the link has no
+  // settings at all (a still image, no camera); a part the camera lacks
+  // (kCameraRefused, kUnknownFeature) is left out.
+  Result<CameraSetup> setup(const std::vector<std::string>& feature_names);
+  // Applies every part `setup` holds: ROI, output, mode, then features.
+  // The first refusal stops and is returned (the caller puts back what it
+  // read before).
+  Result<void> applySetup(const CameraSetup& setup);
 
   virtual uint64_t framesReceived() const = 0;
   virtual const std::string& camera() const = 0;

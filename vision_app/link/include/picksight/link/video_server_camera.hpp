@@ -36,6 +36,8 @@ class VideoServerCamera : public CameraLink {
   Result<void> setRoi(const cv::Rect& roi) override;
   Result<CameraModeSettings> mode() override;
   Result<void> setMode(const CameraModeSettings& mode) override;
+  Result<CameraOutput> output() override;
+  Result<void> setOutput(const CameraOutput& output) override;
   uint64_t framesReceived() const override { return feed_.framesReceived(); }
   const std::string& camera() const override { return camera_; }
 

@@ -27,6 +27,14 @@ using ModelList = std::vector<vision::PartModel>;
 using GraspMap = std::map<int, GraspSetup>;  // by type; a type without grasps may be absent
 
 // What undo() put back.
+// A model's files as stored (JOB SAVE): the model file's text and its
+// teach image (none: the type has none).
+struct StoredModelFiles {
+  int type = -1;
+  std::string yaml;
+  std::optional<std::string> teach_png;
+};
+
 struct UndoOutcome {
   int type = -1;
   std::string change;  // the request undone, as recorded ("LEARN 3 bracket")
@@ -96,6 +104,19 @@ class ModelLibrary {
   size_t undoDepth() const;
   // The history's entries that do not read back, one line each.
   std::vector<std::string> checkHistory() const;
+
+  // Every model's files, read under the library's lock (no LEARN between
+  // two of them).
+  Result<std::vector<StoredModelFiles>> files() const;
+  // JOB LOAD: makes `staged` (a complete models directory written and
+  // synced by the caller, beside directory()) the library's directory and
+  // `models` with `grasps` (read from those files) the models in force, in
+  // one step for readers. The two directories are exchanged in one rename
+  // (renameat2 RENAME_EXCHANGE), so a crash leaves one whole set of files
+  // or the other; `staged` then holds the previous directory, for the
+  // caller to remove. The undo history goes with the previous directory:
+  // its changes were made to other models.
+  Result<void> adoptDirectory(const std::string& staged, ModelList models, GraspMap grasps);
 
   std::shared_ptr<const ModelList> snapshot() const;
   std::shared_ptr<const GraspMap> grasps() const;
