@@ -197,8 +197,16 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
     return out;
   };
   const std::string good = contents(cell.jobFile("bars"));
+  // The content's checksum made again over everything but the files'
+  // bytes (which carry their own), as the job file keeps it.
   const auto reChecksummed = [](nlohmann::json j) {
-    j["content_sha256"] = store::sha256Hex(j["content"].dump());
+    nlohmann::json manifest = j["content"];
+    for (const char* key : {"vision_json", "calibration_yaml"}) manifest.erase(key);
+    for (auto& m : manifest["models"]) {
+      m.erase("yaml");
+      m.erase("teach_png");
+    }
+    j["content_sha256"] = store::sha256Hex(manifest.dump());
     return j.dump();
   };
   struct Damage {
@@ -213,6 +221,8 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
     yaml[yaml.size() / 2] ^= 1;
     edited["content"]["models"][0]["yaml"] = yaml;
   }
+  auto retyped = parsed;
+  retyped["content"]["models"][0]["type"] = 3;
   auto missing = parsed;
   missing["content"]["models"] = nlohmann::json::array();
   auto bad_settings = parsed;
@@ -220,9 +230,11 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
   bad_settings["content"]["vision_json_sha256"] = store::sha256Hex("{\"format\":\"nonsense\"}");
   const std::vector<Damage> damages = {
       {"cut short", good.substr(0, good.size() / 2), "not JSON"},
-      {"a byte changed", edited.dump(), "content checksum does not match"},
-      {"a byte changed, content checksum made again", reChecksummed(edited),
+      {"a byte of a model file changed", edited.dump(),
        "type 2's model file: checksum does not match"},
+      {"a type number changed", retyped.dump(), "content checksum does not match"},
+      {"a type number changed, the checksum made again", reChecksummed(retyped),
+       "type 3's model file holds type 2"},
       {"not JSON", "PK\x03\x04 zip file", "not JSON"},
       {"a model missing", reChecksummed(missing), "model missing: 0 of 1"},
       {"vision settings that do not read", reChecksummed(bad_settings), "its vision settings"},

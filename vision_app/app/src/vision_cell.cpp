@@ -42,6 +42,7 @@ std::vector<std::string> VisionCell::load() {
     problems.push_back(
         "calibration rejected (LOCATE and changes refused until repaired, or CLEARCAL): " +
         ok.error().message);
+  if (auto resumed = jobs_.resume()) problems.push_back("jobs: " + *resumed);
   return problems;
 }
 

@@ -710,8 +710,6 @@ Result<void> VisionService::adoptSettings(const VisionOptions& options, const st
     std::filesystem::rename(staged, path, ec);
     if (ec)
       return makeError(VisionSettingsErrc::kStorage, "cannot write " + path + ": " + ec.message());
-    const std::string directory = std::filesystem::path(path).parent_path().string();
-    (void)syncDirectory(directory.empty() ? "." : directory);
   } else {
     std::filesystem::remove(staged, ec);
   }

@@ -37,6 +37,31 @@ constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
 
 Error damaged(const std::string& what) { return makeError(JobErrc::kDamaged, what); }
 
+// The fields whose bytes carry their own SHA-256 beside them.
+bool isPayload(const std::string& key) {
+  return key == "yaml" || key == "teach_png" || key == "vision_json" || key == "calibration_yaml";
+}
+
+// The content without its payloads (each stands for itself through its
+// checksum): what content_sha256 covers, so that a type number, a count or
+// a camera setting cannot be edited either, without hashing the payloads'
+// megabytes twice.
+json manifestOf(const json& content) {
+  if (content.is_object()) {
+    json out = json::object();
+    for (const auto& [key, value] : content.items()) {
+      if (!isPayload(key)) out[key] = manifestOf(value);
+    }
+    return out;
+  }
+  if (content.is_array()) {
+    json out = json::array();
+    for (const auto& value : content) out.push_back(manifestOf(value));
+    return out;
+  }
+  return content;
+}
+
 const char* modeName(link::CameraMode mode) {
   switch (mode) {
     case link::CameraMode::kFreeRun:
@@ -248,7 +273,7 @@ std::string jobToText(const Job& job) {
   }
   content["camera"] = job.camera ? cameraToJson(*job.camera) : json(nullptr);
   json file = {{"format", kFormat}, {"version", kJobFormatVersion}, {"name", job.name}};
-  file["content_sha256"] = sha256Hex(content.dump());
+  file["content_sha256"] = sha256Hex(manifestOf(content).dump());
   file["content"] = std::move(content);
   return file.dump(1) + "\n";
 }
@@ -270,7 +295,7 @@ Result<Job> jobFromText(std::string_view text) {
   const auto content = file.find("content");
   if (content == file.end() || !content->is_object()) return damaged("no content");
   if (!file.contains("content_sha256") || !file["content_sha256"].is_string() ||
-      file["content_sha256"].get<std::string>() != sha256Hex(content->dump()))
+      file["content_sha256"].get<std::string>() != sha256Hex(manifestOf(*content).dump()))
     return damaged("content checksum does not match (damaged or edited)");
   const auto models = content->find("models");
   if (models == content->end() || !models->is_array()) return damaged("no model list");

@@ -2,11 +2,14 @@
 #include "picksight/jobs/job_switch.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <set>
 
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/atomic_file.hpp"
@@ -16,10 +19,37 @@ namespace picksight::jobs {
 namespace fs = std::filesystem;
 namespace {
 constexpr const char* kStaging = ".job-staging";
+constexpr const char* kSwitchingMarker = "switching";
+// Models directories a switch replaced: <models>.job-replaced.<n>.
+constexpr const char* kRemoved = ".job-replaced.";
 
-// One file of a staged job: written and synced, not renamed (its directory,
-// or its rename over the cell's file, makes it count).
-Result<void> writeSynced(const std::string& path, std::string_view bytes) {
+// Removes every models directory a switch replaced beside `models`.
+void removeReplaced(const std::string& models) {
+  const fs::path path(models);
+  const std::string prefix = path.filename().string() + kRemoved;
+  std::error_code ec;
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::vector<fs::path> found;
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->path().filename().string().rfind(prefix, 0) == 0) found.push_back(it->path());
+  }
+  for (const auto& p : found) fs::remove_all(p, ec);
+}
+
+// What tells one version of a file from another without reading it: an
+// atomic write makes a new inode, an edit in place a new size or time.
+std::string fileIdentity(const std::string& path) {
+  struct stat s {};
+  if (::stat(path.c_str(), &s) != 0) return {};
+  return std::to_string(s.st_dev) + ":" + std::to_string(s.st_ino) + ":" +
+         std::to_string(s.st_size) + ":" + std::to_string(s.st_mtim.tv_sec) + "." +
+         std::to_string(s.st_mtim.tv_nsec);
+}
+
+// One file of a staged job: written, not yet synced (syncStaged() syncs
+// them all at once), not renamed (its directory, or its rename over the
+// cell's file, makes it count).
+Result<void> writeStaged(const std::string& path, std::string_view bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return makeError(JobErrc::kStorage, path + ": " + std::strerror(errno));
   size_t done = 0;
@@ -33,10 +63,22 @@ Result<void> writeSynced(const std::string& path, std::string_view bytes) {
     }
     done += static_cast<size_t>(n);
   }
-  const bool synced = ::fsync(fd) == 0;
+  if (::close(fd) != 0) return makeError(JobErrc::kStorage, path + ": " + std::strerror(errno));
+  return {};
+}
+
+// Every staged file and directory on disk before any is renamed in: one
+// syncfs() of the file system they are on. An fsync per file costs a
+// journal commit each (on ext4 about 5 ms apiece: 33 files, most of a
+// switch); one sync of the file system costs one, whatever else is
+// pending on it.
+Result<void> syncStaged(const std::string& directory) {
+  const int fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return makeError(JobErrc::kStorage, directory + ": " + std::strerror(errno));
+  const bool synced = ::syncfs(fd) == 0;
   const int e = errno;
   ::close(fd);
-  if (!synced) return makeError(JobErrc::kStorage, path + ": " + std::strerror(e));
+  if (!synced) return makeError(JobErrc::kStorage, directory + ": " + std::strerror(e));
   return {};
 }
 
@@ -75,12 +117,56 @@ const std::vector<std::string>& jobCameraFeatures() {
 JobSwitch::JobSwitch(std::string directory, cell::CellContext& cell, store::ModelLibrary& models)
     : cell_(cell), models_(models), store_(std::move(directory)) {}
 
+JobSwitch::~JobSwitch() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  finishCleaning();
+}
+
+void JobSwitch::finishCleaning() {
+  if (cleaner_.joinable()) cleaner_.join();
+}
+
 std::vector<std::string> JobSwitch::clean() {
   std::lock_guard<std::mutex> lock(mutex_);
+  finishCleaning();
   Staging{models_.directory() + kStaging, cell_.vision.settingsPath() + kStaging,
           cell_.calibration.path() + kStaging}
       .remove();
+  removeReplaced(models_.directory());
   return store_.clean();
+}
+
+std::optional<std::string> JobSwitch::resume() {
+  const std::string marker = store_.directory() + "/" + kSwitchingMarker;
+  auto text = readFile(marker);
+  if (!text) return std::nullopt;
+  std::string name = *text;
+  while (!name.empty() && name.back() == '\n') name.pop_back();
+  auto loaded = load(name);
+  if (loaded) return "JOB LOAD " + name + " was interrupted (a crash or a stop): loaded again";
+  // Whatever the files are now, they are not the job: say so, once.
+  std::error_code ec;
+  fs::remove(marker, ec);
+  return "JOB LOAD " + name.substr(0, kMaxJobName) + " was interrupted and cannot be made again (" +
+         loaded.error().message + "): the cell's files may mix two jobs; load a job";
+}
+
+Result<std::shared_ptr<const Job>> JobSwitch::parsed(const std::string& name) {
+  const std::string identity = fileIdentity(store_.pathOf(name));
+  for (const auto& k : kept_) {
+    if (k.name == name && !identity.empty() && k.identity == identity) return k.job;
+  }
+  auto job = store_.read(name);
+  if (!job) return job.error();
+  job->name = name;
+  auto shared = std::make_shared<const Job>(std::move(*job));
+  kept_.erase(
+      std::remove_if(kept_.begin(), kept_.end(), [&](const KeptJob& k) { return k.name == name; }),
+      kept_.end());
+  if (kept_.size() >= kParsedJobs) kept_.erase(kept_.begin());
+  // The identity read before the file: a change since shows as another.
+  if (!identity.empty()) kept_.push_back({name, identity, shared});
+  return shared;
 }
 
 Result<Job> JobSwitch::capture(const std::string& name) {
@@ -138,10 +224,9 @@ Result<JobSummary> JobSwitch::save(const std::string& name) {
 Result<JobSummary> JobSwitch::load(const std::string& name) {
   if (auto ok = checkJobName(name); !ok) return ok.error();
   std::lock_guard<std::mutex> lock(mutex_);
-  auto job = store_.read(name);
+  auto job = parsed(name);
   if (!job) return job.error();
-  job->name = name;
-  auto loaded = apply(*job);
+  auto loaded = apply(**job);
   if (!loaded) {
     // Which file, for a refusal that is the job's fault.
     if (loaded.error().code == JobErrc::kDamaged)
@@ -161,8 +246,11 @@ Result<JobSummary> JobSwitch::apply(const Job& job) {
   const Staging staging{models_.directory() + kStaging, cell_.vision.settingsPath() + kStaging,
                         cell_.calibration.path() + kStaging};
   staging.remove();
+  const std::string marker = store_.directory() + "/" + kSwitchingMarker;
   const auto fail = [&](const Error& e) -> Error {
     staging.remove();
+    std::error_code ignored;
+    fs::remove(marker, ignored);
     return e;
   };
   std::error_code ec;
@@ -172,24 +260,27 @@ Result<JobSummary> JobSwitch::apply(const Job& job) {
   store::GraspMap grasps;
   for (const auto& m : job.models) {
     const std::string base = staging.models + "/type_" + std::to_string(m.type);
-    if (auto ok = writeSynced(base + ".yaml", m.yaml); !ok) return fail(ok.error());
+    if (auto ok = writeStaged(base + ".yaml", m.yaml); !ok) return fail(ok.error());
     if (m.teach_png) {
-      if (auto ok = writeSynced(base + ".png", *m.teach_png); !ok) return fail(ok.error());
+      if (auto ok = writeStaged(base + ".png", *m.teach_png); !ok) return fail(ok.error());
     }
     models.push_back(m.record.model);
     grasps[m.type] = m.record.grasp;
   }
-  if (auto ok = syncDirectory(staging.models); !ok)
-    return fail(makeError(JobErrc::kStorage, ok.error().message));
+
   if (!cell_.vision.settingsPath().empty()) {
-    if (auto ok = writeSynced(staging.vision, job.vision_json); !ok) return fail(ok.error());
+    if (auto ok = writeStaged(staging.vision, job.vision_json); !ok) return fail(ok.error());
   }
   if (job.calibration_yaml) {
-    if (auto ok = writeSynced(staging.calibration, *job.calibration_yaml); !ok)
+    if (auto ok = writeStaged(staging.calibration, *job.calibration_yaml); !ok)
       return fail(ok.error());
     if (auto ok = store::CellCalibration::check(staging.calibration); !ok)
       return fail(makeError(JobErrc::kDamaged, "its calibration: " + ok.error().message));
   }
+  // The marker is on disk with the staged files, before the first rename.
+  fs::create_directories(store_.directory(), ec);
+  if (auto ok = writeStaged(marker, job.name + "\n"); !ok) return fail(ok.error());
+  if (auto ok = syncStaged(staging.models); !ok) return fail(ok.error());
 
   {
     const Switching alone(cell_.job_switch);
@@ -221,8 +312,37 @@ Result<JobSummary> JobSwitch::apply(const Job& job) {
         !ok)
       return fail(ok.error());
   }
-  // The previous models directory, exchanged into the staging path.
-  staging.remove();
+  // One sync for the three renames (their directories: the data directory
+  // in a VisionCell), then the marker goes.
+  std::set<std::string> directories;
+  for (const auto& path :
+       {models_.directory(), cell_.vision.settingsPath(), cell_.calibration.path()}) {
+    if (path.empty()) continue;
+    const std::string parent = fs::path(path).parent_path().string();
+    directories.insert(parent.empty() ? "." : parent);
+  }
+  for (const auto& directory : directories) {
+    if (auto ok = syncDirectory(directory); !ok)
+      logWarning("JOB LOAD ", job.name, ": ", ok.error().message);
+  }
+  fs::remove(marker, ec);
+  // The previous models directory, exchanged into the staging path, goes
+  // after the reply: removing a few MB of files is no part of the switch
+  // (on ext4 it can take longer than the switch). Renamed out of the next
+  // switch's way, it is removed by the cleaner, with any a busy cleaner
+  // left before.
+  const std::string old = models_.directory() + kRemoved + std::to_string(++removed_);
+  fs::rename(staging.models, old, ec);
+  if (ec) {
+    staging.remove();
+  } else if (cleaning_done_) {
+    finishCleaning();
+    cleaning_done_ = false;
+    cleaner_ = std::thread([this, models = models_.directory()] {
+      removeReplaced(models);
+      cleaning_done_ = true;
+    });
+  }
   JobSummary summary;
   summary.name = job.name;
   summary.models = job.models.size();

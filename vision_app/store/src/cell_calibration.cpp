@@ -132,8 +132,6 @@ Result<void> CellCalibration::adopt(const std::optional<std::string>& staged) {
     std::filesystem::remove(path, ec);
   }
   if (ec) return makeError(CellCalibrationErrc::kCalibrationStorage, path + ": " + ec.message());
-  const std::string directory = std::filesystem::path(path).parent_path().string();
-  (void)syncDirectory(directory.empty() ? "." : directory);
   ++revision_;
   calibration::CalibrationStore fresh(path);
   auto ok = fresh.load();

@@ -399,8 +399,6 @@ Result<void> ModelLibrary::adoptDirectory(const std::string& staged, ModelList m
     fs::rename(staged, directory_, ec);
     if (ec) return makeError(ModelErrc::kStorage, directory_ + ": " + ec.message());
   }
-  const fs::path parent = fs::absolute(directory_, ec).parent_path();
-  if (!ec) (void)syncDirectory(parent.string());
   std::sort(models.begin(), models.end(),
             [](const vision::PartModel& a, const vision::PartModel& b) { return a.type < b.type; });
   models_ = std::make_shared<const ModelList>(std::move(models));

@@ -275,8 +275,8 @@ class VisionService {
   Result<std::pair<VisionOptions, VisionOptions>> changeSettings(
       const std::vector<std::pair<std::string, std::string>>& pairs);
   // JOB LOAD: `options` in force, their file `staged` (written and synced
-  // by the caller beside the settings file) renamed over it; a damaged
-  // file's refusal is lifted.
+  // by the caller beside the settings file) renamed over it (the caller
+  // syncs the directory); a damaged file's refusal is lifted.
   Result<void> adoptSettings(const VisionOptions& options, const std::string& staged);
   // The settings file's path (empty: changes are not stored).
   std::string settingsPath() const;

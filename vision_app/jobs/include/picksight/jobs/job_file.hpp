@@ -1,7 +1,7 @@
 // A job as one file: a product's models (with their grasps and teach
 // images), vision settings, calibration and camera settings, written as
-// JSON with every stored file's bytes inside (images in base64) and a
-// SHA-256 of each file and of the whole content, so that a truncated,
+// JSON with every stored file's bytes inside (images in base64), a
+// SHA-256 of each file and one of the rest (types, counts, camera), so that a truncated,
 // edited or damaged job is refused by name before anything is changed. The
 // same text is kept under <data dir>/jobs/ and moved between cells (export,
 // import).

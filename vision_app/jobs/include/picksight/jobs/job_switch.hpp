@@ -9,17 +9,29 @@
 // calibration.yaml with .job-staging): anything wrong and the cell is as
 // before. Then, holding the switch alone: the camera settings (put back
 // as they were if the camera refuses one), the models directory exchanged
-// in one rename, the settings and calibration files renamed over theirs.
+// in one rename, the settings and calibration files renamed over theirs;
+// the data directory synced once after. A crash among those renames is
+// found at the next start by the marker jobs/switching (naming the job,
+// durable before the first rename, removed after the sync): the start
+// loads that job again (resume()).
+//
+// Loaded jobs are kept parsed (at most kParsedJobs, each with the identity
+// of its file: device, inode, size, modification time), so that switching
+// back to one costs no parsing unless its file changed.
 //
 // Threading: every member is thread-safe; job requests run one at a time.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -50,9 +62,19 @@ class JobSwitch {
   // live in `directory` (<data dir>/jobs).
   JobSwitch(std::string directory, cell::CellContext& cell, store::ModelLibrary& models);
 
+  ~JobSwitch();
+  JobSwitch(const JobSwitch&) = delete;
+  JobSwitch& operator=(const JobSwitch&) = delete;
+
+  static constexpr size_t kParsedJobs = 4;
+
   // At start: removes what an interrupted switch or write left; one line
   // per problem.
   std::vector<std::string> clean();
+  // At start, after the cell's files are loaded: a JOB LOAD a crash
+  // interrupted is made again (its name and outcome, for the log);
+  // nullopt when none was.
+  std::optional<std::string> resume();
 
   Result<JobSummary> save(const std::string& name);
   Result<JobSummary> load(const std::string& name);
@@ -82,6 +104,12 @@ class JobSwitch {
   // The cell as a job, under the switch's shared hold.
   Result<Job> capture(const std::string& name);
   Result<JobSummary> apply(const Job& job);
+  // The job `name` as parsed: from kept_ when its file is the same, else
+  // read and checked (store_.read). With mutex_ held.
+  Result<std::shared_ptr<const Job>> parsed(const std::string& name);
+  // With mutex_ held: waits for the removal of the previous switch's
+  // models directory.
+  void finishCleaning();
   // importText() with mutex_ held.
   Result<JobSummary> importLocked(const std::string& name, std::string_view text);
 
@@ -96,6 +124,16 @@ class JobSwitch {
     std::string bytes;
   };
   std::optional<PendingImport> pending_;
+  struct KeptJob {
+    std::string name;
+    std::string identity;  // of its file when parsed
+    std::shared_ptr<const Job> job;
+  };
+  std::vector<KeptJob> kept_;  // newest last; guarded by mutex_
+  // Removes the models directories switches replaced, after the reply.
+  std::thread cleaner_;                    // guarded by mutex_
+  std::atomic<bool> cleaning_done_{true};  // cleaner_ finished (or none)
+  uint64_t removed_ = 0;                   // names replaced directories; guarded by mutex_
 };
 
 }  // namespace picksight::jobs

@@ -121,9 +121,10 @@ class CellCalibration {
   // JOB LOAD. check(): whether a calibration file at `staged` can be used
   // (kDamaged names what is wrong), read without touching the cell's.
   static Result<void> check(const std::string& staged);
-  // Puts the checked file `staged` in place of the cell's (rename) and in
-  // force, or with nullopt removes the cell's: LOCATE then replies in
-  // vision pixels. A COMPUTE under way is refused (kPointsChanged).
+  // Puts the checked file `staged` in place of the cell's (rename; the
+  // caller syncs the directory) and in force, or with nullopt removes the
+  // cell's: LOCATE then replies in vision pixels. A COMPUTE under way is
+  // refused (kPointsChanged).
   Result<void> adopt(const std::optional<std::string>& staged);
   // The file's text as stored (JOB SAVE); nullopt when there is none.
   // kDamaged while the file is damaged.

@@ -114,8 +114,9 @@ class ModelLibrary {
   // one step for readers. The two directories are exchanged in one rename
   // (renameat2 RENAME_EXCHANGE), so a crash leaves one whole set of files
   // or the other; `staged` then holds the previous directory, for the
-  // caller to remove. The undo history goes with the previous directory:
-  // its changes were made to other models.
+  // caller to remove, and the caller syncs their parent directory (once for
+  // all of a job's files). The undo history goes with the previous
+  // directory: its changes were made to other models.
   Result<void> adoptDirectory(const std::string& staged, ModelList models, GraspMap grasps);
 
   std::shared_ptr<const ModelList> snapshot() const;
