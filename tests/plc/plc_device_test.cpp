@@ -194,8 +194,11 @@ TEST_CASE("bad requests get Modbus exceptions and the port goes on", "[plc][exce
   CHECK(plc.readError(reg::kCount - 1, 2) == EMBXILADD);
   CHECK(plc.readError(1000, 1) == EMBXILADD);
   const uint16_t two[2] = {0, 7};
-  CHECK(modbus_write_registers(plc.ctx(), 1, 2, two) == -1);  // 2 is read-only
+  CHECK(modbus_write_registers(plc.ctx(), 2, 2, two) == -1);  // 3 is read-only
   CHECK(errno == EMBXILADD);
+  // A job number out of range.
+  CHECK(plc.writeError(reg::kJobNumber, 10000) == EMBXILVAL);
+  CHECK(plc.read(reg::kJobNumber) == 0);
   // A part type out of range.
   CHECK(plc.writeError(reg::kPartType, 10000) == EMBXILVAL);
   CHECK(plc.read(reg::kPartType) == 0);

@@ -253,6 +253,13 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
   }
   CHECK(cell.ask("JOB LOAD nothing").rfind("ERROR 50 ", 0) == 0);
   CHECK(cell.state() == before);
+  // A job loaded before (kept parsed) whose file is damaged since: the
+  // file is what counts.
+  writeText(cell.jobFile("plates"), good.substr(0, good.size() / 3));
+  const std::string reply = cell.ask("JOB LOAD plates");
+  CHECK(reply.rfind("ERROR 51 ", 0) == 0);
+  CHECK(reply.find(cell.jobFile("plates")) != std::string::npos);
+  CHECK(cell.state() == before);
 }
 
 TEST_CASE("job names are checked, changes refused on a read-only port", "[e2e][jobs]") {

@@ -8,7 +8,9 @@ namespace picksight::app {
 PlcPort::PlcPort(const PlcPortOptions& options, VisionCell& cell)
     : device_(options.device, plc::cellPicker(cell.context(), cell.results()),
               plc::cellFrameState(cell.calibration()), plc::robotErrorCodeOf),
-      server_(options.server, device_) {}
+      server_(options.server, device_) {
+  device_.setJobs(plc::cellJobLoader(cell.jobs()), plc::cellJobState(cell.jobs()));
+}
 
 void PlcPort::start() {
   device_.start();

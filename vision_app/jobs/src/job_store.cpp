@@ -98,7 +98,6 @@ Result<void> JobStore::remove(const std::string& name) {
     return makeError(JobErrc::kNoSuchJob, "no job " + name);
   }
   (void)syncDirectory(directory_);
-  if (current() == name) setCurrent(std::nullopt);
   return {};
 }
 

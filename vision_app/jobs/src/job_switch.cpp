@@ -108,6 +108,21 @@ class Switching {
 };
 }  // namespace
 
+std::optional<uint16_t> jobNumber(std::string_view name) {
+  size_t digits = 0;
+  while (digits < name.size() && name[digits] >= '0' && name[digits] <= '9') ++digits;
+  if (digits == 0) return std::nullopt;
+  if (digits < name.size() && name[digits] != '-' && name[digits] != '_' && name[digits] != '.')
+    return std::nullopt;
+  unsigned value = 0;
+  for (size_t i = 0; i < digits; ++i) {
+    value = value * 10 + static_cast<unsigned>(name[i] - '0');
+    if (value > 9999) return std::nullopt;
+  }
+  if (value == 0) return std::nullopt;
+  return static_cast<uint16_t>(value);
+}
+
 const std::vector<std::string>& jobCameraFeatures() {
   static const std::vector<std::string> names = {
       "ExposureTime", "ExposureTimeAbs", "exposure_time_absolute", "Gain", "GainRaw", "gain"};
@@ -133,6 +148,10 @@ std::vector<std::string> JobSwitch::clean() {
           cell_.calibration.path() + kStaging}
       .remove();
   removeReplaced(models_.directory());
+  {
+    std::lock_guard<std::mutex> current(current_mutex_);
+    current_ = store_.current();
+  }
   return store_.clean();
 }
 
@@ -212,7 +231,7 @@ Result<JobSummary> JobSwitch::save(const std::string& name) {
     return makeError(JobErrc::kTooLarge, "job " + name + " would be over " +
                                              std::to_string(kMaxJobBytes >> 20) + " MiB");
   if (auto ok = store_.write(name, text); !ok) return ok.error();
-  store_.setCurrent(name);
+  setCurrent(name);
   summary.name = name;
   summary.models = job->models.size();
   summary.calibrated = job->calibration_yaml.has_value();
@@ -233,7 +252,7 @@ Result<JobSummary> JobSwitch::load(const std::string& name) {
       return makeError(JobErrc::kDamaged, store_.pathOf(name) + ": " + loaded.error().message);
     return loaded;
   }
-  store_.setCurrent(name);
+  setCurrent(name);
   return loaded;
 }
 
@@ -358,7 +377,9 @@ Result<std::vector<JobEntry>> JobSwitch::list() const {
 
 Result<void> JobSwitch::remove(const std::string& name) {
   std::lock_guard<std::mutex> lock(mutex_);
-  return store_.remove(name);
+  if (auto ok = store_.remove(name); !ok) return ok;
+  if (current() == name) setCurrent(std::nullopt);
+  return {};
 }
 
 Result<std::string> JobSwitch::exportText(const std::string& name) const {
@@ -430,8 +451,36 @@ Result<JobSummary> JobSwitch::importLocked(const std::string& name, std::string_
 }
 
 std::optional<std::string> JobSwitch::current() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return store_.current();
+  std::lock_guard<std::mutex> lock(current_mutex_);
+  return current_;
+}
+
+void JobSwitch::setCurrent(const std::optional<std::string>& name) {
+  store_.setCurrent(name);
+  std::lock_guard<std::mutex> lock(current_mutex_);
+  current_ = name;
+}
+
+uint16_t JobSwitch::currentNumber() const {
+  const auto name = current();
+  return name ? jobNumber(*name).value_or(0) : 0;
+}
+
+Result<JobSummary> JobSwitch::loadNumber(uint16_t number) {
+  auto jobs = list();
+  if (!jobs) return jobs.error();
+  std::vector<std::string> named;
+  for (const auto& entry : *jobs) {
+    if (jobNumber(entry.name) == number) named.push_back(entry.name);
+  }
+  if (named.empty())
+    return makeError(JobErrc::kNoSuchJob, "no job numbered " + std::to_string(number) +
+                                              " (a job's number starts its name: " +
+                                              std::to_string(number) + "-<name>)");
+  if (named.size() > 1)
+    return makeError(JobErrc::kNoSuchJob, "jobs " + named[0] + " and " + named[1] +
+                                              " both have number " + std::to_string(number));
+  return load(named[0]);
 }
 
 }  // namespace picksight::jobs

@@ -66,4 +66,16 @@ PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration) 
 
 int robotErrorCodeOf(const Error& error) { return app::robotErrorCode(error.code); }
 
+PlcDevice::JobLoader cellJobLoader(jobs::JobSwitch& jobs) {
+  return [&jobs](uint16_t number) -> Result<void> {
+    auto loaded = jobs.loadNumber(number);
+    if (!loaded) return loaded.error();
+    return {};
+  };
+}
+
+PlcDevice::JobState cellJobState(const jobs::JobSwitch& jobs) {
+  return [&jobs] { return jobs.currentNumber(); };
+}
+
 }  // namespace picksight::plc

@@ -26,6 +26,8 @@ int checkValues(uint16_t address, const uint8_t* values, uint16_t count) {
     const uint16_t v = word(values + 2 * i);
     if (address + i == reg::kPartType && v > kMaxType && v != kAllTypes)
       return MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;
+    if (address + i == reg::kJobNumber && v > kMaxJobNumber)
+      return MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;
   }
   return 0;
 }
@@ -58,6 +60,12 @@ PlcDevice::PlcDevice(PlcDeviceOptions options, Picker picker, FrameState frame_s
 PlcDevice::~PlcDevice() {
   stop();
   modbus_mapping_free(mapping_);
+}
+
+void PlcDevice::setJobs(JobLoader loader, JobState state) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  job_loader_ = std::move(loader);
+  job_state_ = std::move(state);
 }
 
 void PlcDevice::start() {
@@ -139,6 +147,7 @@ bool PlcDevice::handle(modbus_t* ctx, const uint8_t* adu, size_t size) {
   const auto ticks = (std::chrono::steady_clock::now() - started_) / kHeartbeatTick;
   r[reg::kHeartbeat] = static_cast<uint16_t>(ticks);
   r[reg::kCalibration] = frame_state_();
+  if (job_state_) r[reg::kJobInForce] = job_state_();
   refreshStatus();
   if (pdu[0] == MODBUS_FC_READ_INPUT_REGISTERS)
     std::memcpy(mapping_->tab_input_registers, r, sizeof(uint16_t) * reg::kCount);
@@ -162,6 +171,23 @@ void PlcDevice::onControl(uint16_t written) {
     r[reg::kErrorCode] = 0;
   }
   if ((rising & kControlResultsAck) && results_valid_) results_valid_ = false;
+  if (falling & kControlLoadJob) job_done_ = false;
+  if (rising & kControlLoadJob) {
+    // As a trigger: one request at a time; the results of the job before
+    // are no longer valid.
+    if (busy_ || stop_ || !worker_.joinable()) {
+      ++r[reg::kMissedTriggers];
+    } else {
+      busy_ = true;
+      job_done_ = false;
+      error_ = false;
+      r[reg::kErrorCode] = 0;
+      results_valid_ = false;
+      clearResult();
+      job_load_ = r[reg::kJobNumber];
+      wake_.notify_all();
+    }
+  }
   if (rising & kControlTrigger) {
     if (busy_ || results_valid_ || stop_ || !worker_.joinable()) {
       ++r[reg::kMissedTriggers];
@@ -189,6 +215,7 @@ void PlcDevice::refreshStatus() {
   if (results_valid_) status |= kStatusResultsValid;
   if (error_) status |= kStatusError;
   if (r[reg::kCalibration] == kFrameRobot) status |= kStatusCalibrated;
+  if (job_done_) status |= kStatusJobDone;
   r[reg::kStatus] = status;
 }
 
@@ -221,8 +248,12 @@ void PlcDevice::writeResult(const PlcResult& result) {
 void PlcDevice::workerLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
-    wake_.wait(lock, [this] { return stop_ || job_.has_value(); });
+    wake_.wait(lock, [this] { return stop_ || job_.has_value() || job_load_.has_value(); });
     if (stop_) break;
+    if (job_load_) {
+      loadJob(lock);
+      continue;
+    }
     const int type = *job_;
     job_.reset();
     lock.unlock();
@@ -249,6 +280,34 @@ void PlcDevice::workerLoop() {
   // A trigger that was accepted but not run leaves the device idle.
   busy_ = false;
   job_.reset();
+  job_load_.reset();
+  refreshStatus();
+}
+
+void PlcDevice::loadJob(std::unique_lock<std::mutex>& lock) {
+  const uint16_t number = *job_load_;
+  job_load_.reset();
+  const JobLoader loader = job_loader_;
+  lock.unlock();
+  // The load runs without the registers' lock: the PLC keeps polling.
+  Result<void> loaded =
+      makeError(std::errc::operation_not_supported, "this cell has no jobs to select from the PLC");
+  try {
+    if (loader) loaded = loader(number);
+  } catch (const std::exception& e) {
+    logError("PLC job load: ", e.what());
+    loaded = makeError(std::errc::state_not_recoverable, e.what());
+  }
+  const int code = loaded ? 0 : error_code_(loaded.error());
+  if (!loaded) logInfo("PLC job load (", number, "): ", loaded.error().message);
+  lock.lock();
+  if (!loaded) {
+    error_ = true;
+    mapping_->tab_registers[reg::kErrorCode] = static_cast<uint16_t>(code);
+  }
+  if (job_state_) mapping_->tab_registers[reg::kJobInForce] = job_state_();
+  job_done_ = (control_ & kControlLoadJob) != 0;
+  busy_ = false;
   refreshStatus();
 }
 

@@ -47,6 +47,11 @@ namespace picksight::jobs {
 // HMI's Camera panel reads the same): the first of each list it has.
 const std::vector<std::string>& jobCameraFeatures();
 
+// The number a PLC selects a job by: the digits its name starts with,
+// followed by nothing or one of - _ . ("7", "007-brackets", "12_lids": 7,
+// 7, 12); nullopt for other names, 0, or past 9999.
+std::optional<uint16_t> jobNumber(std::string_view name);
+
 struct JobSummary {
   std::string name;
   size_t models = 0;
@@ -78,6 +83,12 @@ class JobSwitch {
 
   Result<JobSummary> save(const std::string& name);
   Result<JobSummary> load(const std::string& name);
+  // JOB LOAD of the one job whose number (jobNumber) is `number`:
+  // kNoSuchJob when none or several have it.
+  Result<JobSummary> loadNumber(uint16_t number);
+  // The number of the job in force (0: none, or its name has none); never
+  // waits for a job request (the PLC's registers read it at every poll).
+  uint16_t currentNumber() const;
   Result<std::vector<JobEntry>> list() const;
   Result<void> remove(const std::string& name);
   // The job file's text, checked whole (a damaged job is not handed out).
@@ -110,6 +121,8 @@ class JobSwitch {
   // With mutex_ held: waits for the removal of the previous switch's
   // models directory.
   void finishCleaning();
+  // The job in force, kept in memory and in jobs/current.
+  void setCurrent(const std::optional<std::string>& name);
   // importText() with mutex_ held.
   Result<JobSummary> importLocked(const std::string& name, std::string_view text);
 
@@ -117,6 +130,8 @@ class JobSwitch {
   store::ModelLibrary& models_;
   mutable std::mutex mutex_;  // serializes job requests; guards store_
   JobStore store_;
+  mutable std::mutex current_mutex_;    // guards current_
+  std::optional<std::string> current_;  // as store_.current(), read at clean()
   // The import under way (importPiece); guarded by mutex_.
   struct PendingImport {
     std::string name;

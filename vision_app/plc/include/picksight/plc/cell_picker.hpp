@@ -5,6 +5,7 @@
 #pragma once
 
 #include "picksight/cell/cell_locate.hpp"
+#include "picksight/jobs/job_switch.hpp"
 #include "picksight/plc/plc_device.hpp"
 #include "picksight/results/results_publisher.hpp"
 
@@ -22,5 +23,9 @@ PlcResult plcResult(const app::CellLocate& located);
 PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results);
 PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration);
 int robotErrorCodeOf(const Error& error);
+// LOAD_JOB over `jobs` (borrowed; outlives the device): the job numbered
+// so (jobs::jobNumber), and the number of the job in force.
+PlcDevice::JobLoader cellJobLoader(jobs::JobSwitch& jobs);
+PlcDevice::JobState cellJobState(const jobs::JobSwitch& jobs);
 
 }  // namespace picksight::plc

@@ -60,11 +60,20 @@ class PlcDevice {
   using FrameState = std::function<uint16_t()>;
   // Turns a LOCATE's error into the robot protocol's ERROR code.
   using ErrorCode = std::function<int(const Error&)>;
+  // Loads the job of a number (jobs/job_switch.hpp: the job whose name
+  // starts with it); called on the worker thread.
+  using JobLoader = std::function<Result<void>(uint16_t number)>;
+  // The number of the job in force (0: none); called on handle()'s thread.
+  using JobState = std::function<uint16_t()>;
 
   PlcDevice(PlcDeviceOptions options, Picker picker, FrameState frame_state, ErrorCode error_code);
   ~PlcDevice();
   PlcDevice(const PlcDevice&) = delete;
   PlcDevice& operator=(const PlcDevice&) = delete;
+
+  // Lets the PLC select jobs (LOAD_JOB); without it a LOAD_JOB fails
+  // (ERROR 99). Call before start().
+  void setJobs(JobLoader loader, JobState state);
 
   // Starts and stops the worker; a LOCATE under way is finished first.
   void start();
@@ -91,6 +100,9 @@ class PlcDevice {
   // register image, or 0.
   int screen(const uint8_t* pdu, size_t size) const;
   void workerLoop();
+  // On the worker, with `lock` (of mutex_) held: runs the job load asked
+  // for, without the lock meanwhile.
+  void loadJob(std::unique_lock<std::mutex>& lock);
 
   const PlcDeviceOptions options_;
   const Picker picker_;
@@ -106,7 +118,11 @@ class PlcDevice {
   bool trigger_ack_ = false;
   bool results_valid_ = false;
   bool error_ = false;
-  std::optional<int> job_;  // the type of the LOCATE the worker is to run
+  std::optional<int> job_;            // the type of the LOCATE the worker is to run
+  std::optional<uint16_t> job_load_;  // the job number the worker is to load
+  bool job_done_ = false;
+  JobLoader job_loader_;  // set before start()
+  JobState job_state_;
   bool stop_ = false;
   std::thread worker_;
 };

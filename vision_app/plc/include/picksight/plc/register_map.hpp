@@ -14,7 +14,8 @@ namespace picksight::plc {
 namespace reg {
 constexpr uint16_t kControl = 0;          // PLC writes: the kControl* bits
 constexpr uint16_t kPartType = 1;         // PLC writes: 0..9999, kAllTypes
-constexpr uint16_t kWritableEnd = 2;      // [0, kWritableEnd) accept writes
+constexpr uint16_t kJobNumber = 2;        // PLC writes: the job LOAD_JOB loads, 1..9999
+constexpr uint16_t kWritableEnd = 3;      // [0, kWritableEnd) accept writes
 constexpr uint16_t kStatus = 10;          // the kStatus* bits
 constexpr uint16_t kHeartbeat = 11;       // +1 every 100 ms, wraps
 constexpr uint16_t kErrorCode = 12;       // robot protocol ERROR code, 0 = none
@@ -22,6 +23,7 @@ constexpr uint16_t kCalibration = 13;     // the cell's reply frame now (kFrame*
 constexpr uint16_t kResultFrame = 14;     // the frame the results are in (kFrame*)
 constexpr uint16_t kTriggerCount = 15;    // triggers accepted, wraps
 constexpr uint16_t kMissedTriggers = 16;  // rising edges while not ready, wraps
+constexpr uint16_t kJobInForce = 17;      // the number of the job in force, 0 = none
 constexpr uint16_t kFrameSequence = 18;   // 32 bits: 18, 19
 constexpr uint16_t kPartCount = 20;       // parts in the result registers
 constexpr uint16_t kPartsOffered = 21;    // poses LOCATE offered (may exceed kMaxParts)
@@ -41,7 +43,9 @@ constexpr uint16_t kCount = kFirstPart + kPartStride * kMaxParts;  // 190 regist
 constexpr uint16_t kControlTrigger = 1u << 0;
 constexpr uint16_t kControlClearError = 1u << 1;
 constexpr uint16_t kControlResultsAck = 1u << 2;
-constexpr uint16_t kControlMask = kControlTrigger | kControlClearError | kControlResultsAck;
+constexpr uint16_t kControlLoadJob = 1u << 3;  // rising edge: JOB LOAD of kJobNumber
+constexpr uint16_t kControlMask =
+    kControlTrigger | kControlClearError | kControlResultsAck | kControlLoadJob;
 
 constexpr uint16_t kStatusReady = 1u << 0;
 constexpr uint16_t kStatusBusy = 1u << 1;
@@ -49,9 +53,12 @@ constexpr uint16_t kStatusTriggerAck = 1u << 2;
 constexpr uint16_t kStatusResultsValid = 1u << 3;
 constexpr uint16_t kStatusError = 1u << 4;
 constexpr uint16_t kStatusCalibrated = 1u << 5;  // results in the robot frame
+constexpr uint16_t kStatusJobDone =
+    1u << 6;  // a LOAD_JOB finished (ok or ERROR), until LOAD_JOB falls
 
 constexpr uint16_t kAllTypes = 0xFFFF;  // INT -1 in the PLC
 constexpr uint16_t kMaxType = 9999;
+constexpr uint16_t kMaxJobNumber = 9999;
 
 // The codes of kCalibration and kResultFrame.
 constexpr uint16_t kFrameVisionPixels = 0;

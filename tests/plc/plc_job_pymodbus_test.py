@@ -1,0 +1,220 @@
+#!/usr/bin/python3
+"""Jobs selected by a PLC through pymodbus (Debian's python3-pymodbus): the
+LOAD_JOB handshake (JOB_NUMBER, LOAD_JOB, JOB_DONE, JOB_IN_FORCE) switching
+between two jobs saved over the robot port, each trigger after a switch
+answering with the job's own model; a number no job has is ERROR 50 and
+changes nothing; a job loaded over the robot port shows in JOB_IN_FORCE.
+
+usage: /usr/bin/python3 plc_job_pymodbus_test.py --bin-dir BUILD/bin
+"""
+import argparse
+import os
+import queue
+import shutil
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+from pymodbus.client import ModbusTcpClient
+
+# docs/PLC.md, register map.
+CONTROL, PART_TYPE, STATUS, HEARTBEAT, ERROR_CODE = 0, 1, 10, 11, 12
+CALIBRATION, RESULT_FRAME, TRIGGER_COUNT = 13, 14, 15
+FRAME_SEQUENCE, PART_COUNT, FIRST_PART, PART_STRIDE = 18, 20, 30, 10
+TRIGGER, CLEAR_ERROR, RESULTS_ACK = 1, 2, 4
+READY, BUSY, TRIGGER_ACK, RESULTS_VALID, ERROR = 1, 2, 4, 8, 16
+ALL_TYPES = 0xFFFF
+JOB_NUMBER, JOB_IN_FORCE, LOAD_JOB, JOB_DONE = 2, 17, 8, 64
+UNIT = 5
+
+
+class Process:
+    """A build-tree binary whose stdout lines are read by a thread."""
+
+    def __init__(self, argv):
+        self.proc = subprocess.Popen(argv, stdout=subprocess.PIPE, text=True)
+        self.lines = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in self.proc.stdout:
+            self.lines.put(line.rstrip("\n"))
+
+    def wait_for(self, prefix, timeout=10.0):
+        deadline = time.monotonic() + timeout
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise AssertionError(f"no line starting with {prefix!r}")
+            try:
+                line = self.lines.get(timeout=left)
+            except queue.Empty:
+                continue
+            if line.startswith(prefix):
+                return line[len(prefix):]
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+class Robot:
+    def __init__(self, port):
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=20)
+        self.file = self.sock.makefile("rw", newline="\n")
+
+    def request(self, line):
+        self.file.write(line + "\n")
+        self.file.flush()
+        return self.file.readline().rstrip("\n")
+
+
+class Plc:
+    def __init__(self, port):
+        self.client = ModbusTcpClient("127.0.0.1", port=port, timeout=10)
+        assert self.client.connect(), "cannot connect to the Modbus port"
+
+    def read(self, address, count=1):
+        rr = self.client.read_holding_registers(address, count, slave=UNIT)
+        assert not rr.isError(), f"read {address}+{count}: {rr}"
+        return rr.registers
+
+    def write(self, address, value):
+        rr = self.client.write_register(address, value, slave=UNIT)
+        assert not rr.isError(), f"write {address}={value}: {rr}"
+
+    def status(self):
+        return self.read(STATUS)[0]
+
+    def wait_for(self, any_bits, timeout=20.0):
+        deadline = time.monotonic() + timeout
+        while True:
+            s = self.status()
+            if s & any_bits:
+                return s
+            assert time.monotonic() < deadline, f"status {s:#x}: none of {any_bits:#x}"
+            time.sleep(0.001)
+
+    def trigger(self, part_type):
+        """The handshake: wait ready, select, trigger, wait, drop the trigger."""
+        self.wait_for(READY)
+        self.write(PART_TYPE, part_type)
+        self.write(CONTROL, TRIGGER)
+        assert self.status() & (BUSY | TRIGGER_ACK | RESULTS_VALID | ERROR)
+        self.wait_for(RESULTS_VALID | ERROR)
+        self.write(CONTROL, 0)
+        return self.status()
+
+    def acknowledge(self):
+        self.write(CONTROL, RESULTS_ACK)
+        self.write(CONTROL, 0)
+
+
+
+def load_job(plc, number):
+    """The LOAD_JOB handshake: number, rising edge, JOB_DONE, edge down."""
+    plc.write(JOB_NUMBER, number)
+    plc.write(CONTROL, LOAD_JOB)
+    s = plc.wait_for(JOB_DONE)
+    assert not s & BUSY, hex(s)
+    plc.write(CONTROL, 0)
+    assert not plc.status() & JOB_DONE
+    return s
+
+
+def located_types(plc):
+    """Trigger LOCATE ALL; the types of the parts found."""
+    s = plc.trigger(ALL_TYPES)
+    assert s & RESULTS_VALID and not s & ERROR, hex(s)
+    count = plc.read(PART_COUNT)[0]
+    types = [plc.read(FIRST_PART + PART_STRIDE * i)[0] for i in range(count)]
+    plc.acknowledge()
+    return types
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--bin-dir", required=True)
+    args = parser.parse_args()
+    data_dir = tempfile.mkdtemp(prefix="picksight-plc-jobs-")
+    server = vision = None
+    checks = 0
+    try:
+        server = Process([os.path.join(args.bin_dir, "picksight-video-server"), "--source",
+                          "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,noise=0",
+                          "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*",
+                          "--mode", "trigger"])
+        frames = server.wait_for("frames ")
+        control = server.wait_for("control ")
+        vision = Process([os.path.join(args.bin_dir, "picksight-vision"), "--frames", frames,
+                          "--control", control, "--robot-port", "0", "--bind", "127.0.0.1",
+                          "--data-dir", data_dir, "--modbus-port", "0", "--modbus-bind",
+                          "127.0.0.1", "--modbus-unit", str(UNIT)])
+        robot = Robot(int(vision.wait_for("robot ")))
+        plc = Plc(int(vision.wait_for("modbus ")))
+        vision.wait_for("ready")
+
+        # Two jobs: the part as type 1 (job 1), the same part as type 5 (job 12).
+        assert robot.request("LEARN 1 bracket").startswith("OK 1 bracket ")
+        assert robot.request("JOB SAVE 1-bracket").startswith("OK 1-bracket 1 0 1 ")
+        assert robot.request("FORGET 1") == "OK"
+        assert robot.request("LEARN 5 bracket").startswith("OK 5 bracket ")
+        assert robot.request("JOB SAVE 12_lid").startswith("OK 12_lid 1 0 1 ")
+        assert plc.read(JOB_IN_FORCE) == [12]
+        assert located_types(plc) == [5]
+        checks += 1
+
+        for number, part_type in ((1, 1), (12, 5), (1, 1)):
+            s = load_job(plc, number)
+            assert not s & ERROR, (number, hex(s), plc.read(ERROR_CODE))
+            assert plc.read(JOB_IN_FORCE) == [number]
+            assert located_types(plc) == [part_type], number
+            name = "1-bracket" if number == 1 else "12_lid"
+            assert robot.request("JOB") == "OK " + name
+            checks += 1
+
+        # A number no job has: ERROR 50, the job in force and its answers as before.
+        s = load_job(plc, 7)
+        assert s & ERROR, hex(s)
+        assert plc.read(ERROR_CODE) == [50], plc.read(ERROR_CODE)
+        assert plc.read(JOB_IN_FORCE) == [1]
+        plc.write(CONTROL, CLEAR_ERROR)
+        plc.write(CONTROL, 0)
+        assert located_types(plc) == [1]
+        checks += 1
+
+        # A number past 9999 is refused by the register itself (exception 3).
+        rr = plc.client.write_register(JOB_NUMBER, 10000, slave=UNIT)
+        assert rr.isError() and rr.exception_code == 3, rr
+        checks += 1
+
+        # A job loaded over the robot port shows in JOB_IN_FORCE.
+        assert robot.request("JOB LOAD 12_lid") == "OK 12_lid 1 0 1"
+        assert plc.read(JOB_IN_FORCE) == [12]
+        assert located_types(plc) == [5]
+        checks += 1
+        plc.client.close()
+    except AssertionError as e:
+        print(f"FAILED after {checks} checks: {e}")
+        print(f"{checks} passed, 1 failed")
+        return 1
+    finally:
+        for p in (vision, server):
+            if p:
+                p.stop()
+        shutil.rmtree(data_dir, ignore_errors=True)
+    print(f"{checks} passed, 0 failed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
