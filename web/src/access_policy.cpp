@@ -42,7 +42,15 @@ Role roleForCommand(std::string_view line) {
   if (command == "TOLERANCE" && w.size() <= 2) return Role::kOperator;
   if ((command == "GRASP" || command == "GRIPPER") && w.size() == 3 && w[2] == "LIST")
     return Role::kOperator;
+  // Which job is in force, the list, a job's file: reads.
+  if (command == "JOB" && (w.size() == 1 || w[1] == "LIST" || w[1] == "EXPORT"))
+    return Role::kOperator;
   return Role::kEngineer;
+}
+
+bool isJobImportPiece(std::string_view line) {
+  const auto w = words(line.substr(0, 16));
+  return w.size() >= 2 && w[0] == "JOB" && w[1] == "IMPORT";
 }
 
 bool changesCell(std::string_view line) {
@@ -62,6 +70,8 @@ std::optional<std::string> readBackLine(std::string_view line) {
   }
   if (command == "EXPOSURE" || command == "ROI" || command == "CAMMODE" || command == "VISION")
     return command;
+  // The job in force, and the jobs stored.
+  if (command == "JOB" && w.size() > 1) return std::string(w[1] == "LOAD" ? "JOB" : "JOB LIST");
   return std::nullopt;
 }
 

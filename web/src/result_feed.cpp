@@ -214,11 +214,11 @@ std::map<std::string, RequestFigures> ResultFeed::figures() const {
   return figures_;
 }
 
-Result<std::string> ResultFeed::command(const std::string& line) {
+Result<std::string> ResultFeed::command(const std::string& line, size_t max_bytes) {
   if (line.empty()) return makeError(WebErrc::kBadRequest, "empty command line");
-  if (line.size() > kMaxCommandBytes)
+  if (line.size() > max_bytes)
     return makeError(WebErrc::kBadRequest,
-                     "command line longer than " + std::to_string(kMaxCommandBytes) + " bytes");
+                     "command line longer than " + std::to_string(max_bytes) + " bytes");
   if (line.find_first_of("\r\n") != std::string::npos)
     return makeError(WebErrc::kBadRequest, "command line contains CR or LF");
   std::lock_guard<std::mutex> lock(line_mutex_);

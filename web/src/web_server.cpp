@@ -1142,14 +1142,19 @@ void WebServer::Impl::command(ResultFeed& app, const std::string& line, const ht
     return sendJson(
         res, {{"error", std::string("this line needs the ") + roleName(needed) + " role"}}, 403);
   }
-  const auto read_back = change ? readBackLine(line) : std::nullopt;
+  const bool piece = isJobImportPiece(line);
+  // A piece's base64 is no part of the trail: its name, offset and size are.
+  if (piece) record.arguments = {{"line", line.substr(0, line.rfind(' ')) + " ..."}};
+  const auto read_back = change && !piece ? readBackLine(line) : std::nullopt;
   const auto ask = [&](const std::string& read) -> nlohmann::json {
     auto r = app.command(read);
     return r ? nlohmann::json(*r) : nlohmann::json("(" + r.error().message + ")");
   };
   if (read_back) record.before = ask(*read_back);
-  auto reply = app.command(line);
-  if (change) {
+  auto reply = app.command(line, piece ? kMaxJobPieceBytes : kMaxCommandBytes);
+  // Pieces before the last change nothing yet: the import is recorded once.
+  const bool more = piece && reply && reply->rfind("MORE ", 0) == 0;
+  if (change && !more) {
     if (!reply) {
       record.outcome = "error";
       record.status = httpStatus(reply.error());

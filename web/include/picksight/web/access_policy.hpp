@@ -26,6 +26,10 @@ bool changesCell(std::string_view line);
 // for the audit trail; nullopt for a line that changes nothing or whose
 // state no cheap read shows (LEARN, CALCAM...).
 std::optional<std::string> readBackLine(std::string_view line);
+// A piece of a job import (JOB IMPORT <name> <offset> <total> <base64>):
+// longer than other lines, and recorded once, when the last piece makes
+// the import (the app replies MORE before it).
+bool isJobImportPiece(std::string_view line);
 // The role a camera action (POST /api/cameras/<camera>/<action>) needs.
 Role roleForCameraAction(std::string_view action);
 

@@ -59,8 +59,11 @@ struct RequestFigures {
 // feed's thread converts it itself (as CameraFeed's JPEGs, kEncoderStarved).
 constexpr std::chrono::milliseconds kResultsStarved{3000};
 
-// The longest robot line the page may send (bytes, without the newline).
+// The longest robot line the page may send (bytes, without the newline);
+// a piece of a job import (JOB IMPORT, access_policy.hpp) may be longer,
+// as the robot port allows.
 constexpr size_t kMaxCommandBytes = 256;
+constexpr size_t kMaxJobPieceBytes = 4000;
 
 class ResultFeed {
  public:
@@ -85,9 +88,9 @@ class ResultFeed {
   std::map<std::string, RequestFigures> figures() const;
 
   // Takes one robot-protocol line to the app and returns its reply line.
-  // Lines over kMaxCommandBytes or with CR/LF are refused (kBadRequest); a
+  // Lines over `max_bytes` or with CR/LF are refused (kBadRequest); a
   // dead app is kUnreachable.
-  Result<std::string> command(const std::string& line);
+  Result<std::string> command(const std::string& line, size_t max_bytes = kMaxCommandBytes);
 
   // Handles one received result as the thread does (also for tests).
   void accept(proto::VisionResult result);
