@@ -39,6 +39,10 @@ Undone = namedtuple("Undone", "type restored left change")
 # TRYLEARN: the model LEARN would store, the parts of its type and all parts
 # LOCATE ALL then finds on that frame, and LEARN's warnings.
 TriedModel = namedtuple("TriedModel", "model found parts warnings")
+# JOB SAVE / LOAD: the job's name, its models, whether it holds a
+# calibration and camera settings, the job file's size (None after a load)
+# and the notes after ';' (e.g. why the camera settings were not kept).
+Job = namedtuple("Job", "name models calibrated camera bytes notes")
 Blob = namedtuple(
     "Blob",
     "x y angle area perimeter roundness holes eccentricity bx by bw bh "
@@ -96,6 +100,28 @@ def _status_value(key, text):
         except ValueError:
             pass
     return text
+
+
+def _job_name(name):
+    """A job name as the protocol takes it (one word; the vision app checks
+    the rest and answers RobotError 54)."""
+    name = str(name)
+    if not name or any(c.isspace() for c in name):
+        raise ValueError(f"a job name is one word, got {name!r}")
+    return name
+
+
+def _job(words, saved):
+    """A JOB SAVE or LOAD reply: name models calibrated camera [bytes] [; ...]."""
+    fields, notes = [], []
+    if ";" in words:
+        cut = words.index(";")
+        fields, rest = words[:cut], " ".join(words[cut + 1:])
+        notes = [n.strip() for n in rest.split(" ; ") if n.strip()]
+    else:
+        fields = words
+    return Job(fields[0], int(fields[1]), fields[2] == "1", fields[3] == "1",
+               int(fields[4]) if saved else None, notes)
 
 
 def _vision_settings(words):
@@ -329,6 +355,33 @@ class RobotClient:
         """VISION RESET: the settings in force written over a damaged
         settings file, which lifts the refusal of LOCATE and LEARN."""
         return _vision_settings(self.request("VISION RESET"))
+
+    # ------------------------------------------------------------------ jobs
+
+    def job_save(self, name):
+        """JOB SAVE: the cell as it is now (models with their teach images
+        and grasps, vision settings, calibration, camera settings) saved as
+        job `name`. Returns a Job."""
+        return _job(self.request(f"JOB SAVE {_job_name(name)}"), saved=True)
+
+    def job_load(self, name):
+        """JOB LOAD: job `name` in force, in one switch no LOCATE sees half
+        of. RobotError 50 when there is no such job, 51 when its file is
+        damaged (nothing changed). Returns a Job."""
+        return _job(self.request(f"JOB LOAD {_job_name(name)}"), saved=False)
+
+    def job_list(self):
+        """The names of the stored jobs, sorted."""
+        words = self.request("JOB LIST")
+        return words[1:1 + int(words[0])]
+
+    def job_current(self):
+        """The job last saved or loaded; None before any."""
+        name = self.request("JOB")[0]
+        return None if name == "none" else name
+
+    def job_delete(self, name):
+        self.request(f"JOB DELETE {_job_name(name)}")
 
     def forget(self, part_type):
         self.request(f"FORGET {int(part_type)}")

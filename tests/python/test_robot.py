@@ -269,3 +269,31 @@ def test_no_reply_in_time_is_a_timeout_and_closes_the_client():
     with pytest.raises(OSError):
         robot.ping()  # closed: a late reply can never be taken for another's
     s.close()
+
+
+def test_jobs_saved_listed_loaded_and_refused(cell_factory, tmp_path):
+    scene = Scene(tmp_path)
+    scene.show([(320, 240, 40)])
+    _, vision = cell_factory("--source", f"cam0=file:{scene.path}", "--mode", "trigger")
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        assert robot.job_current() is None
+        robot.learn(1, "disc")
+        saved = robot.job_save("1-discs")
+        assert (saved.name, saved.models, saved.calibrated) == ("1-discs", 1, False)
+        assert saved.bytes > 0
+        robot.forget(1)
+        robot.learn(2, "disc")
+        robot.job_save("2-other")
+        assert robot.job_list() == ["1-discs", "2-other"]
+        loaded = robot.job_load("1-discs")
+        assert (loaded.name, loaded.models, loaded.bytes) == ("1-discs", 1, None)
+        assert [m.type for m in robot.models()] == [1]
+        assert robot.job_current() == "1-discs"
+        with pytest.raises(RobotError) as e:
+            robot.job_load("nothing")
+        assert e.value.code == 50
+        with pytest.raises(RobotError) as e:
+            robot.job_save("../x")
+        assert e.value.code == 54
+        robot.job_delete("2-other")
+        assert robot.job_list() == ["1-discs"]
