@@ -34,7 +34,7 @@ picksight::app::VisionCell& cell() {
   }();
   (void)made;
   static picksight::app::VisionCell instance(dir, std::make_unique<picksight::link::NoCamera>(),
-                                             picksight::app::VisionOptions{});
+                                             picksight::cell::VisionOptions{});
   static const bool loaded = (instance.load(), true);
   (void)loaded;
   return instance;

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
       logInfo("vision settings from the command line, over ", options->data_dir,
               "/vision.json: ", keys, " (a VISION change replaces them until the next start)");
     }
-    logInfo("vision settings: ", app::visionSettingsText(cell.vision().options()));
+    logInfo("vision settings: ", cell::visionSettingsText(cell.vision().options()));
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
     // The results stream: subscribers see what each request saw, after
     // its reply; they never slow a robot.

@@ -172,7 +172,7 @@ TEST_CASE("WHY reads the scale of a copy and names a mirror image", "[vision][wh
                                          {test::scaled(l_shape, 1.25), 700, 250, 100},
                                          {l_shape, 450, 550, 70, true}},
                                         7);
-  const auto outcome = app::locateInFrame(frameFromImage(scene, "cam", 1), {}, models, 1);
+  const auto outcome = cell::locateInFrame(frameFromImage(scene, "cam", 1), {}, models, 1);
   REQUIRE(outcome.parts.size() == 1);
   results::RequestRecord record;
   record.request = "LOCATE";

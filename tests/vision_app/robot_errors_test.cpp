@@ -15,6 +15,7 @@
 
 using namespace picksight;
 using namespace picksight::app;
+using namespace picksight::cell;
 using namespace picksight::store;
 
 TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]") {

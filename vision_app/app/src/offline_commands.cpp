@@ -23,6 +23,16 @@
 
 namespace picksight::app {
 
+using cell::blobsInImage;
+using cell::learnInImage;
+using cell::locateAndPick;
+using cell::locateInFrame;
+using cell::LocateOutcome;
+using cell::parseVisionSettingsJson;
+using cell::teachImagePng;
+using cell::VisionOptions;
+using cell::VisionServiceErrc;
+
 using store::CellCalibration;
 using store::CellCalibrationErrc;
 using store::ModelLibrary;

@@ -9,6 +9,8 @@
 
 namespace picksight::app {
 
+using cell::VisionOptions;
+
 VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,
                        VisionOptions options, std::vector<std::string> command_line_settings)
     : settings_file_(data_dir + "/vision.json"),

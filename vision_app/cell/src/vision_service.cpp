@@ -20,7 +20,7 @@
 #include "picksight/vision/segmentation/colour_axis.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 using store::ModelLibrary;
 using store::ModelList;
@@ -733,4 +733,4 @@ std::shared_ptr<const Frame> VisionService::lastFramePixels() const {
   return last_pixels_;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

@@ -21,7 +21,7 @@ uint16_t frameCode(store::CoordinateFrame frame) {
   return kFrameVisionPixels;
 }
 
-PlcResult plcResult(const app::CellLocate& located) {
+PlcResult plcResult(const cell::CellLocate& located) {
   PlcResult result;
   result.frame_sequence = located.outcome.frame.sequence;
   result.frame = frameCode(located.pick.frame);
@@ -34,10 +34,10 @@ PlcResult plcResult(const app::CellLocate& located) {
   return result;
 }
 
-PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results) {
+PlcDevice::Picker cellPicker(cell::CellContext& cell, results::ResultsPublisher* const& results) {
   return [&cell, &results](int type) -> Result<PlcResult> {
     const auto started = std::chrono::steady_clock::now();
-    auto located = app::locateAndPick(cell, type);
+    auto located = cell::locateAndPick(cell, type);
     Result<PlcResult> result =
         located ? Result<PlcResult>(plcResult(*located)) : Result<PlcResult>(located.error());
     if (results) {

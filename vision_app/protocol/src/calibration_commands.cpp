@@ -10,6 +10,10 @@
 
 namespace picksight::app {
 
+using cell::TargetOutcome;
+using cell::VisionService;
+using cell::VisionServiceErrc;
+
 using store::CellCalibration;
 using store::CellCalibrationErrc;
 

@@ -10,6 +10,13 @@
 
 namespace picksight::app {
 
+using cell::CellContext;
+using cell::CellLocate;
+using cell::CellPick;
+using cell::locateAndPick;
+using cell::VisionService;
+using cell::VisionServiceErrc;
+
 using store::frameName;
 using store::GraspSetup;
 using store::ModelErrc;

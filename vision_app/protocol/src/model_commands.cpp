@@ -12,6 +12,12 @@
 
 namespace picksight::app {
 
+using cell::CellLocate;
+using cell::LearnOutcome;
+using cell::TryLearnOutcome;
+using cell::VisionService;
+using cell::VisionServiceErrc;
+
 using store::ModelErrc;
 using store::ModelList;
 using store::UndoOutcome;

@@ -15,6 +15,9 @@
 
 namespace picksight::app {
 
+using cell::VisionServiceErrc;
+using cell::VisionSettingsErrc;
+
 using store::CellCalibrationErrc;
 using store::ModelErrc;
 

@@ -4,6 +4,9 @@
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
+
+using cell::VisionService;
+
 namespace {
 constexpr const char* kVersion = "0.1.0";
 }  // namespace

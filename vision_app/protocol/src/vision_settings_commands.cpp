@@ -9,6 +9,11 @@
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
+
+using cell::modelsToReteach;
+using cell::VisionService;
+using cell::visionSettingsText;
+
 namespace {
 
 constexpr const char* kUsage = "VISION [RESET | <key> <value> [<key> <value>]...]";

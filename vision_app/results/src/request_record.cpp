@@ -10,11 +10,11 @@
 #include "picksight/vision/recognition/region_explanation.hpp"
 
 namespace picksight::results {
-using app::CellLocate;
-using app::LocatedPart;
-using app::LocateScene;
-using app::ScreenedRegion;
-using app::VisionOptions;
+using cell::CellLocate;
+using cell::LocatedPart;
+using cell::LocateScene;
+using cell::ScreenedRegion;
+using cell::VisionOptions;
 using store::ModelList;
 namespace {
 

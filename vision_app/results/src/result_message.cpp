@@ -11,12 +11,12 @@
 #include "picksight/grasp/grasp.hpp"
 
 namespace picksight::results {
-using app::greyImage;
-using app::LocatedPart;
-using app::LocateOutcome;
-using app::LocateScene;
-using app::modelOf;
-using app::partPoseInVisionFrame;
+using cell::greyImage;
+using cell::LocatedPart;
+using cell::LocateOutcome;
+using cell::LocateScene;
+using cell::modelOf;
+using cell::partPoseInVisionFrame;
 using store::CoordinateFrame;
 using store::GraspSetup;
 namespace {

@@ -28,7 +28,7 @@ struct AppOptions {
   // A second, full-access port for set-up (--setup-port); same limits and
   // allow-list as the robot port, on loopback unless --setup-bind says.
   std::optional<RobotServerOptions> setup;
-  VisionOptions vision;
+  cell::VisionOptions vision;
   // The vision settings keys (vision_settings.hpp) the command line or
   // --config set: they win over <data dir>/vision.json at start.
   std::vector<std::string> vision_settings_given;

@@ -29,7 +29,7 @@ class VisionCell {
   // vision settings keys (vision_settings.hpp) set on the command line, which
   // win over vision.json at start.
   VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,
-             VisionOptions options, std::vector<std::string> command_line_settings = {});
+             cell::VisionOptions options, std::vector<std::string> command_line_settings = {});
   VisionCell(const VisionCell&) = delete;
   VisionCell& operator=(const VisionCell&) = delete;
 
@@ -54,20 +54,20 @@ class VisionCell {
   // Where requests publish (null: nowhere); read at each request.
   results::ResultsPublisher* const& results() const { return results_; }
 
-  VisionService& vision() { return vision_; }
+  cell::VisionService& vision() { return vision_; }
   store::ModelLibrary& models() { return models_; }
   store::CellCalibration& calibration() { return calibration_; }
-  const CellContext& context() const { return context_; }
-  CellContext& context() { return context_; }
+  const cell::CellContext& context() const { return context_; }
+  cell::CellContext& context() { return context_; }
 
  private:
   const std::string settings_file_;
   const std::vector<std::string> command_line_settings_;
   store::ModelLibrary models_;
   store::CellCalibration calibration_;
-  VisionService vision_;
+  cell::VisionService vision_;
   RobotProtocol protocol_;
-  CellContext context_;
+  cell::CellContext context_;
   results::ResultsPublisher* results_ = nullptr;
 };
 

@@ -24,7 +24,7 @@
 #include "picksight/vision/segmentation/blob_features.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 class ScaledModelCache;
 
@@ -310,6 +310,6 @@ class VisionService {
   std::unique_ptr<ScaledModelCache> scaled_models_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::cell
 
-PICKSIGHT_ERROR_ENUM(picksight::app::VisionServiceErrc)
+PICKSIGHT_ERROR_ENUM(picksight::cell::VisionServiceErrc)

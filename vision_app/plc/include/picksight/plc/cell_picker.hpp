@@ -14,12 +14,12 @@ uint16_t frameCode(store::CoordinateFrame frame);  // kFrame*
 
 // A LOCATE's poses as the PLC registers hold them: each pose with its
 // part's type and score.
-PlcResult plcResult(const app::CellLocate& located);
+PlcResult plcResult(const cell::CellLocate& located);
 
 // The three callbacks of a PlcDevice over `cell` (borrowed; outlives the
 // device). The picker publishes each trigger's record on `results` when it
 // is set (read at each trigger; the pointer outlives the device).
-PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results);
+PlcDevice::Picker cellPicker(cell::CellContext& cell, results::ResultsPublisher* const& results);
 PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration);
 int robotErrorCodeOf(const Error& error);
 

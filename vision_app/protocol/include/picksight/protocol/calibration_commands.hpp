@@ -9,7 +9,7 @@
 namespace picksight::app {
 
 // Registers the commands; `vision` and `calibration` outlive `table`.
-void addCalibrationCommands(CommandTable& table, VisionService& vision,
+void addCalibrationCommands(CommandTable& table, cell::VisionService& vision,
                             store::CellCalibration& calibration);
 
 }  // namespace picksight::app

@@ -8,13 +8,13 @@
 namespace picksight::app {
 
 // Registers the commands; `vision` (with its model library) outlives `table`.
-void addModelCommands(CommandTable& table, VisionService& vision);
+void addModelCommands(CommandTable& table, cell::VisionService& vision);
 
 // The reply fields of one model ("<type> <name> <area> <holes> <symmetry>").
 std::string modelSummary(const vision::PartModel& model);
 // LEARN's reply: "OK <type> <name> <area> <holes> <symmetry> <mirror 0/1>",
 // then " ; warning: <text>" for each warning.
-std::string learnReply(const LearnOutcome& learned);
+std::string learnReply(const cell::LearnOutcome& learned);
 // TOLERANCE's reply: "OK <type> <name>" then " <key>=<value>" for each
 // tolerance a model file stores (area_tolerance, hu_tolerance,
 // verify_percent, edge_tolerance_px, mirror_symmetric).
@@ -22,7 +22,7 @@ std::string toleranceReply(const vision::PartModel& model);
 // TRYLEARN's reply: LEARN's fields, then "<found> <parts>" (the parts of
 // the type LOCATE ALL finds on the same frame with the new model, and all
 // it finds), LEARN's warnings and notes, and " ; note: nothing stored".
-std::string tryLearnReply(const TryLearnOutcome& tried);
+std::string tryLearnReply(const cell::TryLearnOutcome& tried);
 // UNDO's reply: "OK <type> restored|removed <changes left> ; undid: <request>
 // ; type <type> is <model summary> again" (or "has no model again").
 std::string undoReply(const store::UndoOutcome& undone);

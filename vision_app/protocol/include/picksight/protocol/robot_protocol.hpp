@@ -13,7 +13,7 @@ namespace picksight::app {
 
 class RobotProtocol {
  public:
-  explicit RobotProtocol(VisionService& vision);
+  explicit RobotProtocol(cell::VisionService& vision);
 
   // One request line in, one reply line out; on a read-only port requests
   // that change the cell are refused. Thread-safe.
@@ -28,7 +28,7 @@ class RobotProtocol {
  private:
   std::string frame(const Request& request);
 
-  VisionService& vision_;
+  cell::VisionService& vision_;
   CommandTable table_;
 };
 

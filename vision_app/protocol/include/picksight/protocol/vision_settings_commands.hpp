@@ -8,6 +8,6 @@
 namespace picksight::app {
 
 // Registers VISION; `vision` (with its model library) outlives `table`.
-void addVisionSettingsCommands(CommandTable& table, VisionService& vision);
+void addVisionSettingsCommands(CommandTable& table, cell::VisionService& vision);
 
 }  // namespace picksight::app

@@ -57,15 +57,15 @@ class RequestRecord {
 
   // LOCATE: its outcome and what the grasps were chosen with (none when
   // the request failed before a frame).
-  std::optional<app::LocateOutcome> locate;
-  app::CellPick pick;
+  std::optional<cell::LocateOutcome> locate;
+  cell::CellPick pick;
   std::shared_ptr<const store::GraspMap> grasps;
   std::optional<store::CellGeometry> geometry;
 
   // Other requests: the frame they worked on (regions are found from it by
   // the publisher) and the settings to find them with.
   std::shared_ptr<const Frame> frame;
-  app::VisionOptions options;
+  cell::VisionOptions options;
 
   // The frame the request worked on, if any.
   std::optional<FrameInfo> frameInfo() const;
@@ -89,7 +89,7 @@ class RequestRecord {
 // the client, the reply and the time once they are known. Its settings are
 // those the location ran with when it says (LocateOutcome::settings), else
 // `options`.
-std::shared_ptr<RequestRecord> locateRecord(Result<app::CellLocate>&& located, int type,
-                                            const app::VisionOptions& options);
+std::shared_ptr<RequestRecord> locateRecord(Result<cell::CellLocate>&& located, int type,
+                                            const cell::VisionOptions& options);
 
 }  // namespace picksight::results
