@@ -24,7 +24,6 @@
 #include "picksight/vision/segmentation/regions.hpp"
 
 using namespace picksight;
-using namespace picksight::app;
 using namespace picksight::cell;
 using namespace picksight::store;
 namespace ps = picksight::synthetic;
