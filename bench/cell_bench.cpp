@@ -122,7 +122,7 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
           });
       if (!located) return {};
       b.poses += located->pick.poses.size();
-      digest(b.poses_digest, picksight::app::locateReply(located->pick));
+      digest(b.poses_digest, picksight::protocol::locateReply(located->pick));
     }
   }
   return b;

@@ -74,14 +74,14 @@ int main(int argc, char** argv) {
       cell.publishResultsTo(results.get());
     }
     const bool read_only = options->robot_read_only;
-    app::RobotServer robots(options->robot,
-                            [&cell, read_only](std::string_view line, app::Session& session) {
-                              return cell.handle(line, read_only, &session);
-                            });
-    std::unique_ptr<app::RobotServer> setup;
+    protocol::RobotServer robots(
+        options->robot, [&cell, read_only](std::string_view line, protocol::Session& session) {
+          return cell.handle(line, read_only, &session);
+        });
+    std::unique_ptr<protocol::RobotServer> setup;
     if (options->setup) {
-      setup = std::make_unique<app::RobotServer>(
-          *options->setup, [&cell](std::string_view line, app::Session& session) {
+      setup = std::make_unique<protocol::RobotServer>(
+          *options->setup, [&cell](std::string_view line, protocol::Session& session) {
             return cell.handle(line, false, &session);
           });
     }

@@ -14,6 +14,7 @@
 #include "temp_dir.hpp"
 
 using namespace picksight::app;
+using namespace picksight::protocol;
 using namespace picksight::cell;
 
 namespace {

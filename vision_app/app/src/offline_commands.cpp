@@ -23,6 +23,15 @@
 
 namespace picksight::app {
 
+using protocol::blobSummary;
+using protocol::errorReply;
+using protocol::learnReply;
+using protocol::locateReply;
+using protocol::parseType;
+using protocol::printable;
+using protocol::ProtocolErrc;
+using protocol::validModelName;
+
 using cell::blobsInImage;
 using cell::learnInImage;
 using cell::locateAndPick;

@@ -9,6 +9,13 @@
 
 namespace picksight::app {
 
+using protocol::addCalibrationCommands;
+using protocol::addCellCommands;
+using protocol::addModelCommands;
+using protocol::addVisionSettingsCommands;
+using protocol::Publishes;
+using protocol::Session;
+
 using cell::VisionOptions;
 
 VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,

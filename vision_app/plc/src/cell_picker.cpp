@@ -43,7 +43,7 @@ PlcDevice::Picker cellPicker(cell::CellContext& cell, results::ResultsPublisher*
     if (results) {
       // Queued only: the publisher builds and sends it on its own thread.
       const std::string reply =
-          located ? app::locateReply(located->pick) : app::errorReply(located.error());
+          located ? protocol::locateReply(located->pick) : protocol::errorReply(located.error());
       auto record = results::locateRecord(std::move(located), type, cell.vision.options());
       record->request_line = "PLC TRIGGER " + std::to_string(type);
       record->client = "plc";
@@ -64,6 +64,6 @@ PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration) 
   };
 }
 
-int robotErrorCodeOf(const Error& error) { return app::robotErrorCode(error.code); }
+int robotErrorCodeOf(const Error& error) { return protocol::robotErrorCode(error.code); }
 
 }  // namespace picksight::plc

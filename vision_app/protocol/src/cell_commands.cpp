@@ -8,7 +8,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 using cell::CellContext;
 using cell::CellLocate;
@@ -356,4 +356,4 @@ void addCellCommands(CommandTable& table, CellContext& cell) {
       [&cell](const Request& r) { return cameraMode(r, cell); }, changesWithArguments);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -5,7 +5,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/robot_errors.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 const char* errorName(ProtocolErrc e) {
   switch (e) {
@@ -137,4 +137,4 @@ std::string CommandTable::help() const {
   return out;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -10,7 +10,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 using cell::CellLocate;
 using cell::LearnOutcome;
@@ -385,4 +385,4 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
       neverChanges, Publishes::kFrame);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -13,7 +13,7 @@
 #include "picksight/store/model_library.hpp"
 #include "picksight/transport/control_client.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 using cell::VisionServiceErrc;
 using cell::VisionSettingsErrc;
@@ -84,4 +84,4 @@ int robotErrorCode(const std::error_code& code) {
   return kInternal;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -8,7 +8,7 @@
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/text.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 using cell::modelsToReteach;
 using cell::VisionService;
@@ -78,4 +78,4 @@ void addVisionSettingsCommands(CommandTable& table, VisionService& vision) {
       changesWithArguments);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

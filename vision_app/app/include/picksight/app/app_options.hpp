@@ -22,12 +22,12 @@ struct AppOptions {
   // The results stream's PUB endpoint ("none": no stream).
   std::string results_bind = "tcp://127.0.0.1:*";
   std::string data_dir = "picksight-data";
-  RobotServerOptions robot;
+  protocol::RobotServerOptions robot;
   // The robot port refuses requests that change the cell (docs/SECURITY.md).
   bool robot_read_only = false;
   // A second, full-access port for set-up (--setup-port); same limits and
   // allow-list as the robot port, on loopback unless --setup-bind says.
-  std::optional<RobotServerOptions> setup;
+  std::optional<protocol::RobotServerOptions> setup;
   cell::VisionOptions vision;
   // The vision settings keys (vision_settings.hpp) the command line or
   // --config set: they win over <data dir>/vision.json at start.

@@ -46,7 +46,7 @@ class VisionCell {
   // left in session->after_reply for after the reply; without, it is
   // queued before this returns.
   std::string handle(std::string_view line, bool read_only = false,
-                     Session* session = nullptr) const;
+                     protocol::Session* session = nullptr) const;
 
   // Every vision request publishes its result there from now on (null:
   // none); `results` outlives the cell. Call before serving starts.
@@ -66,7 +66,7 @@ class VisionCell {
   store::ModelLibrary models_;
   store::CellCalibration calibration_;
   cell::VisionService vision_;
-  RobotProtocol protocol_;
+  protocol::RobotProtocol protocol_;
   cell::CellContext context_;
   results::ResultsPublisher* results_ = nullptr;
 };

@@ -11,7 +11,7 @@
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // The LOCATE reply a robot reads: "OK <n>" then x y rz of each pose.
 std::string locateReply(const cell::CellPick& pick);
@@ -28,4 +28,4 @@ const std::vector<std::string>& exposureFeatureNames();
 // stream.
 void addCellCommands(CommandTable& table, cell::CellContext& cell);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

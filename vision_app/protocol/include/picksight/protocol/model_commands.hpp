@@ -5,7 +5,7 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // Registers the commands; `vision` (with its model library) outlives `table`.
 void addModelCommands(CommandTable& table, cell::VisionService& vision);
@@ -32,4 +32,4 @@ std::string blobSummary(const vision::BlobFeatures& blob);
 // A model name: 1 to 32 of A-Z a-z 0-9 _ - .
 bool validModelName(std::string_view name);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -9,7 +9,7 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 class RobotProtocol {
  public:
@@ -32,4 +32,4 @@ class RobotProtocol {
   CommandTable table_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

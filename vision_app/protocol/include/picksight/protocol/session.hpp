@@ -14,7 +14,7 @@
 
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // What a request publishes on the results stream once its reply is sent;
 // its command's table entry says (CommandTable::add), VisionCell publishes.
@@ -43,4 +43,4 @@ struct Session {
   std::shared_ptr<results::RequestRecord> record;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol
