@@ -252,6 +252,8 @@ void buildVisionResult(const RequestRecord& record, const std::string& app, uint
       rejection->set_measured(r.measured);
       rejection->set_low(r.low);
       rejection->set_high(r.high);
+      rejection->set_remedy_key(r.remedy_key);
+      rejection->set_remedy_value(r.remedy_value);
       rejection->set_text(r.text);
     }
   } else if (record.frame) {

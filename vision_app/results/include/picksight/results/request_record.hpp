@@ -37,7 +37,13 @@ struct RegionRejection {
   double measured = 0;
   double low = 0;
   double high = 0;
-  std::string text;  // as WHY prints it
+  // The smallest change of one tolerance of the nearest model with which
+  // LOCATE accepts the region, when one test alone refuses it
+  // (vision::remedyFor): `TOLERANCE <nearest_type> <remedy_key>
+  // <remedy_value>`; empty when there is none.
+  std::string remedy_key;
+  std::string remedy_value;  // as written, the text TOLERANCE reads
+  std::string text;          // as WHY prints it, the remedy included
 };
 
 // Regions published (and explained) per request, largest first.
