@@ -180,15 +180,15 @@ TEST_CASE("the remedy WHY names, sent as TOLERANCE, makes the next LOCATE accept
   REQUIRE_THAT(cell.ask("TOLERANCE 1 " + remedy), Catch::StartsWith("OK 1 plate "));
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
 
-  // The plate as taught, turned, with a Hu tolerance below any region's
-  // distance: refused on its shape alone.
-  cell.scene.show(scene(kPlate, 30));
-  REQUIRE_THAT(cell.ask("TOLERANCE 1 hu_tolerance 0.000001"), Catch::StartsWith("OK 1 plate "));
+  // The plate 1 % larger with an area tolerance of 1 %: a scaled copy of
+  // the part, refused on its size alone.
+  cell.scene.show(scene(test::scaled(kPlate, 1.01), 30));
+  REQUIRE_THAT(cell.ask("TOLERANCE 1 area_tolerance 0.01"), Catch::StartsWith("OK 1 plate "));
   REQUIRE(cell.ask("LOCATE 1") == "OK 0");
   why = cell.ask("WHY");
-  CHECK_THAT(why, Catch::Contains("region 0 shape distance "));
+  CHECK_THAT(why, Catch::Contains("region 0 scaled 1.01x outside "));
   remedy = remedyIn(why);
-  CHECK_THAT(remedy, Catch::StartsWith("hu_tolerance "));
+  CHECK_THAT(remedy, Catch::StartsWith("area_tolerance "));
   REQUIRE_THAT(cell.ask("TOLERANCE 1 " + remedy), Catch::StartsWith("OK 1 plate "));
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
 

@@ -95,10 +95,14 @@ std::optional<RegionRemedy> candidateRemedy(const RegionExplanation& why, const 
   r.type = model.type;
   r.decimals = kRemedyDecimals;
   switch (why.test) {
-    case RegionTest::kArea: {
+    case RegionTest::kArea:
+    case RegionTest::kScale: {
+      // The area against the model's; a scaled copy's is its scale squared.
       r.key = "area_tolerance";
-      const double gap = std::abs(why.measured / std::max(model.body.area, 1.0) - 1);
-      r.value = roundUp(gap * (1 + kRemedyMargin), r.decimals);
+      const double ratio = why.test == RegionTest::kArea
+                               ? why.measured / std::max(model.body.area, 1.0)
+                               : why.measured * why.measured;
+      r.value = roundUp(std::abs(ratio - 1) * (1 + kRemedyMargin), r.decimals);
       if (r.value >= 1) return std::nullopt;  // area_tolerance is below 1
       return r;
     }

@@ -57,8 +57,8 @@ struct RegionRemedy {
   int decimals = 0;
 };
 
-// The smallest change of the tolerance `why` names (area, Hu distance,
-// verification, mirror) on its nearest model with which `LOCATE
+// The smallest change of the tolerance `why` names (area or scale: the area
+// tolerance; Hu distance, verification, mirror) on its nearest model with which `LOCATE
 // <asked_type>` accepts the region, with a margin for the next frame (a
 // Hu distance or area gap 10 % past the measured one, a verified share 2
 // points below it), or none: a region another test would still refuse,
