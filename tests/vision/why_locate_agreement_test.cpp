@@ -205,9 +205,10 @@ TEST_CASE("the remedy WHY names is one with which LOCATE accepts the region", "[
     double hu_factor;
     double verify_percent;  // 0: as trained
   };
-  const std::vector<Setting> settings = {
-      {"area 0.004", 0.004, 1, 0}, {"hu x0.02", 0, 0.02, 0}, {"verify 99.5", 0, 1, 99.5},
-      {"all tight", 0.004, 0.02, 99.5}};
+  const std::vector<Setting> settings = {{"area 0.004", 0.004, 1, 0},
+                                         {"hu x0.02", 0, 0.02, 0},
+                                         {"verify 99.5", 0, 1, 99.5},
+                                         {"all tight", 0.004, 0.02, 99.5}};
   std::map<std::string, int> remedies;
   int without = 0;
   for (const Setting& setting : settings) {
@@ -226,8 +227,8 @@ TEST_CASE("the remedy WHY names is one with which LOCATE accepts the region", "[
       for (const int asked : {-1, models.models.front().type}) {
         const auto before = recognizeParts(regions, models.models, asked).matches;
         for (size_t i = 0; i < regions.size(); ++i) {
-          const bool found =
-              std::any_of(before.begin(), before.end(), [&](const Match& m) { return m.region == i; });
+          const bool found = std::any_of(before.begin(), before.end(),
+                                         [&](const Match& m) { return m.region == i; });
           if (found) continue;
           const RegionExplanation why = explainRegionAsAsked(regions[i], list, asked);
           const auto remedy = remedyFor(regions[i], models.models, why, asked);

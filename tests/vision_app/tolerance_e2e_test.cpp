@@ -165,7 +165,7 @@ std::string remedyIn(const std::string& why) {
 }
 }  // namespace
 
-TEST_CASE("the remedy WHY names, sent as TOLERANCE, makes the next LOCATE accept the region",
+TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLERANCE",
           "[vision_app][tolerance][why][e2e]") {
   PlateCell cell;
   // The larger plate with a tight edge tolerance fails verification alone.
@@ -195,8 +195,10 @@ TEST_CASE("the remedy WHY names, sent as TOLERANCE, makes the next LOCATE accept
   // Refused on its shape and, that relaxed, on its boundary too: no one
   // change accepts it, and WHY names none.
   cell.scene.show(scene(kLargerPlate, 30));
-  REQUIRE_THAT(cell.ask("TOLERANCE 1 hu_tolerance 0.000001 edge_tolerance_px 0.1 verify_percent 100"),
-               Catch::StartsWith("OK 1 plate "));
+  REQUIRE_THAT(
+      cell.ask("TOLERANCE 1 area_tolerance 0.1 hu_tolerance 0.000001 edge_tolerance_px 0.1 "
+               "verify_percent 100"),
+      Catch::StartsWith("OK 1 plate "));
   REQUIRE(cell.ask("LOCATE 1") == "OK 0");
   why = cell.ask("WHY");
   CHECK_THAT(why, Catch::Contains("region 0 shape distance "));
