@@ -45,38 +45,54 @@ def overlapping(boxes):
 
 
 def test_a_remedy_applied_from_the_page_makes_locate_accept_the_region(cell, browser):
-    wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "4", what="four parts on the table")
+    # Taught alone, then found among four of its kind.
+    cell.set_parts(1)
+    wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "1", what="one part on the table")
     assert cell.say("LEARN 1 ell").startswith("OK 1 ell"), "LEARN"
-    # An area tolerance below the pixel grid's differences between parts
-    # turned otherwise: the other parts are the taught one at another size,
-    # refused on their area alone.
-    assert cell.say("TOLERANCE 1 area_tolerance 0.0001").startswith("OK 1 ell")
+    cell.set_parts(4)
+    wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "4", what="four parts on the table")
+    # An edge tolerance finer than the pixel grid: the parts turned otherwise
+    # than the taught one verify on too little of their boundary, refused
+    # on that alone.
+    assert cell.say("TOLERANCE 1 edge_tolerance_px 0.3").startswith("OK 1 ell")
     select_tab(browser, "live")
     reply, before = locate_on_page(browser, "1")
     assert reply.startswith("OK "), reply
     overlay = overlay_after(browser, before)
-    refused = [r for r in overlay["rejections"] if r["test"] in ("area", "scale")]
+    refused = [r for r in overlay["rejections"] if r["test"] == "verify"]
     assert refused, overlay
-    with_remedy = [r for r in refused if r["remedy"].startswith("area_tolerance ")]
+    with_remedy = [r for r in refused if r["remedy"].startswith("verify_percent ")]
     assert with_remedy, refused
     target = with_remedy[0]
     # Beside the region: the remedy as a clickable line of its label, and the
     # same in the Live panel's list as a button.
-    remedy_lines = browser.driver.find_elements(
-        By.CSS_SELECTOR, f'#overlay .rejection[data-region="{target["region"]}"] .remedy')
-    assert len(remedy_lines) == 1 and remedy_lines[0].text == "apply " + target["remedy"]
+    # (Read in one script: the overlay is drawn again as frames arrive.)
+    remedy_lines = browser.js("""
+        return Array.from(document.querySelectorAll(
+            '#overlay .rejection[data-region="' + arguments[0] + '"] .remedy')).map(t => t.textContent);""",
+        target["region"])
+    assert remedy_lines == ["apply " + target["remedy"]], remedy_lines
     assert target["text"].endswith(", " + target["remedy"] + " would accept it"), target
 
     # A busy frame: the parts' labels and every reason, none covering another.
     boxes = label_boxes(browser)
     assert len(boxes) >= 4, boxes
     assert overlapping(boxes) == [], boxes
-    # Hovered, a label is highlighted (bold) with its region.
-    label = browser.driver.find_element(
-        By.CSS_SELECTOR, f'#overlay .rejection[data-region="{target["region"]}"] .reason')
-    ActionChains(browser.driver).move_to_element(label).perform()
-    wait_until(lambda: browser.js("return getComputedStyle(arguments[0]).fontWeight", label) == "700",
-               what="the hovered label highlighted")
+    # Hovered, a label is highlighted (bold) with its region: the mouse moved
+    # onto the label's middle, the label under it read there.
+    def hovered_weight():
+        at = browser.js("""
+            const t = document.querySelector('#overlay .rejection[data-region="' + arguments[0] + '"] .reason');
+            const r = t.getBoundingClientRect();
+            return [Math.round(r.left + r.width / 2), Math.round(r.top + r.height / 2)];""", target["region"])
+        actions = ActionChains(browser.driver)
+        actions.w3c_actions.pointer_action.move_to_location(at[0], at[1])
+        actions.perform()
+        return browser.js("""
+            const e = document.elementFromPoint(arguments[0], arguments[1]);
+            const t = e && e.closest('text');
+            return t && t.classList.contains('reason') ? getComputedStyle(t).fontWeight : null;""", at[0], at[1])
+    wait_until(lambda: hovered_weight() == "700", what="the hovered label highlighted")
     browser.screenshot("why-remedy")
 
     button = browser.driver.find_element(
@@ -93,7 +109,7 @@ def test_a_remedy_applied_from_the_page_makes_locate_accept_the_region(cell, bro
     assert target["region"] in regions, (target, result.get("parts"))
     assert all(r["region"] != target["region"] for r in after["rejections"]), after
     value = target["remedy"].split()[1]
-    assert re.search(r" area_tolerance=" + re.escape(value), cell.say("TOLERANCE 1")), value
+    assert re.search(r" verify_percent=" + re.escape(value), cell.say("TOLERANCE 1")), value
     # Apart from each other, no part is said to touch another.
     assert not [b for b in label_boxes(browser) if "touching" in b["text"]]
     assert browser.severe() == []
