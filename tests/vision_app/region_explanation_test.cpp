@@ -134,7 +134,7 @@ TEST_CASE("explanations agree with recognition on every separated region",
         if (m.region != i) continue;
         reported = true;
         INFO("reported as " << m.model->name);
-        CHECK_FALSE(m.touching);
+        CHECK_FALSE(m.from_edges);
         CHECK(pv::explainRegion(region, {m.model}).test == pv::RegionTest::kPasses);
         if (pv::holesAtLeast(region, m.model->min_hole_area) != region.holes) ++pinned;
       }
