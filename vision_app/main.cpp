@@ -63,6 +63,18 @@ int main(int argc, char** argv) {
     }
     logInfo("vision settings: ", cell::visionSettingsText(cell.vision().options()));
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
+    // The filmstrip: recent requests' frames. A directory that cannot be
+    // made costs the filmstrip (FILMSTRIP answers ERROR 57), never the start.
+    if (!options->filmstrip.dir.empty()) {
+      auto problems = cell.openFilmstrip(options->filmstrip);
+      if (!problems) {
+        logError("filmstrip off: ", problems.error().message);
+      } else {
+        for (const auto& p : *problems) logError("filmstrip: ", p);
+        logInfo("filmstrip in ", options->filmstrip.dir, ": ", cell.filmstrip()->figures().entries,
+                " entries");
+      }
+    }
     // The results stream: subscribers see what each request saw, after
     // its reply; they never slow a robot.
     std::unique_ptr<results::ResultsPublisher> results;

@@ -254,6 +254,7 @@ Result<LocateOutcome> VisionService::locate(int type) {
   if (!frame) return frame.error();
   auto outcome = locateInFrame(**frame, **settings, models, type, scaled_models_.get());
   outcome.settings = *settings;
+  outcome.pixels = *frame;
   return outcome;
 }
 

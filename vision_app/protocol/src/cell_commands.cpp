@@ -52,6 +52,7 @@ std::string locate(const Request& r, CellContext& cell) {
   const std::string out = !located ? reply(located.error())
                           : all    ? locateAllReply(*located)
                                    : locateReply(located->pick);
+  r.session->frame = located ? located->outcome.pixels : nullptr;
   auto record = results::locateRecord(std::move(located), *type, cell.vision.options());
   record->request_line = r.line;
   record->client = r.session->client;

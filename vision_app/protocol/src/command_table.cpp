@@ -86,6 +86,7 @@ std::string CommandTable::dispatch(std::string_view line, bool read_only, Sessio
     session->command.clear();
     session->publishes = Publishes::kNothing;
     session->record = nullptr;
+    session->frame = nullptr;
     session->changed = false;
   }
   auto request = parseRequest(line);

@@ -7,6 +7,7 @@
 #include "picksight/calibration/robot_camera.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/cell/vision_settings.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/store/cell_calibration.hpp"
@@ -70,6 +71,11 @@ const std::pair<std::error_code, int> kTable[] = {
     {VisionSettingsErrc::kBadSetting, 11},
     {VisionSettingsErrc::kDamaged, 48},
     {VisionSettingsErrc::kStorage, 49},
+    {filmstrip::FilmstripErrc::kNoEntry, 55},
+    {filmstrip::FilmstripErrc::kDamaged, 56},
+    {filmstrip::FilmstripErrc::kOff, 57},
+    {filmstrip::FilmstripErrc::kStorage, 58},
+    {filmstrip::FilmstripErrc::kNoFrame, 59},
     {ProtocolErrc::kInternalError, kInternal},
 };
 

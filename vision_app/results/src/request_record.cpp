@@ -181,6 +181,7 @@ std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int ty
     // Nothing published or explained reads the mask: a connection's last
     // LOCATE (kept for WHY) holds no frame-sized buffer.
     record->locate->scene.mask.release();
+    record->locate->pixels.reset();
     record->pick = std::move(located->pick);
     record->grasps = std::move(located->grasps);
     record->geometry = std::move(located->geometry);

@@ -8,6 +8,7 @@
 #include "picksight/app/plc_port.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/transport/curve_keys.hpp"
 
@@ -33,6 +34,9 @@ struct AppOptions {
   // --config set: they win over <data dir>/vision.json at start.
   std::vector<std::string> vision_settings_given;
   PlcPortOptions plc;  // off unless --modbus-port is given
+  // The frames of recent requests (--filmstrip-*): in <data dir>/filmstrip
+  // unless --filmstrip-dir says; dir empty: none.
+  filmstrip::FilmstripOptions filmstrip;
   // CURVE keys for the camera link (loaded by parseAppArgs); nullopt: plain.
   std::optional<CurveClientKeys> curve;
 };

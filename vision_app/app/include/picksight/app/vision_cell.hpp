@@ -6,6 +6,7 @@
 // Threading: handle() is thread-safe once load() returned.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -13,6 +14,7 @@
 
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"
@@ -54,6 +56,13 @@ class VisionCell {
   // Where requests publish (null: nowhere); read at each request.
   results::ResultsPublisher* const& results() const { return results_; }
 
+  // Keeps the frames of LOCATE, LOCATE ALL and WHY requests in a
+  // filmstrip from now on (and of PLC triggers, through filmstrip());
+  // returns what its directory held that could not be read. Call before
+  // serving starts. Without, FILMSTRIP and REPLAY answer ERROR 57.
+  Result<std::vector<std::string>> openFilmstrip(filmstrip::FilmstripOptions options);
+  filmstrip::Filmstrip* const& filmstrip() const { return filmstrip_; }
+
   cell::VisionService& vision() { return vision_; }
   store::ModelLibrary& models() { return models_; }
   store::CellCalibration& calibration() { return calibration_; }
@@ -69,6 +78,16 @@ class VisionCell {
   protocol::RobotProtocol protocol_;
   cell::CellContext context_;
   results::ResultsPublisher* results_ = nullptr;
+  std::unique_ptr<filmstrip::Filmstrip> filmstrip_owner_;
+  filmstrip::Filmstrip* filmstrip_ = nullptr;  // filmstrip_owner_'s, for the commands
 };
+
+// What to run once a request's reply is sent to keep it in `strip`: a
+// LOCATE (its `record` and the session's frame) or a WHY; null for other
+// requests or without a filmstrip. Reserves the entry's id at once (the
+// session's last_locate_entry for a LOCATE).
+std::function<void(const std::string& reply)> filmstripWhenSent(
+    filmstrip::Filmstrip* strip, std::string_view line, protocol::Session& session,
+    std::shared_ptr<const results::RequestRecord> record);
 
 }  // namespace picksight::app

@@ -87,6 +87,10 @@ struct LocateOutcome {
   // null from locateInFrame alone): what its record publishes, whatever
   // VISION changed since.
   std::shared_ptr<const VisionOptions> settings;
+  // The frame itself (VisionService::locate; null from locateInFrame
+  // alone), for the filmstrip: taken by the request, never kept with the
+  // outcome (results::locateRecord releases it).
+  std::shared_ptr<const Frame> pixels;
 };
 
 // The single calibration target in a frame, in sensor pixels.

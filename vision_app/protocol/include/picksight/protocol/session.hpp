@@ -8,6 +8,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -41,6 +42,12 @@ struct Session {
   // for the web's audit trail.
   bool changed = false;
   std::shared_ptr<results::RequestRecord> record;
+  // The frame the current LOCATE worked on (null for others), for the
+  // filmstrip; VisionCell takes it, so that no session keeps a frame.
+  std::shared_ptr<const Frame> frame;
+  // The filmstrip entry of this connection's last LOCATE (0: none), which
+  // its WHY explains.
+  uint64_t last_locate_entry = 0;
 };
 
 }  // namespace picksight::protocol
