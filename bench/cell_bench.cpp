@@ -103,10 +103,10 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
   for (int i = 0; i < 100; ++i) {
     const int type = 1 + i % static_cast<int>(kTypes.size());
     auto t0 = Clock::now();
-    const auto outcome = picksight::app::locateInFrame(frame, {}, library.snapshot(), type);
+    const auto outcome = picksight::cell::locateInFrame(frame, {}, library.snapshot(), type);
     recognition.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     t0 = Clock::now();
-    const auto pick = picksight::app::pickPoses(outcome, *library.grasps(), geometry);
+    const auto pick = picksight::cell::pickPoses(outcome, *library.grasps(), geometry);
     grasps.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
     if (pick.poses.size() > outcome.parts.size()) return {};
   }
@@ -116,13 +116,13 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
     const picksight::Frame shot = picksight::frameFromImage(scenes.render(1), "cam0", 1);
     for (int type = 1; type <= static_cast<int>(kTypes.size()); ++type) {
       // The cell's one LOCATE path, as the offline CLI runs it on an image.
-      const auto located = picksight::app::locateAndPick(
-          calibration, &library, [&]() -> picksight::Result<picksight::app::LocateOutcome> {
-            return picksight::app::locateInFrame(shot, {}, library.snapshot(), type);
+      const auto located = picksight::cell::locateAndPick(
+          calibration, &library, [&]() -> picksight::Result<picksight::cell::LocateOutcome> {
+            return picksight::cell::locateInFrame(shot, {}, library.snapshot(), type);
           });
       if (!located) return {};
       b.poses += located->pick.poses.size();
-      digest(b.poses_digest, picksight::app::locateReply(located->pick));
+      digest(b.poses_digest, picksight::protocol::locateReply(located->pick));
     }
   }
   return b;

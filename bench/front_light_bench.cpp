@@ -39,7 +39,8 @@
 namespace {
 namespace ps = picksight::synthetic;
 namespace pv = picksight::vision;
-namespace pa = picksight::app;
+namespace pc = picksight::cell;
+namespace pst = picksight::store;
 using picksight::bench::TypeSpec;
 using Clock = std::chrono::steady_clock;
 using Ms = std::chrono::duration<double, std::milli>;
@@ -118,7 +119,7 @@ picksight::Frame frameOf(const cv::Mat& image) {
 // What WHY would say of the region under `at` in `outcome`: the model it
 // comes nearest to and the first test it fails ("passes" for a blob whose
 // search found nothing there), or that no region lies there.
-std::string whyMissed(const pa::LocateOutcome& outcome, cv::Point2d at) {
+std::string whyMissed(const pc::LocateOutcome& outcome, cv::Point2d at) {
   const auto& regions = outcome.scene.regions;
   for (size_t k = 0; k < regions.size(); ++k) {
     if (cv::pointPolygonTest(regions[k].outer, at, false) < 0) continue;
@@ -136,10 +137,10 @@ std::string whyMissed(const pa::LocateOutcome& outcome, cv::Point2d at) {
   return "in no region";
 }
 
-void score(const std::vector<ps::SilhouettePart>& truth, const pa::LocateOutcome& outcome,
+void score(const std::vector<ps::SilhouettePart>& truth, const pc::LocateOutcome& outcome,
            const std::vector<int>& type_of_model, const std::vector<cv::Point2d>& reference,
            bool list, const std::vector<TypeSpec>& specs, Row& row) {
-  const std::vector<pa::LocatedPart>& parts = outcome.parts;
+  const std::vector<pc::LocatedPart>& parts = outcome.parts;
   std::vector<bool> claimed(truth.size(), false);
   for (const auto& t : truth) row.truths += t.kind == ps::PartKind::kTrue ? 1 : 0;
   for (const auto& p : parts) {
@@ -274,7 +275,7 @@ int main(int argc, char** argv) {
     ps::SilhouetteSceneOptions look;
     ps::frontLightCondition(condition, &look.front, &look.part_level, &look.background_level);
     // The vision app's defaults, with the window a user sets for these parts.
-    pa::VisionOptions options;
+    pc::VisionOptions options;
     options.binarize.adaptive_window = kWindow;
     options.regions.cut_shadows = !keep_shadows;
     if (look.part_level > look.background_level) {
@@ -282,7 +283,7 @@ int main(int argc, char** argv) {
     }
     // Teach every type as a user would: LEARN on an image of the part alone
     // under the same light; when LEARN refuses, LEARN ... AT a box around it.
-    auto models = std::make_shared<picksight::store::ModelList>();
+    auto models = std::make_shared<pst::ModelList>();
     std::vector<int> type_of_model;
     std::vector<bool> chiral(types.size(), true);
     std::vector<cv::Point2d> reference(types.size());
@@ -299,7 +300,7 @@ int main(int argc, char** argv) {
       const picksight::Frame frame = frameOf(image);
       const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
       auto learned =
-          pa::learnInImage(grey, frame.mapping, options, models,
+          pc::learnInImage(grey, frame.mapping, options, models,
                            static_cast<int>(models->size()) + 1, specs[i].name, std::nullopt);
       if (learned) {
         taught.learn_ok += 1;
@@ -311,7 +312,7 @@ int main(int argc, char** argv) {
         const double half = 0.6 * specs[i].size_px;
         const cv::Rect at(static_cast<int>(drawn.x - half), static_cast<int>(drawn.y - half),
                           static_cast<int>(2 * half), static_cast<int>(2 * half));
-        learned = pa::learnInImage(grey, frame.mapping, options, models,
+        learned = pc::learnInImage(grey, frame.mapping, options, models,
                                    static_cast<int>(models->size()) + 1, specs[i].name, at);
         if (learned) taught.learn_at_ok += 1;
       }
@@ -345,7 +346,7 @@ int main(int argc, char** argv) {
       reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
                       offset.x * std::sin(back) + offset.y * std::cos(back)};
       chiral[i] = !learned->model.body.mirror_symmetric;
-      auto next = std::make_shared<picksight::store::ModelList>(*models);
+      auto next = std::make_shared<pst::ModelList>(*models);
       next->push_back(std::move(learned->model));
       models = next;
       type_of_model.resize(static_cast<size_t>(models->back().type) + 1, -1);
@@ -372,13 +373,13 @@ int main(int argc, char** argv) {
                 image);
           }
           const picksight::Frame frame = frameOf(image);
-          pa::LocateOutcome outcome;
+          pc::LocateOutcome outcome;
           double sink = 0;
           picksight::bench::timeInTurn<2>(turn++,
                                           {[&] {
                                              if (models->empty()) return;
                                              outcome =
-                                                 pa::locateInFrame(frame, options, models, -1);
+                                                 pc::locateInFrame(frame, options, models, -1);
                                            },
                                            [&] {
                                              cv::Mat grey = image;
@@ -390,9 +391,9 @@ int main(int argc, char** argv) {
           if (stages && !models->empty()) {
             // As locateInFrame prepares them: the vision image (a colour
             // frame projected on the taught colours) and the frame's options.
-            const cv::Mat grey = pa::visionImage(frame, *models);
-            const pa::VisionOptions o =
-                pa::frameOptions(options, frame.mapping, grey.size(), *models);
+            const cv::Mat grey = pc::visionImage(frame, *models);
+            const pc::VisionOptions o =
+                pc::frameOptions(options, frame.mapping, grey.size(), *models);
             cv::Mat mask;
             row.binarize_ms.push_back(
                 picksight::bench::elapsedMs([&] { mask = pv::binarize(grey, o.binarize); }));

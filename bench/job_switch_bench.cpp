@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(dir);
   int status = 0;
   {
-    app::VisionCell cell(dir, std::make_unique<link::StillCamera>(scene()), app::VisionOptions{});
+    app::VisionCell cell(dir, std::make_unique<link::StillCamera>(scene()), cell::VisionOptions{});
     for (const auto& problem : cell.load()) std::fprintf(stderr, "%s\n", problem.c_str());
     for (int k = 0; k < kTypes; ++k) {
       const int x = 480 * (k % 4), y = 270 * (k / 4);

@@ -117,7 +117,8 @@ cv::Point2d referenceOf(const ps::SilhouettePart& t, const std::vector<cv::Point
 void listFalse(const char* what, const pv::Match& m, const ps::SilhouettePart* t,
                const std::vector<TypeSpec>& specs) {
   std::printf("    false report (%s): %s at %.1f, %.1f turned %.2f%s", what, m.model->name.c_str(),
-              m.centroid.x, m.centroid.y, m.angle_deg, m.touching ? " in a blob" : " whole region");
+              m.centroid.x, m.centroid.y, m.angle_deg,
+              m.from_edges ? " in a blob" : " whole region");
   if (t) {
     std::printf("; drawn: %s kind %d turned %.2f, %.0f%% of its outline hidden",
                 specs[t->type].name.c_str(), static_cast<int>(t->kind), t->angle_deg,

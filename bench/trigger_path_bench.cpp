@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
         ++failures;
         continue;
       }
-      const auto outcome = picksight::app::locateInFrame(*frame, {}, nullptr, -1);
+      const auto outcome = picksight::cell::locateInFrame(*frame, {}, nullptr, -1);
       const uint64_t t3 = monotonicNs();
       if (i < 10 || outcome.parts.empty()) continue;  // warm-up
       const uint64_t render_start = frame->info.device_timestamp_ns;

@@ -34,7 +34,7 @@ picksight::app::VisionCell& cell() {
   }();
   (void)made;
   static picksight::app::VisionCell instance(dir, std::make_unique<picksight::link::NoCamera>(),
-                                             picksight::app::VisionOptions{});
+                                             picksight::cell::VisionOptions{});
   static const bool loaded = (instance.load(), true);
   (void)loaded;
   return instance;
@@ -47,7 +47,7 @@ void check(bool ok) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   auto& vision = cell();
-  picksight::app::LineFramer framer(kMaxLine);
+  picksight::protocol::LineFramer framer(kMaxLine);
   const auto on_line = [&](std::string_view line) {
     const std::string reply = vision.handle(line);
     check(reply.find('\n') == std::string::npos && reply.find('\r') == std::string::npos);

@@ -61,8 +61,20 @@ int main(int argc, char** argv) {
       logInfo("vision settings from the command line, over ", options->data_dir,
               "/vision.json: ", keys, " (a VISION change replaces them until the next start)");
     }
-    logInfo("vision settings: ", app::visionSettingsText(cell.vision().options()));
+    logInfo("vision settings: ", cell::visionSettingsText(cell.vision().options()));
     logInfo(cell.models().snapshot()->size(), " part models from ", cell.models().directory());
+    // The filmstrip: recent requests' frames. A directory that cannot be
+    // made costs the filmstrip (FILMSTRIP answers ERROR 57), never the start.
+    if (!options->filmstrip.dir.empty()) {
+      auto problems = cell.openFilmstrip(options->filmstrip);
+      if (!problems) {
+        logError("filmstrip off: ", problems.error().message);
+      } else {
+        for (const auto& p : *problems) logError("filmstrip: ", p);
+        logInfo("filmstrip in ", options->filmstrip.dir, ": ", cell.filmstrip()->figures().entries,
+                " entries");
+      }
+    }
     // The results stream: subscribers see what each request saw, after
     // its reply; they never slow a robot.
     std::unique_ptr<results::ResultsPublisher> results;
@@ -74,14 +86,14 @@ int main(int argc, char** argv) {
       cell.publishResultsTo(results.get());
     }
     const bool read_only = options->robot_read_only;
-    app::RobotServer robots(options->robot,
-                            [&cell, read_only](std::string_view line, app::Session& session) {
-                              return cell.handle(line, read_only, &session);
-                            });
-    std::unique_ptr<app::RobotServer> setup;
+    protocol::RobotServer robots(
+        options->robot, [&cell, read_only](std::string_view line, protocol::Session& session) {
+          return cell.handle(line, read_only, &session);
+        });
+    std::unique_ptr<protocol::RobotServer> setup;
     if (options->setup) {
-      setup = std::make_unique<app::RobotServer>(
-          *options->setup, [&cell](std::string_view line, app::Session& session) {
+      setup = std::make_unique<protocol::RobotServer>(
+          *options->setup, [&cell](std::string_view line, protocol::Session& session) {
             return cell.handle(line, false, &session);
           });
     }

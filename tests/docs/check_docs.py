@@ -3,7 +3,8 @@
 
 * docs/TROUBLESHOOTING.md has a row for every robot ERROR code the vision
   app can return (the codes of the one error table, robot_errors.cpp) and
-  for every WHY sentence (request_record.cpp, cell_commands.cpp), and no
+  for every WHY sentence (request_record.cpp, cell_commands.cpp) and its
+  remedy clause, and no
   row for a code that no longer exists; docs/PROTOCOL.md's Errors table
   lists every code too. A new code or sentence without its line fails here.
 * README.md: every relative link and every docs/*.md it names exists; every
@@ -91,6 +92,10 @@ def check_why_sentences(root):
     for reply in sorted(whole):
         if not any(r.startswith("`OK 0 " + reply.rstrip()) for r in rows):
             fail(f"docs/TROUBLESHOOTING.md: no WHY row for 'OK 0 {reply}'")
+    # The remedy's clause after a sentence (remedyText): ", <key> <value> ...".
+    for clause in set(re.findall(r'" ([a-z ]+ it)";', record)):
+        if not any(clause in r for r in rows):
+            fail(f"docs/TROUBLESHOOTING.md: no WHY row for the remedy '..., <key> <value> {clause}'")
 
 
 def check_readme(root, bin_dir, with_bench):

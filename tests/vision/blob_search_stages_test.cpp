@@ -235,3 +235,22 @@ TEST_CASE("blob search: a part drawn as the mirror image of its model is not rep
   }
   CHECK(bar_found);
 }
+
+TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blob_search]") {
+  // The L alone: found by the search (from its edges), it explains its
+  // region whole and touches nothing.
+  const cv::Mat alone = pt::drawParts(640, 480, {{lShape(), 260, 220, 25}}, 11);
+  const auto regions = findRegions(binarize(alone, {}), {}, alone);
+  REQUIRE(regions.size() == 1);
+  const auto lone = locateInBlob(regions, 0, {&models().l});
+  REQUIRE(lone.size() == 1);
+  CHECK(lone.front().from_edges);
+  CHECK_FALSE(lone.front().touching);
+  // The L against the bar, searched with the L's model alone: one part
+  // found, the bar's pixels left over: it touches them.
+  const Scene pair = touchingPair(false);
+  REQUIRE(pair.regions.size() == 1);
+  const auto beside = locateInBlob(pair.regions, 0, {&models().l});
+  REQUIRE(beside.size() == 1);
+  CHECK(beside.front().touching);
+}

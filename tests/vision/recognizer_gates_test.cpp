@@ -66,12 +66,12 @@ void checkReported(const std::vector<Match>& matches, const std::vector<pt::Draw
                  << parts[i].angle_deg << (parts[i].mirrored ? " mirrored" : ""));
     const Match* m = matchAt(matches, parts[i]);
     if (expected[i].empty()) {
-      CHECK((m == nullptr || m->touching));
+      CHECK((m == nullptr || m->from_edges));
       continue;
     }
     REQUIRE(m);
     CHECK(m->model->name == expected[i]);
-    CHECK_FALSE(m->touching);
+    CHECK_FALSE(m->from_edges);
   }
 }
 

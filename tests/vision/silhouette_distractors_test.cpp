@@ -89,7 +89,7 @@ TEST_CASE("a blurred noisy mirror image whose hole closed is not reported from i
         INFO("seed " << seed << " frame " << frame);
         const ps::SilhouettePart& near = drawnUnder(scene.truth(), m, kNearPx);
         INFO("reported at " << m.centroid.x << ", " << m.centroid.y
-                            << (m.touching ? " from its edges" : " as a whole region"));
+                            << (m.from_edges ? " from its edges" : " as a whole region"));
         const bool as_trained = near.kind == ps::PartKind::kTrue;
         CHECK(as_trained);
         found += as_trained ? 1 : 0;

@@ -118,7 +118,7 @@ inline const synthetic::SilhouettePart* drawnNear(
 inline const synthetic::SilhouettePart& drawnUnder(
     const std::vector<synthetic::SilhouettePart>& truth, const vision::Match& m, double radius) {
   INFO(m.model->name << " reported at " << m.centroid.x << ", " << m.centroid.y
-                     << (m.touching ? " from its edges" : ""));
+                     << (m.from_edges ? " from its edges" : ""));
   const synthetic::SilhouettePart* near = drawnNear(truth, m, radius);
   REQUIRE(near != nullptr);
   return *near;

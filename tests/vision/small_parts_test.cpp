@@ -58,7 +58,7 @@ TEST_CASE("small parts touching others are found however narrow their notches",
         UNSCOPED_INFO("missed, seed " << seed << ": " << specs[t.type].name << " at " << t.centre.x
                                       << ", " << t.centre.y << " turned " << t.angle_deg << ", "
                                       << 100 * t.hidden << " % hidden");
-      } else if (found->touching) {
+      } else if (found->from_edges) {
         ++touching_found;
       }
     }

@@ -24,7 +24,7 @@
 #include "picksight/vision/segmentation/regions.hpp"
 
 using namespace picksight;
-using namespace picksight::app;
+using namespace picksight::cell;
 using namespace picksight::store;
 namespace ps = picksight::synthetic;
 namespace pv = picksight::vision;
@@ -75,6 +75,17 @@ int foundTrue(const std::vector<ps::SilhouettePart>& truth, const std::vector<Lo
 const ps::SilhouetteType& boneType() {
   static const ps::SilhouetteType t = ps::silhouetteFromPartType("t_shape", 200);
   return t;
+}
+
+// Six parts of `type`, separated, no distractors, under `look`.
+ps::SilhouetteScene sixParts(const ps::SilhouetteType& type, ps::SilhouetteSceneOptions look,
+                             cv::Size size, uint64_t seed) {
+  look.width = size.width;
+  look.height = size.height;
+  look.parts = 6;
+  look.distractor_share = 0;
+  look.seed = seed;
+  return ps::SilhouetteScene({type}, {true}, look);
 }
 }  // namespace
 
@@ -310,13 +321,7 @@ TEST_CASE("a part taught beside its shadow is found and placed beside shadows fa
   const ps::SilhouetteSceneOptions look = lookOf("shadow");
   cv::Point2d drawn;
   const cv::Mat teach = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);
-  ps::SilhouetteSceneOptions o = look;
-  o.width = 1000;
-  o.height = 800;
-  o.parts = 6;
-  o.distractor_share = 0;
-  o.seed = 3;
-  const ps::SilhouetteScene scene({boneType()}, {true}, o);
+  const ps::SilhouetteScene scene = sixParts(boneType(), look, {1000, 800}, 3);
   REQUIRE(scene.truth().size() == 6);
   const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
   int found_cut = 0;
@@ -377,13 +382,7 @@ TEST_CASE("the turn of a separated part under a front light is read on its edges
           learnInImage(teach, {}, cellOptions(), noModels(), 1, "part", boxAround(centre, 280));
       INFO((learned.ok() ? std::string() : learned.error().message));
       REQUIRE(learned.ok());
-      ps::SilhouetteSceneOptions o = look;
-      o.width = 1200;
-      o.height = 900;
-      o.parts = 6;
-      o.distractor_share = 0;
-      o.seed = 5;
-      const ps::SilhouetteScene scene({shape}, {true}, o);
+      const ps::SilhouetteScene scene = sixParts(shape, look, {1200, 900}, 5);
       const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
       const LocateOutcome outcome = locateInFrame(frame, cellOptions(), listOf(learned->model), -1);
       for (const auto& t : scene.truth()) {

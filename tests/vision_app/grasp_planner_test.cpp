@@ -16,6 +16,7 @@
 
 using namespace picksight;
 using namespace picksight::app;
+using namespace picksight::cell;
 using namespace picksight::store;
 
 namespace {

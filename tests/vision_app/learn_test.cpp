@@ -25,6 +25,7 @@
 
 using namespace picksight;
 using namespace picksight::app;
+using namespace picksight::cell;
 using namespace picksight::store;
 using picksight::test::DrawnPart;
 

@@ -16,7 +16,7 @@
 #include "picksight/vision/recognition/recognition_pass.hpp"
 
 using namespace picksight;
-using namespace picksight::app;
+using namespace picksight::cell;
 using namespace picksight::store;
 using picksight::test::DrawnPart;
 

@@ -134,7 +134,7 @@ TEST_CASE("explanations agree with recognition on every separated region",
         if (m.region != i) continue;
         reported = true;
         INFO("reported as " << m.model->name);
-        CHECK_FALSE(m.touching);
+        CHECK_FALSE(m.from_edges);
         CHECK(pv::explainRegion(region, {m.model}).test == pv::RegionTest::kPasses);
         if (pv::holesAtLeast(region, m.model->min_hole_area) != region.holes) ++pinned;
       }
@@ -172,7 +172,7 @@ TEST_CASE("WHY reads the scale of a copy and names a mirror image", "[vision][wh
                                          {test::scaled(l_shape, 1.25), 700, 250, 100},
                                          {l_shape, 450, 550, 70, true}},
                                         7);
-  const auto outcome = app::locateInFrame(frameFromImage(scene, "cam", 1), {}, models, 1);
+  const auto outcome = cell::locateInFrame(frameFromImage(scene, "cam", 1), {}, models, 1);
   REQUIRE(outcome.parts.size() == 1);
   results::RequestRecord record;
   record.request = "LOCATE";

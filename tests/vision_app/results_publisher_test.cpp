@@ -12,7 +12,6 @@
 
 #include "picksight/results/results_publisher.hpp"
 
-using namespace picksight::app;
 using namespace picksight::results;
 using namespace std::chrono_literals;
 

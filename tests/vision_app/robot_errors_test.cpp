@@ -14,7 +14,8 @@
 #include "picksight/vision/models/part_model.hpp"
 
 using namespace picksight;
-using namespace picksight::app;
+using namespace picksight::protocol;
+using namespace picksight::cell;
 using namespace picksight::store;
 
 TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]") {

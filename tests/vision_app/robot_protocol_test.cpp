@@ -14,6 +14,8 @@
 #include "temp_dir.hpp"
 
 using namespace picksight::app;
+using namespace picksight::protocol;
+using namespace picksight::cell;
 
 namespace {
 // The whole command table with no camera: enough for every command that

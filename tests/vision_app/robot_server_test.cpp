@@ -22,8 +22,8 @@ std::string echo(std::string_view line) {
   return "OK " + std::to_string(line.size()) + " " + std::string(line.substr(0, 32));
 }
 
-app::RobotServerOptions loopback() {
-  app::RobotServerOptions o;
+protocol::RobotServerOptions loopback() {
+  protocol::RobotServerOptions o;
   o.listen.bind_address = "127.0.0.1";
   o.listen.port = 0;
   return o;
@@ -31,13 +31,13 @@ app::RobotServerOptions loopback() {
 
 struct Server {
   explicit Server(size_t max_connections = 64) {
-    app::RobotServerOptions o = loopback();
+    protocol::RobotServerOptions o = loopback();
     o.listen.max_connections = max_connections;
     start(o);
   }
-  explicit Server(const app::RobotServerOptions& o) { start(o); }
-  void start(const app::RobotServerOptions& o) {
-    server = std::make_unique<app::RobotServer>(o, echo);
+  explicit Server(const protocol::RobotServerOptions& o) { start(o); }
+  void start(const protocol::RobotServerOptions& o) {
+    server = std::make_unique<protocol::RobotServer>(o, echo);
     server->start();
   }
   LineClient connect() {
@@ -45,7 +45,7 @@ struct Server {
     REQUIRE(c);
     return std::move(*c);
   }
-  std::unique_ptr<app::RobotServer> server;
+  std::unique_ptr<protocol::RobotServer> server;
 };
 
 // Two connections served and kept in `held`, then the first line a third gets.
@@ -141,7 +141,7 @@ TEST_CASE("connections beyond the limit are told why and closed", "[vision_app][
 
 TEST_CASE("a peer outside the allow-list gets ERROR 15 and is closed",
           "[vision_app][robot_server]") {
-  app::RobotServerOptions o = loopback();
+  protocol::RobotServerOptions o = loopback();
   auto list = AllowList::parse("10.0.0.0/8");
   REQUIRE(list);
   o.listen.allow = *list;
@@ -161,7 +161,7 @@ TEST_CASE("a peer outside the allow-list gets ERROR 15 and is closed",
 
 TEST_CASE("connections beyond the per-address limit are told why and closed",
           "[vision_app][robot_server]") {
-  app::RobotServerOptions o = loopback();
+  protocol::RobotServerOptions o = loopback();
   o.listen.max_per_address = 2;
   Server s(o);
   std::vector<LineClient> held;
@@ -172,7 +172,7 @@ TEST_CASE("connections beyond the per-address limit are told why and closed",
 
 TEST_CASE("an idle or trickling connection gets ERROR 16 and is closed",
           "[vision_app][robot_server]") {
-  app::RobotServerOptions o = loopback();
+  protocol::RobotServerOptions o = loopback();
   o.listen.idle_timeout = 300ms;
   Server s(o);
   auto idle = s.connect();
@@ -190,7 +190,7 @@ TEST_CASE("an idle or trickling connection gets ERROR 16 and is closed",
 
 TEST_CASE("64 idle connections lock robots out only until the idle timeout",
           "[vision_app][robot_server]") {
-  app::RobotServerOptions o = loopback();
+  protocol::RobotServerOptions o = loopback();
   o.listen.idle_timeout = 1s;
   o.listen.max_per_address = 0;  // all from loopback: the total is what is tested
   Server s(o);
@@ -228,7 +228,7 @@ TEST_CASE("a session's after-reply work runs once the reply is sent", "[robot_se
   std::atomic<int> ran{0};
   std::string client;
   std::string seen_reply;
-  app::RobotServer server(loopback(), [&](std::string_view line, app::Session& session) {
+  protocol::RobotServer server(loopback(), [&](std::string_view line, protocol::Session& session) {
     client = session.client;
     if (line == "LOCATE") {
       session.after_reply = [&, read](const std::string& reply) {

@@ -1,12 +1,14 @@
 // TOLERANCE against a real video server and vision app: a model's
 // tolerances read back, changed, in force at the next LOCATE, kept across a
 // restart with the model's grasp styles, and bad requests refused naming the
-// key without changing anything.
+// key without changing anything; the remedy WHY names for a region one test
+// refuses, sent as TOLERANCE, makes LOCATE accept it.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -150,4 +152,55 @@ TEST_CASE("TOLERANCE refuses a bad request naming the key and changes nothing",
   CHECK(cell.ask("TOLERANCE 1") == before);
   CHECK(cell.modelFile() == file);
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+}
+
+namespace {
+// The remedy in a WHY line ("..., <key> <value> would accept it"): the
+// TOLERANCE arguments, or "" when it names none.
+std::string remedyIn(const std::string& why) {
+  static const std::regex remedy(", ([a-z_]+) ([0-9.]+) would accept it");
+  std::smatch m;
+  if (!std::regex_search(why, m, remedy)) return "";
+  return m[1].str() + " " + m[2].str();
+}
+}  // namespace
+
+TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLERANCE",
+          "[vision_app][tolerance][why][e2e]") {
+  PlateCell cell;
+  // The larger plate with a tight edge tolerance fails verification alone.
+  cell.scene.show(scene(kLargerPlate, 30));
+  REQUIRE_THAT(cell.ask("TOLERANCE 1 edge_tolerance_px 1"), Catch::StartsWith("OK 1 plate "));
+  REQUIRE(cell.ask("LOCATE 1") == "OK 0");
+  std::string why = cell.ask("WHY");
+  INFO(why);
+  CHECK_THAT(why, Catch::Contains("region 0 boundary "));
+  std::string remedy = remedyIn(why);
+  CHECK_THAT(remedy, Catch::StartsWith("verify_percent "));
+  REQUIRE_THAT(cell.ask("TOLERANCE 1 " + remedy), Catch::StartsWith("OK 1 plate "));
+  CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+
+  // The plate 1 % larger with an area tolerance of 1 %: a scaled copy of
+  // the part, refused on its size alone.
+  cell.scene.show(scene(test::scaled(kPlate, 1.01), 30));
+  REQUIRE_THAT(cell.ask("TOLERANCE 1 area_tolerance 0.01"), Catch::StartsWith("OK 1 plate "));
+  REQUIRE(cell.ask("LOCATE 1") == "OK 0");
+  why = cell.ask("WHY");
+  CHECK_THAT(why, Catch::Contains("region 0 scaled 1.01x outside "));
+  remedy = remedyIn(why);
+  CHECK_THAT(remedy, Catch::StartsWith("area_tolerance "));
+  REQUIRE_THAT(cell.ask("TOLERANCE 1 " + remedy), Catch::StartsWith("OK 1 plate "));
+  CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
+
+  // Refused on its shape and, that relaxed, on its boundary too: no one
+  // change accepts it, and WHY names none.
+  cell.scene.show(scene(kLargerPlate, 30));
+  REQUIRE_THAT(
+      cell.ask("TOLERANCE 1 area_tolerance 0.1 hu_tolerance 0.000001 edge_tolerance_px 0.1 "
+               "verify_percent 100"),
+      Catch::StartsWith("OK 1 plate "));
+  REQUIRE(cell.ask("LOCATE 1") == "OK 0");
+  why = cell.ask("WHY");
+  CHECK_THAT(why, Catch::Contains("region 0 shape distance "));
+  CHECK(remedyIn(why).empty());
 }

@@ -114,4 +114,16 @@ TEST_CASE("an operator may locate and read but not teach or calibrate", "[web][u
     CHECK(roleForCameraAction(action) == Role::kEngineer);
 }
 
+TEST_CASE("an operator may read and replay the filmstrip, an engineer exports it",
+          "[web][users][filmstrip]") {
+  for (const char* line :
+       {"FILMSTRIP", "FILMSTRIP 10 FAILURES", "filmstrip show 3", "FILMSTRIP IMAGE 3 160",
+        "FILMSTRIP STATUS", "REPLAY 3", "replay 3 all"}) {
+    CAPTURE(line);
+    CHECK(roleForCommand(line) == Role::kOperator);
+  }
+  CHECK(roleForCommand("FILMSTRIP EXPORT run1") == Role::kEngineer);
+  CHECK(roleForCommand("filmstrip,export,run1") == Role::kEngineer);
+}
+
 }  // namespace picksight::web

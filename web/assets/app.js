@@ -13,7 +13,7 @@
     latest: {},         // app name -> latest VisionResult (JSON)
     lastOverlay: null,  // what overlay.js drew last (read by the tests)
     tab: "live",
-    listeners: { camera: [], result: [], cameras: [], tab: [], rect: [], frame: [] },
+    listeners: { camera: [], result: [], cameras: [], tab: [], rect: [], frame: [], replay: [] },
     errors: [],         // failed requests, newest last (also shown on the page)
   };
   window.picksight = ps;
@@ -379,6 +379,9 @@
       let result;
       try { result = JSON.parse(e.data); } catch (err) { console.warn("picksight: result event", err); return; }
       if (!result.app) return;
+      // A filmstrip replay is of a recorded frame, not the live one: for
+      // the Filmstrip panel alone.
+      if (result.request === "REPLAY") { emit("replay", result); return; }
         const first = !ps.latest[result.app];
       ps.latest[result.app] = result;
       if (first && result.app === ps.app && (ps.binaryWanted || ps.previewQuery !== null)) showFrame();

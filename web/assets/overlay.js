@@ -1,6 +1,8 @@
 // The results overlay of the Live view: the latest VisionResult of the
 // selected app drawn over the frame (outlines, labels, pose axes, grasp,
-// fingers, rejected regions), and its summary in the Live panel. Sets
+// fingers, rejected regions with the remedy WHY names), and its summary in
+// the Live panel. Labels are placed so that none covers another, and a
+// label under the mouse is highlighted with its region. Sets
 // picksight.lastOverlay to what it drew, in CSS pixels of the image.
 "use strict";
 
@@ -28,7 +30,7 @@
     return part.grasp_position ? pt(part.grasp_position) : pt(part.position);
   }
 
-  function drawPart(g, m, result, part, index, size, drawn) {
+  function drawPart(g, m, result, part, index, size, drawn, labels) {
     const svg = ps.svg;
     const cls = part.offered ? "part" : "part not-offered";
     const group = svg(g, "g", { class: cls, "data-index": index });
@@ -60,10 +62,8 @@
     const type = num(part.type);
     const label = (type >= 0 ? (part.name || "type" + type) + " #" + type : "region") +
                   (part.score ? " " + num(part.score).toFixed(2) : "") + (part.touching ? " touching" : "");
-    // Labels near the right edge go to the left of the part, inside the frame.
-    const right = c[0] > 0.7 * m.frameW;
-    svg(group, "text", { class: "label", x: c[0] + (right ? -2 * r : 2 * r), y: c[1] - r * 2,
-                         "font-size": size * 0.025, "text-anchor": right ? "end" : "start" }, label);
+    const text = svg(group, "text", { class: "label", x: 0, y: 0, "font-size": size * 0.025 }, label);
+    labels.push({ el: text, x: c[0], y: c[1], gap: 2 * r });
     const d = ps.frameToDisplay(m, gf[0], gf[1]);
     drawn.parts.push({
       index, type, name: part.name || "", score: num(part.score), offered: !!part.offered,
@@ -72,16 +72,69 @@
     });
   }
 
-  function drawRejection(g, m, result, rej, size, drawn) {
+  function drawRejection(g, m, result, rej, size, drawn, labels) {
     const region = (result.regions || []).find((r) => num(r.index) === num(rej.region));
     if (!region) return;
     const group = ps.svg(g, "g", { class: "rejection", "data-region": num(rej.region) });
     ps.svg(group, "path", { class: "rejected", d: polygonPath(m, [region.outline]) });
     const f = ps.sensorToFrame(m, num(region.box_x) + num(region.box_width), num(region.box_y));
-    ps.svg(group, "text", { class: "reason", x: f[0] + 4, y: f[1] + size * 0.025, "font-size": size * 0.022 },
-           rej.text || rej.test || "rejected");
+    // The reason on one line; the remedy, when WHY names one, on a second
+    // that applies it when clicked.
+    const reason = rej.text || rej.test || "rejected";
+    const cut = rej.remedy_key ? reason.indexOf(", " + rej.remedy_key + " ") : -1;
+    const text = ps.svg(group, "text", { class: "reason", x: 0, y: 0, "font-size": size * 0.022 });
+    ps.svg(text, "tspan", {}, cut >= 0 ? reason.slice(0, cut) : reason);
+    if (rej.remedy_key) {
+      const remedy = ps.svg(text, "tspan", { class: "remedy", x: 0, dy: "1.2em", "data-region": num(rej.region) },
+                            "apply " + rej.remedy_key + " " + rej.remedy_value);
+      remedy.addEventListener("click", () => applyRemedy(result, rej));
+    }
+    labels.push({ el: text, x: f[0], y: f[1], gap: size * 0.006 });
     const c = pt(region.centroid);
-    drawn.rejections.push({ region: num(rej.region), test: rej.test || "", text: rej.text || "", sensor_x: c[0], sensor_y: c[1] });
+    drawn.rejections.push({ region: num(rej.region), test: rej.test || "", text: rej.text || "",
+                            remedy: rej.remedy_key ? rej.remedy_key + " " + rej.remedy_value : "",
+                            sensor_x: c[0], sensor_y: c[1] });
+  }
+
+  // The labels placed one after another (parts first, then the reasons),
+  // each at the first of a few spots around its anchor, nearest first,
+  // where it stays inside the frame and covers no label placed before it;
+  // with no such spot, the first inside the frame. Boxes are the text's
+  // own (getBBox, frame pixels).
+  function placeLabels(labels, m) {
+    const placed = [];
+    const overlaps = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+    for (const l of labels) {
+      const box = l.el.getBBox();
+      const w = box.width;
+      const h = box.height;
+      const spots = [];
+      for (let k = 0; k < 8; k++) {
+        const d = l.gap + k * h;
+        spots.push([l.x + l.gap, l.y - d - h], [l.x + l.gap, l.y + d], [l.x - l.gap - w, l.y - d - h],
+                   [l.x - l.gap - w, l.y + d], [l.x - w / 2, l.y - d - 2 * h], [l.x - w / 2, l.y + d + h]);
+      }
+      const boxAt = (s) => ({ x: s[0], y: s[1], w, h });
+      const inside = (s) => s[0] >= 0 && s[1] >= 0 && s[0] + w <= m.frameW && s[1] + h <= m.frameH;
+      const spot = spots.find((s) => inside(s) && !placed.some((p) => overlaps(boxAt(s), p))) ||
+                   spots.find(inside) || spots[0];
+      // The text's origin is its first baseline: moved by the box's offset.
+      const x = spot[0] - box.x;
+      l.el.setAttribute("x", x);
+      l.el.setAttribute("y", spot[1] - box.y);
+      for (const line of l.el.querySelectorAll("tspan[dy]")) line.setAttribute("x", x);
+      placed.push(boxAt(spot));
+    }
+  }
+
+  // TOLERANCE as WHY named it for the rejected region, then the result's
+  // own LOCATE again, which the remedy was checked with: the region should
+  // now be a part.
+  async function applyRemedy(result, rej) {
+    const line = "TOLERANCE " + num(rej.nearest_type) + " " + rej.remedy_key + " " + rej.remedy_value;
+    const reply = await say(line);
+    const request = String(result.request_line || "");
+    if (reply.startsWith("OK") && request.toUpperCase().startsWith("LOCATE")) await say(request);
   }
 
   function draw() {
@@ -89,7 +142,7 @@
     svgRoot.textContent = "";
     ps.sizeLayers();
     const result = ps.app ? ps.latest[ps.app] : null;
-    const drawn = { app: ps.app, request_id: null, parts: [], rejections: [], regions: 0 };
+    const drawn = { app: ps.app, request_id: null, parts: [], rejections: [], regions: 0, labels: 0 };
     ps.lastOverlay = drawn;
     svgRoot.dataset.parts = "0";
     if (!result || !$("live-overlay").checked) return;
@@ -104,8 +157,13 @@
         drawn.regions += 1;
       }
     }
-    for (const rej of result.rejections || []) drawRejection(g, m, result, rej, size, drawn);
-    (result.parts || []).forEach((part, i) => drawPart(g, m, result, part, i, size, drawn));
+    const partLabels = [];
+    const reasons = [];
+    for (const rej of result.rejections || []) drawRejection(g, m, result, rej, size, drawn, reasons);
+    (result.parts || []).forEach((part, i) => drawPart(g, m, result, part, i, size, drawn, partLabels));
+    // Parts' labels first: they are placed nearest their parts.
+    placeLabels(partLabels.concat(reasons), m);
+    drawn.labels = partLabels.length + reasons.length;
     svgRoot.dataset.parts = String(drawn.parts.length);
     svgRoot.dataset.requestId = drawn.request_id;
   }
@@ -135,6 +193,17 @@
     for (const rej of result.rejections || []) {
       const li = document.createElement("li");
       li.textContent = "region " + num(rej.region) + ": " + (rej.text || rej.test);
+      if (rej.remedy_key) {
+        const apply = document.createElement("button");
+        apply.type = "button";
+        apply.className = "remedy";
+        apply.dataset.region = String(num(rej.region));
+        apply.textContent = "apply " + rej.remedy_key + " " + rej.remedy_value;
+        apply.title = "TOLERANCE " + num(rej.nearest_type) + " " + rej.remedy_key + " " + rej.remedy_value +
+                      ", then " + (result.request_line || "LOCATE");
+        apply.addEventListener("click", () => applyRemedy(result, rej));
+        li.append(" ", apply);
+      }
       $("result-rejections").appendChild(li);
     }
   }

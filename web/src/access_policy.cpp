@@ -35,6 +35,10 @@ Role roleForCommand(std::string_view line) {
   if (w.empty()) return Role::kOperator;  // refused by the app anyway
   const std::string& command = w[0];
   if (reads.count(command) > 0) return Role::kOperator;
+  // The filmstrip: replays and reads change nothing; an export writes a
+  // folder on the vision app's host.
+  if (command == "REPLAY") return Role::kOperator;
+  if (command == "FILMSTRIP" && (w.size() < 2 || w[1] != "EXPORT")) return Role::kOperator;
   // Reads with these arguments, changes with more.
   if ((command == "EXPOSURE" || command == "ROI" || command == "CAMMODE" || command == "VISION") &&
       w.size() == 1)

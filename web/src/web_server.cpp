@@ -34,6 +34,7 @@
 #include "picksight/web/camera_actions.hpp"
 #include "picksight/web/camera_monitor.hpp"
 #include "picksight/web/event_hub.hpp"
+#include "picksight/web/filmstrip_view.hpp"
 #include "picksight/web/http_gate.hpp"
 #include "picksight/web/idle_worker.hpp"
 #include "picksight/web/metrics_text.hpp"
@@ -247,6 +248,8 @@ class WebServer::Impl {
   void changeUser(const httplib::Request& req, httplib::Response& res, AuditRecord record,
                   nlohmann::json after, const std::function<Result<void>()>& change);
   void auditRoutes();
+  // The filmstrip's entries and frames, read through a vision app's port.
+  void filmstripRoutes();
   // http_->Post(pattern, handler), telling the gate (with TLS) that the
   // request has arrived whole before the handler runs.
   void post(const std::string& pattern, httplib::Server::Handler handler);
@@ -1068,6 +1071,7 @@ void WebServer::Impl::routes() {
       return sendError(res, WebErrc::kBadRequest, "\"line\": must be a string");
     command(*app, line->get<std::string>(), req, res);
   });
+  filmstripRoutes();
   http_->Get(R"(/api/cameras/([^/]+)/features)",
              [this](const httplib::Request& req, httplib::Response& res) {
                proto::ControlRequest request;
@@ -1083,6 +1087,43 @@ void WebServer::Impl::routes() {
        [this](const httplib::Request& req, httplib::Response& res) {
          cameraAction(req.matches[1], req.matches[2], req, res);
        });
+}
+
+void WebServer::Impl::filmstripRoutes() {
+  // Reads for operators; REPLAY and FILMSTRIP EXPORT go through the
+  // command route (the role each line needs: access_policy).
+  http_->Get(R"(/api/apps/([^/]+)/filmstrip)", [this](const httplib::Request& req,
+                                                      httplib::Response& res) {
+    ResultFeed* app = appOr404(req.matches[1], res);
+    if (!app) return;
+    size_t count = 24;
+    if (req.has_param("n")) {
+      const auto n = parseInt(req.get_param_value("n"));
+      if (!n || *n < 1 || *n > static_cast<int64_t>(kMaxFilmstripEntries))
+        return sendError(res, WebErrc::kBadRequest,
+                         "n: a number of entries, 1.." + std::to_string(kMaxFilmstripEntries));
+      count = static_cast<size_t>(*n);
+    }
+    auto entries = filmstripEntries(*app, count, req.get_param_value("failures") == "1");
+    if (!entries) return sendError(res, entries.error());
+    sendJson(res, *entries);
+  });
+  http_->Get(R"(/api/apps/([^/]+)/filmstrip/([0-9]{1,10})\.png)",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               ResultFeed* app = appOr404(req.matches[1], res);
+               if (!app) return;
+               int side = 1024;
+               if (req.has_param("side")) {
+                 const auto n = parseInt(req.get_param_value("side"));
+                 if (!n || *n < 16 || *n > 2048)
+                   return sendError(res, WebErrc::kBadRequest, "side: pixels, 16..2048");
+                 side = static_cast<int>(*n);
+               }
+               auto png = filmstripPng(*app, std::stoull(req.matches[2].str()), side);
+               if (!png) return sendError(res, png.error());
+               res.set_header("Cache-Control", "no-store");
+               res.set_content(*png, "image/png");
+             });
 }
 
 void WebServer::Impl::post(const std::string& pattern, httplib::Server::Handler handler) {

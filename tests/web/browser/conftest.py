@@ -68,6 +68,23 @@ def wait_until(condition, timeout=30.0, what="condition", interval=0.05):
     raise AssertionError(f"timed out waiting for {what} (last: {last!r})")
 
 
+def click_css(browser, css, timeout=10.0):
+    """Clicks the element `css` selects. A panel's list is drawn again when a
+    refresh it started returns, so an element found a moment before may be
+    replaced by its copy: the click then goes to the copy."""
+    from selenium.common.exceptions import StaleElementReferenceException
+    from selenium.webdriver.common.by import By
+
+    def attempt():
+        try:
+            browser.driver.find_element(By.CSS_SELECTOR, css).click()
+            return True
+        except StaleElementReferenceException:
+            return False
+
+    wait_until(attempt, timeout=timeout, what=f"a click on {css}")
+
+
 def stdout_lines(process, until="ready", timeout=20.0):
     """Every stdout line of a starting process up to `until`, as
     {first word: rest of the line}."""

@@ -9,7 +9,7 @@ import json
 
 from selenium.webdriver.common.by import By
 
-from conftest import Cell, wait_until
+from conftest import Cell, click_css, wait_until
 from test_page import click, ok_fields, select_tab
 
 import pytest
@@ -38,7 +38,7 @@ def models(cell):
 
 
 def row_button(browser, job, action):
-    browser.driver.find_element(By.CSS_SELECTOR, f'#jobs-list tr[data-job="{job}"] .job-{action}').click()
+    click_css(browser, f'#jobs-list tr[data-job="{job}"] .job-{action}')
 
 
 def test_jobs_panel_saves_loads_exports_and_imports(cell, browser, tmp_path):

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "line_buffer.hpp"
 #include "picksight/common/allow_list.hpp"
 
 namespace picksight {
@@ -111,15 +112,11 @@ Result<std::string> LineClient::readLine(std::chrono::milliseconds timeout) {
   if (fd_ < 0) return systemError(ENOTCONN, "not connected");
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    const size_t nl = buffer_.find('\n');
-    if (nl != std::string::npos) {
-      std::string line = buffer_.substr(0, nl);
-      buffer_.erase(0, nl + 1);
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      return line;
+    if (auto line = takeLine(buffer_)) {
+      if (!line->empty() && line->back() == '\r') line->pop_back();
+      return *line;
     }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    const auto left = timeLeft(deadline);
     if (left.count() <= 0) return systemError(ETIMEDOUT, "no reply in time");
     pollfd p{fd_, POLLIN, 0};
     const int r = ::poll(&p, 1, static_cast<int>(left.count()));

@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "line_buffer.hpp"
+
 extern char** environ;
 
 namespace picksight {
@@ -46,14 +48,8 @@ Subprocess::~Subprocess() {
 std::optional<std::string> Subprocess::readLine(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    const size_t nl = buffer_.find('\n');
-    if (nl != std::string::npos) {
-      std::string line = buffer_.substr(0, nl);
-      buffer_.erase(0, nl + 1);
-      return line;
-    }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    if (auto line = takeLine(buffer_)) return line;
+    const auto left = timeLeft(deadline);
     if (left.count() <= 0 || stdout_fd_ < 0) return std::nullopt;
     pollfd p{stdout_fd_, POLLIN, 0};
     const int r = ::poll(&p, 1, static_cast<int>(left.count()));
@@ -71,8 +67,7 @@ std::optional<std::string> Subprocess::waitForLine(const std::string& prefix,
                                                    std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    const auto left = timeLeft(deadline);
     if (left.count() <= 0) return std::nullopt;
     auto line = readLine(left);
     if (!line) return std::nullopt;

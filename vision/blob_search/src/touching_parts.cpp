@@ -557,6 +557,11 @@ std::vector<Match> BlobSearch::run() {
 
 std::vector<Match> BlobSearch::matches() const {
   std::vector<Match> found;
+  // A part is touching when the blob holds more than it: other parts, or
+  // pixels its placed outline leaves over. One part that explains the blob
+  // whole (a lone part the whole-region tests refused, found here) touches
+  // nothing: its region is its own.
+  const bool alone = taken_.size() == 1 && explainsWhole();
   for (const size_t i : taken_) {
     const Candidate& c = *placed_[i].candidate;
     Match match;
@@ -566,7 +571,8 @@ std::vector<Match> BlobSearch::matches() const {
     match.centroid = c.pose.centre;
     match.symmetry_deg = c.model->symmetryDeg();
     match.angle_deg = reportedTurnDeg(*c.model, c.pose.angle_deg);
-    match.touching = true;
+    match.from_edges = true;
+    match.touching = !alone;
     found.push_back(match);
   }
   return found;

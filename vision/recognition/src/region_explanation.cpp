@@ -1,9 +1,12 @@
 // Region explanations: every model's verdict on the region (judgeRegion,
-// the recognizer's tests), the nearest model's named.
+// the recognizer's tests), the nearest model's named; the remedy that
+// would accept it, checked through the cell's recognition pass.
 #include "picksight/vision/recognition/region_explanation.hpp"
 
 #include <algorithm>
 #include <cmath>
+
+#include "picksight/vision/recognition/recognition_pass.hpp"
 
 namespace picksight::vision {
 
@@ -58,6 +61,101 @@ RegionExplanation explainRegionAsAsked(const Region& region,
   for (const PartModel* m : models)
     if (m->type == asked_type) asked.push_back(m);
   return explainRegion(region, asked);
+}
+
+namespace {
+// A tolerance written with this many decimals: the value TOLERANCE reads
+// back is the one checked here.
+constexpr int kRemedyDecimals = 3;
+constexpr int kRemedyPercentDecimals = 1;
+// Below this a remedy is rounding noise of the measured value.
+constexpr double kRemedySlack = 1e-9;
+// A remedy admits the measured value with a margin: a Hu distance or an
+// area's relative gap this much larger, a verified share this many points
+// lower. The next frame of a live camera measures the region again, a
+// little differently; a bound set exactly on this frame's value would
+// refuse the region as often as not.
+constexpr double kRemedyMargin = 0.1;
+constexpr double kRemedyVerifyPoints = 2;
+
+double roundUp(double v, int decimals) {
+  const double f = std::pow(10.0, decimals);
+  return std::ceil((v + kRemedySlack) * f) / f;
+}
+
+double roundDown(double v, int decimals) {
+  const double f = std::pow(10.0, decimals);
+  return std::floor((v - kRemedySlack) * f) / f;
+}
+
+// The change of `model` that admits the measured value of `why`, within
+// the bounds TOLERANCE accepts; none for tests no tolerance decides.
+std::optional<RegionRemedy> candidateRemedy(const RegionExplanation& why, const PartModel& model) {
+  RegionRemedy r;
+  r.type = model.type;
+  r.decimals = kRemedyDecimals;
+  switch (why.test) {
+    case RegionTest::kArea:
+    case RegionTest::kScale: {
+      // The area against the model's; a scaled copy's is its scale squared.
+      r.key = "area_tolerance";
+      const double ratio = why.test == RegionTest::kArea
+                               ? why.measured / std::max(model.body.area, 1.0)
+                               : why.measured * why.measured;
+      r.value = roundUp(std::abs(ratio - 1) * (1 + kRemedyMargin), r.decimals);
+      if (r.value >= 1) return std::nullopt;  // area_tolerance is below 1
+      return r;
+    }
+    case RegionTest::kHu:
+      r.key = "hu_tolerance";
+      r.value = roundUp(why.measured * (1 + kRemedyMargin), r.decimals);
+      if (r.value > 100) return std::nullopt;
+      return r;
+    case RegionTest::kVerify:
+      r.key = "verify_percent";
+      r.decimals = kRemedyPercentDecimals;
+      r.value = roundDown(why.measured - kRemedyVerifyPoints, r.decimals);
+      if (r.value <= 0) return std::nullopt;
+      return r;
+    case RegionTest::kMirror:
+      r.key = "mirror_symmetric";
+      r.decimals = 0;
+      r.value = 1;
+      return r;
+    default:
+      return std::nullopt;
+  }
+}
+
+void applyRemedy(PartModel& model, const RegionRemedy& r) {
+  const std::string key = r.key;
+  if (key == "area_tolerance") model.body.area_tolerance = r.value;
+  if (key == "hu_tolerance") model.body.hu_tolerance = r.value;
+  if (key == "verify_percent") model.verify_percent = r.value;
+  if (key == "mirror_symmetric") model.body.mirror_symmetric = r.value != 0;
+}
+}  // namespace
+
+std::optional<RegionRemedy> remedyFor(const Region& region, const std::vector<PartModel>& models,
+                                      const RegionExplanation& why, int asked_type) {
+  if (!why.nearest || why.other_type) return std::nullopt;
+  size_t index = 0;
+  while (index < models.size() && &models[index] != why.nearest) ++index;
+  if (index == models.size()) return std::nullopt;
+  const auto remedy = candidateRemedy(why, *why.nearest);
+  if (!remedy) return std::nullopt;
+  std::vector<PartModel> changed = models;
+  applyRemedy(changed[index], *remedy);
+  // The changed model's own verdict first: a region another test still
+  // refuses costs no touching-parts search.
+  const PartModel& model = changed[index];
+  const Region seen = withHolesAtLeast(region, model.min_hole_area);
+  RegionCache cache(seen, model.edge_tolerance);
+  if (judgeRegion(cache, model).test != RegionTest::kPasses) return std::nullopt;
+  // Then LOCATE's own pass on the region (every model, the screen of
+  // LOCATE <type> across types): a part there is a part LOCATE reports.
+  if (recognizeParts({region}, changed, asked_type).matches.empty()) return std::nullopt;
+  return remedy;
 }
 
 }  // namespace picksight::vision

@@ -165,6 +165,23 @@ void addRowNoise(const uint8_t* up, const uint8_t* mid, const uint8_t* down, con
   }
 }
 
+// The deviation of the noise from Immerkaer's residuals summed per cell
+// row (added in row order: the same whatever the number of threads).
+double noiseDeviation(const std::vector<int64_t>& residual_sums,
+                      const std::vector<int64_t>& residual_counts) {
+  int64_t residual_sum = 0;
+  int64_t residual_count = 0;
+  for (size_t j = 0; j < residual_sums.size(); ++j) {
+    residual_sum += residual_sums[j];
+    residual_count += residual_counts[j];
+  }
+  // The kernel's response to white noise of deviation s has mean absolute
+  // value 6 s sqrt(2 / pi).
+  return residual_count > 0 ? static_cast<double>(residual_sum) / residual_count /
+                                  (6 * std::sqrt(2 / 3.14159265358979))
+                            : 0;
+}
+
 // Where a part's edge runs, the threshold that splits it is the grey level
 // halfway up its own step, whatever the light and the part's shading there.
 // A single ratio to the background cannot follow a part shaded lighter on
@@ -271,17 +288,7 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
   });
   level_sums = sums32;
   weights = weights32;
-  int64_t residual_sum = 0;
-  int64_t residual_count = 0;
-  for (size_t j = 0; j < residual_sums.size(); ++j) {
-    residual_sum += residual_sums[j];
-    residual_count += residual_counts[j];
-  }
-  // The kernel's response to white noise of deviation s has mean absolute
-  // value 6 s sqrt(2 / pi).
-  *noise = residual_count > 0 ? static_cast<double>(residual_sum) / residual_count /
-                                    (6 * std::sqrt(2 / 3.14159265358979))
-                              : 0;
+  *noise = noiseDeviation(residual_sums, residual_counts);
 }
 
 struct GuidedThreshold {

@@ -33,6 +33,13 @@ struct RawOptions {
   std::string modbus_word_order;
   std::string curve_server_key;
   std::string curve_key;
+  std::string filmstrip_dir;
+  std::string filmstrip_entries;
+  std::string filmstrip_mb;
+  std::string filmstrip_failures;
+  std::string filmstrip_failure_mb;
+  std::string filmstrip_queue;
+  std::string filmstrip_interval;
 };
 
 std::string checkRange(const std::string& v, long long low, long long high) {
@@ -55,6 +62,49 @@ std::string checkThreshold(const std::string& v) {
     return "fixed level must be in [0, 255], got '" + v + "'";
   }
   return "must be adaptive, otsu or fixed:LEVEL, got '" + v + "'";
+}
+
+// The filmstrip's directory and bounds (filmstrip.hpp).
+void defineFilmstripOptions(CLI::App& app, RawOptions& raw) {
+  const filmstrip::FilmstripOptions defaults;
+  const auto count = [](long long high) {
+    return checkValue([high](const std::string& v) { return checkRange(v, 1, high); });
+  };
+  app.add_option("--filmstrip-dir", raw.filmstrip_dir,
+                 "where the frames of recent LOCATE, WHY and PLC requests are kept "
+                 "(default DATA_DIR/filmstrip; 'none': no filmstrip)")
+      ->type_name("DIR");
+  app.add_option("--filmstrip-entries", raw.filmstrip_entries,
+                 "successful requests kept (default " + std::to_string(defaults.max_entries) + ")")
+      ->type_name("N")
+      ->check(count(1000000));
+  app.add_option("--filmstrip-mb", raw.filmstrip_mb,
+                 "their megabytes on disk at most (default " +
+                     std::to_string(defaults.max_bytes >> 20) + ")")
+      ->type_name("MB")
+      ->check(count(1000000));
+  app.add_option("--filmstrip-failures", raw.filmstrip_failures,
+                 "failed requests (nothing found, an error) and WHYs kept (default " +
+                     std::to_string(defaults.max_failures) + ")")
+      ->type_name("N")
+      ->check(count(1000000));
+  app.add_option("--filmstrip-failure-mb", raw.filmstrip_failure_mb,
+                 "their megabytes on disk at most (default " +
+                     std::to_string(defaults.max_failure_bytes >> 20) + ")")
+      ->type_name("MB")
+      ->check(count(1000000));
+  app.add_option("--filmstrip-queue", raw.filmstrip_queue,
+                 "requests waiting to be written; beyond, successes are dropped first and "
+                 "counted (default " +
+                     std::to_string(defaults.queue) + ")")
+      ->type_name("N")
+      ->check(count(4096));
+  app.add_option("--filmstrip-success-ms", raw.filmstrip_interval,
+                 "a success is recorded only this long after the last one recorded (0: every "
+                 "one; failures always; default " +
+                     std::to_string(defaults.success_interval.count()) + ")")
+      ->type_name("MS")
+      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 86400000); }));
 }
 
 // Declares the options on `app`, bound to `o` and `raw`; parseAppArgs and
@@ -168,6 +218,7 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
       ->check(checkValue([](const std::string& v) {
         return plc::parseWordOrder(v) ? std::string() : "must be ABCD or CDAB, got '" + v + "'";
       }));
+  defineFilmstripOptions(app, raw);
   CLI::Option* server_key =
       app.add_option("--curve-server-key", raw.curve_server_key,
                      "talk CURVE to the video server: its public NAME.key (docs/SECURITY.md)")
@@ -242,6 +293,21 @@ Result<AppOptions> finishOptions(AppOptions o, RawOptions& raw) {
   if (!raw.modbus_allow.empty()) o.plc.server.listen.allow = *AllowList::parse(raw.modbus_allow);
   if (!raw.modbus_word_order.empty())
     o.plc.device.word_order = *plc::parseWordOrder(raw.modbus_word_order);
+  if (raw.filmstrip_dir != "none")
+    o.filmstrip.dir = raw.filmstrip_dir.empty() ? o.data_dir + "/filmstrip" : raw.filmstrip_dir;
+  if (!raw.filmstrip_entries.empty())
+    o.filmstrip.max_entries = static_cast<size_t>(*parseInt(raw.filmstrip_entries));
+  if (!raw.filmstrip_mb.empty())
+    o.filmstrip.max_bytes = static_cast<uint64_t>(*parseInt(raw.filmstrip_mb)) << 20;
+  if (!raw.filmstrip_failures.empty())
+    o.filmstrip.max_failures = static_cast<size_t>(*parseInt(raw.filmstrip_failures));
+  if (!raw.filmstrip_failure_mb.empty())
+    o.filmstrip.max_failure_bytes = static_cast<uint64_t>(*parseInt(raw.filmstrip_failure_mb))
+                                    << 20;
+  if (!raw.filmstrip_queue.empty())
+    o.filmstrip.queue = static_cast<size_t>(*parseInt(raw.filmstrip_queue));
+  if (!raw.filmstrip_interval.empty())
+    o.filmstrip.success_interval = std::chrono::milliseconds(*parseInt(raw.filmstrip_interval));
   if (!raw.curve_server_key.empty()) {
     auto keys = loadClientKeys(raw.curve_key, raw.curve_server_key);
     if (!keys) return keys.error();

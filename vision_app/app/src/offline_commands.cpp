@@ -3,7 +3,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <iomanip>
 #include <optional>
 #include <ostream>
 #include <variant>
@@ -23,6 +25,25 @@
 
 namespace picksight::app {
 
+using protocol::blobSummary;
+using protocol::errorReply;
+using protocol::learnReply;
+using protocol::locateReply;
+using protocol::parseType;
+using protocol::printable;
+using protocol::ProtocolErrc;
+using protocol::validModelName;
+
+using cell::blobsInImage;
+using cell::learnInImage;
+using cell::locateAndPick;
+using cell::locateInFrame;
+using cell::LocateOutcome;
+using cell::parseVisionSettingsJson;
+using cell::teachImagePng;
+using cell::VisionOptions;
+using cell::VisionServiceErrc;
+
 using store::CellCalibration;
 using store::CellCalibrationErrc;
 using store::ModelLibrary;
@@ -32,6 +53,8 @@ std::string offlineUsage() {
          "       picksight-vision locate [--type N] [options] IMAGE...\n"
          "       picksight-vision blobs [options] IMAGE...\n"
          "       picksight-vision lens [--data-dir DIR] [--corners 9x6] [--square MM] IMAGE...\n"
+         "       picksight-vision test-run --models DIR --images DIR --expect N [--type N] "
+         "[options]\n"
          "\n"
          "  learn   trains type N from the single part in IMAGE into DATA_DIR/models\n"
          "          (with --at, the one part inside that rectangle, as LEARN ... AT)\n"
@@ -42,14 +65,17 @@ std::string offlineUsage() {
          "  lens    calibrates the lens from chessboard views (inner corners, square size)\n"
          "          into DATA_DIR/calibration.yaml: 'OK fx fy cx cy rms_px views'; stop the\n"
          "          vision app first, it reads the file at start\n"
+         "  test-run LOCATE (of type N, or all types) on every image of a folder with the\n"
+         "          models, settings and calibration of data dir DIR: a table of the poses\n"
+         "          found per image against N expected, pass or FAIL; exit 1 on any FAIL\n"
          "Options: --data-dir DIR, --threshold, --polarity, --window, --min-area, "
          "--min-hole-area as in server mode; DATA_DIR/vision.json (VISION) supplies those "
          "not given.\n";
 }
 
 bool isOfflineCommand(const std::vector<std::string>& args) {
-  return !args.empty() &&
-         (args[0] == "learn" || args[0] == "locate" || args[0] == "blobs" || args[0] == "lens");
+  return !args.empty() && (args[0] == "learn" || args[0] == "locate" || args[0] == "blobs" ||
+                           args[0] == "lens" || args[0] == "test-run");
 }
 
 namespace {
@@ -195,6 +221,108 @@ std::variant<OfflineRequest, int> parseOfflineRequest(const std::vector<std::str
   return r;
 }
 
+// test-run's command line as a locate over the folder's images (regular,
+// not hidden, in name order, as a dir: camera serves them) and the count
+// expected; or the exit status (2) once what is wrong is written to `err`.
+std::variant<std::pair<std::vector<std::string>, int>, int> testRunRequest(
+    const std::vector<std::string>& args, std::ostream& err) {
+  std::vector<std::string> locate{"test-run"};
+  std::string images;
+  std::optional<int> expect;
+  bool models = false;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has_value = i + 1 < args.size();
+    if (a == "--images" && has_value) {
+      images = args[++i];
+    } else if (a == "--expect" && has_value) {
+      const auto n = parseInt(args[++i]);
+      if (!n || *n < 0 || *n > 100000) {
+        err << "picksight-vision test-run: --expect must be a number of parts in [0, 100000], got '"
+            << printable(args[i]) << "'\n";
+        return 2;
+      }
+      expect = static_cast<int>(*n);
+    } else if (a == "--models" && has_value) {
+      locate.push_back("--data-dir");
+      locate.push_back(args[++i]);
+      models = true;
+    } else if (a.rfind("--", 0) == 0) {
+      // --type and the vision settings, as locate takes them.
+      locate.push_back(a);
+      if (has_value) locate.push_back(args[++i]);
+    } else {
+      err << "picksight-vision test-run: images come from --images DIR, got '" << printable(a)
+          << "'\n";
+      return 2;
+    }
+  }
+  if (images.empty() || !expect || !models) {
+    err << "picksight-vision test-run: needs --models DIR, --images DIR and --expect N\n\n"
+        << offlineUsage();
+    return 2;
+  }
+  std::error_code ec;
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(images, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name[0] == '.' || !e.is_regular_file(ec)) continue;
+    files.push_back(e.path().string());
+  }
+  if (ec) {
+    err << "picksight-vision test-run: --images " << images << ": " << ec.message() << "\n";
+    return 2;
+  }
+  if (files.empty()) {
+    err << "picksight-vision test-run: --images " << images << " holds no image\n";
+    return 2;
+  }
+  std::sort(files.begin(), files.end());
+  locate.insert(locate.end(), files.begin(), files.end());
+  return std::make_pair(locate, *expect);
+}
+
+// LOCATE on each image against the count expected: one row per image
+// (image, poses found, expected, pass or FAIL) and a last line with the
+// totals. 0 when every image passed, else 1.
+int testRun(const OfflineRequest& r, int expect, ModelLibrary& library,
+            const CellCalibration& calibration, std::ostream& out) {
+  size_t width = 5;
+  for (const auto& path : r.images)
+    width = std::max(width, std::filesystem::path(path).filename().string().size());
+  const auto row = [&](const std::string& image, const std::string& found,
+                       const std::string& result) {
+    out << image << std::string(width - image.size() + 2, ' ')
+        << std::string(5 - std::min<size_t>(5, found.size()), ' ') << found << "  " << std::setw(8)
+        << expect << "  " << result << "\n";
+  };
+  out << "image" << std::string(width - 5 + 2, ' ') << "found  expected  result\n";
+  size_t passed = 0;
+  for (const auto& path : r.images) {
+    const std::string name = std::filesystem::path(path).filename().string();
+    const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (grey.empty()) {
+      row(name, "-", "FAIL not an image");
+      continue;
+    }
+    const auto located = locateAndPick(calibration, &library, [&]() -> Result<LocateOutcome> {
+      return locateInFrame(frameFromImage(grey, path, 1), r.options.vision, library.snapshot(),
+                           r.type);
+    });
+    if (!located) {
+      row(name, "-", "FAIL " + errorReply(located.error()));
+      continue;
+    }
+    const int found = static_cast<int>(located->pick.poses.size());
+    passed += found == expect;
+    row(name, std::to_string(found), found == expect ? "pass" : "FAIL");
+  }
+  out << (passed == r.images.size() ? "PASS " : "FAIL ") << passed << " of " << r.images.size()
+      << " images with " << expect
+      << (r.type < 0 ? " parts of any type" : " parts of type " + std::to_string(r.type)) << "\n";
+  return passed == r.images.size() ? 0 : 1;
+}
+
 // picksight-vision learn on its one image: the model stored as LEARN
 // stores it. The exit status.
 int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string& path,
@@ -236,7 +364,14 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
     return 2;
   }
   if (args[0] == "lens") return runLens(args, out, err);
-  auto parsed = parseOfflineRequest(args, err);
+  std::optional<int> expect;
+  std::vector<std::string> request = args;
+  if (args[0] == "test-run") {
+    auto rewritten = testRunRequest(args, err);
+    if (const int* status = std::get_if<int>(&rewritten)) return *status;
+    std::tie(request, expect) = std::get<std::pair<std::vector<std::string>, int>>(rewritten);
+  }
+  auto parsed = parseOfflineRequest(request, err);
   if (const int* status = std::get_if<int>(&parsed)) return *status;
   OfflineRequest& r = std::get<OfflineRequest>(parsed);
   // The vision settings the data dir's vision app runs with (VISION), the
@@ -262,6 +397,7 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   if (auto loaded = calibration.load(); !loaded)
     err << "picksight-vision: calibration rejected: " << loaded.error().message << "\n";
 
+  if (expect) return testRun(r, *expect, library, calibration, out);
   int status = 0;
   for (const auto& path : r.images) {
     const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);

@@ -6,7 +6,7 @@
 namespace picksight::app {
 
 PlcPort::PlcPort(const PlcPortOptions& options, VisionCell& cell)
-    : device_(options.device, plc::cellPicker(cell.context(), cell.results()),
+    : device_(options.device, plc::cellPicker(cell.context(), cell.results(), cell.filmstrip()),
               plc::cellFrameState(cell.calibration()), plc::robotErrorCodeOf),
       server_(options.server, device_) {
   device_.setJobs(plc::cellJobLoader(cell.jobs()), plc::cellJobState(cell.jobs()));

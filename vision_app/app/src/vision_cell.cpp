@@ -5,10 +5,20 @@
 
 #include "picksight/protocol/calibration_commands.hpp"
 #include "picksight/protocol/job_commands.hpp"
+#include "picksight/protocol/filmstrip_commands.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/protocol/vision_settings_commands.hpp"
 
 namespace picksight::app {
+
+using protocol::addCalibrationCommands;
+using protocol::addCellCommands;
+using protocol::addModelCommands;
+using protocol::addVisionSettingsCommands;
+using protocol::Publishes;
+using protocol::Session;
+
+using cell::VisionOptions;
 
 VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,
                        VisionOptions options, std::vector<std::string> command_line_settings)
@@ -26,6 +36,7 @@ VisionCell::VisionCell(const std::string& data_dir, std::unique_ptr<link::Camera
   addCellCommands(protocol_.table(), context_);
   addVisionSettingsCommands(protocol_.table(), vision_);
   protocol::addJobCommands(protocol_.table(), jobs_);
+  protocol::addFilmstripCommands(protocol_.table(), context_, filmstrip_);
 }
 
 std::vector<std::string> VisionCell::load() {
@@ -46,6 +57,40 @@ std::vector<std::string> VisionCell::load() {
   return problems;
 }
 
+Result<std::vector<std::string>> VisionCell::openFilmstrip(filmstrip::FilmstripOptions options) {
+  auto strip = filmstrip::Filmstrip::open(std::move(options));
+  if (!strip) return strip.error();
+  filmstrip_owner_ = std::move(*strip);
+  filmstrip_ = filmstrip_owner_.get();
+  return filmstrip_->problems();
+}
+
+std::function<void(const std::string& reply)> filmstripWhenSent(
+    filmstrip::Filmstrip* strip, std::string_view line, Session& s,
+    std::shared_ptr<const results::RequestRecord> record) {
+  const bool locate = s.command == "LOCATE" && record;
+  if (!strip || (!locate && s.command != "WHY")) return nullptr;
+  const uint64_t id = strip->reserve();
+  if (locate) {
+    s.last_locate_entry = id;
+    filmstrip::Take take{std::move(record), std::move(s.frame), "LOCATE", 0};
+    return [strip, id, take = std::move(take)](const std::string&) mutable {
+      strip->record(id, std::move(take));
+    };
+  }
+  // WHY has no record of its own: one with its line and reply, for the
+  // entry; its frame is the LOCATE's it explains.
+  return [strip, id, line = std::string(line), client = s.client,
+          explains = s.last_locate_entry](const std::string& reply) {
+    auto why = std::make_shared<results::RequestRecord>();
+    why->request = "WHY";
+    why->request_line = line;
+    why->client = client;
+    why->reply = reply;
+    strip->record(id, {std::move(why), nullptr, "WHY", explains});
+  };
+}
+
 }  // namespace picksight::app
 
 namespace picksight::app {
@@ -56,6 +101,8 @@ std::string VisionCell::handle(std::string_view line, bool read_only, Session* s
   if (!session) s.received = std::chrono::steady_clock::now();
   const auto frame_before = results_ ? vision_.lastFramePixels() : nullptr;
   std::string reply = protocol_.handle(line, read_only, &s);
+  // After the results stream's (which fills in the LOCATE record's reply).
+  auto film = filmstripWhenSent(filmstrip_, line, s, s.record);
   if (s.publishes == Publishes::kRecord && s.record) {
     // Filled in (reply, time) even with no results stream: WHY keeps it.
     s.after_reply = results::publishWhenSent(std::move(s.record), s.received, results_);
@@ -73,6 +120,18 @@ std::string VisionCell::handle(std::string_view line, bool read_only, Session* s
     if (frame != frame_before) record->frame = std::move(frame);
     s.after_reply = results::publishWhenSent(std::move(record), s.received, results_);
   }
+  if (film) {
+    if (s.after_reply) {
+      s.after_reply = [publish = std::move(s.after_reply),
+                       film = std::move(film)](const std::string& sent) {
+        publish(sent);
+        film(sent);
+      };
+    } else {
+      s.after_reply = std::move(film);
+    }
+  }
+  s.frame = nullptr;  // no session keeps a frame
   if (!session && s.after_reply) {
     s.after_reply(reply);
     s.after_reply = nullptr;

@@ -1,7 +1,7 @@
 // The cell's LOCATE: parts, grasps, reply frame, and the STATUS figures.
 #include "picksight/cell/cell_locate.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 using store::CellCalibration;
 using store::GraspMap;
@@ -61,4 +61,4 @@ Result<CellLocate> locateAndPick(CellContext& cell, int type) {
   return located;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

@@ -9,7 +9,7 @@
 
 #include "picksight/common/angles.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 using store::CellGeometry;
 using store::GraspMap;
@@ -170,4 +170,4 @@ CellPick pickPoses(const LocateOutcome& outcome, const GraspMap& grasps,
   return pick;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

@@ -6,7 +6,7 @@
 
 #include "picksight/cell/vision_service.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 using store::ModelList;
 
@@ -45,4 +45,4 @@ uint64_t ScaledModelCache::builds() const {
   return builds_;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

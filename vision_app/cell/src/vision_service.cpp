@@ -20,7 +20,7 @@
 #include "picksight/vision/segmentation/colour_axis.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 using store::ModelLibrary;
 using store::ModelList;
@@ -254,6 +254,7 @@ Result<LocateOutcome> VisionService::locate(int type) {
   if (!frame) return frame.error();
   auto outcome = locateInFrame(**frame, **settings, models, type, scaled_models_.get());
   outcome.settings = *settings;
+  outcome.pixels = *frame;
   return outcome;
 }
 
@@ -759,4 +760,4 @@ std::shared_ptr<const Frame> VisionService::lastFramePixels() const {
   return last_pixels_;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

@@ -11,7 +11,7 @@
 
 #include "picksight/common/text.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 using store::ModelList;
 
@@ -298,4 +298,4 @@ std::vector<std::string> modelsToReteach(const VisionOptions& before, const Visi
   return out;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

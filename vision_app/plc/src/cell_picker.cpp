@@ -21,7 +21,7 @@ uint16_t frameCode(store::CoordinateFrame frame) {
   return kFrameVisionPixels;
 }
 
-PlcResult plcResult(const app::CellLocate& located) {
+PlcResult plcResult(const cell::CellLocate& located) {
   PlcResult result;
   result.frame_sequence = located.outcome.frame.sequence;
   result.frame = frameCode(located.pick.frame);
@@ -34,16 +34,19 @@ PlcResult plcResult(const app::CellLocate& located) {
   return result;
 }
 
-PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results) {
-  return [&cell, &results](int type) -> Result<PlcResult> {
+PlcDevice::Picker cellPicker(cell::CellContext& cell, results::ResultsPublisher* const& results,
+                             filmstrip::Filmstrip* const& filmstrip) {
+  return [&cell, &results, &filmstrip](int type) -> Result<PlcResult> {
     const auto started = std::chrono::steady_clock::now();
-    auto located = app::locateAndPick(cell, type);
+    auto located = cell::locateAndPick(cell, type);
     Result<PlcResult> result =
         located ? Result<PlcResult>(plcResult(*located)) : Result<PlcResult>(located.error());
-    if (results) {
-      // Queued only: the publisher builds and sends it on its own thread.
+    if (results || filmstrip) {
+      // Queued only: the publisher and the filmstrip's writer do their
+      // work on their own threads.
       const std::string reply =
-          located ? app::locateReply(located->pick) : app::errorReply(located.error());
+          located ? protocol::locateReply(located->pick) : protocol::errorReply(located.error());
+      auto frame = located ? located->outcome.pixels : nullptr;
       auto record = results::locateRecord(std::move(located), type, cell.vision.options());
       record->request_line = "PLC TRIGGER " + std::to_string(type);
       record->client = "plc";
@@ -51,7 +54,8 @@ PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* 
       record->elapsed_ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
               .count();
-      results->publish(std::move(record));
+      if (filmstrip) filmstrip->record(filmstrip->reserve(), {record, std::move(frame), "PLC", 0});
+      if (results) results->publish(std::move(record));
     }
     return result;
   };
@@ -64,7 +68,7 @@ PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration) 
   };
 }
 
-int robotErrorCodeOf(const Error& error) { return app::robotErrorCode(error.code); }
+int robotErrorCodeOf(const Error& error) { return protocol::robotErrorCode(error.code); }
 
 PlcDevice::JobLoader cellJobLoader(jobs::JobSwitch& jobs) {
   return [&jobs](uint16_t number) -> Result<void> {

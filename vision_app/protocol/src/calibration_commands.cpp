@@ -8,7 +8,11 @@
 #include "picksight/calibration/target_measurement.hpp"
 #include "picksight/common/text.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
+
+using cell::TargetOutcome;
+using cell::VisionService;
+using cell::VisionServiceErrc;
 
 using store::CellCalibration;
 using store::CellCalibrationErrc;
@@ -212,4 +216,4 @@ void addCalibrationCommands(CommandTable& table, VisionService& vision,
       neverChanges);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

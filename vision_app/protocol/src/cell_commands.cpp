@@ -8,7 +8,14 @@
 #include "picksight/common/text.hpp"
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
+
+using cell::CellContext;
+using cell::CellLocate;
+using cell::CellPick;
+using cell::locateAndPick;
+using cell::VisionService;
+using cell::VisionServiceErrc;
 
 using store::frameName;
 using store::GraspSetup;
@@ -45,6 +52,7 @@ std::string locate(const Request& r, CellContext& cell) {
   const std::string out = !located ? reply(located.error())
                           : all    ? locateAllReply(*located)
                                    : locateReply(located->pick);
+  r.session->frame = located ? located->outcome.pixels : nullptr;
   auto record = results::locateRecord(std::move(located), *type, cell.vision.options());
   record->request_line = r.line;
   record->client = r.session->client;
@@ -349,4 +357,4 @@ void addCellCommands(CommandTable& table, CellContext& cell) {
       [&cell](const Request& r) { return cameraMode(r, cell); }, changesWithArguments);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -5,7 +5,7 @@
 #include "picksight/common/text.hpp"
 #include "picksight/protocol/robot_errors.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 const char* errorName(ProtocolErrc e) {
   switch (e) {
@@ -86,6 +86,7 @@ std::string CommandTable::dispatch(std::string_view line, bool read_only, Sessio
     session->command.clear();
     session->publishes = Publishes::kNothing;
     session->record = nullptr;
+    session->frame = nullptr;
     session->changed = false;
   }
   auto request = parseRequest(line);
@@ -137,4 +138,4 @@ std::string CommandTable::help() const {
   return out;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -1,7 +1,7 @@
 // Robot protocol line framing.
 #include "picksight/protocol/line_framer.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 bool LineFramer::feed(std::string_view bytes, const LineHandler& on_line,
                       const TooLongHandler& on_too_long) {
@@ -33,4 +33,4 @@ bool LineFramer::feed(std::string_view bytes, const LineHandler& on_line,
   return true;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -10,7 +10,13 @@
 #include "picksight/common/text.hpp"
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
+
+using cell::CellLocate;
+using cell::LearnOutcome;
+using cell::TryLearnOutcome;
+using cell::VisionService;
+using cell::VisionServiceErrc;
 
 using store::ModelErrc;
 using store::ModelList;
@@ -379,4 +385,4 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
       neverChanges, Publishes::kFrame);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -8,13 +8,17 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/jobs/job_file.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
 #include "picksight/transport/control_client.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
+
+using cell::VisionServiceErrc;
+using cell::VisionSettingsErrc;
 
 using store::CellCalibrationErrc;
 using store::ModelErrc;
@@ -73,6 +77,11 @@ const std::pair<std::error_code, int> kTable[] = {
     {jobs::JobErrc::kStorage, 52},
     {jobs::JobErrc::kTooLarge, 53},
     {jobs::JobErrc::kBadName, 54},
+    {filmstrip::FilmstripErrc::kNoEntry, 55},
+    {filmstrip::FilmstripErrc::kDamaged, 56},
+    {filmstrip::FilmstripErrc::kOff, 57},
+    {filmstrip::FilmstripErrc::kStorage, 58},
+    {filmstrip::FilmstripErrc::kNoFrame, 59},
     {ProtocolErrc::kInternalError, kInternal},
 };
 
@@ -87,4 +96,4 @@ int robotErrorCode(const std::error_code& code) {
   return kInternal;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -3,7 +3,10 @@
 
 #include "picksight/common/text.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
+
+using cell::VisionService;
+
 namespace {
 constexpr const char* kVersion = "0.1.0";
 }  // namespace
@@ -35,4 +38,4 @@ std::string RobotProtocol::frame(const Request& request) {
          std::to_string(f->height) + " " + (f->triggered ? "1" : "0");
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

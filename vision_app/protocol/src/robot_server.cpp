@@ -13,7 +13,7 @@
 #include "picksight/protocol/line_framer.hpp"
 #include "picksight/protocol/robot_errors.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 namespace {
 std::string errorLine(ProtocolErrc code, const std::string& text) {
   return errorReply(code, text) + "\n";
@@ -155,4 +155,4 @@ void RobotServer::serve(Connection& connection) {
   connection.done = true;
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

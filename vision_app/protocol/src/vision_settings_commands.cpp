@@ -8,7 +8,12 @@
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/text.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
+
+using cell::modelsToReteach;
+using cell::VisionService;
+using cell::visionSettingsText;
+
 namespace {
 
 constexpr const char* kUsage = "VISION [RESET | <key> <value> [<key> <value>]...]";
@@ -73,4 +78,4 @@ void addVisionSettingsCommands(CommandTable& table, VisionService& vision) {
       changesWithArguments);
 }
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

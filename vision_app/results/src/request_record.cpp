@@ -1,6 +1,7 @@
 // Rejections and the WHY line of a LOCATE: every region no offered part
 // came from, explained against the asked type's models (or as a part of
-// another type, or one with no free grasp).
+// another type, or one with no free grasp), with the tolerance change that
+// would accept it where one test alone refuses it.
 #include "picksight/results/request_record.hpp"
 
 #include <algorithm>
@@ -10,11 +11,11 @@
 #include "picksight/vision/recognition/region_explanation.hpp"
 
 namespace picksight::results {
-using app::CellLocate;
-using app::LocatedPart;
-using app::LocateScene;
-using app::ScreenedRegion;
-using app::VisionOptions;
+using cell::CellLocate;
+using cell::LocatedPart;
+using cell::LocateScene;
+using cell::ScreenedRegion;
+using cell::VisionOptions;
 using store::ModelList;
 namespace {
 
@@ -53,6 +54,13 @@ std::string rejectionText(const RegionRejection& r) {
   if (r.test == "edge") return region + " touches the frame border";
   if (r.test == "no model") return region + " no model";
   return region + " passes every test" + ofType(r.nearest_type) + " yet not reported";
+}
+
+// The remedy's clause after a rejection's sentence: "<key> <value> would
+// accept it" (the change of the nearest type's model, see remedyFor).
+std::string remedyText(const RegionRejection& r) {
+  if (r.remedy_key.empty()) return "";
+  return ", " + r.remedy_key + " " + r.remedy_value + " would accept it";
 }
 
 std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type) {
@@ -126,6 +134,10 @@ void RequestRecord::explain() const {
         r.measured = e.measured;
         r.low = e.low;
         r.high = e.high;
+        if (const auto remedy = vision::remedyFor(scene.regions[i], models, e, asked_type)) {
+          r.remedy_key = remedy->key;
+          r.remedy_value = formatFixed(remedy->value, remedy->decimals);
+        }
         if (e.test == vision::RegionTest::kArea) {
           r.measured = scene.mapping.areaToSensor(r.measured);
           r.low = scene.mapping.areaToSensor(r.low);
@@ -137,7 +149,7 @@ void RequestRecord::explain() const {
       for (const auto& m : models)
         if (m.type == r.nearest_type) r.nearest_name = m.name;
     }
-    r.text = rejectionText(r);
+    r.text = rejectionText(r) + remedyText(r);
     rejections_.push_back(std::move(r));
   }
   why_ = "OK " + std::to_string(rejections_.size());
@@ -169,6 +181,7 @@ std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int ty
     // Nothing published or explained reads the mask: a connection's last
     // LOCATE (kept for WHY) holds no frame-sized buffer.
     record->locate->scene.mask.release();
+    record->locate->pixels.reset();
     record->pick = std::move(located->pick);
     record->grasps = std::move(located->grasps);
     record->geometry = std::move(located->geometry);

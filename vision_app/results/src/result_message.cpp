@@ -11,12 +11,12 @@
 #include "picksight/grasp/grasp.hpp"
 
 namespace picksight::results {
-using app::greyImage;
-using app::LocatedPart;
-using app::LocateOutcome;
-using app::LocateScene;
-using app::modelOf;
-using app::partPoseInVisionFrame;
+using cell::greyImage;
+using cell::LocatedPart;
+using cell::LocateOutcome;
+using cell::LocateScene;
+using cell::modelOf;
+using cell::partPoseInVisionFrame;
 using store::CoordinateFrame;
 using store::GraspSetup;
 namespace {
@@ -252,6 +252,8 @@ void buildVisionResult(const RequestRecord& record, const std::string& app, uint
       rejection->set_measured(r.measured);
       rejection->set_low(r.low);
       rejection->set_high(r.high);
+      rejection->set_remedy_key(r.remedy_key);
+      rejection->set_remedy_value(r.remedy_value);
       rejection->set_text(r.text);
     }
   } else if (record.frame) {

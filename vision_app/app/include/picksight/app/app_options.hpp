@@ -8,6 +8,7 @@
 #include "picksight/app/plc_port.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/result.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/protocol/robot_server.hpp"
 #include "picksight/transport/curve_keys.hpp"
 
@@ -22,17 +23,20 @@ struct AppOptions {
   // The results stream's PUB endpoint ("none": no stream).
   std::string results_bind = "tcp://127.0.0.1:*";
   std::string data_dir = "picksight-data";
-  RobotServerOptions robot;
+  protocol::RobotServerOptions robot;
   // The robot port refuses requests that change the cell (docs/SECURITY.md).
   bool robot_read_only = false;
   // A second, full-access port for set-up (--setup-port); same limits and
   // allow-list as the robot port, on loopback unless --setup-bind says.
-  std::optional<RobotServerOptions> setup;
-  VisionOptions vision;
+  std::optional<protocol::RobotServerOptions> setup;
+  cell::VisionOptions vision;
   // The vision settings keys (vision_settings.hpp) the command line or
   // --config set: they win over <data dir>/vision.json at start.
   std::vector<std::string> vision_settings_given;
   PlcPortOptions plc;  // off unless --modbus-port is given
+  // The frames of recent requests (--filmstrip-*): in <data dir>/filmstrip
+  // unless --filmstrip-dir says; dir empty: none.
+  filmstrip::FilmstripOptions filmstrip;
   // CURVE keys for the camera link (loaded by parseAppArgs); nullopt: plain.
   std::optional<CurveClientKeys> curve;
 };

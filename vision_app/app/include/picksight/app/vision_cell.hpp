@@ -6,6 +6,7 @@
 // Threading: handle() is thread-safe once load() returned.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -14,6 +15,7 @@
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/jobs/job_switch.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"
@@ -30,7 +32,7 @@ class VisionCell {
   // vision settings keys (vision_settings.hpp) set on the command line, which
   // win over vision.json at start.
   VisionCell(const std::string& data_dir, std::unique_ptr<link::CameraLink> camera,
-             VisionOptions options, std::vector<std::string> command_line_settings = {});
+             cell::VisionOptions options, std::vector<std::string> command_line_settings = {});
   VisionCell(const VisionCell&) = delete;
   VisionCell& operator=(const VisionCell&) = delete;
 
@@ -47,7 +49,7 @@ class VisionCell {
   // left in session->after_reply for after the reply; without, it is
   // queued before this returns.
   std::string handle(std::string_view line, bool read_only = false,
-                     Session* session = nullptr) const;
+                     protocol::Session* session = nullptr) const;
 
   // Every vision request publishes its result there from now on (null:
   // none); `results` outlives the cell. Call before serving starts.
@@ -55,23 +57,40 @@ class VisionCell {
   // Where requests publish (null: nowhere); read at each request.
   results::ResultsPublisher* const& results() const { return results_; }
 
-  VisionService& vision() { return vision_; }
+  // Keeps the frames of LOCATE, LOCATE ALL and WHY requests in a
+  // filmstrip from now on (and of PLC triggers, through filmstrip());
+  // returns what its directory held that could not be read. Call before
+  // serving starts. Without, FILMSTRIP and REPLAY answer ERROR 57.
+  Result<std::vector<std::string>> openFilmstrip(filmstrip::FilmstripOptions options);
+  filmstrip::Filmstrip* const& filmstrip() const { return filmstrip_; }
+
+  cell::VisionService& vision() { return vision_; }
   store::ModelLibrary& models() { return models_; }
   store::CellCalibration& calibration() { return calibration_; }
   jobs::JobSwitch& jobs() { return jobs_; }
-  const CellContext& context() const { return context_; }
-  CellContext& context() { return context_; }
+  const cell::CellContext& context() const { return context_; }
+  cell::CellContext& context() { return context_; }
 
  private:
   const std::string settings_file_;
   const std::vector<std::string> command_line_settings_;
   store::ModelLibrary models_;
   store::CellCalibration calibration_;
-  VisionService vision_;
-  RobotProtocol protocol_;
-  CellContext context_;
+  cell::VisionService vision_;
+  protocol::RobotProtocol protocol_;
+  cell::CellContext context_;
   jobs::JobSwitch jobs_;
   results::ResultsPublisher* results_ = nullptr;
+  std::unique_ptr<filmstrip::Filmstrip> filmstrip_owner_;
+  filmstrip::Filmstrip* filmstrip_ = nullptr;  // filmstrip_owner_'s, for the commands
 };
+
+// What to run once a request's reply is sent to keep it in `strip`: a
+// LOCATE (its `record` and the session's frame) or a WHY; null for other
+// requests or without a filmstrip. Reserves the entry's id at once (the
+// session's last_locate_entry for a LOCATE).
+std::function<void(const std::string& reply)> filmstripWhenSent(
+    filmstrip::Filmstrip* strip, std::string_view line, protocol::Session& session,
+    std::shared_ptr<const results::RequestRecord> record);
 
 }  // namespace picksight::app

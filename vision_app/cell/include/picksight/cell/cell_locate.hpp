@@ -21,7 +21,7 @@
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 // A LOCATE's parts and the grasp poses offered for them.
 struct CellLocate {
@@ -96,4 +96,4 @@ Result<CellLocate> locateAndPick(const store::CellCalibration& calibration,
 // trigger, so both give the same poses for the same frame.
 Result<CellLocate> locateAndPick(CellContext& cell, int type);
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

@@ -11,7 +11,7 @@
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 struct CellPick {
   std::vector<grasp::Pose> poses;  // reply frame, in the order of the parts
@@ -46,4 +46,4 @@ grasp::Pose replyPose(const LocatedPart& part, const grasp::Pose& pose,
 CellPick pickPoses(const LocateOutcome& outcome, const store::GraspMap& grasps,
                    const store::CellGeometry& geometry);
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

@@ -19,7 +19,7 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/store/model_library.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 class ScaledModelCache {
  public:
@@ -44,4 +44,4 @@ class ScaledModelCache {
   uint64_t builds_ = 0;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::cell

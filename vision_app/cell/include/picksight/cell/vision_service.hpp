@@ -24,7 +24,7 @@
 #include "picksight/vision/segmentation/blob_features.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 class ScaledModelCache;
 
@@ -87,6 +87,10 @@ struct LocateOutcome {
   // null from locateInFrame alone): what its record publishes, whatever
   // VISION changed since.
   std::shared_ptr<const VisionOptions> settings;
+  // The frame itself (VisionService::locate; null from locateInFrame
+  // alone), for the filmstrip: taken by the request, never kept with the
+  // outcome (results::locateRecord releases it).
+  std::shared_ptr<const Frame> pixels;
 };
 
 // The single calibration target in a frame, in sensor pixels.
@@ -316,6 +320,6 @@ class VisionService {
   std::unique_ptr<ScaledModelCache> scaled_models_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::cell
 
-PICKSIGHT_ERROR_ENUM(picksight::app::VisionServiceErrc)
+PICKSIGHT_ERROR_ENUM(picksight::cell::VisionServiceErrc)

@@ -12,7 +12,7 @@
 #include "picksight/common/result.hpp"
 #include "picksight/vision/models/part_model.hpp"
 
-namespace picksight::app {
+namespace picksight::cell {
 
 enum class VisionSettingsErrc {
   kBadSetting = 1,  // an unknown key, a key twice, a value out of bounds
@@ -55,6 +55,6 @@ Result<VisionOptions> parseVisionSettingsJson(const std::string& text, VisionOpt
 std::vector<std::string> modelsToReteach(const VisionOptions& before, const VisionOptions& after,
                                          const store::ModelList& models);
 
-}  // namespace picksight::app
+}  // namespace picksight::cell
 
-PICKSIGHT_ERROR_ENUM(picksight::app::VisionSettingsErrc)
+PICKSIGHT_ERROR_ENUM(picksight::cell::VisionSettingsErrc)

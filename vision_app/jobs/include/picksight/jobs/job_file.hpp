@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "picksight/common/result.hpp"
-#include "picksight/jobs/namespaces.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/store/model_file.hpp"
 

@@ -6,6 +6,7 @@
 
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/jobs/job_switch.hpp"
+#include "picksight/filmstrip/filmstrip.hpp"
 #include "picksight/plc/plc_device.hpp"
 #include "picksight/results/results_publisher.hpp"
 
@@ -15,12 +16,14 @@ uint16_t frameCode(store::CoordinateFrame frame);  // kFrame*
 
 // A LOCATE's poses as the PLC registers hold them: each pose with its
 // part's type and score.
-PlcResult plcResult(const app::CellLocate& located);
+PlcResult plcResult(const cell::CellLocate& located);
 
 // The three callbacks of a PlcDevice over `cell` (borrowed; outlives the
-// device). The picker publishes each trigger's record on `results` when it
-// is set (read at each trigger; the pointer outlives the device).
-PlcDevice::Picker cellPicker(app::CellContext& cell, results::ResultsPublisher* const& results);
+// device). The picker publishes each trigger's record on `results` and
+// keeps its frame in `filmstrip` when they are set (read at each trigger;
+// the pointers outlive the device).
+PlcDevice::Picker cellPicker(cell::CellContext& cell, results::ResultsPublisher* const& results,
+                             filmstrip::Filmstrip* const& filmstrip);
 PlcDevice::FrameState cellFrameState(const store::CellCalibration& calibration);
 int robotErrorCodeOf(const Error& error);
 // LOAD_JOB over `jobs` (borrowed; outlives the device): the job numbered

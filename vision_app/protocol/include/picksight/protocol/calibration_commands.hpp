@@ -6,10 +6,10 @@
 #include "picksight/protocol/command_table.hpp"
 #include "picksight/store/cell_calibration.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // Registers the commands; `vision` and `calibration` outlive `table`.
-void addCalibrationCommands(CommandTable& table, VisionService& vision,
+void addCalibrationCommands(CommandTable& table, cell::VisionService& vision,
                             store::CellCalibration& calibration);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

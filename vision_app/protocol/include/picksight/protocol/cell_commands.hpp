@@ -11,13 +11,13 @@
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // The LOCATE reply a robot reads: "OK <n>" then x y rz of each pose.
-std::string locateReply(const CellPick& pick);
+std::string locateReply(const cell::CellPick& pick);
 
 // The LOCATE ALL reply: "OK <n>" then type x y rz of each pose.
-std::string locateAllReply(const CellLocate& located);
+std::string locateAllReply(const cell::CellLocate& located);
 
 // The camera feature names EXPOSURE tries, in order: GenICam SFNC, older
 // GenICam cameras, V4L2.
@@ -26,6 +26,6 @@ const std::vector<std::string>& exposureFeatureNames();
 // Registers the commands; `cell` outlives `table`. LOCATE leaves its
 // record in the session (Publishes::kRecord) for WHY and the results
 // stream.
-void addCellCommands(CommandTable& table, CellContext& cell);
+void addCellCommands(CommandTable& table, cell::CellContext& cell);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

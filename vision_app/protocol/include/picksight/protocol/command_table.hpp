@@ -13,7 +13,7 @@
 #include "picksight/common/result.hpp"
 #include "picksight/protocol/session.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // Failures of the protocol itself, shared by every command.
 enum class ProtocolErrc {
@@ -103,6 +103,6 @@ class CommandTable {
   std::map<std::string, Entry> commands_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol
 
-PICKSIGHT_ERROR_ENUM(picksight::app::ProtocolErrc)
+PICKSIGHT_ERROR_ENUM(picksight::protocol::ProtocolErrc)

@@ -3,7 +3,6 @@
 #pragma once
 
 #include "picksight/jobs/job_switch.hpp"
-#include "picksight/jobs/namespaces.hpp"
 #include "picksight/protocol/command_table.hpp"
 
 namespace picksight::protocol {

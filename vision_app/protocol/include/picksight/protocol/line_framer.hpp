@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 class LineFramer {
  public:
@@ -33,4 +33,4 @@ class LineFramer {
   bool discarding_ = false;  // inside an over-long line, skipping to its end
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

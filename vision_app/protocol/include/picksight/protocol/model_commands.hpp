@@ -5,16 +5,16 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // Registers the commands; `vision` (with its model library) outlives `table`.
-void addModelCommands(CommandTable& table, VisionService& vision);
+void addModelCommands(CommandTable& table, cell::VisionService& vision);
 
 // The reply fields of one model ("<type> <name> <area> <holes> <symmetry>").
 std::string modelSummary(const vision::PartModel& model);
 // LEARN's reply: "OK <type> <name> <area> <holes> <symmetry> <mirror 0/1>",
 // then " ; warning: <text>" for each warning.
-std::string learnReply(const LearnOutcome& learned);
+std::string learnReply(const cell::LearnOutcome& learned);
 // TOLERANCE's reply: "OK <type> <name>" then " <key>=<value>" for each
 // tolerance a model file stores (area_tolerance, hu_tolerance,
 // verify_percent, edge_tolerance_px, mirror_symmetric).
@@ -22,7 +22,7 @@ std::string toleranceReply(const vision::PartModel& model);
 // TRYLEARN's reply: LEARN's fields, then "<found> <parts>" (the parts of
 // the type LOCATE ALL finds on the same frame with the new model, and all
 // it finds), LEARN's warnings and notes, and " ; note: nothing stored".
-std::string tryLearnReply(const TryLearnOutcome& tried);
+std::string tryLearnReply(const cell::TryLearnOutcome& tried);
 // UNDO's reply: "OK <type> restored|removed <changes left> ; undid: <request>
 // ; type <type> is <model summary> again" (or "has no model again").
 std::string undoReply(const store::UndoOutcome& undone);
@@ -32,4 +32,4 @@ std::string blobSummary(const vision::BlobFeatures& blob);
 // A model name: 1 to 32 of A-Z a-z 0-9 _ - .
 bool validModelName(std::string_view name);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -6,10 +6,10 @@
 
 #include <system_error>
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // The ERROR code for `code`; 99 (internal error) for one the table does
 // not know.
 int robotErrorCode(const std::error_code& code);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -9,11 +9,11 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 class RobotProtocol {
  public:
-  explicit RobotProtocol(VisionService& vision);
+  explicit RobotProtocol(cell::VisionService& vision);
 
   // One request line in, one reply line out; on a read-only port requests
   // that change the cell are refused. Thread-safe.
@@ -28,8 +28,8 @@ class RobotProtocol {
  private:
   std::string frame(const Request& request);
 
-  VisionService& vision_;
+  cell::VisionService& vision_;
   CommandTable table_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

@@ -25,7 +25,7 @@
 #include "picksight/common/tcp_listener.hpp"
 #include "picksight/protocol/session.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 struct RobotServerOptions {
   // Where and whom: the admission policy every PickSight port shares. Every
@@ -84,4 +84,4 @@ class RobotServer {
   std::list<Connection> connections_;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

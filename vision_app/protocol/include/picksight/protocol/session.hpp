@@ -8,13 +8,14 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
 
 #include "picksight/results/request_record.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // What a request publishes on the results stream once its reply is sent;
 // its command's table entry says (CommandTable::add), VisionCell publishes.
@@ -41,6 +42,12 @@ struct Session {
   // for the web's audit trail.
   bool changed = false;
   std::shared_ptr<results::RequestRecord> record;
+  // The frame the current LOCATE worked on (null for others), for the
+  // filmstrip; VisionCell takes it, so that no session keeps a frame.
+  std::shared_ptr<const Frame> frame;
+  // The filmstrip entry of this connection's last LOCATE (0: none), which
+  // its WHY explains.
+  uint64_t last_locate_entry = 0;
 };
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

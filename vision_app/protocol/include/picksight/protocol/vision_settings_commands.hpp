@@ -5,9 +5,9 @@
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/protocol/command_table.hpp"
 
-namespace picksight::app {
+namespace picksight::protocol {
 
 // Registers VISION; `vision` (with its model library) outlives `table`.
-void addVisionSettingsCommands(CommandTable& table, VisionService& vision);
+void addVisionSettingsCommands(CommandTable& table, cell::VisionService& vision);
 
-}  // namespace picksight::app
+}  // namespace picksight::protocol

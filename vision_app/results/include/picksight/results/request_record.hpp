@@ -37,7 +37,13 @@ struct RegionRejection {
   double measured = 0;
   double low = 0;
   double high = 0;
-  std::string text;  // as WHY prints it
+  // The smallest change of one tolerance of the nearest model with which
+  // LOCATE accepts the region, when one test alone refuses it
+  // (vision::remedyFor): `TOLERANCE <nearest_type> <remedy_key>
+  // <remedy_value>`; empty when there is none.
+  std::string remedy_key;
+  std::string remedy_value;  // as written, the text TOLERANCE reads
+  std::string text;          // as WHY prints it, the remedy included
 };
 
 // Regions published (and explained) per request, largest first.
@@ -57,15 +63,15 @@ class RequestRecord {
 
   // LOCATE: its outcome and what the grasps were chosen with (none when
   // the request failed before a frame).
-  std::optional<app::LocateOutcome> locate;
-  app::CellPick pick;
+  std::optional<cell::LocateOutcome> locate;
+  cell::CellPick pick;
   std::shared_ptr<const store::GraspMap> grasps;
   std::optional<store::CellGeometry> geometry;
 
   // Other requests: the frame they worked on (regions are found from it by
   // the publisher) and the settings to find them with.
   std::shared_ptr<const Frame> frame;
-  app::VisionOptions options;
+  cell::VisionOptions options;
 
   // The frame the request worked on, if any.
   std::optional<FrameInfo> frameInfo() const;
@@ -89,7 +95,7 @@ class RequestRecord {
 // the client, the reply and the time once they are known. Its settings are
 // those the location ran with when it says (LocateOutcome::settings), else
 // `options`.
-std::shared_ptr<RequestRecord> locateRecord(Result<app::CellLocate>&& located, int type,
-                                            const app::VisionOptions& options);
+std::shared_ptr<RequestRecord> locateRecord(Result<cell::CellLocate>&& located, int type,
+                                            const cell::VisionOptions& options);
 
 }  // namespace picksight::results

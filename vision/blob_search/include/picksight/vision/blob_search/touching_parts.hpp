@@ -55,7 +55,8 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
 void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin);
 
 // The parts of the given models inside region `index` of `regions`, a blob
-// that matched no model as a whole. Best score first; Match::touching set.
+// that matched no model as a whole. Best score first; Match::touching set
+// unless one part explains the blob whole.
 // A part whose mirrored model verifies about as well is not reported. Of two
 // poses that cannot both be parts (they would share more than parts lying
 // on each other do), the one lying on more of the blob's edges is reported.

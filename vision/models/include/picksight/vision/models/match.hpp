@@ -21,8 +21,12 @@ struct Match {
   double angle_deg = 0;
   double symmetry_deg = 360;  // the model's: 360 none, 180, 120..., 0 any turn
   double body_distance = 0;   // Hu distance (0 for a part found inside a merged blob)
-  // Found inside a blob it shares with other parts (they touch), located
-  // from its edges instead of the blob's moments.
+  // Found by the search inside a blob (no model explained the region
+  // whole), located from its edges instead of the region's moments.
+  bool from_edges = false;
+  // Found inside a blob it shares with other parts, or with pixels it does
+  // not explain: it touches something. A part the search found alone,
+  // explaining its blob whole, touches nothing (its region is its own).
   bool touching = false;
 };
 

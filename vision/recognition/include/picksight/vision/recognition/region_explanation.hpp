@@ -7,6 +7,7 @@
 // explanation never disagrees with the recognizer about a separated region.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "picksight/vision/models/part_model.hpp"
@@ -45,5 +46,28 @@ RegionExplanation explainRegion(const Region& region, const std::vector<const Pa
 // fails.
 RegionExplanation explainRegionAsAsked(const Region& region,
                                        const std::vector<const PartModel*>& models, int asked_type);
+
+// One tolerance of one model changed (`TOLERANCE <type> <key> <value>`).
+struct RegionRemedy {
+  int type = -1;
+  // "area_tolerance", "hu_tolerance", "verify_percent" or "mirror_symmetric"
+  // (the keys of TOLERANCE and of the model file).
+  const char* key = "";
+  double value = 0;  // as written with `decimals` decimals
+  int decimals = 0;
+};
+
+// The smallest change of the tolerance `why` names (area or scale: the area
+// tolerance; Hu distance, verification, mirror) on its nearest model with which `LOCATE
+// <asked_type>` accepts the region, with a margin for the next frame (a
+// Hu distance or area gap 10 % past the measured one, a verified share 2
+// points below it), or none: a region another test would still refuse,
+// or one no tolerance within its bounds admits. Checked, not
+// estimated: the changed models are run through recognizeParts() on the
+// region, so a remedy named is one LOCATE takes. `why` is
+// explainRegionAsAsked's on `region` with pointers into `models` (frame
+// pixels, as LOCATE judged it).
+std::optional<RegionRemedy> remedyFor(const Region& region, const std::vector<PartModel>& models,
+                                      const RegionExplanation& why, int asked_type);
 
 }  // namespace picksight::vision
