@@ -4,8 +4,8 @@
 #include <chrono>
 
 #include "picksight/protocol/calibration_commands.hpp"
-#include "picksight/protocol/job_commands.hpp"
 #include "picksight/protocol/filmstrip_commands.hpp"
+#include "picksight/protocol/job_commands.hpp"
 #include "picksight/protocol/model_commands.hpp"
 #include "picksight/protocol/vision_settings_commands.hpp"
 

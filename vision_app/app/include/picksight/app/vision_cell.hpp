@@ -14,8 +14,8 @@
 
 #include "picksight/cell/cell_locate.hpp"
 #include "picksight/cell/vision_service.hpp"
-#include "picksight/jobs/job_switch.hpp"
 #include "picksight/filmstrip/filmstrip.hpp"
+#include "picksight/jobs/job_switch.hpp"
 #include "picksight/link/camera_link.hpp"
 #include "picksight/protocol/cell_commands.hpp"
 #include "picksight/protocol/robot_protocol.hpp"

@@ -5,8 +5,8 @@
 #pragma once
 
 #include "picksight/cell/cell_locate.hpp"
-#include "picksight/jobs/job_switch.hpp"
 #include "picksight/filmstrip/filmstrip.hpp"
+#include "picksight/jobs/job_switch.hpp"
 #include "picksight/plc/plc_device.hpp"
 #include "picksight/results/results_publisher.hpp"
 
