@@ -98,6 +98,16 @@ inline cv::Mat drawParts(int width, int height, const std::vector<DrawnPart>& pa
   return out;
 }
 
+// The plate with a hole and the long bar the vision app's end-to-end tests
+// teach: two types no test confuses (about 22000 and 15600 px).
+inline const synthetic::Shape kPlate{{rectLoop(200, 120), circleLoop(25, {45, 0})}};
+inline const synthetic::Shape kBar{{rectLoop(260, 60)}};
+
+// `shape` alone in the middle of a 640 x 480 frame, turned by `angle_deg`.
+inline cv::Mat aloneInFrame(const synthetic::Shape& shape, double angle_deg = 0) {
+  return drawParts(640, 480, {{shape, 320, 240, angle_deg}}, 11);
+}
+
 // `count` parts of `shape` in a row of cells 180 px apart, turned by
 // different angles (every other one mirrored when `alternate_mirror`).
 inline std::vector<DrawnPart> partRow(const synthetic::Shape& shape, int count, double y,

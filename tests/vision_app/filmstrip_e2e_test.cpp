@@ -25,17 +25,13 @@ using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
 namespace {
-const synthetic::Shape kPlate{{test::rectLoop(200, 120), test::circleLoop(25, {45, 0})}};
-const synthetic::Shape kBar{{test::rectLoop(260, 60)}};
-
-cv::Mat scene(const synthetic::Shape& shape) {
-  return test::drawParts(640, 480, {{shape, 320, 240, 0}}, 11);
-}
+using test::kBar;
+using test::kPlate;
 
 // A file camera in trigger mode, a vision app with its filmstrip, the plate
 // learned as type 1.
 struct FilmCell {
-  SceneFile scene{::scene(kPlate)};
+  SceneFile scene{test::aloneInFrame(kPlate)};
   VideoServerProcess server{{"--source", "cam0=file:" + scene.path, "--mode", "trigger"}};
   // Every success recorded (by default, one a second at most).
   VisionProcess vision{server, "cam0", "", {"--filmstrip-success-ms", "0"}};
@@ -66,7 +62,7 @@ TEST_CASE("REPLAY answers as the LOCATE did with the same models, and as today's
   FilmCell cell;
   const std::string found = cell.ask("LOCATE 1");
   REQUIRE(parseLocateReply(found).size() == 1);
-  cell.scene.show(scene(kBar));
+  cell.scene.show(test::aloneInFrame(kBar));
   const std::string missed = cell.ask("LOCATE 1");
   REQUIRE(missed == "OK 0");
   const std::string why = cell.ask("WHY");
@@ -131,7 +127,7 @@ TEST_CASE("a filmstrip export is served by a dir: camera and checked by test-run
           "[vision_app][filmstrip][e2e]") {
   FilmCell cell;
   REQUIRE(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
-  cell.scene.show(scene(kBar));
+  cell.scene.show(test::aloneInFrame(kBar));
   REQUIRE(cell.ask("LOCATE 1") == "OK 0");
   REQUIRE_THAT(cell.ask("WHY"), Catch::StartsWith("OK 1 "));
   cell.written(3);

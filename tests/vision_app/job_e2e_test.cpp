@@ -21,6 +21,7 @@
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
+#include "file_text.hpp"
 #include "picksight/jobs/job_file.hpp"
 #include "picksight/store/model_history.hpp"
 #include "scene_file.hpp"
@@ -40,19 +41,6 @@ cv::Mat scene() {
       640, 480,
       {{kPlate, 160, 120, 0}, {kPlate, 470, 130, 30}, {kBar, 170, 360, 10}, {kBar, 460, 350, -20}},
       7);
-}
-
-std::string contents(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void writeText(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  REQUIRE(out.good());
 }
 
 // Half a millimetre per pixel: LOCATE replies in vision-mm.
@@ -80,7 +68,7 @@ struct JobCell {
 
   JobCell() {
     fs::create_directories(data_dir);
-    writeText(data_dir + "/calibration.yaml", kCalibration);
+    test::writeFileText(data_dir + "/calibration.yaml", kCalibration);
     vision = std::make_unique<VisionProcess>(
         server, "cam0", data_dir,
         std::vector<std::string>{"--robot-read-only", "--setup-port", "0"});
@@ -191,12 +179,13 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
   const auto files = [&] {
     std::vector<std::string> out;
     for (const auto& e : fs::recursive_directory_iterator(cell.data_dir)) {
-      if (e.is_regular_file()) out.push_back(e.path().string() + "=" + contents(e.path()));
+      if (e.is_regular_file())
+        out.push_back(e.path().string() + "=" + test::readFileText(e.path()));
     }
     std::sort(out.begin(), out.end());
     return out;
   };
-  const std::string good = contents(cell.jobFile("bars"));
+  const std::string good = test::readFileText(cell.jobFile("bars"));
   // The content's checksum made again over everything but the files'
   // bytes (which carry their own), as the job file keeps it.
   const auto reChecksummed = [](nlohmann::json j) {
@@ -242,7 +231,7 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
   const auto on_disk = files();
   for (const auto& d : damages) {
     INFO(d.what);
-    writeText(cell.jobFile("broken"), d.text);
+    test::writeFileText(cell.jobFile("broken"), d.text);
     const std::string reply = cell.ask("JOB LOAD broken");
     CHECK(reply.rfind("ERROR 51 ", 0) == 0);
     CHECK(reply.find(cell.jobFile("broken")) != std::string::npos);
@@ -255,7 +244,7 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
   CHECK(cell.state() == before);
   // A job loaded before (kept parsed) whose file is damaged since: the
   // file is what counts.
-  writeText(cell.jobFile("plates"), good.substr(0, good.size() / 3));
+  test::writeFileText(cell.jobFile("plates"), good.substr(0, good.size() / 3));
   const std::string reply = cell.ask("JOB LOAD plates");
   CHECK(reply.rfind("ERROR 51 ", 0) == 0);
   CHECK(reply.find(cell.jobFile("plates")) != std::string::npos);
@@ -300,7 +289,7 @@ TEST_CASE("a job exported in pieces and imported under another name loads as the
     file += *bytes;
     if (file.size() >= total) break;
   }
-  CHECK(file == contents(cell.jobFile("bars")));
+  CHECK(file == test::readFileText(cell.jobFile("bars")));
   std::string last;
   for (size_t at = 0; at < file.size(); at += 2880) {
     const std::string piece = file.substr(at, 2880);

@@ -15,6 +15,7 @@
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
+#include "file_text.hpp"
 #include "scene_file.hpp"
 
 using namespace picksight;
@@ -22,16 +23,13 @@ using namespace picksight::e2e;
 using namespace std::chrono_literals;
 
 namespace {
+using test::kPlate;
+
 // A plate 200 x 120 px with one round hole, and the same plate 3 % larger:
 // its area (6 % more) is within the learned tolerance, its shape the same,
 // but its sides lie 1.8 px (long) and 3 px (short) from the model's, so it
 // verifies within an edge tolerance of 6 px and not within 1 px.
-const synthetic::Shape kPlate{{test::rectLoop(200, 120), test::circleLoop(25, {45, 0})}};
 const synthetic::Shape kLargerPlate = test::scaled(kPlate, 1.03);
-
-cv::Mat scene(const synthetic::Shape& shape, double angle_deg) {
-  return test::drawParts(640, 480, {{shape, 320, 240, angle_deg}}, 11);
-}
 
 std::string askRobot(LineClient& robot, const std::string& request) {
   auto reply = robot.request(request, 20s);
@@ -39,17 +37,10 @@ std::string askRobot(LineClient& robot, const std::string& request) {
   return *reply;
 }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // A file camera in trigger mode showing one plate, a vision app on it whose
 // data directory outlives it (restart), the plate learned as type 1.
 struct PlateCell {
-  SceneFile scene{::scene(kPlate, 0)};
+  SceneFile scene{test::aloneInFrame(kPlate, 0)};
   std::string data_dir = scene.dir + "/data";
   VideoServerProcess server{{"--source", "cam0=file:" + scene.path, "--mode", "trigger"}};
   std::unique_ptr<VisionProcess> vision;
@@ -67,7 +58,7 @@ struct PlateCell {
     robot = std::make_unique<LineClient>(vision->connect());
   }
   std::string ask(const std::string& request) { return askRobot(*robot, request); }
-  std::string modelFile() const { return readFile(data_dir + "/models/type_1.yaml"); }
+  std::string modelFile() const { return test::readFileText(data_dir + "/models/type_1.yaml"); }
 };
 }  // namespace
 
@@ -78,7 +69,7 @@ TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next
   CHECK_THAT(learned, Catch::StartsWith("OK 1 plate area_tolerance=0.100000 hu_tolerance="));
   CHECK_THAT(learned, Catch::EndsWith(" verify_percent=80.000 edge_tolerance_px=2.000 "
                                       "mirror_symmetric=1"));
-  cell.scene.show(scene(kPlate, 30));
+  cell.scene.show(test::aloneInFrame(kPlate, 30));
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
   // A grasp style, stored in the model's file: every TOLERANCE that
   // rewrites the file must keep it.
@@ -86,7 +77,7 @@ TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next
 
   // The larger plate with a tight edge tolerance: the next LOCATE leaves it
   // out, and WHY says the boundary failed.
-  cell.scene.show(scene(kLargerPlate, 30));
+  cell.scene.show(test::aloneInFrame(kLargerPlate, 30));
   CHECK_THAT(cell.ask("TOLERANCE 1 edge_tolerance_px 1"),
              Catch::EndsWith(" verify_percent=80.000 edge_tolerance_px=1.000 mirror_symmetric=1"));
   CHECK(cell.ask("LOCATE 1") == "OK 0");
@@ -169,7 +160,7 @@ TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLE
           "[vision_app][tolerance][why][e2e]") {
   PlateCell cell;
   // The larger plate with a tight edge tolerance fails verification alone.
-  cell.scene.show(scene(kLargerPlate, 30));
+  cell.scene.show(test::aloneInFrame(kLargerPlate, 30));
   REQUIRE_THAT(cell.ask("TOLERANCE 1 edge_tolerance_px 1"), Catch::StartsWith("OK 1 plate "));
   REQUIRE(cell.ask("LOCATE 1") == "OK 0");
   std::string why = cell.ask("WHY");
@@ -182,7 +173,7 @@ TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLE
 
   // The plate 1 % larger with an area tolerance of 1 %: a scaled copy of
   // the part, refused on its size alone.
-  cell.scene.show(scene(test::scaled(kPlate, 1.01), 30));
+  cell.scene.show(test::aloneInFrame(test::scaled(kPlate, 1.01), 30));
   REQUIRE_THAT(cell.ask("TOLERANCE 1 area_tolerance 0.01"), Catch::StartsWith("OK 1 plate "));
   REQUIRE(cell.ask("LOCATE 1") == "OK 0");
   why = cell.ask("WHY");
@@ -194,7 +185,7 @@ TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLE
 
   // Refused on its shape and, that relaxed, on its boundary too: no one
   // change accepts it, and WHY names none.
-  cell.scene.show(scene(kLargerPlate, 30));
+  cell.scene.show(test::aloneInFrame(kLargerPlate, 30));
   REQUIRE_THAT(
       cell.ask("TOLERANCE 1 area_tolerance 0.1 hu_tolerance 0.000001 edge_tolerance_px 0.1 "
                "verify_percent 100"),

@@ -18,6 +18,7 @@
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
+#include "file_text.hpp"
 #include "scene_file.hpp"
 
 using namespace picksight;
@@ -26,19 +27,8 @@ using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
 namespace {
-const synthetic::Shape kPlate{{test::rectLoop(200, 120), test::circleLoop(25, {45, 0})}};
-const synthetic::Shape kBar{{test::rectLoop(260, 60)}};
-
-cv::Mat scene(const synthetic::Shape& shape) {
-  return test::drawParts(640, 480, {{shape, 320, 240, 0}}, 11);
-}
-
-std::string contents(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using test::kBar;
+using test::kPlate;
 
 size_t entries(const std::string& dir, const std::string& suffix) {
   size_t n = 0;
@@ -54,7 +44,7 @@ size_t entries(const std::string& dir, const std::string& suffix) {
 // A file camera in trigger mode showing a plate, a vision app whose data
 // directory outlives it, the plate learned as type 1.
 struct UndoCell {
-  SceneFile scene{::scene(kPlate)};
+  SceneFile scene{test::aloneInFrame(kPlate)};
   std::string data_dir = scene.dir + "/data";
   VideoServerProcess server{{"--source", "cam0=file:" + scene.path, "--mode", "trigger"}};
   std::unique_ptr<VisionProcess> vision;
@@ -77,7 +67,7 @@ struct UndoCell {
     return *reply;
   }
   std::string model(int type = 1) const {
-    return contents(data_dir + "/models/type_" + std::to_string(type) + ".yaml");
+    return test::readFileText(data_dir + "/models/type_" + std::to_string(type) + ".yaml");
   }
   std::string undoDir() const { return data_dir + "/models/undo"; }
   // The newest entry of the history.
@@ -102,7 +92,7 @@ TEST_CASE("UNDO takes back a LEARN over an existing type byte for byte with its 
   CHECK_THAT(tuned_tolerances, Catch::Contains("area_tolerance=0.200000"));
 
   // Taught again over type 1, from another part: the tuned model is replaced.
-  cell.scene.show(scene(kBar));
+  cell.scene.show(test::aloneInFrame(kBar));
   REQUIRE(cell.ask("LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);
   REQUIRE(cell.model() != tuned);
   CHECK_THAT(cell.ask("TOLERANCE 1"), Catch::Contains("area_tolerance=0.100000"));
@@ -113,9 +103,9 @@ TEST_CASE("UNDO takes back a LEARN over an existing type byte for byte with its 
   CHECK(cell.model() == tuned);
   // The model in use is the file's: the tuned tolerances, the plate found.
   CHECK(cell.ask("TOLERANCE 1") == tuned_tolerances);
-  cell.scene.show(scene(kPlate));
+  cell.scene.show(test::aloneInFrame(kPlate));
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).size() == 1);
-  cell.scene.show(scene(kBar));
+  cell.scene.show(test::aloneInFrame(kBar));
   CHECK(parseLocateReply(cell.ask("LOCATE 1")).empty());
 
   // Back past the tolerance change, then past the first LEARN: no model.
@@ -170,29 +160,29 @@ TEST_CASE("LEARN stores its teach image beside the model and FORGET and UNDO fol
           "[vision_app][undo][e2e]") {
   UndoCell cell;  // the plate learned as type 1
   const std::string png = cell.data_dir + "/models/type_1.png";
-  const cv::Mat plate = scene(kPlate);
+  const cv::Mat plate = test::aloneInFrame(kPlate);
   REQUIRE(fs::exists(png));
   CHECK(same(teachImage(cell), plate));
-  const std::string plate_png = contents(png);
+  const std::string plate_png = test::readFileText(png);
 
   // Taught again from the bar: its image replaces the plate's.
-  cell.scene.show(scene(kBar));
+  cell.scene.show(test::aloneInFrame(kBar));
   REQUIRE(cell.ask("LEARN 1 bar").rfind("OK 1 bar ", 0) == 0);
-  CHECK(same(teachImage(cell), scene(kBar)));
+  CHECK(same(teachImage(cell), test::aloneInFrame(kBar)));
   // A change that is not a teach leaves the image alone, and so does its UNDO.
-  const std::string bar_png = contents(png);
+  const std::string bar_png = test::readFileText(png);
   REQUIRE(cell.ask("TOLERANCE 1 area_tolerance 0.2").rfind("OK 1 bar", 0) == 0);
-  CHECK(contents(png) == bar_png);
+  CHECK(test::readFileText(png) == bar_png);
   REQUIRE(cell.ask("UNDO").rfind("OK 1 restored 2 ; undid: TOLERANCE", 0) == 0);
-  CHECK(contents(png) == bar_png);
+  CHECK(test::readFileText(png) == bar_png);
   // UNDO of the second LEARN: the plate's image again, byte for byte.
   REQUIRE(cell.ask("UNDO").rfind("OK 1 restored 1 ; undid: LEARN 1 bar", 0) == 0);
-  CHECK(contents(png) == plate_png);
+  CHECK(test::readFileText(png) == plate_png);
 
   REQUIRE(cell.ask("FORGET 1") == "OK");
   CHECK_FALSE(fs::exists(png));
   REQUIRE(cell.ask("UNDO").rfind("OK 1 restored 1 ; undid: FORGET 1", 0) == 0);
-  CHECK(contents(png) == plate_png);
+  CHECK(test::readFileText(png) == plate_png);
   // Back past the first LEARN: no model, no image.
   REQUIRE(cell.ask("UNDO").rfind("OK 1 removed 0 ; undid: LEARN 1 plate", 0) == 0);
   CHECK_FALSE(fs::exists(png));
@@ -254,7 +244,7 @@ TEST_CASE("UNDO refuses a damaged entry or a file edited since and goes on past 
     REQUIRE(cell.ask("LEARN 2 second").rfind("OK 2 second", 0) == 0);
     const std::string second = cell.model(2);
     const std::string entry = cell.newestEntry();
-    std::string bytes = contents(entry);
+    std::string bytes = test::readFileText(entry);
     bytes[bytes.size() - 10] ^= 0x01;
     std::ofstream(entry, std::ios::binary | std::ios::trunc) << bytes;
     cell.restart();  // the start's log names it (not checked here)

@@ -23,6 +23,7 @@
 #include <zmq.hpp>
 
 #include "cell_fixture.hpp"
+#include "file_text.hpp"
 #include "results.pb.h"
 #include "scene_file.hpp"
 
@@ -46,19 +47,6 @@ cv::Mat lightOnDarkTable() {
   cv::randn(noise, 0, 3);
   cv::add(image, noise, image);
   return image;
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void writeText(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  REQUIRE(out.good());
 }
 
 // The count of a LOCATE reply "OK <n> ..."; REQUIREs the OK.
@@ -152,7 +140,7 @@ TEST_CASE("VISION polarity light finds light parts on a dark table without a res
   CHECK(located(cell.ask("LOCATE ALL")) == 6);
   CHECK(located(cell.askRobot("LOCATE ALL")) == 6);
   CHECK(largestBlobArea(cell.ask("BLOBS")) < 0.05 * 640 * 480);
-  const std::string file = readText(cell.settings_file);
+  const std::string file = test::readFileText(cell.settings_file);
   CHECK_THAT(file, Catch::Contains("\"format\": \"picksight-vision-settings\""));
   CHECK_THAT(file, Catch::Contains("\"polarity\": \"light\""));
 
@@ -191,7 +179,7 @@ TEST_CASE("VISION refuses a bad request naming the key and changes nothing",
           "[vision_app][vision_settings][e2e]") {
   TableCell cell;
   REQUIRE(cell.ask("VISION polarity light") == kLight);
-  const std::string file = readText(cell.settings_file);
+  const std::string file = test::readFileText(cell.settings_file);
   struct Bad {
     const char* request;
     const char* says;
@@ -230,7 +218,7 @@ TEST_CASE("VISION refuses a bad request naming the key and changes nothing",
   CHECK_THAT(cell.ask("VISION polarity " + std::string(3000, 'x')),
              Catch::EndsWith("got '" + std::string(40, 'x') + "...'"));
   CHECK(cell.ask("VISION") == kLight);
-  CHECK(readText(cell.settings_file) == file);
+  CHECK(test::readFileText(cell.settings_file) == file);
   CHECK(located(cell.ask("LOCATE ALL")) == 6);
 }
 
@@ -259,7 +247,7 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
           "[vision_app][vision_settings][e2e]") {
   TableCell cell;
   REQUIRE(cell.ask("VISION polarity light") == kLight);
-  const std::string good = readText(cell.settings_file);
+  const std::string good = test::readFileText(cell.settings_file);
   const std::string damaged[] = {
       "{\"format\": \"picksight-vision-settings\", \"version\": 1, \"polarity\": \"light\"",
       "{\"format\": \"picksight-vision-settings\", \"version\": 1, \"polarity\": \"sideways\"}",
@@ -274,7 +262,7 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
   for (size_t i = 0; i < std::size(damaged); ++i) {
     INFO(damaged[i].substr(0, 100));
     cell.restart();  // the app running writes nothing now: the file is ours
-    writeText(cell.settings_file, damaged[i]);
+    test::writeFileText(cell.settings_file, damaged[i]);
     cell.restart();
     // Not silently replaced by defaults: every request that binarizes is
     // refused naming the file, and so is a change, which would overwrite it.
@@ -289,7 +277,7 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
                                             cell.settings_file));
       CHECK_THAT(refused, Catch::EndsWith("repair it and restart, or VISION RESET"));
     }
-    CHECK(readText(cell.settings_file) == damaged[i]);
+    CHECK(test::readFileText(cell.settings_file) == damaged[i]);
     // The offline tool on that data dir refuses too, whatever it is given.
     const auto offline = run({binPath("picksight-vision"), "locate", "--data-dir", cell.data_dir,
                               "--polarity", "light", cell.scene.path});
@@ -309,22 +297,22 @@ TEST_CASE("A damaged vision.json is refused by name until it is repaired or VISI
   std::filesystem::remove_all(cell.settings_file);
 
   // A bad value is refused even where the command line overrides it.
-  writeText(cell.settings_file, damaged[1]);
+  test::writeFileText(cell.settings_file, damaged[1]);
   cell.restart({"--polarity", "light"});
   CHECK_THAT(cell.ask("LOCATE ALL"), Catch::StartsWith("ERROR 48 "));
   // Repaired by hand: in force at the next start.
-  writeText(cell.settings_file, good);
+  test::writeFileText(cell.settings_file, good);
   cell.restart();
   CHECK(cell.ask("VISION") == kLight);
   CHECK(located(cell.ask("LOCATE ALL")) == 6);
   // Or replaced, on purpose, by the settings in use.
-  writeText(cell.settings_file, "garbage");
+  test::writeFileText(cell.settings_file, "garbage");
   cell.restart({"--polarity", "light"});
   CHECK_THAT(cell.ask("LOCATE ALL"), Catch::StartsWith("ERROR 48 "));
   CHECK(cell.ask("VISION RESET") == kLight);
   CHECK(located(cell.ask("LOCATE ALL")) == 6);
   CHECK(cell.ask("VISION") == kLight);
-  CHECK_THAT(readText(cell.settings_file), Catch::Contains("\"polarity\": \"light\""));
+  CHECK_THAT(test::readFileText(cell.settings_file), Catch::Contains("\"polarity\": \"light\""));
 }
 
 TEST_CASE("A VISION change names the models it leaves taught under other settings",
