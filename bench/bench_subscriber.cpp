@@ -41,9 +41,9 @@ int main(int argc, char** argv) {
       ->type_name("FILE");
   app.add_option("--curve-key", curve_key, "this client's secret key file")->type_name("FILE");
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
-  std::optional<picksight::CurveClientKeys> curve;
+  std::optional<picksight::transport::CurveClientKeys> curve;
   if (!curve_server_key.empty()) {
-    auto keys = picksight::loadClientKeys(curve_key, curve_server_key);
+    auto keys = picksight::transport::loadClientKeys(curve_key, curve_server_key);
     if (!keys) {
       std::fprintf(stderr, "picksight-bench-subscriber: %s\n", keys.error().message.c_str());
       return 2;
@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
       latency_ms.push_back(static_cast<double>(now - sent_ns) / 1e6);
     }
   } else {
-    picksight::FrameSubscriber sub(context, endpoint, camera, 4, curve);
+    picksight::transport::FrameSubscriber sub(context, endpoint, camera, 4, curve);
     while (picksight::monotonicNs() < end) {
       auto f = sub.receive(std::chrono::milliseconds(100));
       if (!f) continue;

@@ -47,7 +47,7 @@ class SnapLoop {
  public:
   SnapLoop(zmq::context_t& context, const std::string& control, const std::string& camera)
       : thread_([this, &context, control, camera] {
-          picksight::ControlClient client(context, control, 5000ms);
+          picksight::transport::ControlClient client(context, control, 5000ms);
           picksight::proto::ControlRequest snap;
           snap.mutable_snap()->set_camera(camera);
           while (!stop_) {

@@ -114,12 +114,13 @@ BenchKeys writeKeys() {
   BenchKeys k{dir, std::string(dir) + "/server.key_secret", std::string(dir) + "/server.key",
               std::string(dir) + "/client.key_secret"};
   for (const char* name : {"server", "client"}) {
-    auto pair = picksight::generateKeyPair();
+    auto pair = picksight::transport::generateKeyPair();
     if (!pair) throw std::runtime_error(pair.error().message);
     const std::string base = std::string(dir) + "/" + name;
-    if (!picksight::writeFileAtomically(base + ".key", picksight::publicKeyFileText(*pair)) ||
+    if (!picksight::writeFileAtomically(base + ".key",
+                                        picksight::transport::publicKeyFileText(*pair)) ||
         !picksight::writeFileAtomically(base + ".key_secret",
-                                        picksight::secretKeyFileText(*pair))) {
+                                        picksight::transport::secretKeyFileText(*pair))) {
       throw std::runtime_error("cannot write keys in " + std::string(dir));
     }
     ::chmod((base + ".key_secret").c_str(), 0600);
@@ -131,15 +132,15 @@ BenchKeys writeKeys() {
 // SUB of another context (so each side has its own I/O thread), one at a
 // time: the time of the frame's way, with CURVE its encryption and
 // decryption as well.
-double roundTripMs(const picksight::CurveServer* curve,
-                   const std::optional<picksight::CurveClientKeys>& client, int frames) {
+double roundTripMs(const picksight::transport::CurveServer* curve,
+                   const std::optional<picksight::transport::CurveClientKeys>& client, int frames) {
   zmq::context_t server_context;
   zmq::context_t client_context;
   zmq::socket_t pub(server_context, zmq::socket_type::pub);
-  picksight::secureServerSocket(pub, curve);
+  picksight::transport::secureServerSocket(pub, curve);
   pub.bind("tcp://127.0.0.1:*");
   zmq::socket_t sub(client_context, zmq::socket_type::sub);
-  picksight::secureClientSocket(sub, client);
+  picksight::transport::secureClientSocket(sub, client);
   sub.set(zmq::sockopt::subscribe, "");
   sub.connect(pub.get(zmq::sockopt::last_endpoint));
   const std::vector<uint8_t> payload(1920 * 1080, 128);
@@ -228,8 +229,8 @@ int main(int argc, char** argv) {
 
   const int frames = 200;
   zmq::context_t keys_context;  // the CURVE server's (no allow-list: no ZAP thread)
-  auto curve = picksight::CurveServer::start(keys_context, keys.server_secret, "");
-  auto client = picksight::loadClientKeys(keys.client_secret, keys.server_public);
+  auto curve = picksight::transport::CurveServer::start(keys_context, keys.server_secret, "");
+  auto client = picksight::transport::loadClientKeys(keys.client_secret, keys.server_public);
   if (!curve || !client) return 1;
   const double plain_ms = roundTripMs(nullptr, std::nullopt, frames);
   const double curve_ms = roundTripMs(curve->get(), *client, frames);

@@ -77,7 +77,7 @@ void row(const char* what, const Stats& s, double baseline) {
 std::optional<picksight::TruthPart> loneTruthPart(zmq::context_t& context,
                                                   const std::string& frames,
                                                   picksight::LineClient& robot) {
-  picksight::FrameSubscriber watcher(context, frames, "cam0", 8);
+  picksight::transport::FrameSubscriber watcher(context, frames, "cam0", 8);
   const auto deadline = Clock::now() + 10s;
   while (Clock::now() < deadline) {
     (void)robot.request("LOCATE 1", 10s);
@@ -121,7 +121,7 @@ bool learnAndResize(zmq::context_t& context, const picksight::bench::VideoServer
   }
   std::printf("learned: %s (a %s)\n", learned->c_str(), part->type.c_str());
   if (scale == 1) return true;
-  picksight::ControlClient control(context, server.control);
+  picksight::transport::ControlClient control(context, server.control);
   picksight::proto::ControlRequest request;
   request.mutable_set_size()->set_camera("cam0");
   request.mutable_set_size()->set_scale(scale);
@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
   // during the timed requests the vision app is the camera's one
   // subscriber, as in a cell, and a watcher would share the CPU and the
   // server's sends with it.
-  picksight::FrameSubscriber watcher(context, server->frames, "cam0", 64);
+  picksight::transport::FrameSubscriber watcher(context, server->frames, "cam0", 64);
   std::this_thread::sleep_for(300ms);
   for (int i = 0; i < 20; ++i) (void)robot->request("LOCATE 1", 10s);
   robot->close();

@@ -96,13 +96,13 @@ CameraSteps timeCameraSteps(const std::string& uri, const picksight::bench::Loca
     frame.info.camera = "cam0";
     frame.truth = grabbed->truth;
     b = monotonicNs();
-    const std::string header = picksight::frameHeaderOf(frame).SerializeAsString();
+    const std::string header = picksight::transport::frameHeaderOf(frame).SerializeAsString();
     a = monotonicNs();
     t.header_encode.push_back(msBetween(b, a));
     picksight::proto::FrameHeader parsed;
     parsed.ParseFromString(header);
     // The pixels lent, not copied, as ZeroMQ hands over a received message.
-    auto decoded = picksight::decodeFrame(
+    auto decoded = picksight::transport::decodeFrame(
         parsed, zmq::message_t(
                     frame.image.data, frame.image.total() * frame.image.elemSize(),
                     [](void*, void*) {}, nullptr));
@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
   {
     zmq::context_t context;
     picksight::link::FrameFeed feed(context, *frames, "cam0");
-    picksight::ControlClient control(context, *control_endpoint, 2000ms);
+    picksight::transport::ControlClient control(context, *control_endpoint, 2000ms);
     feed.start();
     picksight::proto::ControlRequest trigger;
     trigger.mutable_trigger()->set_camera("cam0");

@@ -266,7 +266,7 @@ int main(int argc, char** argv) {
   zmq::context_t context;
   {
     // cam1 free-runs at 30 fps: the full-rate camera the viewers watch.
-    picksight::ControlClient client(context, server.control, 5000ms);
+    picksight::transport::ControlClient client(context, server.control, 5000ms);
     picksight::proto::ControlRequest mode;
     mode.mutable_set_mode()->set_camera("cam1");
     mode.mutable_set_mode()->set_mode(picksight::proto::FREERUN);
@@ -313,7 +313,7 @@ int main(int argc, char** argv) {
   // A model, so that LOCATE does its whole pass: taught from one part alone
   // on the table, as an integrator would.
   const auto setParts = [&](int parts) {
-    picksight::ControlClient client(context, server.control, 5000ms);
+    picksight::transport::ControlClient client(context, server.control, 5000ms);
     picksight::proto::ControlRequest request;
     request.mutable_set_feature()->set_camera("cam0");
     request.mutable_set_feature()->set_name("Parts");
@@ -349,7 +349,7 @@ int main(int argc, char** argv) {
   // LOCATEs outside the measures.
   const auto settle = [&] {
     for (int i = 0; i < 2; ++i) locate(ignored);
-    picksight::ControlClient client(context, server.control, 5000ms);
+    picksight::transport::ControlClient client(context, server.control, 5000ms);
     picksight::proto::ControlRequest trigger;
     trigger.mutable_trigger()->set_camera("cam0");
     (void)client.call(trigger);

@@ -29,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return 0;
   }
   const auto& request = *decoded;
-  check(size <= picksight::kMaxControlRequestBytes);
+  check(size <= picksight::transport::kMaxControlRequestBytes);
   check(request.request_case() != picksight::proto::ControlRequest::REQUEST_NOT_SET);
   const auto camera = video::requestCamera(request);
   if (camera) check(camera->size() <= video::kMaxControlName);

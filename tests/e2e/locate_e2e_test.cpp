@@ -14,6 +14,7 @@
 
 using namespace picksight;
 using namespace picksight::e2e;
+using namespace picksight::transport;
 using namespace std::chrono_literals;
 
 namespace {

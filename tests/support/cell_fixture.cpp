@@ -13,6 +13,10 @@
 #include "picksight/transport/control_client.hpp"
 
 namespace picksight::e2e {
+
+using transport::ControlClient;
+using transport::FrameSubscriber;
+
 using namespace std::chrono_literals;
 
 std::string binPath(const std::string& name) { return std::string(PICKSIGHT_BIN_DIR) + "/" + name; }

@@ -52,14 +52,15 @@ struct CommandResult {
 CommandResult run(const std::vector<std::string>& argv);
 
 // Receives frames until one satisfies `accept` or `tries` frames went by.
-std::optional<Frame> receiveUntil(FrameSubscriber& subscriber,
+std::optional<Frame> receiveUntil(transport::FrameSubscriber& subscriber,
                                   const std::function<bool(const Frame&)>& accept, int tries = 100);
 
 // Sends software triggers to `camera` until `subscriber` has a frame (for a
 // server in trigger mode): the subscription has then reached the server and
 // nothing published later is lost to it. REQUIREs it within 10 s. Returns
 // that frame's sequence number.
-uint64_t waitForSubscription(const VideoServerProcess& server, FrameSubscriber& subscriber,
+uint64_t waitForSubscription(const VideoServerProcess& server,
+                             transport::FrameSubscriber& subscriber,
                              const std::string& camera = "cam0");
 
 // The numbers of a reply "OK a b ..."; REQUIREs "OK" and `expected` numbers.

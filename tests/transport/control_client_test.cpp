@@ -13,7 +13,7 @@
 
 using namespace std::chrono_literals;
 namespace proto = picksight::proto;
-using picksight::ControlClient;
+using picksight::transport::ControlClient;
 
 namespace {
 
@@ -81,7 +81,7 @@ TEST_CASE("ControlClient turns a server error into an Error with its code and te
   auto reply = client.call(listRequest());
   server.join();
   REQUIRE_FALSE(reply);
-  CHECK(reply.error().code == picksight::ControlErrc::kUnknownCamera);
+  CHECK(reply.error().code == picksight::transport::ControlErrc::kUnknownCamera);
   CHECK(reply.error().message == "unknown camera 'camX'");
 }
 
@@ -94,7 +94,7 @@ TEST_CASE("ControlClient reports a malformed reply as INTERNAL", "[common]") {
   auto reply = client.call(listRequest());
   server.join();
   REQUIRE_FALSE(reply);
-  CHECK(reply.error().code == picksight::ControlErrc::kInternal);
+  CHECK(reply.error().code == picksight::transport::ControlErrc::kInternal);
 }
 
 TEST_CASE("ControlClient times out on a silent server and works again afterwards", "[common]") {
@@ -109,7 +109,7 @@ TEST_CASE("ControlClient times out on a silent server and works again afterwards
   auto first = client.call(listRequest());
   const auto elapsed = std::chrono::steady_clock::now() - start;
   REQUIRE_FALSE(first);
-  CHECK(first.error().code == picksight::ControlErrc::kNoReply);
+  CHECK(first.error().code == picksight::transport::ControlErrc::kNoReply);
   CHECK_THAT(first.error().message, Catch::Contains(endpoint));
   // Bounded by the timeout, with a generous allowance for a loaded machine.
   CHECK(elapsed < timeout + 10s);
@@ -132,7 +132,7 @@ TEST_CASE("ControlClient times out on a silent server and works again afterwards
   std::optional<picksight::Result<proto::ControlReply>> second;
   for (int attempt = 0; attempt < 20; ++attempt) {
     second.emplace(client.call(listRequest()));
-    if (second->ok() || second->error().code != picksight::ControlErrc::kNoReply) break;
+    if (second->ok() || second->error().code != picksight::transport::ControlErrc::kNoReply) break;
   }
   stop = true;
   server.join();

@@ -17,6 +17,7 @@
 #include "temp_dir.hpp"
 
 using namespace picksight;
+using namespace picksight::transport;
 using namespace std::chrono_literals;
 
 namespace {

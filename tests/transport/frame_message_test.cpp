@@ -14,7 +14,7 @@
 using namespace std::chrono_literals;
 namespace proto = picksight::proto;
 using picksight::Frame;
-using picksight::FrameSubscriber;
+using picksight::transport::FrameSubscriber;
 
 namespace {
 
@@ -77,13 +77,13 @@ std::optional<Frame> receiveNonProbe(FrameSubscriber& sub) {
 }  // namespace
 
 TEST_CASE("bytesPerPixel knows mono8 and bgr8 only", "[common]") {
-  CHECK(picksight::bytesPerPixel(proto::MONO8) == 1);
-  CHECK(picksight::bytesPerPixel(proto::BGR8) == 3);
-  CHECK(picksight::bytesPerPixel(proto::PIXEL_FORMAT_UNSPECIFIED) == 0);
+  CHECK(picksight::transport::bytesPerPixel(proto::MONO8) == 1);
+  CHECK(picksight::transport::bytesPerPixel(proto::BGR8) == 3);
+  CHECK(picksight::transport::bytesPerPixel(proto::PIXEL_FORMAT_UNSPECIFIED) == 0);
 }
 
 TEST_CASE("frameIsConsistent checks format, sizes, stride and payload length", "[common]") {
-  using picksight::frameIsConsistent;
+  using picksight::transport::frameIsConsistent;
   const auto h = monoHeader("cam", 1, 4, 3, 4);
   CHECK(frameIsConsistent(h, 12));
   CHECK(frameIsConsistent(h, 20));  // trailing bytes are harmless
@@ -114,7 +114,8 @@ TEST_CASE("decodeFrame image is a view on the pixel bytes with the stride", "[co
   const std::string bytes = pattern(64);
   zmq::message_t mono_pixels(bytes.data(), bytes.size());
   const void* mono_data = mono_pixels.data();
-  const auto frame = picksight::decodeFrame(monoHeader("cam", 1, 3, 2, 4), std::move(mono_pixels));
+  const auto frame =
+      picksight::transport::decodeFrame(monoHeader("cam", 1, 3, 2, 4), std::move(mono_pixels));
   REQUIRE(frame);
   const cv::Mat image = frame->image;
   REQUIRE(image.type() == CV_8UC1);
@@ -127,7 +128,8 @@ TEST_CASE("decodeFrame image is a view on the pixel bytes with the stride", "[co
   auto colour_header = monoHeader("cam", 1, 2, 2, 6);
   colour_header.set_pixel_format(proto::BGR8);
   const std::string bgr = pattern(12);
-  const auto colour = picksight::decodeFrame(colour_header, zmq::message_t(bgr.data(), bgr.size()));
+  const auto colour =
+      picksight::transport::decodeFrame(colour_header, zmq::message_t(bgr.data(), bgr.size()));
   REQUIRE(colour);
   const cv::Mat c = colour->image;
   REQUIRE(c.type() == CV_8UC3);
@@ -136,8 +138,8 @@ TEST_CASE("decodeFrame image is a view on the pixel bytes with the stride", "[co
 
 TEST_CASE("decodeFrame refuses an inconsistent header and fills the mapping", "[common]") {
   const std::string bytes = pattern(12);
-  CHECK_FALSE(
-      picksight::decodeFrame(monoHeader("cam", 1, 4, 3, 4), zmq::message_t(bytes.data(), 11)));
+  CHECK_FALSE(picksight::transport::decodeFrame(monoHeader("cam", 1, 4, 3, 4),
+                                                zmq::message_t(bytes.data(), 11)));
   auto h = monoHeader("cam", 9, 4, 3, 4);
   h.set_roi_x(10);
   h.set_roi_y(20);
@@ -149,7 +151,8 @@ TEST_CASE("decodeFrame refuses an inconsistent header and fills the mapping", "[
   t->set_type("disc");
   t->set_x(1.5);
   t->set_symmetry_deg(0);
-  const auto frame = picksight::decodeFrame(h, zmq::message_t(bytes.data(), bytes.size()));
+  const auto frame =
+      picksight::transport::decodeFrame(h, zmq::message_t(bytes.data(), bytes.size()));
   REQUIRE(frame);
   CHECK(frame->mapping.roi_x == 10);
   CHECK(frame->mapping.roi_y == 20);
@@ -187,7 +190,7 @@ TEST_CASE("A frame survives encoding and decoding and outlives its sender's imag
   sent.info.triggered = true;
   sent.truth.push_back({"ring", 1, 2, 30, 180, 400});
   const cv::Mat expected = sent.image.clone();
-  picksight::sendFrame(pub, sent);
+  picksight::transport::sendFrame(pub, sent);
   sent = Frame{};
   sensor.release();
 

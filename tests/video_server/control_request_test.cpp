@@ -106,7 +106,7 @@ TEST_CASE("decodeRequest refuses non-finite and out-of-range numbers naming the 
 }
 
 TEST_CASE("decodeRequest bounds the message and its strings", "[video_server][control]") {
-  const std::string huge(picksight::kMaxControlRequestBytes + 1, '\x0a');
+  const std::string huge(picksight::transport::kMaxControlRequestBytes + 1, '\x0a');
   auto r = decodeRequest(huge.data(), huge.size());
   REQUIRE_FALSE(r);
   CHECK(r.error().code == VideoErrc::kBadRequest);
@@ -135,14 +135,14 @@ TEST_CASE("a control message over the limit is dropped and the server goes on",
   server.start();
   zmq::context_t context;
   // ControlClient refuses it itself, saying why.
-  picksight::ControlClient client(context, server.controlEndpoint(), 5s);
+  picksight::transport::ControlClient client(context, server.controlEndpoint(), 5s);
   proto::ControlRequest big;
   big.mutable_set_feature()->set_camera("cam");
   big.mutable_set_feature()->set_name("Note");
   big.mutable_set_feature()->set_value(std::string(1 << 20, 'x'));
   auto refused = client.call(big);
   REQUIRE_FALSE(refused);
-  CHECK(refused.error().code == picksight::ControlErrc::kBadRequest);
+  CHECK(refused.error().code == picksight::transport::ControlErrc::kBadRequest);
   CHECK_THAT(refused.error().message, Catch::Contains("65536"));
 
   // A raw client sending it anyway gets nothing back: ZeroMQ drops the

@@ -190,7 +190,7 @@ TEST_CASE("Triggers are answered at once while other clients snap and read a slo
   std::atomic<int> snaps{0};
   std::atomic<int> failures{0};
   std::thread reader([&] {
-    picksight::ControlClient client(context, server.controlEndpoint(), kTimeout);
+    picksight::transport::ControlClient client(context, server.controlEndpoint(), kTimeout);
     while (!done) {
       if (client.call(getFeature("slow", "SlowRead"))) {
         ++slow_reads;
@@ -200,7 +200,7 @@ TEST_CASE("Triggers are answered at once while other clients snap and read a slo
     }
   });
   std::thread snapper([&] {
-    picksight::ControlClient client(context, server.controlEndpoint(), kTimeout);
+    picksight::transport::ControlClient client(context, server.controlEndpoint(), kTimeout);
     while (!done) {
       if (client.call(snap("cam"))) {
         ++snaps;
@@ -212,7 +212,7 @@ TEST_CASE("Triggers are answered at once while other clients snap and read a slo
 
   // Trigger both cameras throughout at least two slow reads: on a server that
   // answers one request at a time, most triggers would wait behind a read.
-  picksight::ControlClient robot(context, server.controlEndpoint(), kTimeout);
+  picksight::transport::ControlClient robot(context, server.controlEndpoint(), kTimeout);
   std::vector<double> round_trips_ms;
   const auto deadline = Clock::now() + 30s;
   while ((slow_reads < 2 || snaps < 2) && Clock::now() < deadline) {
@@ -329,7 +329,7 @@ TEST_CASE("A full queue of slow requests answers busy at once and recovers",
   }));
   CHECK(busy->error().code() == proto::Error::BUSY);
   CHECK_THAT(busy->error().text(), Catch::Contains("busy"));
-  picksight::ControlClient client(context, control.boundEndpoint(), kTimeout);
+  picksight::transport::ControlClient client(context, control.boundEndpoint(), kTimeout);
   CHECK(client.call(trigger("cam")));
 
   release.open();
@@ -350,10 +350,10 @@ TEST_CASE("A throwing handler is an INTERNAL reply and the server goes on",
     return okReply();
   });
   control.start();
-  picksight::ControlClient client(context, control.boundEndpoint(), kTimeout);
+  picksight::transport::ControlClient client(context, control.boundEndpoint(), kTimeout);
   const auto thrown = client.call(snap("cam"));
   REQUIRE_FALSE(thrown);
-  CHECK(thrown.error().code == picksight::ControlErrc::kInternal);
+  CHECK(thrown.error().code == picksight::transport::ControlErrc::kInternal);
   CHECK_THAT(thrown.error().message, Catch::Contains("boom"));
   CHECK(client.call(trigger("cam")));
   CHECK(client.call(describe("cam")));

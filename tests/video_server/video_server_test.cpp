@@ -90,7 +90,8 @@ void waitStreaming(VideoServer& server) {
 
 // Triggers cam1 until the subscriber has a frame: the subscription has then
 // reached the publisher and nothing sent later is lost to it.
-void waitForSubscription(picksight::ControlClient& control, picksight::FrameSubscriber& sub) {
+void waitForSubscription(picksight::transport::ControlClient& control,
+                         picksight::transport::FrameSubscriber& sub) {
   for (int i = 0; i < 50; ++i) {
     REQUIRE(control.call(trigger("cam1")));
     if (sub.receive(200ms)) return;
@@ -99,7 +100,7 @@ void waitForSubscription(picksight::ControlClient& control, picksight::FrameSubs
 }
 
 // The cam1 frame with exactly this sequence (earlier ones are skipped).
-std::optional<picksight::Frame> receiveSequence(picksight::FrameSubscriber& sub,
+std::optional<picksight::Frame> receiveSequence(picksight::transport::FrameSubscriber& sub,
                                                 uint64_t sequence) {
   const auto deadline = std::chrono::steady_clock::now() + kTimeout;
   while (std::chrono::steady_clock::now() < deadline) {
@@ -339,7 +340,7 @@ TEST_CASE("VideoServer answers a real ControlClient on its bound endpoint", "[vi
   VideoServer server(testConfig());
   server.start();
   zmq::context_t context;
-  picksight::ControlClient client(context, server.controlEndpoint(), 10000ms);
+  picksight::transport::ControlClient client(context, server.controlEndpoint(), 10000ms);
 
   proto::ControlRequest list;
   list.mutable_list_cameras();
@@ -349,7 +350,7 @@ TEST_CASE("VideoServer answers a real ControlClient on its bound endpoint", "[vi
 
   auto unknown = client.call(describe("nope"));
   REQUIRE_FALSE(unknown);
-  CHECK(unknown.error().code == picksight::ControlErrc::kUnknownCamera);
+  CHECK(unknown.error().code == picksight::transport::ControlErrc::kUnknownCamera);
   CHECK_THAT(unknown.error().message, Catch::Contains("nope"));
 
   auto first = client.call(trigger("cam1"));
@@ -360,7 +361,8 @@ TEST_CASE("VideoServer answers a real ControlClient on its bound endpoint", "[vi
   CHECK(second->trigger().sequence() == first->trigger().sequence() + 1);
 
   // An empty or undecodable request gets BAD_REQUEST, and the socket goes on.
-  CHECK(client.call(proto::ControlRequest{}).error().code == picksight::ControlErrc::kBadRequest);
+  CHECK(client.call(proto::ControlRequest{}).error().code ==
+        picksight::transport::ControlErrc::kBadRequest);
   {
     zmq::socket_t raw(context, zmq::socket_type::req);
     raw.set(zmq::sockopt::linger, 0);
@@ -380,8 +382,8 @@ TEST_CASE("VideoServer frames reach a FrameSubscriber with consistent headers", 
   VideoServer server(testConfig());
   server.start();
   zmq::context_t context;
-  picksight::ControlClient control(context, server.controlEndpoint(), 10000ms);
-  picksight::FrameSubscriber sub(context, server.framesEndpoint(), "cam1", 16);
+  picksight::transport::ControlClient control(context, server.controlEndpoint(), 10000ms);
+  picksight::transport::FrameSubscriber sub(context, server.framesEndpoint(), "cam1", 16);
   waitForSubscription(control, sub);
 
   SECTION("full sensor, mono") {
@@ -472,7 +474,7 @@ TEST_CASE("VideoServer frames of a free-running camera arrive in order", "[video
   VideoServer server(testConfig());
   server.start();
   zmq::context_t context;
-  picksight::FrameSubscriber sub(context, server.framesEndpoint(), "cam10", 16);
+  picksight::transport::FrameSubscriber sub(context, server.framesEndpoint(), "cam10", 16);
   uint64_t previous = 0;
   int received = 0;
   const auto deadline = std::chrono::steady_clock::now() + kTimeout;

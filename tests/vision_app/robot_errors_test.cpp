@@ -17,6 +17,7 @@ using namespace picksight;
 using namespace picksight::protocol;
 using namespace picksight::cell;
 using namespace picksight::store;
+using namespace picksight::transport;
 
 TEST_CASE("robot error codes are the documented ones", "[vision_app][protocol]") {
   CHECK(robotErrorCode(VisionServiceErrc::kNoTarget) == 1);

@@ -20,7 +20,7 @@ using picksight::web::CameraFeed;
 // triggers may come before its subscription is connected); that frame's
 // generation.
 uint64_t triggerFrame(zmq::context_t& context, const VideoServerProcess& server, CameraFeed& feed) {
-  picksight::ControlClient client(context, server.control, 5000ms);
+  picksight::transport::ControlClient client(context, server.control, 5000ms);
   picksight::proto::ControlRequest trigger;
   trigger.mutable_trigger()->set_camera("cam0");
   const uint64_t before = feed.generation();

@@ -27,6 +27,8 @@ using namespace std::chrono_literals;
 using e2e::VideoServerProcess;
 using e2e::VisionProcess;
 using nlohmann::json;
+using transport::ControlClient;
+using transport::FrameSubscriber;
 
 // The parts of a multipart/x-mixed-replace body as they arrive.
 class MjpegParser {

@@ -13,6 +13,11 @@
 
 namespace picksight::cam {
 
+using transport::ControlClient;
+using transport::ControlErrc;
+using transport::CurveClientKeys;
+using transport::loadClientKeys;
+
 const char* errorName(CliErrc e) {
   return e == CliErrc::kUsage ? "usage" : e == CliErrc::kBadReply ? "bad reply" : "save failed";
 }

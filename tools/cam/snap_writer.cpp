@@ -13,6 +13,9 @@
 
 namespace picksight::cam {
 
+using transport::decodeFrame;
+using transport::frameIsConsistent;
+
 Result<void> saveSnap(const std::string& camera, const proto::SnapReply& snap,
                       const std::string& file, bool as_json, std::ostream& out) {
   const proto::FrameHeader& h = snap.header();

@@ -142,8 +142,8 @@ class Cell {
     return false;
   }
 
-  picksight::ControlClient control_;
-  picksight::FrameSubscriber watcher_;
+  picksight::transport::ControlClient control_;
+  picksight::transport::FrameSubscriber watcher_;
   picksight::LineClient robot_;
   int failures_ = 0;
 };

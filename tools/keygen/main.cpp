@@ -59,17 +59,19 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  auto keys = picksight::generateKeyPair();
+  auto keys = picksight::transport::generateKeyPair();
   if (!keys) {
     std::cerr << "picksight-keygen: " << keys.error().message << "\n";
     return 1;
   }
   // The secret first: a public key without its secret is useless.
-  if (auto ok = writeWithMode(secret_path, picksight::secretKeyFileText(*keys), 077); !ok) {
+  if (auto ok = writeWithMode(secret_path, picksight::transport::secretKeyFileText(*keys), 077);
+      !ok) {
     std::cerr << "picksight-keygen: " << ok.error().message << "\n";
     return 1;
   }
-  if (auto ok = writeWithMode(public_path, picksight::publicKeyFileText(*keys), 022); !ok) {
+  if (auto ok = writeWithMode(public_path, picksight::transport::publicKeyFileText(*keys), 022);
+      !ok) {
     std::cerr << "picksight-keygen: " << ok.error().message << "\n";
     return 1;
   }

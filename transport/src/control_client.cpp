@@ -2,7 +2,7 @@
 // so on timeout the socket is dropped and a new one connected.
 #include "picksight/transport/control_client.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 namespace {
 ControlErrc fromWire(proto::Error::Code code) {
   // Same numbers; a code this client does not know is the server's problem.
@@ -98,4 +98,4 @@ Result<proto::ControlReply> ControlClient::call(const proto::ControlRequest& req
   return reply;
 }
 
-}  // namespace picksight
+}  // namespace picksight::transport

@@ -14,7 +14,7 @@
 
 #include "picksight/common/atomic_file.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 namespace {
 
 // Bounds what is read: a key file is a few hundred bytes, an allow-list file
@@ -240,4 +240,4 @@ void secureClientSocket(zmq::socket_t& socket, const std::optional<CurveClientKe
   socket.set(zmq::sockopt::curve_secretkey, keys->own.secret_key);
 }
 
-}  // namespace picksight
+}  // namespace picksight::transport

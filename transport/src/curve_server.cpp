@@ -8,7 +8,7 @@
 
 #include "picksight/common/log.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 namespace {
 
 constexpr const char* kZapEndpoint = "inproc://zeromq.zap.01";
@@ -131,4 +131,4 @@ void CurveServer::run(zmq::socket_t socket) {
   }
 }
 
-}  // namespace picksight
+}  // namespace picksight::transport

@@ -7,7 +7,7 @@
 
 #include "picksight/common/clock.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 namespace {
 
 // What ZeroMQ holds while it sends a frame's pixels without copying them.
@@ -178,4 +178,4 @@ std::optional<Frame> FrameSubscriber::receive(std::chrono::milliseconds timeout)
   }
 }
 
-}  // namespace picksight
+}  // namespace picksight::transport

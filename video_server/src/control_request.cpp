@@ -12,6 +12,9 @@
 #include "picksight/video_server/video_errors.hpp"
 
 namespace picksight::video {
+
+using transport::kMaxControlRequestBytes;
+
 namespace {
 
 // "nan", "-inf", "Infinity"...: text a driver would read as a non-finite number.

@@ -13,6 +13,10 @@
 #include "picksight/video_server/video_errors.hpp"
 
 namespace picksight::video {
+
+using transport::kMaxControlRequestBytes;
+using transport::secureServerSocket;
+
 namespace {
 constexpr std::chrono::milliseconds kPollPeriod{100};  // how soon the socket thread sees stop()
 

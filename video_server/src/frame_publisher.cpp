@@ -9,6 +9,11 @@
 #include "picksight/common/log.hpp"
 
 namespace picksight::video {
+
+using transport::CurveServer;
+using transport::secureServerSocket;
+using transport::sendFrame;
+
 namespace {
 std::atomic<int> g_monitor_id{0};
 }  // namespace

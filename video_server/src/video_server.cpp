@@ -11,6 +11,10 @@
 #include "picksight/video_server/video_errors.hpp"
 
 namespace picksight::video {
+
+using transport::CurveServer;
+using transport::frameHeaderOf;
+
 namespace {
 proto::AcquisitionMode toProto(AcquisitionMode m) {
   switch (m) {

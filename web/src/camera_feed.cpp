@@ -10,6 +10,9 @@
 #include "picksight/web/idle_priority.hpp"
 
 namespace picksight::web {
+
+using transport::FrameSubscriber;
+
 namespace {
 
 uint64_t threadCpuNs() {

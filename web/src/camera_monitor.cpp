@@ -8,6 +8,9 @@
 #include "picksight/web/web_errors.hpp"
 
 namespace picksight::web {
+
+using transport::ControlClient;
+
 namespace {
 using namespace std::chrono_literals;
 

@@ -47,6 +47,9 @@
 #include "picksight/web/web_errors.hpp"
 
 namespace picksight::web {
+
+using transport::ControlErrc;
+
 namespace {
 using namespace std::chrono_literals;
 

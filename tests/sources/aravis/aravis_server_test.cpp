@@ -14,6 +14,7 @@
 #include "temp_dir.hpp"
 
 using namespace picksight;
+using namespace picksight::transport;
 using namespace std::chrono_literals;
 using picksight::e2e::receiveUntil;
 using picksight::test::FakeGvCamera;

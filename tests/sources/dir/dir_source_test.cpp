@@ -140,7 +140,7 @@ TEST_CASE("picksight-video-server publishes a dir: source's images in order",
   auto endpoint = server.waitForLine("frames ", 10s);
   REQUIRE(endpoint);
   zmq::context_t context;
-  picksight::FrameSubscriber subscriber(context, *endpoint, "cam0", 64);
+  picksight::transport::FrameSubscriber subscriber(context, *endpoint, "cam0", 64);
   // Sequence numbers count frames from 1 with none given to failures, so
   // frame s is image (s - 1) mod n; checking that per frame holds even when
   // the subscriber misses some.

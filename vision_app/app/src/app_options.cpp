@@ -11,6 +11,8 @@
 
 namespace picksight::app {
 
+using transport::loadClientKeys;
+
 namespace {
 
 // Values checked by the options' validators, converted after the parse.

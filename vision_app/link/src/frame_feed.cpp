@@ -5,6 +5,9 @@
 
 namespace picksight::link {
 
+using transport::CurveClientKeys;
+using transport::FrameSubscriber;
+
 FrameFeed::FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
                      std::optional<CurveClientKeys> curve)
     : context_(context),

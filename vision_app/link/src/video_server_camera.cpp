@@ -7,6 +7,10 @@
 
 namespace picksight::link {
 
+using transport::ControlErrc;
+using transport::CurveClientKeys;
+using transport::kDefaultControlTimeout;
+
 VideoServerCamera::VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
                                      const std::string& control_endpoint, std::string camera,
                                      std::chrono::milliseconds frame_timeout,

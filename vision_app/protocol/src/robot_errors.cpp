@@ -23,6 +23,8 @@ using cell::VisionSettingsErrc;
 using store::CellCalibrationErrc;
 using store::ModelErrc;
 
+using transport::ControlErrc;
+
 namespace {
 
 using calibration::CalibrationErrc;

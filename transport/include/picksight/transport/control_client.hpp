@@ -14,7 +14,7 @@
 #include "picksight/common/result.hpp"
 #include "picksight/transport/curve_keys.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 
 // Why a control call failed: the server's answer, its wire code decoded
 // (the values are proto::Error::Code's, so a tool can print the wire code),
@@ -65,6 +65,6 @@ class ControlClient {
   std::unique_ptr<zmq::socket_t> socket_;
 };
 
-}  // namespace picksight
+}  // namespace picksight::transport
 
-PICKSIGHT_ERROR_ENUM(picksight::ControlErrc)
+PICKSIGHT_ERROR_ENUM(picksight::transport::ControlErrc)

@@ -17,7 +17,7 @@
 
 #include "picksight/common/result.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 
 enum class CurveErrc {
   kBadKeyFile = 1,   // missing, unreadable or malformed key or allow-list file
@@ -76,6 +76,6 @@ Result<CurveClientKeys> loadClientKeys(const std::string& key_file,
 // nullopt it stays plain: callers pass their optional keys through.
 void secureClientSocket(zmq::socket_t& socket, const std::optional<CurveClientKeys>& keys);
 
-}  // namespace picksight
+}  // namespace picksight::transport
 
-PICKSIGHT_ERROR_ENUM(picksight::CurveErrc)
+PICKSIGHT_ERROR_ENUM(picksight::transport::CurveErrc)

@@ -21,7 +21,7 @@
 
 #include "picksight/transport/curve_keys.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 
 class CurveServer {
  public:
@@ -66,4 +66,4 @@ inline void secureServerSocket(zmq::socket_t& socket, const CurveServer* curve) 
   if (curve) curve->secure(socket);
 }
 
-}  // namespace picksight
+}  // namespace picksight::transport

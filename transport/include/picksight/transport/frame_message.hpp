@@ -17,7 +17,7 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/transport/curve_keys.hpp"
 
-namespace picksight {
+namespace picksight::transport {
 
 // ------------------------------------------------------------------ encoder
 
@@ -76,4 +76,4 @@ class FrameSubscriber {
   std::map<std::string, uint64_t> last_sequence_;  // per camera
 };
 
-}  // namespace picksight
+}  // namespace picksight::transport

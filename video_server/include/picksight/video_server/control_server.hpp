@@ -43,9 +43,9 @@
 namespace picksight::video {
 
 struct ControlServerOptions {
-  size_t workers = 4;                  // parallel lanes (cameras) of slow requests
-  size_t max_pending = 64;             // slow requests waiting for a worker
-  const CurveServer* curve = nullptr;  // makes the ROUTER a CURVE server
+  size_t workers = 4;                             // parallel lanes (cameras) of slow requests
+  size_t max_pending = 64;                        // slow requests waiting for a worker
+  const transport::CurveServer* curve = nullptr;  // makes the ROUTER a CURVE server
 };
 
 class ControlServer {

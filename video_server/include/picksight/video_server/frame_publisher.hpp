@@ -35,7 +35,7 @@ class FramePublisher : public FrameSink {
   // wait at most; `subscriber_queue` frames per subscriber in ZeroMQ. With
   // `curve` the socket is a CURVE server (the object need not outlive this).
   FramePublisher(zmq::context_t& context, const std::string& endpoint, size_t queue_limit = 8,
-                 int subscriber_queue = 4, const CurveServer* curve = nullptr);
+                 int subscriber_queue = 4, const transport::CurveServer* curve = nullptr);
   ~FramePublisher() override;
 
   // The endpoint actually bound (a wildcard port resolved).

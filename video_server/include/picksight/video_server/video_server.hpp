@@ -52,7 +52,7 @@ class VideoServer {
   // thread, 35 to 47 with two; plain frames do not need them).
   zmq::context_t context_{2};
   // Before the sockets: its ZAP handler's socket closes after theirs.
-  std::unique_ptr<CurveServer> curve_;
+  std::unique_ptr<transport::CurveServer> curve_;
   std::unique_ptr<FramePublisher> publisher_;
   std::vector<std::unique_ptr<Camera>> cameras_;
   std::unique_ptr<ControlServer> control_;

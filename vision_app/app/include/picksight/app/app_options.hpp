@@ -38,7 +38,7 @@ struct AppOptions {
   // unless --filmstrip-dir says; dir empty: none.
   filmstrip::FilmstripOptions filmstrip;
   // CURVE keys for the camera link (loaded by parseAppArgs); nullopt: plain.
-  std::optional<CurveClientKeys> curve;
+  std::optional<transport::CurveClientKeys> curve;
 };
 
 // Parses argv without the program name; errors name the option. With

@@ -20,7 +20,7 @@ namespace picksight::link {
 class FrameFeed {
  public:
   FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
-            std::optional<CurveClientKeys> curve = std::nullopt);
+            std::optional<transport::CurveClientKeys> curve = std::nullopt);
   ~FrameFeed();
 
   void start();
@@ -41,7 +41,7 @@ class FrameFeed {
   zmq::context_t& context_;
   const std::string endpoint_;
   const std::string camera_;
-  const std::optional<CurveClientKeys> curve_;
+  const std::optional<transport::CurveClientKeys> curve_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<uint64_t> received_{0};

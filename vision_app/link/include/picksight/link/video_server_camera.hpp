@@ -26,7 +26,7 @@ class VideoServerCamera : public CameraLink {
   VideoServerCamera(zmq::context_t& context, const std::string& frames_endpoint,
                     const std::string& control_endpoint, std::string camera,
                     std::chrono::milliseconds frame_timeout,
-                    const std::optional<CurveClientKeys>& curve = std::nullopt);
+                    const std::optional<transport::CurveClientKeys>& curve = std::nullopt);
   void start() override { feed_.start(); }
   void stop() override { feed_.stop(); }
   Result<std::shared_ptr<const Frame>> freshFrame() override;
@@ -51,7 +51,7 @@ class VideoServerCamera : public CameraLink {
   const std::string camera_;
   const std::chrono::milliseconds frame_timeout_;
   FrameFeed feed_;
-  ControlClient control_;
+  transport::ControlClient control_;
 };
 
 }  // namespace picksight::link
