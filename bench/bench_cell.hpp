@@ -31,7 +31,7 @@ inline std::string makeDataDir() {
 }
 
 struct VideoServerRun {
-  std::unique_ptr<Subprocess> process;
+  std::unique_ptr<tool_support::Subprocess> process;
   std::string frames;
   std::string control;
 };
@@ -40,7 +40,7 @@ struct VideoServerRun {
 inline std::optional<VideoServerRun> startVideoServer(const std::string& camera) {
   using namespace std::chrono_literals;
   VideoServerRun run;
-  run.process = std::make_unique<Subprocess>(std::vector<std::string>{
+  run.process = std::make_unique<tool_support::Subprocess>(std::vector<std::string>{
       binDir() + "/picksight-video-server", "--source", camera, "--frames", "tcp://127.0.0.1:*",
       "--control", "tcp://127.0.0.1:*", "--mode", "trigger"});
   const auto frames = run.process->waitForLine("frames ", 10s);
@@ -52,8 +52,8 @@ inline std::optional<VideoServerRun> startVideoServer(const std::string& camera)
 }
 
 struct VisionRun {
-  std::unique_ptr<Subprocess> process;
-  LineClient robot;
+  std::unique_ptr<tool_support::Subprocess> process;
+  tool_support::LineClient robot;
 };
 
 // Starts a vision app on `server`'s camera with `data_dir` (and `extra`
@@ -72,10 +72,11 @@ inline std::optional<VisionRun> startVision(const VideoServerRun& server,
                                    data_dir};
   for (const char* option : {"--robot-port", "0", "--bind", "127.0.0.1"}) command.push_back(option);
   command.insert(command.end(), extra.begin(), extra.end());
-  run.process = std::make_unique<Subprocess>(command);
+  run.process = std::make_unique<tool_support::Subprocess>(command);
   const auto port = run.process->waitForLine("robot ", 10s);
   if (!port || !run.process->waitForLine("ready", 10s)) return std::nullopt;
-  auto robot = LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
+  auto robot =
+      tool_support::LineClient::connect("127.0.0.1", static_cast<uint16_t>(std::stoi(*port)), 5s);
   if (!robot) return std::nullopt;
   run.robot = std::move(*robot);
   return run;

@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
   if (!server) return 1;
   auto vision = picksight::bench::startVision(*server, data_dir);
   if (!vision) return 1;
-  picksight::LineClient* robot = &vision->robot;
+  picksight::tool_support::LineClient* robot = &vision->robot;
 
   for (int i = 0; i < 10; ++i) (void)robot->request("LOCATE 1", 10s);  // warm-up
   std::vector<double> ms;

@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   if (!server || data_dir.empty()) return 1;
   auto vision = picksight::bench::startVision(*server, data_dir);
   if (!vision) return 1;
-  picksight::LineClient* robot = &vision->robot;
+  picksight::tool_support::LineClient* robot = &vision->robot;
 
   zmq::context_t context;
   int failures = 0;

@@ -47,14 +47,14 @@ struct Summary {
 // `extra` goes on each subscriber's command line (its CURVE keys).
 Summary runSubscribers(const std::string& dir, const std::string& endpoint, int count,
                        double seconds, bool bare, const std::vector<std::string>& extra = {}) {
-  std::vector<std::unique_ptr<picksight::Subprocess>> subs;
+  std::vector<std::unique_ptr<picksight::tool_support::Subprocess>> subs;
   for (int i = 0; i < count; ++i) {
     std::vector<std::string> argv = {
         dir + "/picksight-bench-subscriber", "--frames", endpoint, "--camera", "cam0", "--seconds",
         picksight::formatFixed(seconds, 1)};
     if (bare) argv.push_back("--bare");
     argv.insert(argv.end(), extra.begin(), extra.end());
-    subs.push_back(std::make_unique<picksight::Subprocess>(argv));
+    subs.push_back(std::make_unique<picksight::tool_support::Subprocess>(argv));
     subs.back()->waitForLine("subscribed", 5s);
   }
   Summary s;
@@ -199,10 +199,10 @@ int main(int argc, char** argv) {
       row("bare ZeroMQ PUB/SUB", n, s);
     }
     {
-      picksight::Subprocess server({dir + "/picksight-video-server", "--source",
-                                    "cam0=synthetic:width=1920,height=1080,parts=20", "--fps", "60",
-                                    "--frames", "tcp://127.0.0.1:*", "--control",
-                                    "tcp://127.0.0.1:*"});
+      picksight::tool_support::Subprocess server({dir + "/picksight-video-server", "--source",
+                                                  "cam0=synthetic:width=1920,height=1080,parts=20",
+                                                  "--fps", "60", "--frames", "tcp://127.0.0.1:*",
+                                                  "--control", "tcp://127.0.0.1:*"});
       auto frames = server.waitForLine("frames ", 10s);
       if (!frames) return 1;
       const Summary s = runSubscribers(dir, *frames, n, seconds, false);
@@ -219,7 +219,7 @@ int main(int argc, char** argv) {
                                        "--control",
                                        "tcp://127.0.0.1:*"};
       argv.insert(argv.end(), server_curve.begin(), server_curve.end());
-      picksight::Subprocess server(argv);
+      picksight::tool_support::Subprocess server(argv);
       auto frames = server.waitForLine("frames ", 10s);
       if (!frames) return 1;
       const Summary s = runSubscribers(dir, *frames, n, seconds, false, client_curve);

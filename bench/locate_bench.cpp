@@ -76,7 +76,7 @@ void row(const char* what, const Stats& s, double baseline) {
 // pixels), from a frame the robot's LOCATE triggers; nullopt when none came.
 std::optional<picksight::TruthPart> loneTruthPart(zmq::context_t& context,
                                                   const std::string& frames,
-                                                  picksight::LineClient& robot) {
+                                                  picksight::tool_support::LineClient& robot) {
   picksight::transport::FrameSubscriber watcher(context, frames, "cam0", 8);
   const auto deadline = Clock::now() + 10s;
   while (Clock::now() < deadline) {
@@ -103,7 +103,7 @@ std::optional<picksight::TruthPart> loneTruthPart(zmq::context_t& context,
 // LEARN 1 AT a box around the lone part, then the camera resized to
 // `scale` (1: left alone). False, with a message, when either failed.
 bool learnAndResize(zmq::context_t& context, const picksight::bench::VideoServerRun& server,
-                    picksight::LineClient& robot, double scale) {
+                    picksight::tool_support::LineClient& robot, double scale) {
   const auto part = loneTruthPart(context, server.frames, robot);
   if (!part) {
     std::cerr << "bench: no frame with parts to learn from\n";
@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
   if (!results_bind.empty()) vision_options = {"--results-bind", results_bind};
   auto vision = picksight::bench::startVision(*server, data_dir, vision_options);
   if (!vision) return 1;
-  picksight::LineClient* robot = &vision->robot;
+  picksight::tool_support::LineClient* robot = &vision->robot;
   zmq::context_t context;
   if ((learn || scale != 1) && !learnAndResize(context, *server, *robot, scale)) return 1;
 

@@ -20,6 +20,7 @@
 namespace {
 using namespace std::chrono_literals;
 using namespace picksight;
+using namespace picksight::tool_support;
 using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {

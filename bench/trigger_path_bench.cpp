@@ -138,9 +138,9 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  picksight::Subprocess server({dir + "/picksight-video-server", "--source",
-                                "cam0=synthetic:" + params, "--frames", "tcp://127.0.0.1:*",
-                                "--control", "tcp://127.0.0.1:*", "--mode", "trigger"});
+  picksight::tool_support::Subprocess server(
+      {dir + "/picksight-video-server", "--source", "cam0=synthetic:" + params, "--frames",
+       "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode", "trigger"});
   const auto frames = server.waitForLine("frames ", 10s);
   const auto control_endpoint = server.waitForLine("control ", 10s);
   if (!frames || !control_endpoint) return 1;
@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
     auto vision = picksight::bench::startVision(endpoints, data_dir);
     if (!vision) return 1;
     std::this_thread::sleep_for(300ms);
-    picksight::LineClient* robot = &vision->robot;
+    picksight::tool_support::LineClient* robot = &vision->robot;
     for (int i = 0; i < args.requests + 10; ++i) {
       const uint64_t t0 = monotonicNs();
       auto r = robot->request("LOCATE 1", 10s);

@@ -251,7 +251,7 @@ int main(int argc, char** argv) {
   const std::string bin = picksight::bench::binDir();
 
   picksight::bench::VideoServerRun server;
-  server.process = std::make_unique<picksight::Subprocess>(std::vector<std::string>{
+  server.process = std::make_unique<picksight::tool_support::Subprocess>(std::vector<std::string>{
       bin + "/picksight-video-server", "--source", picksight::bench::syntheticCamera(args),
       "--source",
       "cam1=synthetic:width=" + std::to_string(args.width) +
@@ -279,9 +279,9 @@ int main(int argc, char** argv) {
   auto vision = picksight::bench::startVision(server, data_dir, {"--results-bind", results});
   if (!vision) return 1;
   // The page's commands would go to the third field; the bench sends none.
-  picksight::Subprocess web({bin + "/picksight-web", "--listen", "127.0.0.1:0", "--video-server",
-                             server.frames + "," + server.control, "--vision-app",
-                             "cam0," + results + ",127.0.0.1:9"});
+  picksight::tool_support::Subprocess web({bin + "/picksight-web", "--listen", "127.0.0.1:0",
+                                           "--video-server", server.frames + "," + server.control,
+                                           "--vision-app", "cam0," + results + ",127.0.0.1:9"});
   const auto url = web.waitForLine("web http://127.0.0.1:", 10s);
   if (!url) return 1;
   const int port = std::stoi(*url);
@@ -297,7 +297,7 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_for(50ms);
     }
   }
-  picksight::LineClient* robot = &vision->robot;
+  picksight::tool_support::LineClient* robot = &vision->robot;
   int failures = 0;
   const auto locate = [&](std::vector<double>& into) {
     const auto t0 = Clock::now();

@@ -275,9 +275,9 @@ int main(int argc, char** argv) {
   }
 
   const std::string bin = picksight::bench::binDir();
-  picksight::Subprocess server({bin + "/picksight-video-server", "--source",
-                                "cam0=synthetic:width=640,height=480,parts=4", "--fps", "10",
-                                "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"});
+  picksight::tool_support::Subprocess server(
+      {bin + "/picksight-video-server", "--source", "cam0=synthetic:width=640,height=480,parts=4",
+       "--fps", "10", "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"});
   const auto frames = server.waitForLine("frames ", 10s);
   const auto control = server.waitForLine("control ", 10s);
   if (!frames || !control) return 1;
@@ -288,16 +288,17 @@ int main(int argc, char** argv) {
     if (!::mkdtemp(dir)) return 1;
     const std::string cert = std::string(dir) + "/web.crt";
     const std::string key = std::string(dir) + "/web.key";
-    picksight::Subprocess openssl({"/usr/bin/openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt",
-                                   "ec_paramgen_curve:prime256v1", "-nodes", "-days", "2", "-subj",
-                                   "/CN=localhost", "-keyout", key, "-out", cert});
+    picksight::tool_support::Subprocess openssl({"/usr/bin/openssl", "req", "-x509", "-newkey",
+                                                 "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1",
+                                                 "-nodes", "-days", "2", "-subj", "/CN=localhost",
+                                                 "-keyout", key, "-out", cert});
     if (openssl.wait(30s) != 0) {
       std::fprintf(stderr, "openssl could not make a certificate\n");
       return 1;
     }
     command.insert(command.end(), {"--tls-cert", cert, "--tls-key", key});
   }
-  picksight::Subprocess web(command);
+  picksight::tool_support::Subprocess web(command);
   const auto password = web.waitForLine("admin-password ", 10s);
   const auto url =
       web.waitForLine(args.tls ? "web https://127.0.0.1:" : "web http://127.0.0.1:", 10s);

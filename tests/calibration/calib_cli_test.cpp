@@ -15,6 +15,7 @@
 #include "picksight/tool_support/subprocess.hpp"
 
 using namespace picksight;
+using namespace picksight::tool_support;
 using namespace std::chrono_literals;
 
 namespace {

@@ -15,6 +15,7 @@
 using namespace picksight;
 using namespace picksight::e2e;
 using namespace picksight::transport;
+using namespace picksight::tool_support;
 using namespace std::chrono_literals;
 
 namespace {

@@ -13,6 +13,7 @@
 using namespace picksight;
 using namespace picksight::e2e;
 using namespace picksight::plc;
+using namespace picksight::tool_support;
 using picksight::plc::test::ModbusClient;
 using namespace std::chrono_literals;
 

@@ -14,6 +14,8 @@
 
 namespace picksight::e2e {
 
+using tool_support::LineClient;
+using tool_support::Subprocess;
 using transport::ControlClient;
 using transport::FrameSubscriber;
 

@@ -23,7 +23,7 @@ struct VideoServerProcess {
   // Starts the server with `args` plus free-port endpoints; REQUIREs that it
   // printed its endpoints. With a `log_file` its stderr (the log) goes there.
   explicit VideoServerProcess(std::vector<std::string> args, const std::string& log_file = "");
-  std::unique_ptr<Subprocess> process;
+  std::unique_ptr<tool_support::Subprocess> process;
   std::string frames;
   std::string control;
 };
@@ -35,13 +35,13 @@ struct VisionProcess {
   VisionProcess(const VideoServerProcess& server, const std::string& camera = "cam0",
                 const std::string& data_dir = "", const std::vector<std::string>& extra_args = {});
   ~VisionProcess();
-  std::unique_ptr<Subprocess> process;
+  std::unique_ptr<tool_support::Subprocess> process;
   uint16_t robot_port = 0;
   uint16_t setup_port = 0;
   std::string results_endpoint;  // empty with --results-bind none
   std::string data_dir;
   bool own_data_dir = true;
-  LineClient connect() const;
+  tool_support::LineClient connect() const;
 };
 
 struct CommandResult {

@@ -17,7 +17,7 @@
 #include "picksight/tool_support/line_client.hpp"
 
 using namespace std::chrono_literals;
-using picksight::LineClient;
+using picksight::tool_support::LineClient;
 
 namespace {
 

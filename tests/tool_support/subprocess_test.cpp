@@ -13,7 +13,7 @@
 #include "picksight/tool_support/subprocess.hpp"
 
 using namespace std::chrono_literals;
-using picksight::Subprocess;
+using picksight::tool_support::Subprocess;
 
 namespace {
 constexpr auto kTimeout = 10000ms;

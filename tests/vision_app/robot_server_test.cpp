@@ -14,6 +14,7 @@
 #include "picksight/tool_support/line_client.hpp"
 
 using namespace picksight;
+using namespace picksight::tool_support;
 using namespace std::chrono_literals;
 
 namespace {

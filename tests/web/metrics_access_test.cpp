@@ -12,6 +12,7 @@
 namespace picksight::webtest {
 namespace {
 using e2e::VideoServerProcess;
+using tool_support::Subprocess;
 
 // A GET from `source` (a loopback address) with extra header lines.
 std::string rawGet(const WebProcess& web, const std::string& path, const std::string& source,

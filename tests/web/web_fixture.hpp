@@ -28,7 +28,7 @@ struct WebProcess {
       : ca(std::move(ca_cert)) {
     std::vector<std::string> argv = {e2e::binPath("picksight-web"), "--listen", "127.0.0.1:0"};
     argv.insert(argv.end(), args.begin(), args.end());
-    process = std::make_unique<Subprocess>(argv);
+    process = std::make_unique<tool_support::Subprocess>(argv);
     // With no users yet the server makes 'admin' and prints its password
     // once, before its URL; the tests log in with it.
     std::string url_prefix = "web http://127.0.0.1:";
@@ -83,7 +83,7 @@ struct WebProcess {
   // "Cookie: ...\r\n" for a raw request, logged in as the admin.
   std::string cookieLine() const { return cookie.empty() ? "" : "Cookie: " + cookie + "\r\n"; }
   std::string ca;
-  std::unique_ptr<Subprocess> process;
+  std::unique_ptr<tool_support::Subprocess> process;
   int port = 0;
   bool https = false;
   std::string redirect_url;  // "http://127.0.0.1:PORT" with --http-redirect

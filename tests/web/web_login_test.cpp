@@ -24,6 +24,7 @@ using namespace std::chrono_literals;
 using e2e::VideoServerProcess;
 using e2e::VisionProcess;
 using nlohmann::json;
+using tool_support::Subprocess;
 
 httplib::Result post(httplib::Client& client, const std::string& path, const json& body) {
   return postJson(client, path, body);

@@ -24,6 +24,7 @@
 namespace picksight::webtest {
 namespace {
 using e2e::VideoServerProcess;
+using tool_support::Subprocess;
 
 struct Certificate {
   std::string cert;

@@ -65,7 +65,7 @@ std::vector<double> replyNumbers(const std::string& reply) {
 class Cell {
  public:
   Cell(zmq::context_t& context, const std::string& control, const std::string& frames,
-       picksight::LineClient robot)
+       picksight::tool_support::LineClient robot)
       : control_(context, control, 10s),
         watcher_(context, frames, "cam0", 64),
         robot_(std::move(robot)) {}
@@ -144,7 +144,7 @@ class Cell {
 
   picksight::transport::ControlClient control_;
   picksight::transport::FrameSubscriber watcher_;
-  picksight::LineClient robot_;
+  picksight::tool_support::LineClient robot_;
   int failures_ = 0;
 };
 
@@ -242,7 +242,7 @@ void pick(Cell& cell, const cv::Matx33d& robot_to_sensor, int parts, int request
 
 // The start-up lines of a PickSight process ("robot 1234", "results tcp://...")
 // up to its "ready" line, by their first word.
-std::map<std::string, std::string> startLines(picksight::Subprocess& process) {
+std::map<std::string, std::string> startLines(picksight::tool_support::Subprocess& process) {
   std::map<std::string, std::string> lines;
   while (auto line = process.readLine(10s)) {
     if (*line == "ready") break;
@@ -257,11 +257,11 @@ int serveWeb(const picksight::StopSignals& stop, Cell& cell, const std::string& 
              const std::string& frames, const std::string& control, const std::string& results,
              int robot_port, int port) {
   cell.setFreerun(10);
-  picksight::Subprocess web({dir + "/picksight-web", "--listen",
-                             "127.0.0.1:" + std::to_string(port), "--video-server",
-                             frames + "," + control, "--vision-app",
-                             "cam0," + (results.empty() ? "none" : results) +
-                                 ",127.0.0.1:" + std::to_string(robot_port)});
+  picksight::tool_support::Subprocess web({dir + "/picksight-web", "--listen",
+                                           "127.0.0.1:" + std::to_string(port), "--video-server",
+                                           frames + "," + control, "--vision-app",
+                                           "cam0," + (results.empty() ? "none" : results) +
+                                               ",127.0.0.1:" + std::to_string(robot_port)});
   // Its users live in memory: it prints the one admin's random password
   // before its URL.
   std::string password;
@@ -348,18 +348,18 @@ int main(int argc, char** argv) {
       ",target_radius=" + formatFixed(kTargetRadius, 3);
   std::cout << "PickSight demo: a whole cell on the synthetic camera (" << width << "x" << height
             << ") and its simulated robot\n";
-  picksight::Subprocess server({dir + "/picksight-video-server", "--source", source, "--frames",
-                                "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*", "--mode",
-                                "trigger"});
+  picksight::tool_support::Subprocess server({dir + "/picksight-video-server", "--source", source,
+                                              "--frames", "tcp://127.0.0.1:*", "--control",
+                                              "tcp://127.0.0.1:*", "--mode", "trigger"});
   auto frames = server.waitForLine("frames ", 10s);
   auto control = server.waitForLine("control ", 10s);
   if (!frames || !control) {
     std::cerr << "demo: the video server did not start\n";
     return 1;
   }
-  picksight::Subprocess vision({dir + "/picksight-vision", "--frames", *frames, "--control",
-                                *control, "--camera", "cam0", "--robot-port", "0", "--bind",
-                                "127.0.0.1", "--data-dir", data_dir});
+  picksight::tool_support::Subprocess vision(
+      {dir + "/picksight-vision", "--frames", *frames, "--control", *control, "--camera", "cam0",
+       "--robot-port", "0", "--bind", "127.0.0.1", "--data-dir", data_dir});
   auto started = startLines(vision);
   auto port = started.count("robot") ? picksight::parseInt(started["robot"]) : std::nullopt;
   if (!port) {
@@ -368,7 +368,8 @@ int main(int argc, char** argv) {
   }
   std::cout << "video server: frames " << *frames << ", control " << *control
             << "\nvision app: robot port " << *port << ", data " << data_dir << "\n";
-  auto robot = picksight::LineClient::connect("127.0.0.1", static_cast<uint16_t>(*port), 5s);
+  auto robot =
+      picksight::tool_support::LineClient::connect("127.0.0.1", static_cast<uint16_t>(*port), 5s);
   if (!robot) {
     std::cerr << "demo: " << robot.error().message << "\n";
     return 1;

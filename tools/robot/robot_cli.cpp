@@ -7,6 +7,9 @@
 #include "picksight/common/command_line.hpp"
 
 namespace picksight::robot {
+
+using tool_support::LineClient;
+
 namespace {
 
 bool isOkReply(const std::string& reply) { return reply == "OK" || reply.rfind("OK ", 0) == 0; }

@@ -54,7 +54,7 @@ class RobotSession {
 
  private:
   RobotOptions options_;
-  std::optional<LineClient> client_;
+  std::optional<tool_support::LineClient> client_;
 };
 
 // True for lines a script or a person types that are not requests: blank

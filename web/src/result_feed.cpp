@@ -9,6 +9,9 @@
 #include "picksight/web/web_errors.hpp"
 
 namespace picksight::web {
+
+using tool_support::LineClient;
+
 namespace {
 using namespace std::chrono_literals;
 

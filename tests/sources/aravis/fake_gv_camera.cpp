@@ -9,6 +9,9 @@
 #include "picksight/sources/source.hpp"
 
 namespace picksight::test {
+
+using tool_support::Subprocess;
+
 using namespace std::chrono_literals;
 
 FakeGvCamera::FakeGvCamera() { start(); }

@@ -29,7 +29,7 @@ class FakeGvCamera {
   bool running() const { return process_ != nullptr; }
 
  private:
-  std::unique_ptr<Subprocess> process_;
+  std::unique_ptr<tool_support::Subprocess> process_;
 };
 
 // The fake camera draws a diagonal ramp, (x + y + frame id) mod 255, scaled by

@@ -134,9 +134,10 @@ TEST_CASE("picksight-video-server publishes a dir: source's images in order",
   for (int i = 0; i < kImages; ++i) {
     writeImage(dir.path() / ("img_" + std::to_string(i) + ".png"), 40 + 50 * i, {64, 48});
   }
-  picksight::Subprocess server({std::string(PICKSIGHT_BIN_DIR) + "/picksight-video-server",
-                                "--source", "cam0=dir:" + dir.path().string(), "--fps", "20",
-                                "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*"});
+  picksight::tool_support::Subprocess server(
+      {std::string(PICKSIGHT_BIN_DIR) + "/picksight-video-server", "--source",
+       "cam0=dir:" + dir.path().string(), "--fps", "20", "--frames", "tcp://127.0.0.1:*",
+       "--control", "tcp://127.0.0.1:*"});
   auto endpoint = server.waitForLine("frames ", 10s);
   REQUIRE(endpoint);
   zmq::context_t context;

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-namespace picksight {
+namespace picksight::tool_support {
 
 // The first whole line of `buffer` (without its '\n'), taken out of it;
 // none while no '\n' has arrived.
@@ -24,4 +24,4 @@ inline std::chrono::milliseconds timeLeft(std::chrono::steady_clock::time_point 
                                                                std::chrono::steady_clock::now());
 }
 
-}  // namespace picksight
+}  // namespace picksight::tool_support

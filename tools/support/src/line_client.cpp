@@ -15,7 +15,7 @@
 #include "line_buffer.hpp"
 #include "picksight/common/allow_list.hpp"
 
-namespace picksight {
+namespace picksight::tool_support {
 
 LineClient::~LineClient() { close(); }
 
@@ -137,4 +137,4 @@ Result<std::string> LineClient::request(const std::string& line,
   return readLine(timeout);
 }
 
-}  // namespace picksight
+}  // namespace picksight::tool_support

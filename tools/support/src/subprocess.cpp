@@ -17,7 +17,7 @@
 
 extern char** environ;
 
-namespace picksight {
+namespace picksight::tool_support {
 
 Subprocess::Subprocess(const std::vector<std::string>& argv) {
   if (argv.empty()) throw std::invalid_argument("Subprocess: empty argv");
@@ -123,4 +123,4 @@ int Subprocess::terminate(std::chrono::milliseconds grace) {
   return status;
 }
 
-}  // namespace picksight
+}  // namespace picksight::tool_support

@@ -130,7 +130,7 @@ class ResultFeed {
   const ChangeHandler on_change_;
 
   std::mutex line_mutex_;
-  LineClient line_;  // under line_mutex_
+  tool_support::LineClient line_;  // under line_mutex_
   // This end of the last few command connections ("127.0.0.1:41234"): a
   // change's record may arrive after its connection was replaced.
   mutable std::mutex own_mutex_;

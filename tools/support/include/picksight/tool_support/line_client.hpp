@@ -9,7 +9,7 @@
 
 #include "picksight/common/result.hpp"
 
-namespace picksight {
+namespace picksight::tool_support {
 
 class LineClient {
  public:
@@ -41,4 +41,4 @@ class LineClient {
   std::string buffer_;
 };
 
-}  // namespace picksight
+}  // namespace picksight::tool_support

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace picksight {
+namespace picksight::tool_support {
 
 class Subprocess {
  public:
@@ -44,4 +44,4 @@ class Subprocess {
   std::optional<int> status_;
 };
 
-}  // namespace picksight
+}  // namespace picksight::tool_support
