@@ -10,6 +10,10 @@
 * README.md: every relative link and every docs/*.md it names exists; every
   command line `build/bin/picksight-...` names a built binary, and every
   --option on it is one that binary's --help lists (a renamed flag fails).
+* docs/ARCHITECTURE.md's namespace table against the code: the flat
+  namespace `picksight` is opened only by the library its row names (and
+  that library's tests), and every `picksight::x` product code opens has a
+  row (a library moved back into `picksight`, or a new one left out, fails).
 
 Usage: check_docs.py SOURCE_DIR BIN_DIR [with-bench|no-bench]
 (no-bench: a build without the benchmarks; their lines are not run.)
@@ -130,6 +134,49 @@ def check_readme(root, bin_dir, with_bench):
                 fail(f"README.md: '{line}': {binary.name} --help has no {option}")
 
 
+def namespace_table(architecture):
+    """{namespace: library cell} from the table after 'Namespaces:'."""
+    match = re.search(r"^Namespaces:.*?\n\n((?:\|[^\n]*\n)+)", architecture, re.M | re.S)
+    if not match:
+        fail("docs/ARCHITECTURE.md: no namespace table after 'Namespaces:'")
+        return {}
+    table = {}
+    for line in match.group(1).splitlines()[2:]:
+        cells = [c.strip() for c in line.split("|")[1:-1]]
+        prefix = None
+        for name in re.findall(r"`([\w:]+)`", cells[0]):
+            # `picksight::a`, `::b`: the second is picksight::b
+            full = prefix + name if name.startswith("::") and prefix else name
+            prefix = full.rsplit("::", 1)[0] if "::" in full else full
+            table[full] = cells[1]
+    return table
+
+
+def check_namespaces(root):
+    table = namespace_table((root / "docs" / "ARCHITECTURE.md").read_text())
+    if "picksight" not in table:
+        fail("docs/ARCHITECTURE.md: the namespace table has no row for `picksight`")
+        return
+    # The folder of the one library the flat namespace belongs to.
+    flat_owner = re.findall(r"`([\w/]+)`", table["picksight"])[:1]
+    sources = [p for p in root.rglob("*") if p.suffix in (".cpp", ".hpp", ".h")
+               and "build" not in p.relative_to(root).parts[0]]
+    for path in sources:
+        parts = path.relative_to(root).parts
+        text = path.read_text(errors="replace")
+        if re.search(r"^namespace picksight \{", text, re.M):
+            owned = parts[0] in flat_owner or (parts[0] == "tests" and parts[1] in flat_owner)
+            if not owned:
+                fail(f"{path.relative_to(root)}: opens the flat namespace `picksight`, "
+                     f"which docs/ARCHITECTURE.md gives to {', '.join(flat_owner)} alone")
+        if parts[0] == "tests":
+            continue  # tests and their fixtures name namespaces of their own
+        for name in re.findall(r"^namespace (picksight::\w+)", text, re.M):
+            if name not in table:
+                fail(f"{path.relative_to(root)}: namespace {name} has no row in "
+                     "docs/ARCHITECTURE.md's namespace table")
+
+
 def main():
     if len(sys.argv) not in (3, 4) or sys.argv[3:] not in ([], ["with-bench"], ["no-bench"]):
         print(__doc__, file=sys.stderr)
@@ -139,6 +186,7 @@ def main():
     check_error_codes(root)
     check_why_sentences(root)
     check_readme(root, bin_dir, sys.argv[3:] != ["no-bench"])
+    check_namespaces(root)
     for f in failures:
         print("FAIL:", f, file=sys.stderr)
     if not failures:
