@@ -464,12 +464,23 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const cv::Mat& g
   }
   const double small_hole = kSmallHoleShare * r.area;
   int small = 0;
-  for (const auto& hole : r.hole_boundaries) small += cv::contourArea(hole) < small_hole ? 1 : 0;
+  double largest_small = 0;
+  for (const auto& hole : r.hole_boundaries) {
+    const double area = cv::contourArea(hole);
+    if (area >= small_hole) continue;
+    ++small;
+    largest_small = std::max(largest_small, area);
+  }
   if (small > 0) {
-    warnings.push_back(std::to_string(small) + (small == 1 ? " hole" : " holes") +
-                       " smaller than " +
-                       std::to_string(std::lround(mapping.areaToSensor(small_hole))) +
-                       " px (noise or uneven light? every LOCATE needs the same count)");
+    // The setting that leaves them all out (holes under it are not counted),
+    // named so the reader need not measure them: the relief of a coin gave
+    // 26 such holes, and every other coin was refused on its hole count.
+    const long leave_out = static_cast<long>(std::floor(mapping.areaToSensor(largest_small))) + 1;
+    warnings.push_back(
+        std::to_string(small) + (small == 1 ? " hole" : " holes") + " smaller than " +
+        std::to_string(std::lround(mapping.areaToSensor(small_hole))) +
+        " px (noise or uneven light? every LOCATE needs the same count; " +
+        "VISION min_hole_area " + std::to_string(leave_out) + " and LEARN again leaves them out)");
   }
   if (r.touches_border) warnings.push_back("the part touches the frame border");
   const double area = mapping.areaToSensor(r.area);
