@@ -246,6 +246,21 @@ TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blo
   REQUIRE(lone.size() == 1);
   CHECK(lone.front().from_edges);
   CHECK_FALSE(lone.front().touching);
+  // An L 7 % larger than the one taught, alone: the model fits it loosely
+  // (the search goes on looking for more), but it leaves only a rim of its
+  // blob and touches nothing.
+  ps::Shape larger = lDrawing();
+  for (auto& loop : larger.loops) {
+    for (auto& p : loop) p *= 1.07;
+  }
+  const cv::Mat loose = pt::drawParts(640, 480, {{pt::centred(larger), 260, 220, 25}}, 11);
+  const auto loose_regions = findRegions(binarize(loose, {}), {}, loose);
+  REQUIRE(loose_regions.size() == 1);
+  BlobSearch search(loose_regions, 0, {&models().l}, nullptr);
+  const auto found = search.run();
+  REQUIRE(found.size() == 1);
+  CHECK_FALSE(search.explainsWhole());
+  CHECK_FALSE(found.front().touching);
   // The L against the bar, searched with the L's model alone: one part
   // found, the bar's pixels left over: it touches them.
   const Scene pair = touchingPair(false);

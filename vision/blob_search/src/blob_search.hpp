@@ -74,8 +74,11 @@ class BlobSearch {
   // Takes the parts among those placed.
   void choose();
   // Whether the parts taken are the whole blob: each fits its edges closely,
-  // and together they cover every pixel of it but a thin seam.
+  // and together they cover it (coversBlob).
   bool explainsWhole() const;
+  // Whether the parts taken cover every pixel of the blob but a seam up to
+  // `seam_px` wide.
+  bool coversBlob(int seam_px) const;
   // Turns the next screenings to the anchors near the blob's pixels that the
   // parts taken leave unexplained (when any remain past a seam). Returns
   // the area of those pixels (at least 1).
