@@ -249,11 +249,7 @@ TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blo
   // An L 7 % larger than the one taught, alone: the model fits it loosely
   // (the search goes on looking for more), but it leaves only a rim of its
   // blob and touches nothing.
-  ps::Shape larger = lDrawing();
-  for (auto& loop : larger.loops) {
-    for (auto& p : loop) p *= 1.07;
-  }
-  const cv::Mat loose = pt::drawParts(640, 480, {{pt::centred(larger), 260, 220, 25}}, 11);
+  const cv::Mat loose = pt::drawParts(640, 480, {{pt::scaled(lShape(), 1.07), 260, 220, 25}}, 11);
   const auto loose_regions = findRegions(binarize(loose, {}), {}, loose);
   REQUIRE(loose_regions.size() == 1);
   BlobSearch search(loose_regions, 0, {&models().l}, nullptr);
