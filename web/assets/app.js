@@ -83,6 +83,27 @@
     return w.slice(1);
   };
 
+  // The frame a result's reply poses are in (VisionResult.reply_frame;
+  // STATUS frame=), as the page names it: {text, short, title}. Image
+  // positions are sensor pixels with y down; every reply frame has y up
+  // and angles counter-clockwise (docs/PROTOCOL.md, "Coordinates").
+  const replyFrames = {
+    pixels: { text: "vision px (y up; no CALCAM yet)", short: "vision px",
+              title: "the vision frame in sensor pixels: origin at pixel (0, 0), x right, y UP the image " +
+                     "(image y negated), rz counter-clockwise (STATUS frame=vision-px)" },
+    vision_mm: { text: "vision mm (y up; CALCAM, no COMPUTE yet)", short: "vision mm",
+                 title: "the vision frame in millimetres: origin at pixel (0, 0), x right, y UP the image, " +
+                        "rz counter-clockwise (STATUS frame=vision-mm)" },
+    robot_mm: { text: "robot mm (robot frame)", short: "robot mm",
+                title: "the robot's base frame in millimetres, rz in degrees counter-clockwise, through the " +
+                       "transform COMPUTE found (STATUS frame=robot)" },
+  };
+  ps.replyFrame = function (name) {
+    if (!name) return { text: "no frame (this request replies no pose)", short: "-", title: "" };
+    return replyFrames[name] || { text: "'" + name + "' (a frame this page does not know)", short: name,
+                                  title: "STATUS frame= names it" };
+  };
+
   // Appends a row of text cells to a table body, with a last cell holding
   // one button when `button` is given; the row.
   ps.tableRow = function (tbody, texts, button, onClick) {
@@ -328,9 +349,9 @@
     text("stat-fps", Number(c.fps || 0).toFixed(1));
     text("stat-drops", c.drops || 0);
     text("stat-reconnects", c.reconnects || 0);
-    text("stat-size", (c.width || 0) + "x" + (c.height || 0));
+    text("stat-size", (c.width || 0) + "x" + (c.height || 0) + " px");
     const r = c.roi || {};
-    text("stat-roi", (r.x || 0) + "," + (r.y || 0) + " " + (r.width || 0) + "x" + (r.height || 0));
+    text("stat-roi", (r.x || 0) + "," + (r.y || 0) + " " + (r.width || 0) + "x" + (r.height || 0) + " px");
     text("stat-error", c.last_error || "");
     $("stat-error").title = c.last_error || "";  // the whole text; the line shows what fits
     document.body.classList.toggle("simulated", !!c.simulated_robot);

@@ -36,13 +36,19 @@
       const i = w.indexOf("=");
       if (i > 0) kv[w.slice(0, i)] = w.slice(i + 1);
     }
-    const mm = kv.scale && kv.scale !== "none" ? kv.scale.split("x").map(Number) : [1, 1];
-    cal.mmPerPx = mm.length === 2 && mm[0] > 0 && mm[1] > 0 ? mm : [1, 1];
+    const mm = kv.scale && kv.scale !== "none" ? kv.scale.split("x").map(Number) : [];
+    const scaled = mm.length === 2 && mm[0] > 0 && mm[1] > 0;
+    cal.mmPerPx = scaled ? mm : [1, 1];
+    // LIST's vision coordinates are sensor pixels until CALCAM gives a scale.
+    const unit = scaled ? "mm" : "px";
+    for (const el of document.querySelectorAll("#cal-points th .unit")) el.textContent = unit;
+    $("cal-vision-unit").textContent = scaled ? "mm" : "sensor px (no CALCAM yet)";
     const t = kv.transform && kv.transform !== "none" ? kv.transform.split(",").map(Number) : null;
     cal.rz = t ? t[2] : 0;
     $("cal-transform").textContent =
-      "frame " + (kv.frame || "?") + ", scale " + (kv.scale || "?") + " mm/px, points " + (kv.points || 0) +
-      ", transform " + (t ? "dx " + t[0] + " dy " + t[1] + " rz " + t[2] + " rms " + kv.rms + " mm" : "none") +
+      "frame " + (kv.frame || "?") + ", scale " + (scaled ? kv.scale + " mm/px" : (kv.scale || "?") + " (1 unit per px)") +
+      ", points " + (kv.points || 0) +
+      ", transform " + (t ? "dx " + t[0] + " mm, dy " + t[1] + " mm, rz " + t[2] + "\u00b0, rms " + kv.rms + " mm" : "none") +
       (kv.calibration === "damaged" ? " (calibration file damaged)" : "");
     return kv;
   }

@@ -24,6 +24,13 @@
     return f ? f.value : "";
   }
 
+  // The feature's unit as the camera names it ("us", "100us", "dB"...);
+  // "" when it names none, or has no such feature.
+  function featureUnit(name) {
+    const f = features.find((x) => x.name === name);
+    return f && f.unit ? f.unit : "";
+  }
+
   async function refreshFeatures() {
     if (!ps.camera) return;
     const r = await ps.get("/api/cameras/" + encodeURIComponent(ps.camera) + "/features");
@@ -35,7 +42,7 @@
     for (const f of features) {
       const range = f.choices && f.choices.length ? f.choices.join(" | ")
         : f.has_range ? (f.min || 0) + " .. " + (f.max || 0) + (f.unit ? " " + f.unit : "") : "";
-      const row = ps.tableRow(tbody, [f.name, f.value === undefined ? "" : String(f.value), range]);
+      const row = ps.tableRow(tbody, [f.name, f.value === undefined ? "" : String(f.value), f.unit || "", range]);
       row.addEventListener("click", () => {
         ps.setField("feature-name", f.name, true);
         ps.setField("feature-value", f.value === undefined ? "" : f.value, true);
@@ -46,6 +53,8 @@
     }
     ps.setField("cam-exposure", featureValue(exposureName()));
     ps.setField("cam-gain", featureValue(gainName()));
+    $("cam-exposure-unit").textContent = featureUnit(exposureName());
+    $("cam-gain-unit").textContent = featureUnit(gainName());
   }
 
   // Sets a feature to the value of its field(s); the list and the exposure

@@ -82,9 +82,21 @@
     ];
     if (e.why && e.why !== e.reply) lines.push("why: " + e.why);
     if (e.camera) lines.push("camera " + e.camera + ", frame " + e.sequence + (e.width ? ", " + e.width + "x" + e.height + " px" : ""));
+    // The parts as found on the image (the orange circles); the reply's
+    // numbers above are in the frame the app replied in then (STATUS frame=).
+    const parts = e.parts || [];
+    if (parts.length) lines.push("parts found (sensor px, y down; angle \u00b0 clockwise on the screen):");
+    for (const p of parts.slice(0, 16)) {
+      const type = Number(p.type || 0);
+      lines.push("  " + (type >= 0 ? "type " + type : "no model") + " at x " + Number(p.x || 0).toFixed(1) +
+                 ", y " + Number(p.y || 0).toFixed(1) + ", angle " + Number(p.angle_deg || 0).toFixed(1) +
+                 (type >= 0 ? ", score " + Number(p.score || 0).toFixed(3) : "") + (p.offered ? "" : ", not offered"));
+    }
+    if (parts.length > 16) lines.push("  ... " + (parts.length - 16) + " more");
     $("filmstrip-detail").textContent = lines.join("\n");
     $("filmstrip-detail").classList.toggle("failed", !!e.failure);
     $("filmstrip-replay-reply").textContent = "";
+    $("filmstrip-replay-frame").textContent = "";
     $("filmstrip-replay").disabled = !e.image;
     const img = $("filmstrip-frame");
     img.onload = () => { mark(e.parts || [], "recorded"); mark([], "replayed"); };
@@ -117,6 +129,8 @@
     }));
     mark(parts, "replayed");
     $("filmstrip-marks").dataset.replayed = String(parts.length);
+    $("filmstrip-replay-frame").textContent = "the replay's reply in " + ps.replyFrame(result.reply_frame).text;
+    $("filmstrip-replay-frame").dataset.frame = result.reply_frame || "";
   });
   ps.on("tab", (tab) => { if (tab === "filmstrip") refresh(); });
   document.addEventListener("DOMContentLoaded", () => {

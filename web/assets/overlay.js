@@ -174,21 +174,41 @@
     const tbody = $("result-parts").querySelector("tbody");
     tbody.textContent = "";
     $("result-rejections").textContent = "";
-    if (!result) { $("result-summary").textContent = "no result yet"; return; }
+    if (!result) {
+      $("result-summary").textContent = "no result yet";
+      $("result-frame").textContent = "the reply's frame";
+      return;
+    }
     $("result-summary").textContent =
       "#" + (result.request_id || 0) + " " + (result.request_line || result.request || "") + " -> " +
       (result.reply || "") + " (" + num(result.elapsed_ms).toFixed(1) + " ms, frame " +
       (result.frame_sequence || 0) + ", " + num(result.regions_total) + " regions)" +
-      (result.why ? "\nwhy: " + result.why : "");
+      (result.why ? "\nwhy: " + result.why : "") +
+      (result.reply_frame ? "\nreply in " + ps.replyFrame(result.reply_frame).text : "");
+    const frame = ps.replyFrame(result.reply_frame);
+    $("result-frame").textContent = frame.text;
+    $("result-frame").dataset.frame = result.reply_frame || "";
+    $("result-frame").title = frame.title;
+    for (const unit of document.querySelectorAll("#result-parts th .unit")) unit.textContent = frame.short;
+    $("result-parts").querySelector("th[data-col=reply]").title = frame.title;
     for (const part of result.parts || []) {
       const [x, y] = pt(part.position);
+      const modelled = num(part.type) >= 0;
       const fingers = (part.fingers || []).map((f) => (f.blocked ? "blocked" : "free")).join(" ");
+      const style = num(part.grasp_style);
+      // A region with no model has no score and no grasp style: it is
+      // reported at its own pose.
+      const grasp = !part.offered ? "not offered" : style >= 0 ? "style " + (style + 1) : "own pose";
+      const pose = part.offered ? part.reply_pose || {} : null;
       const row = ps.tableRow(tbody, [
-        num(part.type), part.name || "", num(part.score).toFixed(3), x.toFixed(1), y.toFixed(1),
-        num(part.angle_deg).toFixed(1),
-        (part.offered ? "style " + num(part.grasp_style) : "not offered") + (fingers ? " (" + fingers + ")" : ""),
+        num(part.type) + " " + (modelled ? part.name || "" : "no model"), modelled ? num(part.score).toFixed(2) : "-",
+        x.toFixed(1), y.toFixed(1), num(part.angle_deg).toFixed(1), grasp,
+        pose ? num(pose.x).toFixed(1) : "-", pose ? num(pose.y).toFixed(1) : "-", pose ? num(pose.rz_deg).toFixed(1) : "-",
       ]);
+      // The fingers' states in the grasp cell's tooltip: the column stays narrow.
+      if (fingers) row.cells[5].title = "fingers: " + fingers;
       if (!part.offered) row.className = "not-offered";
+      if (!modelled) row.classList.add("no-model");
     }
     for (const rej of result.rejections || []) {
       const li = document.createElement("li");

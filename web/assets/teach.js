@@ -100,7 +100,7 @@
     const parts = reply.split(" ; ").slice(1);
     const warnings = parts.filter((p) => p.startsWith("warning: ")).map((p) => p.slice(9));
     $("teach-preview-text").textContent =
-      "Type " + f[0] + " '" + f[1] + "': " + Number(f[2]).toFixed(0) + " px, " + f[3] + " holes. " +
+      "Type " + f[0] + " '" + f[1] + "': " + Number(f[2]).toFixed(0) + " px\u00b2, " + f[3] + " holes. " +
       "LOCATE ALL on this frame would find " + f[6] + " of type " + f[0] + " (" + f[7] +
       " parts in all; outlines on the image). " +
       (old ? "Saving replaces type " + old[0] + " '" + old[1] + "' (its tolerances back to the defaults, its grasps kept)."
@@ -125,7 +125,7 @@
     await refreshModels();
     const old = modelOf(p.type);
     if (old && !window.confirm("Replace model " + old[0] + " '" + old[1] + "' (area " +
-                               Number(old[2]).toFixed(0) + " px) with the new '" + p.name +
+                               Number(old[2]).toFixed(0) + " px\u00b2) with the new '" + p.name +
                                "'? Its tolerances go back to the defaults; Undo takes this back.")) {
       ps.show("teach-reply", "LEARN " + p.args, "not sent: model " + old[0] + " '" + old[1] + "' kept");
       return;
@@ -290,12 +290,17 @@
     $("grasp-type").classList.remove("dirty");  // the type shown below from now on
     const status = ps.okFields(await ps.command("STATUS")) || [];
     const scale = status.find((w) => w.startsWith("scale="));
-    const mm = scale && scale !== "scale=none" ? scale.slice(6).split("x").map(Number) : [1, 1];
-    grasp.mmPerPx = mm.length === 2 && mm[0] > 0 && mm[1] > 0 ? mm : [1, 1];
+    const mm = scale && scale !== "scale=none" ? scale.slice(6).split("x").map(Number) : [];
+    const scaled = mm.length === 2 && mm[0] > 0 && mm[1] > 0;
+    grasp.mmPerPx = scaled ? mm : [1, 1];
+    // Before CALCAM the part frame's units are sensor pixels.
+    const unit = scaled ? "mm" : "px";
+    for (const el of document.querySelectorAll("#panel-teach .grasp-unit")) el.textContent = unit;
     grasp.styles = groups(await ps.command("GRASP " + type + " LIST"), 3).map((g) => g.map(Number));
     grasp.fingers = groups(await ps.command("GRIPPER " + type + " LIST"), 4).map((g) => g.map(Number));
-    list($("style-list"), grasp.styles, (s) => "x " + s[0] + "  y " + s[1] + "  rz " + s[2]);
-    list($("finger-list"), grasp.fingers, (f) => "x " + f[0] + "  y " + f[1] + "  w " + f[2] + "  h " + f[3]);
+    list($("style-list"), grasp.styles, (s) => "x " + s[0] + " " + unit + "  y " + s[1] + " " + unit + "  rz " + s[2] + "\u00b0");
+    list($("finger-list"), grasp.fingers,
+         (f) => "x " + f[0] + "  y " + f[1] + "  w " + f[2] + "  h " + f[3] + " " + unit);
     ps.drawTool();
   }
 

@@ -154,7 +154,7 @@
       if (!region) continue;
       const text = document.createElement("span");
       text.textContent = "Region " + (region.index || 0) + " covers most of the image (" +
-        Math.round(region.area || 0) + " px, " + (region.holes || 0) + " holes): the surface is " +
+        Math.round(region.area || 0) + " px\u00b2, " + (region.holes || 0) + " holes): the surface is " +
         "probably taken for a part. Parts " + (dark ? "lighter" : "darker") + " than their surface need polarity " +
         other + ". ";
       el.append(text, tryButton(other));
