@@ -7,6 +7,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   build-essential cmake pkg-config git clang clang-format
+  # CMake's Ninja generator: quickstart's and CI's build trees (docs/CI.md)
+  ninja-build
   # libFuzzer and the sanitizer runtimes for clang (fuzz run in CI)
   libclang-rt-14-dev
   # core libraries
