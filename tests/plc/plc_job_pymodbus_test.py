@@ -8,13 +8,12 @@ changes nothing; a job loaded over the robot port shows in JOB_IN_FORCE.
 usage: /usr/bin/python3 plc_job_pymodbus_test.py --bin-dir BUILD/bin
 """
 import argparse
-import os
 import shutil
 import sys
 import tempfile
 
 from plc_modbus import (CONTROL, ERROR_CODE, PART_COUNT, FIRST_PART, PART_STRIDE, CLEAR_ERROR,
-    BUSY, RESULTS_VALID, ERROR, ALL_TYPES, UNIT, Process, Robot, Plc)
+    BUSY, RESULTS_VALID, ERROR, ALL_TYPES, UNIT, Robot, Plc, video_server, vision_app)
 
 # docs/PLC.md, the job registers and bits.
 JOB_NUMBER, JOB_IN_FORCE, LOAD_JOB, JOB_DONE = 2, 17, 8, 64
@@ -49,16 +48,10 @@ def main():
     server = vision = None
     checks = 0
     try:
-        server = Process([os.path.join(args.bin_dir, "picksight-video-server"), "--source",
-                          "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,noise=0",
-                          "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*",
-                          "--mode", "trigger"])
+        server = video_server(args.bin_dir)
         frames = server.wait_for("frames ")
         control = server.wait_for("control ")
-        vision = Process([os.path.join(args.bin_dir, "picksight-vision"), "--frames", frames,
-                          "--control", control, "--robot-port", "0", "--bind", "127.0.0.1",
-                          "--data-dir", data_dir, "--modbus-port", "0", "--modbus-bind",
-                          "127.0.0.1", "--modbus-unit", str(UNIT)])
+        vision = vision_app(args.bin_dir, frames, control, data_dir)
         robot = Robot(int(vision.wait_for("robot ")))
         plc = Plc(int(vision.wait_for("modbus ")))
         vision.wait_for("ready")

@@ -2,6 +2,7 @@
 binary read line by line, a robot connection and a pymodbus client with the
 trigger handshake. Imported by plc_pymodbus_test.py and
 plc_job_pymodbus_test.py (run from this folder)."""
+import os
 import queue
 import socket
 import subprocess
@@ -105,3 +106,21 @@ class Plc:
     def acknowledge(self):
         self.write(CONTROL, RESULTS_ACK)
         self.write(CONTROL, 0)
+
+
+def video_server(bin_dir):
+    """The video server of both tests: one L-shaped part, no noise, trigger
+    mode, on ports it picks (read 'frames ' and 'control ' from it)."""
+    return Process([os.path.join(bin_dir, "picksight-video-server"), "--source",
+                    "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,noise=0",
+                    "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*",
+                    "--mode", "trigger"])
+
+
+def vision_app(bin_dir, frames, control, data_dir, *extra):
+    """A vision app on that server with robot and Modbus ports on 127.0.0.1
+    (read 'robot ', 'modbus ' and 'ready' from it), unit UNIT."""
+    return Process([os.path.join(bin_dir, "picksight-vision"), "--frames", frames,
+                    "--control", control, "--robot-port", "0", "--bind", "127.0.0.1",
+                    "--data-dir", data_dir, "--modbus-port", "0", "--modbus-bind",
+                    "127.0.0.1", "--modbus-unit", str(UNIT), *extra])

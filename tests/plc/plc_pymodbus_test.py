@@ -8,7 +8,6 @@ type, camera down).
 usage: /usr/bin/python3 plc_pymodbus_test.py --bin-dir BUILD/bin
 """
 import argparse
-import os
 import shutil
 import struct
 import sys
@@ -16,7 +15,7 @@ import tempfile
 
 from plc_modbus import (CONTROL, STATUS, ERROR_CODE, CALIBRATION, RESULT_FRAME,
     FRAME_SEQUENCE, PART_COUNT, FIRST_PART, PART_STRIDE, CLEAR_ERROR,
-    READY, RESULTS_VALID, ERROR, ALL_TYPES, UNIT, Process, Robot, Plc)
+    READY, RESULTS_VALID, ERROR, ALL_TYPES, UNIT, Robot, Plc, video_server, vision_app)
 
 
 def float_cdab(words):
@@ -43,16 +42,10 @@ def main():
     server = vision = None
     checks = 0
     try:
-        server = Process([os.path.join(args.bin_dir, "picksight-video-server"), "--source",
-                          "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,noise=0",
-                          "--frames", "tcp://127.0.0.1:*", "--control", "tcp://127.0.0.1:*",
-                          "--mode", "trigger"])
+        server = video_server(args.bin_dir)
         frames = server.wait_for("frames ")
         control = server.wait_for("control ")
-        vision = Process([os.path.join(args.bin_dir, "picksight-vision"), "--frames", frames,
-                          "--control", control, "--robot-port", "0", "--bind", "127.0.0.1",
-                          "--data-dir", data_dir, "--modbus-port", "0", "--modbus-bind",
-                          "127.0.0.1", "--modbus-unit", str(UNIT), "--modbus-word-order", "CDAB"])
+        vision = vision_app(args.bin_dir, frames, control, data_dir, "--modbus-word-order", "CDAB")
         robot = Robot(int(vision.wait_for("robot ")))
         plc = Plc(int(vision.wait_for("modbus ")))
         vision.wait_for("ready")
