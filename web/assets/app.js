@@ -224,6 +224,9 @@
 
   // ---- the frame: MJPEG stream, or the binarized image on demand ------------
   let binaryTimer = null;
+  // Counts showFrame() calls: a binarized image's load that settles after
+  // the frame was switched again schedules nothing.
+  let frameGeneration = 0;
   ps.binaryWanted = false;
   // The Vision panel's preview: query parameters (polarity, threshold,
   // level, window) that replace the app's settings in the binarized image;
@@ -231,7 +234,8 @@
   ps.previewQuery = null;
   function showFrame() {
     const img = $("frame");
-    if (binaryTimer) { clearInterval(binaryTimer); binaryTimer = null; }
+    if (binaryTimer) { clearTimeout(binaryTimer); binaryTimer = null; }
+    const generation = ++frameGeneration;
     if (!ps.camera) { img.removeAttribute("src"); return; }
     // The server binarizes the frame of the app's camera with the settings
     // of its latest result: none before the app's first vision request.
@@ -240,9 +244,21 @@
     $("live-binary-note").textContent = wanted && !binary ? "after the app's first vision request" : "";
     if (binary) {
       const query = ps.previewQuery ? ps.previewQuery + "&" : "";
-      const load = () => { img.src = "/binary/" + encodeURIComponent(ps.app) + ".png?" + query + "t=" + Date.now(); };
+      // The next image a second after the last one settled, never on a
+      // fixed clock: the server makes them at idle priority, and on a busy
+      // machine one can take seconds; a new src every second would cancel
+      // each before it arrived and the image would never show.
+      const load = () => {
+        const settled = () => {
+          img.removeEventListener("load", settled);
+          img.removeEventListener("error", settled);
+          if (generation === frameGeneration) binaryTimer = setTimeout(load, 1000);
+        };
+        img.addEventListener("load", settled);
+        img.addEventListener("error", settled);
+        img.src = "/binary/" + encodeURIComponent(ps.app) + ".png?" + query + "t=" + Date.now();
+      };
       load();
-      binaryTimer = setInterval(load, 1000);
     } else {
       img.src = "/stream/" + encodeURIComponent(ps.camera) + ".mjpg";
     }
@@ -314,6 +330,16 @@
     return mine.length ? mine : ps.apps.map((a) => a.name);
   }
 
+  // An app's newest result, from the event stream or fetched when the app
+  // is chosen: a binarized image asked for before the app's first known
+  // result is shown once it is known.
+  function noteResult(result) {
+    const first = !ps.latest[result.app];
+    ps.latest[result.app] = result;
+    if (first && result.app === ps.app && (ps.binaryWanted || ps.previewQuery !== null)) showFrame();
+    emit("result", result);
+  }
+
   function selectApp(name) {
     ps.app = name || null;
     fillSelect($("app-select"), appsOfCamera(), ps.app);
@@ -321,7 +347,7 @@
     const entry = ps.apps.find((a) => a.name === ps.app);
     if (entry && Number(entry.last_result_id || 0) > 0 && !ps.latest[ps.app]) {
       ps.get("/api/results/" + encodeURIComponent(ps.app) + "/latest").then((r) => {
-        if (r.ok && !ps.latest[ps.app]) { ps.latest[ps.app] = r.body; emit("result", r.body); }
+        if (r.ok && !ps.latest[ps.app]) noteResult(r.body);
       });
     }
   }
@@ -403,10 +429,7 @@
       // A filmstrip replay is of a recorded frame, not the live one: for
       // the Filmstrip panel alone.
       if (result.request === "REPLAY") { emit("replay", result); return; }
-        const first = !ps.latest[result.app];
-      ps.latest[result.app] = result;
-      if (first && result.app === ps.app && (ps.binaryWanted || ps.previewQuery !== null)) showFrame();
-      emit("result", result);
+      noteResult(result);
     });
   }
 

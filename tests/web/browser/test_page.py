@@ -227,7 +227,11 @@ def test_overlay_shows_the_located_parts(cell, browser):
 
 
 def test_binarized_image_on_demand(cell, browser):
-    select_tab(browser, "live")  # after a LOCATE: the app's binarization is known
+    select_tab(browser, "live")
+    # A LOCATE of its own, whatever ran before: the server binarizes with
+    # the settings of the app's latest result.
+    reply, _ = locate_on_page(browser, "1")
+    assert reply.startswith("OK "), reply
     click(browser, "live-binary")
     try:
         wait_until(lambda: browser.js("""const img = document.getElementById('frame');
