@@ -265,3 +265,44 @@ TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blo
   REQUIRE(beside.size() == 1);
   CHECK(beside.front().touching);
 }
+
+TEST_CASE("blob search: a stretch of a part the mask lost is read from the grey levels",
+          "[vision][blob_search]") {
+  // The touching pair with the end of the L's short arm cut out of the mask,
+  // as a threshold loses a thin limb whose light is uneven at low contrast.
+  const Scene pair = touchingPair(false);
+  const ps::ShapeMoments lm = ps::shapeMoments(lDrawing());
+  const double c = std::cos(25 * M_PI / 180);
+  const double s = std::sin(25 * M_PI / 180);
+  std::vector<cv::Point> tip;
+  for (const cv::Point2d d :
+       {cv::Point2d(-3, 65), cv::Point2d(33, 65), cv::Point2d(33, 74), cv::Point2d(-3, 74)}) {
+    const cv::Point2d q(d.x - lm.cx, d.y - lm.cy);
+    tip.emplace_back(static_cast<int>(std::lround(pair.l_pose.centre.x + c * q.x - s * q.y)),
+                     static_cast<int>(std::lround(pair.l_pose.centre.y + s * q.x + c * q.y)));
+  }
+  cv::Mat mask = binarize(pair.grey, {});
+  cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(0));
+  const auto lFound = [&](const cv::Mat& grey) {
+    const auto regions = findRegions(mask, {}, grey);
+    REQUIRE(regions.size() == 1);
+    for (const auto& m : locateInBlob(regions, 0, {&models().l, &models().b})) {
+      if (m.model == &models().l &&
+          std::hypot(m.centroid.x - pair.l_pose.centre.x, m.centroid.y - pair.l_pose.centre.y) < 2)
+        return true;
+    }
+    return false;
+  };
+  // The grey levels still show the arm, darker than the surface by 0.6 of
+  // the contrast: the L's boundary there is on a part, not the background.
+  cv::Mat in_tip(mask.size(), CV_8UC1, cv::Scalar(0));
+  cv::fillPoly(in_tip, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(255));
+  cv::Mat faint = pair.grey.clone();
+  faint.setTo(cv::Scalar(200 - 0.6 * 155), in_tip & (pair.grey < 122));
+  CHECK(lFound(faint));
+  // The arm truly missing (the surface's level where it was): the L's model
+  // crosses the background there, as a look-alike would.
+  cv::Mat missing = pair.grey.clone();
+  cv::fillPoly(missing, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(200));
+  CHECK_FALSE(lFound(missing));
+}

@@ -120,6 +120,7 @@ class BlobSearch {
   cv::Rect blob_box_;
   cv::Mat blob_;  // 255 on the blob's pixels, over blob_box_
   std::optional<Coverage> coverage_;
+  std::optional<FaintPart> faint_;  // made when a candidate is first placed
   int blob_pixels_ = 0;
   size_t budget_ = 0;  // edge fits the blob may cost
   cv::Mat seam_;       // what erodes a seam away

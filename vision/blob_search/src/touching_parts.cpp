@@ -99,9 +99,9 @@ constexpr int kRestAnchorPx = 6;
 constexpr double kMaxOnBackground = 0.02;
 
 // Whether more of the boundary at the pose than a part can show lies off
-// the edges on the background.
+// the edges on the background (and not on a faint part the mask lost).
 bool crossesBackground(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
-                       const Coverage& coverage) {
+                       const Coverage& coverage, const FaintPart& faint) {
   const double c = std::cos(pose.angle_deg * kRadPerDeg);
   const double s = std::sin(pose.angle_deg * kRadPerDeg);
   const double flip = pose.mirrored ? -1.0 : 1.0;
@@ -110,7 +110,8 @@ bool crossesBackground(const PartModel& m, const ImagePose& pose, const EdgeDist
   for (const auto& sample : m.samples) {
     total += sample.weight;
     const cv::Point2d p = pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s);
-    if (edges.at(p) > m.edge_tolerance && coverage.at(p) < 0.5) background += sample.weight;
+    if (edges.at(p) > m.edge_tolerance && coverage.at(p) < 0.5 && !faint.at(p))
+      background += sample.weight;
   }
   return background > kMaxOnBackground * total;
 }
@@ -279,6 +280,74 @@ std::vector<size_t> chooseParts(const std::vector<Placed>& placed, MirrorTest&& 
 
 namespace touching {
 
+namespace {
+// See FaintPart: the share of the contrast, and the least contrast (grey
+// levels) worth reading. The surface's grain stays under a quarter of a
+// 30-level contrast once smoothed over 3 x 3 pixels.
+constexpr double kFaintShare = 0.35;
+constexpr double kMinFaintContrast = 8;
+// The blob's level is read this far inside its edge, the surface's in a
+// ring this far outside it (pixels): clear of the edges' blur.
+constexpr int kLevelInsetPx = 2;
+constexpr int kRingFromPx = 3;
+constexpr int kRingToPx = 7;
+
+// The median grey level of `grey` where `mask` is set; -1 for none.
+double medianWhere(const cv::Mat& grey, const cv::Mat& mask) {
+  const int channels[] = {0};
+  const int bins[] = {256};
+  const float range[] = {0, 256};
+  const float* ranges[] = {range};
+  cv::Mat hist;
+  cv::calcHist(&grey, 1, channels, mask, hist, 1, bins, ranges);
+  const double total = cv::sum(hist)[0];
+  if (total <= 0) return -1;
+  double seen = 0;
+  for (int i = 0; i < 256; ++i) {
+    seen += hist.at<float>(i);
+    if (seen >= total / 2) return i;
+  }
+  return 255;
+}
+}  // namespace
+
+FaintPart::FaintPart(const Region& r, const cv::Mat& blob, cv::Rect blob_box) {
+  if (r.grey.empty()) return;
+  origin_ = r.grey_origin;
+  const cv::Rect grey_box(origin_, r.grey.size());
+  const cv::Rect both = blob_box & grey_box;
+  if (both.empty()) return;
+  cv::Mat mask(r.grey.size(), CV_8UC1, cv::Scalar(0));
+  blob(both - blob_box.tl()).copyTo(mask(both - origin_));
+  const auto disc = [](int radius) {
+    return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+  };
+  cv::Mat inside;
+  cv::Mat near;
+  cv::Mat ring;
+  cv::erode(mask, inside, disc(kLevelInsetPx));
+  cv::dilate(mask, near, disc(kRingFromPx));
+  cv::dilate(mask, ring, disc(kRingToPx));
+  ring.setTo(0, near);
+  const double part = medianWhere(r.grey, inside);
+  const double surface = medianWhere(r.grey, ring);
+  if (part < 0 || surface < 0 || std::abs(surface - part) < kMinFaintContrast) return;
+  cv::Mat smooth;
+  cv::blur(r.grey, smooth, cv::Size(3, 3));
+  // Darker than the surface by the share of the contrast (lighter, for a
+  // blob lighter than its surface).
+  const double level = surface - kFaintShare * (surface - part);
+  cv::compare(smooth, level, faint_, surface > part ? cv::CMP_LE : cv::CMP_GE);
+}
+
+bool FaintPart::at(cv::Point2d p) const {
+  if (faint_.empty()) return false;
+  const int x = static_cast<int>(std::lround(p.x)) - origin_.x;
+  const int y = static_cast<int>(std::lround(p.y)) - origin_.y;
+  if (x < 0 || y < 0 || x >= faint_.cols || y >= faint_.rows) return false;
+  return faint_.at<uint8_t>(y, x) != 0;
+}
+
 BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
                        const std::vector<const PartModel*>& models, const EdgeDistance* built_edges)
     : region_(regions[index]), index_(index) {
@@ -354,7 +423,8 @@ bool BlobSearch::place(const Candidate& c) {
   // Below the verify fraction, a part may be partly hidden (kMinVisible).
   const bool verified = c.score * 100 >= m.verify_percent;
   if (!verified && c.score < kMinVisible) return false;
-  const bool crosses = crossesBackground(m, c.pose, *edges_, *coverage_);
+  if (!faint_) faint_.emplace(region_, blob_, blob_box_);
+  const bool crosses = crossesBackground(m, c.pose, *edges_, *coverage_, *faint_);
   if (!verified && crosses) return false;
   const auto outline = placedOutline(m, c.pose);
   cv::Rect box;

@@ -77,6 +77,24 @@ class Coverage {
   cv::Point2d last_;  // the last column and row
 };
 
+// Where the grey image shows a part the mask lost: pixels beside a blob
+// darker than the surface round it by kFaintShare of the contrast between
+// the blob's level and the surface's (lighter, for light parts: the
+// contrast's sign follows). At low contrast the threshold drops the thin
+// limbs of a part whose light is uneven (a shaded side 15 levels lighter on
+// a contrast of 30); its boundary there is not on the background. Empty
+// (nothing faint) without a grey image or a contrast to read.
+class FaintPart {
+ public:
+  // `blob`: 255 on the blob's pixels, over `blob_box` (image coordinates).
+  FaintPart(const Region& r, const cv::Mat& blob, cv::Rect blob_box);
+  bool at(cv::Point2d p) const;
+
+ private:
+  cv::Mat faint_;  // 255 where faint, over the region's grey box
+  cv::Point origin_;
+};
+
 struct Candidate {
   const PartModel* model = nullptr;
   ImagePose pose;

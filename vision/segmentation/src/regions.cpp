@@ -1049,6 +1049,19 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
   for (size_t k = 0; k < found.size(); ++k) {
     if (kept[k]) regions.push_back(std::move(found[k]));
   }
+  if (!grey.empty()) {
+    const cv::Rect image(0, 0, grey.cols, grey.rows);
+    for (auto& r : regions) {
+      const cv::Rect box =
+          cv::Rect(r.bbox.x - kGreyMarginPx, r.bbox.y - kGreyMarginPx,
+                   r.bbox.width + 2 * kGreyMarginPx, r.bbox.height + 2 * kGreyMarginPx) &
+          image;
+      // A frame on memory OpenCV does not own (a received message) may be
+      // gone before the regions are.
+      r.grey = grey.u ? grey(box) : grey(box).clone();
+      r.grey_origin = box.tl();
+    }
+  }
   std::stable_sort(regions.begin(), regions.end(),
                    [](const Region& a, const Region& b) { return a.area > b.area; });
   return regions;

@@ -42,7 +42,17 @@ struct Region {
   // of the box: outside a curved or slender part, and its holes, that is
   // most of it. Empty (height 0) when not known: the whole box is read.
   RowRuns covered;
+  // The grey image round the region (its box and kGreyMarginPx beyond,
+  // clipped to the image), top-left pixel at `grey_origin`: where the mask
+  // lost a faint stretch of a part (a thin limb at low contrast), the blob
+  // search reads it here. Empty without a grey image. Shares the frame's
+  // pixels when OpenCV counts their references, else a copy of the box.
+  cv::Mat grey;
+  cv::Point grey_origin;
 };
+
+// How far past its box a region keeps the grey image (Region::grey).
+constexpr int kGreyMarginPx = 12;
 
 struct RegionOptions {
   double min_area = 50;  // smaller regions are noise
