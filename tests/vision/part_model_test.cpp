@@ -14,6 +14,7 @@
 #include "picksight/synthetic/scene.hpp"
 #include "picksight/vision/models/part_model.hpp"
 #include "picksight/vision/recognition/recognizer.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
 using namespace picksight::vision;
@@ -112,6 +113,43 @@ TEST_CASE("a hole becomes one arc and a rectangle four lines with convex right-a
     }
   }
   CHECK(right_angles >= 4);
+}
+
+TEST_CASE("the boundary is trusted as far as its edge is as strong as the part's",
+          "[vision][model]") {
+  // A dark plate with a faint blotch of the surface against its lower side
+  // (30 levels under the surface, the plate 160): a threshold that takes
+  // the blotch into the part, as a textured belt's does at low contrast.
+  cv::Mat grey(300, 300, CV_8UC1, cv::Scalar(200));
+  cv::rectangle(grey, cv::Rect(80, 100, 120, 60), cv::Scalar(40), cv::FILLED);
+  cv::rectangle(grey, cv::Rect(120, 160, 30, 20), cv::Scalar(170), cv::FILLED);
+  cv::GaussianBlur(grey, grey, cv::Size(0, 0), 0.7);
+  // Not cut off as a shadow would be (its level is a shadow's): the mask
+  // keeps it whole, as the threshold did.
+  RegionOptions whole;
+  whole.cut_shadows = false;
+  const auto regions = findRegions(grey < 185, whole, grey);
+  REQUIRE(regions.size() == 1);
+  const auto trained = trainModelFromRegion(grey, regions[0], 1, "plate");
+  REQUIRE(trained.ok());
+  const PartModel& m = trained.value();
+  // Weights by where the primitive runs, in image coordinates.
+  double plate_min = 1;
+  double blotch_max = 0;
+  int blotch = 0;
+  for (const auto& p : m.loops[0].primitives) {
+    const cv::Point2d mid = p.pointAt(0.5) + m.trained_centroid;
+    if (p.length() < 8) continue;  // corners' short primitives: too few readings
+    if (mid.y > 163) {
+      ++blotch;
+      blotch_max = std::max(blotch_max, p.weight);
+    } else {
+      plate_min = std::min(plate_min, p.weight);
+    }
+  }
+  CHECK(blotch >= 2);
+  CHECK(blotch_max < 0.5);
+  CHECK(plate_min == 1.0);
 }
 
 TEST_CASE("a part is never taken for its mirror image", "[vision][model][mirror]") {

@@ -105,6 +105,71 @@ void centreOnEdges(PartModel& m, const Region& r) {
   prepareModel(m);
 }
 
+// A stretch of the trained boundary is trusted as far as the training
+// image's edge there is as strong as the part's edge elsewhere. Under front
+// light a blotch of the surface as dark as the part joins it in the mask:
+// its outline is an edge of the surface's texture, a fraction of the
+// part's contrast, and no other copy of the part shows it; counted at full
+// weight, it put copies off the background test of the blob search.
+// The contrast is read across the boundary kContrastProbePx either way, on
+// the image smoothed over 3 x 3 pixels; a primitive whose median contrast
+// is below kFullContrastShare of the whole boundary's median has its weight
+// cut in proportion, to no less than kMinEdgeWeight.
+constexpr double kContrastProbePx = 2.0;
+constexpr double kFullContrastShare = 0.6;
+constexpr double kMinEdgeWeight = 0.1;
+constexpr int kMinContrastSamples = 4;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+void weighByContrast(PartModel& m, const cv::Mat& grey, cv::Point2d origin) {
+  cv::Mat smooth;
+  grey.convertTo(smooth, CV_32F);
+  cv::blur(smooth, smooth, cv::Size(3, 3));
+  const cv::Point2d last(smooth.cols - 1, smooth.rows - 1);
+  const auto level = [&](cv::Point2d p) { return bilinearAt(smooth, p.x, p.y, last, -1.f); };
+  std::vector<std::vector<double>> per_primitive;
+  std::vector<double> all;
+  for (const auto& loop : m.loops) {
+    for (const auto& p : loop.primitives) {
+      std::vector<double> contrast;
+      const int steps = static_cast<int>(std::floor(p.length()));
+      for (int i = 1; i < steps; ++i) {
+        const double t = static_cast<double>(i) / steps;
+        const double dt = 0.5 / std::max(p.length(), 1.0);
+        const cv::Point2d along =
+            p.pointAt(std::min(1.0, t + dt)) - p.pointAt(std::max(0.0, t - dt));
+        const double n = std::hypot(along.x, along.y);
+        if (n <= 0) continue;
+        const cv::Point2d normal(-along.y / n, along.x / n);
+        const cv::Point2d at = p.pointAt(t) + origin;
+        const float a = level(at + kContrastProbePx * normal);
+        const float b = level(at - kContrastProbePx * normal);
+        if (a < 0 || b < 0) continue;
+        contrast.push_back(std::abs(a - b));
+      }
+      all.insert(all.end(), contrast.begin(), contrast.end());
+      per_primitive.push_back(std::move(contrast));
+    }
+  }
+  const double whole = median(all);
+  if (!(whole > 0)) return;
+  size_t k = 0;
+  for (auto& loop : m.loops) {
+    for (auto& p : loop.primitives) {
+      const auto& contrast = per_primitive[k++];
+      if (static_cast<int>(contrast.size()) < kMinContrastSamples) continue;
+      const double share = median(contrast) / whole;
+      p.weight = std::clamp(share / kFullContrastShare, kMinEdgeWeight, 1.0);
+    }
+  }
+  prepareModel(m);
+}
+
 std::vector<std::vector<cv::Point>> contoursOf(const Region& r) {
   std::vector<std::vector<cv::Point>> all{r.outer};
   all.insert(all.end(), r.hole_boundaries.begin(), r.hole_boundaries.end());
@@ -291,6 +356,7 @@ Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int
   m.corners = findCorners(m.loops, m.conformity);
   prepareModel(m);
   centreOnEdges(m, r);
+  weighByContrast(m, grey, r.centroid);
 
   setOrientation(m, r);
   setSymmetries(m, r);
