@@ -306,3 +306,55 @@ TEST_CASE("blob search: a stretch of a part the mask lost is read from the grey 
   cv::fillPoly(missing, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(200));
   CHECK_FALSE(lFound(missing));
 }
+
+namespace {
+// A disc 30 px across, taught alone; `centres` drawn as one blob.
+const PartModel& discModel() {
+  static const PartModel m = trainAlone(ps::Shape{{pt::circleLoop(15, {0, 0})}}, 4, "disc");
+  return m;
+}
+
+// The discs found in the one blob of `centres` drawn, each matched to the
+// nearest centre (farther than 0.3 px: not matched).
+std::pair<size_t, size_t> discsFound(const std::vector<cv::Point2d>& centres) {
+  std::vector<pt::DrawnPart> parts;
+  for (const auto& c : centres)
+    parts.push_back({ps::Shape{{pt::circleLoop(15, {0, 0})}}, c.x, c.y, 0});
+  const cv::Mat grey = pt::drawParts(400, 300, parts, 21);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  REQUIRE(regions.size() == 1);
+  const auto found = locateInBlob(regions, 0, {&discModel()});
+  size_t matched = 0;
+  for (const auto& f : found) {
+    for (const auto& c : centres) {
+      if (std::hypot(f.centroid.x - c.x, f.centroid.y - c.y) < 0.3) {
+        ++matched;
+        break;
+      }
+    }
+  }
+  return {found.size(), matched};
+}
+}  // namespace
+
+TEST_CASE("blob search: every disc of a pile larger than one screening is found",
+          "[vision][blob_search]") {
+  // A disc's turn is unseen by its edges: the edge fit must still settle.
+  // Twelve discs 29 px apart in two rows of six (each overlapping its
+  // neighbours by a pixel: one blob), more than one screening keeps.
+  std::vector<cv::Point2d> grid;
+  for (int row = 0; row < 2; ++row) {
+    for (int col = 0; col < 6; ++col) grid.emplace_back(110 + 29 * col, 130 + 29 * row);
+  }
+  const auto [found, matched] = discsFound(grid);
+  CHECK(found == 12);
+  CHECK(matched == 12);
+}
+
+TEST_CASE("blob search: a disc overlapped on both sides still shows enough of its rim",
+          "[vision][blob_search]") {
+  // Three discs 25 px apart in a row: the middle one shows 0.63 of its rim.
+  const auto [found, matched] = discsFound({{150, 150}, {175, 150}, {200, 150}});
+  CHECK(found == 3);
+  CHECK(matched == 3);
+}
