@@ -353,8 +353,43 @@ TEST_CASE("blob search: every disc of a pile larger than one screening is found"
 
 TEST_CASE("blob search: a disc overlapped on both sides still shows enough of its rim",
           "[vision][blob_search]") {
-  // Three discs 25 px apart in a row: the middle one shows 0.63 of its rim.
-  const auto [found, matched] = discsFound({{150, 150}, {175, 150}, {200, 150}});
+  // Three discs 23 px apart in a row: 0.63 of the middle one's rim lies
+  // on edges (0.57 at 21 px, 0.72 at 25).
+  const auto [found, matched] = discsFound({{150, 150}, {173, 150}, {196, 150}});
   CHECK(found == 3);
   CHECK(matched == 3);
+}
+
+TEST_CASE("blob search: a part placed on the relief inside a larger part is refused",
+          "[vision][blob_search]") {
+  // A large disc whose face shows eight specks (the relief of a coin under
+  // a lamp: small holes in the mask) on a circle as wide as the small disc
+  // taught: a pose of the small disc there has its rim by those specks'
+  // edges, and nowhere on the large disc's outline.
+  const cv::Point2d centre(200, 150);
+  ps::Shape face{{pt::circleLoop(40, {0, 0})}};
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * M_PI / 4;
+    face.loops.push_back(pt::rectLoop(2, 2, {15 * std::cos(a), 15 * std::sin(a)}));
+  }
+  const cv::Mat grey = pt::drawParts(400, 300, {{face, centre.x, centre.y, 0}}, 5);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  REQUIRE(regions.size() == 1);
+  REQUIRE(regions[0].holes >= 6);
+  BlobSearch search(regions, 0, {&discModel()}, nullptr);
+  Candidate inside{&discModel(), {centre, 0, false}, 0.9};
+  CHECK_FALSE(search.place(inside));
+  // A small disc drawn against the large one's rim: most of its boundary
+  // on the blob's outline, placed.
+  const cv::Point2d beside = centre + cv::Point2d(54, 0);
+  const cv::Mat pair =
+      pt::drawParts(400, 300,
+                    {{face, centre.x, centre.y, 0},
+                     {ps::Shape{{pt::circleLoop(15, {0, 0})}}, beside.x, beside.y, 0}},
+                    5);
+  const auto pair_regions = findRegions(binarize(pair, {}), {}, pair);
+  REQUIRE(pair_regions.size() == 1);
+  BlobSearch pair_search(pair_regions, 0, {&discModel()}, nullptr);
+  Candidate touching{&discModel(), {beside, 0, false}, 0.9};
+  CHECK(pair_search.place(touching));
 }

@@ -96,6 +96,9 @@ class BlobSearch {
   std::vector<Match> matches() const;
 
  private:
+  // The share of the boundary of `m` at `pose` on the blob's outline (see
+  // kMinOnOutline).
+  double onOutline(const PartModel& m, const ImagePose& pose);
   // The blob's pixels the parts taken leave unexplained (over its box).
   cv::Mat unexplained() const;
   // The blob's pixels in `box` that `drawn` (over `box`) covers.
@@ -121,6 +124,9 @@ class BlobSearch {
   cv::Mat blob_;  // 255 on the blob's pixels, over blob_box_
   std::optional<Coverage> coverage_;
   std::optional<FaintPart> faint_;  // made when a candidate is first placed
+  // Distance to the blob's outline and large holes (see onOutline): empty
+  // when that is every edge (edges_); made when first asked.
+  std::optional<EdgeDistance> outline_;
   int blob_pixels_ = 0;
   size_t budget_ = 0;  // edge fits the blob may cost
   cv::Mat seam_;       // what erodes a seam away
