@@ -1,0 +1,153 @@
+// The photographs in tests/data/scenes, each through a file camera and the
+// robot protocol as an integrator would use them: LEARN ... AT a box around
+// a part (after the vision settings the scene needs), then LOCATE ALL, which
+// must report exactly the parts a person sees, each where it is. The truth
+// (counts and centres, image pixels) was read off the photographs by eye,
+// within a few pixels; coins.png and smarties.png have their own tests
+// (vision_settings_e2e_test.cpp, front_light_test.cpp).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cell_fixture.hpp"
+
+using namespace picksight;
+using namespace picksight::e2e;
+using namespace std::chrono_literals;
+
+namespace {
+struct Located {
+  int type = 0;
+  double x = 0;  // image pixels, y down
+  double y = 0;
+};
+
+// LOCATE ALL's parts; the reply is in vision pixels, y up.
+std::vector<Located> parts(const std::string& reply) {
+  INFO(reply);
+  REQUIRE(reply.rfind("OK ", 0) == 0);
+  std::istringstream fields(reply.substr(3));
+  int count = 0;
+  fields >> count;
+  std::vector<Located> out(static_cast<size_t>(count));
+  for (auto& p : out) {
+    double angle = 0;
+    fields >> p.type >> p.x >> p.y >> angle;
+    p.y = -p.y;
+  }
+  REQUIRE(fields);
+  return out;
+}
+
+struct Expected {
+  int type;
+  double x;
+  double y;
+};
+
+struct Photograph {
+  std::string file;
+  std::vector<std::string> setup;  // VISION and LEARN ... AT lines, in order
+  std::vector<Expected> parts;     // every part LOCATE ALL must report
+  double within_px;                // of the centre read by eye
+};
+
+void check(const Photograph& photo) {
+  INFO(photo.file);
+  VideoServerProcess server{
+      {"--source", "cam0=file:" + std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + photo.file,
+       "--mode", "trigger"}};
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  const auto ask = [&](const std::string& request) {
+    auto reply = robot.request(request, 20s);
+    REQUIRE(reply);
+    return *reply;
+  };
+  for (const auto& line : photo.setup) {
+    const std::string reply = ask(line);
+    INFO(line << " -> " << reply);
+    REQUIRE(reply.rfind("OK", 0) == 0);
+  }
+  const std::string reply = ask("LOCATE ALL");
+  INFO(reply);
+  const auto found = parts(reply);
+  CHECK(found.size() == photo.parts.size());
+  // Each part seen once, of its type, where it lies.
+  std::vector<bool> used(found.size(), false);
+  for (const auto& e : photo.parts) {
+    bool seen = false;
+    for (size_t i = 0; i < found.size() && !seen; ++i) {
+      if (used[i] || found[i].type != e.type) continue;
+      if (std::hypot(found[i].x - e.x, found[i].y - e.y) > photo.within_px) continue;
+      used[i] = seen = true;
+    }
+    INFO("type " << e.type << " at " << e.x << " " << e.y);
+    CHECK(seen);
+  }
+}
+}  // namespace
+
+TEST_CASE("photographs: shapes cut from card, each taught and found once", "[e2e][photographs]") {
+  // pic1.png (OpenCV samples): a tilted tile, a triangle, a head, a blurred
+  // bar, beside a plate with seven holes and a question mark.
+  check({"pic1.png",
+         {"LEARN 1 tile AT 245 35 150 155", "LEARN 2 triangle AT 238 200 148 86",
+          "LEARN 3 head AT 8 155 100 135", "LEARN 4 bar AT 148 172 55 110"},
+         {{1, 319, 112}, {2, 310, 228}, {3, 55, 219}, {4, 175, 228}},
+         4});
+}
+
+TEST_CASE("photographs: the small painted square and not the large one", "[e2e][photographs]") {
+  // pic3.png (OpenCV samples): four outlines painted in colour on white; two
+  // squares of different sizes.
+  check({"pic3.png", {"LEARN 1 square AT 230 160 135 135"}, {{1, 295, 227}}, 4});
+}
+
+TEST_CASE("photographs: a pencil, a cap and a lighter on a wooden desk", "[e2e][photographs]") {
+  // stuff.jpg (OpenCV samples): a front-lit desk with grain and vignetting;
+  // the dark objects (the white ball and the coin are lighter than the desk).
+  check({"stuff.jpg",
+         {"LEARN 1 pencil AT 50 80 300 180", "LEARN 2 cap AT 180 10 100 100",
+          "LEARN 3 lighter AT 300 300 80 170"},
+         {{1, 196, 172}, {2, 228, 56}, {3, 337, 395}},
+         5});
+}
+
+TEST_CASE("photographs: one wooden block among blocks of other shapes and poses",
+          "[e2e][photographs]") {
+  // blox.jpg (OpenCV samples): blocks on a table and a platform.
+  check({"blox.jpg", {"LEARN 1 block AT 70 185 55 60"}, {{1, 99, 217}}, 4});
+}
+
+TEST_CASE("photographs: the horse silhouette", "[e2e][photographs]") {
+  // horse.png (scikit-image data).
+  check({"horse.png", {"LEARN 1 horse AT 5 0 395 328"}, {{1, 187, 145}}, 5});
+}
+
+TEST_CASE("photographs: a lone disc and the discs of a pile that show most of their rim",
+          "[e2e][photographs]") {
+  // detect_blob.png (OpenCV samples): light shapes on black; a pile of about
+  // twenty discs as large as the lone one at (181, 61). Thirteen of the
+  // pile show more than 0.6 of their rim, the others lie under them.
+  check({"detect_blob.png",
+         {"VISION polarity light", "LEARN 1 dot AT 160 40 45 45"},
+         {{1, 181, 61},
+          {1, 405, 475},
+          {1, 445, 478},
+          {1, 483, 487},
+          {1, 362, 517},
+          {1, 472, 522},
+          {1, 363, 542},
+          {1, 447, 563},
+          {1, 465, 567},
+          {1, 373, 577},
+          {1, 367, 597},
+          {1, 412, 603},
+          {1, 438, 617},
+          {1, 375, 623}},
+         4});
+}
