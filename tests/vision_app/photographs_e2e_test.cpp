@@ -3,8 +3,8 @@
 // a part (after the vision settings the scene needs), then LOCATE ALL, which
 // must report exactly the parts a person sees, each where it is. The truth
 // (counts and centres, image pixels) was read off the photographs by eye,
-// within a few pixels; coins.png and smarties.png have their own tests
-// (vision_settings_e2e_test.cpp, front_light_test.cpp).
+// within a few pixels; coins.png has its own test
+// (vision_settings_e2e_test.cpp).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -150,4 +150,23 @@ TEST_CASE("photographs: a lone disc and the discs of a pile that show most of th
           {1, 438, 617},
           {1, 375, 623}},
          4});
+}
+
+TEST_CASE("photographs: every whole sweet from one taught in colour", "[e2e][photographs]") {
+  // smarties.png (OpenCV samples): glossy sweets of six colours on white,
+  // two pairs touching; the three cut by the frame's edge are not whole.
+  check({"smarties.png",
+         {"LEARN 1 sweet AT 236 85 64 64"},
+         {{1, 377, 81},
+          {1, 269, 117},
+          {1, 205, 211},
+          {1, 287, 213},
+          {1, 347, 238},
+          {1, 33, 228},
+          {1, 98, 259},
+          {1, 152, 271},
+          {1, 219, 306},
+          {1, 294, 320},
+          {1, 134, 327}},
+         5});
 }
