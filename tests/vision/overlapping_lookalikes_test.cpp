@@ -116,8 +116,10 @@ TEST_CASE("a partly hidden hand is never reported as the look-alike hand",
 TEST_CASE("a partly hidden hand is never reported as the look-alike hand when blurred",
           "[vision][locator][overlap]") {
   // Seeds 31 and 59 of 1 to 60 under the benchmark's blurred look, where
-  // the 7_4 verified above the verify fraction on a hidden 7_1.
-  const HandCount count = checkHandsNeverConfused(blurred(), {31, 59});
+  // the 7_4 verified above the verify fraction on a hidden 7_1; 55, where
+  // the 7_1 showed 0.69 of its boundary on a 7_4 12 % hidden, fitted at
+  // 1.08 px (a partly hidden part that shows under 0.7 must fit closely).
+  const HandCount count = checkHandsNeverConfused(blurred(), {31, 55, 59});
   CHECK(count.found >= 8);
 }
 

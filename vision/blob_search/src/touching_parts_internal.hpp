@@ -77,7 +77,7 @@ class Coverage {
   cv::Point2d last_;  // the last column and row
 };
 
-// Where the grey image shows a part the mask lost: pixels beside a blob
+// Where the grey image shows a part the mask lost: pixels joined to a blob
 // darker than the surface round it by kFaintShare of the contrast between
 // the blob's level and the surface's (lighter, for light parts: the
 // contrast's sign follows). At low contrast the threshold drops the thin
