@@ -49,6 +49,9 @@ def test_an_operator_cannot_teach(cell, anonymous):
     anonymous.login("otto", "operator-otto")
     wait_until(anonymous.logged_in, what="the operator's login")
     assert "operator" in anonymous.js("return document.getElementById('user-name').textContent")
+    # The page sends commands to the vision app it has chosen: on a loaded
+    # machine that comes a moment after the login ("ERROR no vision app").
+    wait_until(lambda: anonymous.js("return window.picksight.app"), what="the page's vision app")
     before = models(cell)
     reply = command(anonymous, "LEARN 7 taught AT 0 0 200 200")
     assert reply.startswith("ERROR"), reply
