@@ -220,10 +220,16 @@ class Browser:
         self.driver.quit()
 
 
+def admin_browser(cell, profile):
+    """A browser on `cell`'s page, logged in through its form as the admin."""
+    b = Browser(cell.url + "/", profile)
+    b.login("admin", cell.admin_password)
+    wait_until(b.logged_in, what="the admin's login")
+    return b
+
+
 @pytest.fixture(scope="module")
 def browser(cell, tmp_path_factory):
-    b = Browser(cell.url + "/", tmp_path_factory.mktemp("chromium"))
-    b.login("admin", cell.admin_password)
-    wait_until(b.logged_in, what="the login")
+    b = admin_browser(cell, tmp_path_factory.mktemp("chromium"))
     yield b
     b.quit()

@@ -9,7 +9,7 @@ import os
 
 import pytest
 
-from conftest import CAMERA, Browser, Cell, wait_until
+from conftest import CAMERA, Cell, admin_browser, wait_until
 from test_page import check_overlay_matches, drag_a_rectangle, locate_on_page, overlay_after, poses, \
     select_tab, teach_on_page
 
@@ -30,9 +30,7 @@ def sweets(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def sweets_browser(sweets, tmp_path_factory):
-    b = Browser(sweets.url + "/", tmp_path_factory.mktemp("chromium-sweets"))
-    b.login("admin", sweets.admin_password)
-    wait_until(b.logged_in, what="the login")
+    b = admin_browser(sweets, tmp_path_factory.mktemp("chromium-sweets"))
     yield b
     b.quit()
 

@@ -10,16 +10,14 @@ import urllib.request
 
 import pytest
 
-from conftest import APP, Browser, wait_until
+from conftest import APP, admin_browser, wait_until
 
 
 @pytest.fixture(scope="module")
 def page(cell, tmp_path_factory):
     """A browser that logs in through the page's form (not the fixture's
     session), as the admin first."""
-    b = Browser(cell.url + "/", tmp_path_factory.mktemp("chromium-users-panel"))
-    b.login("admin", cell.admin_password)
-    wait_until(b.logged_in, what="the admin's login")
+    b = admin_browser(cell, tmp_path_factory.mktemp("chromium-users-panel"))
     yield b
     b.quit()
 

@@ -113,22 +113,30 @@ constexpr double kMaxOnBackground = 0.02;
 constexpr double kMinOnOutline = 0.25;
 constexpr double kOutlineHoleShare = 0.25;
 
-// Whether more of the boundary at the pose than a part can show lies off
-// the edges on the background (and not on a faint part the mask lost).
-bool crossesBackground(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
-                       const Coverage& coverage, const FaintPart& faint) {
+// The share of the model's boundary, placed at the pose, whose points
+// satisfy `where` (image coordinates), by the samples' weights.
+template <typename Where>
+double boundaryShare(const PartModel& m, const ImagePose& pose, Where where) {
   const double c = std::cos(pose.angle_deg * kRadPerDeg);
   const double s = std::sin(pose.angle_deg * kRadPerDeg);
   const double flip = pose.mirrored ? -1.0 : 1.0;
   double total = 0;
-  double background = 0;
+  double share = 0;
   for (const auto& sample : m.samples) {
     total += sample.weight;
-    const cv::Point2d p = pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s);
-    if (edges.at(p) > m.edge_tolerance && coverage.at(p) < 0.5 && !faint.at(p))
-      background += sample.weight;
+    if (where(pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s)))
+      share += sample.weight;
   }
-  return background > kMaxOnBackground * total;
+  return total > 0 ? share / total : 0;
+}
+
+// Whether more of the boundary at the pose than a part can show lies off
+// the edges on the background (and not on a faint part the mask lost).
+bool crossesBackground(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
+                       const Coverage& coverage, const FaintPart& faint) {
+  return boundaryShare(m, pose, [&](cv::Point2d p) {
+           return edges.at(p) > m.edge_tolerance && coverage.at(p) < 0.5 && !faint.at(p);
+         }) > kMaxOnBackground;
 }
 
 bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double px, double deg) {
@@ -485,17 +493,7 @@ double BlobSearch::onOutline(const PartModel& m, const ImagePose& pose) {
     }
   }
   const EdgeDistance& outline = outline_->empty() ? *edges_ : *outline_;
-  const double c = std::cos(pose.angle_deg * kRadPerDeg);
-  const double s = std::sin(pose.angle_deg * kRadPerDeg);
-  const double flip = pose.mirrored ? -1.0 : 1.0;
-  double total = 0;
-  double on = 0;
-  for (const auto& sample : m.samples) {
-    total += sample.weight;
-    const cv::Point2d p = pose.centre + rotate({sample.point.x, flip * sample.point.y}, c, s);
-    if (outline.at(p) <= m.edge_tolerance) on += sample.weight;
-  }
-  return total > 0 ? on / total : 0;
+  return boundaryShare(m, pose, [&](cv::Point2d p) { return outline.at(p) <= m.edge_tolerance; });
 }
 
 bool BlobSearch::place(const Candidate& c) {
