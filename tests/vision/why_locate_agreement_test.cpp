@@ -27,6 +27,33 @@ using namespace picksight::vision;
 using namespace picksight::test;
 namespace ps = picksight::synthetic;
 
+namespace {
+// Tolerances as TOLERANCE sets them, each 0 (1 for the Hu factor) as
+// trained.
+struct Tolerances {
+  const char* name;
+  double area_tolerance;
+  double hu_factor;  // times the trained Hu tolerance
+  double verify_percent;
+  double edge_tolerance = 0;
+};
+
+// `trained` with `t` set on every model.
+SilhouetteModels withTolerances(const SilhouetteModels& trained, const Tolerances& t) {
+  SilhouetteModels models = trained;
+  for (PartModel& m : models.models) {
+    if (t.area_tolerance > 0) m.body.area_tolerance = t.area_tolerance;
+    m.body.hu_tolerance *= t.hu_factor;
+    if (t.verify_percent > 0) m.verify_percent = t.verify_percent;
+    if (t.edge_tolerance > 0) {
+      m.edge_tolerance = t.edge_tolerance;
+      prepareModel(m);  // the distance map follows the edge tolerance
+    }
+  }
+  return models;
+}
+}  // namespace
+
 TEST_CASE("WHY names a passing model exactly where LOCATE reports that model's whole part",
           "[vision][why]") {
   const ps::SilhouetteSceneOptions look;
@@ -45,34 +72,17 @@ TEST_CASE("WHY names a passing model exactly where LOCATE reports that model's w
   // WHY and in LOCATE alike (area 0.004, Hu x0.02 and edge 0.7 px each
   // turn passing regions of these scenes into failing ones; as trained, no
   // region here fails on its Hu distance or its boundary).
-  struct Setting {
-    const char* name;
-    double area_tolerance;  // 0: as trained
-    double hu_factor;       // times the trained Hu tolerance
-    double verify_percent;  // 0: as trained
-    double edge_tolerance;  // 0: as trained
-  };
-  const std::vector<Setting> settings = {
+  const std::vector<Tolerances> settings = {
       {"as trained", 0, 1, 0, 0},     {"tight", 0.01, 0.1, 97, 1.2}, {"loose", 0.3, 3, 60, 3},
       {"area 0.004", 0.004, 1, 0, 0}, {"hu x0.02", 0, 0.02, 0, 0},   {"edge 0.7 px", 0, 1, 0, 0.7},
   };
   std::map<RegionTest, int> verdicts;
   int touching_parts = 0;
-  for (const Setting& setting : settings) {
-    SilhouetteModels models = trained;
-    for (size_t i = 0; i < models.models.size(); ++i) {
-      PartModel& m = models.models[i];
-      // Half the models judge holes from 4 px up, as if taught with that
-      // setting: two groups, each seeing the regions its own way.
-      if (i % 2 == 0) m.min_hole_area = 4;
-      if (setting.area_tolerance > 0) m.body.area_tolerance = setting.area_tolerance;
-      m.body.hu_tolerance *= setting.hu_factor;
-      if (setting.verify_percent > 0) m.verify_percent = setting.verify_percent;
-      if (setting.edge_tolerance > 0) {
-        m.edge_tolerance = setting.edge_tolerance;
-        prepareModel(m);  // the distance map follows the edge tolerance
-      }
-    }
+  for (const Tolerances& setting : settings) {
+    SilhouetteModels models = withTolerances(trained, setting);
+    // Half the models judge holes from 4 px up, as if taught with that
+    // setting: two groups, each seeing the regions its own way.
+    for (size_t i = 0; i < models.models.size(); i += 2) models.models[i].min_hole_area = 4;
     const auto list = models.list();
     for (const auto arrangement :
          {ps::Arrangement::kSeparated, ps::Arrangement::kTouching, ps::Arrangement::kOverlapping}) {
@@ -199,25 +209,14 @@ TEST_CASE("the remedy WHY names is one with which LOCATE accepts the region", "[
   // Each tolerance tightened alone, so that regions fail one test; and all
   // at once, so that some fail several (no remedy may be named for those
   // unless one change suffices).
-  struct Setting {
-    const char* name;
-    double area_tolerance;  // 0: as trained
-    double hu_factor;
-    double verify_percent;  // 0: as trained
-  };
-  const std::vector<Setting> settings = {{"area 0.004", 0.004, 1, 0},
-                                         {"hu x0.02", 0, 0.02, 0},
-                                         {"verify 99.5", 0, 1, 99.5},
-                                         {"all tight", 0.004, 0.02, 99.5}};
+  const std::vector<Tolerances> settings = {{"area 0.004", 0.004, 1, 0},
+                                            {"hu x0.02", 0, 0.02, 0},
+                                            {"verify 99.5", 0, 1, 99.5},
+                                            {"all tight", 0.004, 0.02, 99.5}};
   std::map<std::string, int> remedies;
   int without = 0;
-  for (const Setting& setting : settings) {
-    SilhouetteModels models = trained;
-    for (PartModel& m : models.models) {
-      if (setting.area_tolerance > 0) m.body.area_tolerance = setting.area_tolerance;
-      m.body.hu_tolerance *= setting.hu_factor;
-      if (setting.verify_percent > 0) m.verify_percent = setting.verify_percent;
-    }
+  for (const Tolerances& setting : settings) {
+    const SilhouetteModels models = withTolerances(trained, setting);
     const auto list = models.list();
     for (uint64_t seed = 1; seed <= 2; ++seed) {
       const ps::SilhouetteScene scene(models.types, models.chiral,
