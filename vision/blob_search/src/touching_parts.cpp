@@ -370,8 +370,8 @@ FaintPart::FaintPart(const Region& r, const cv::Mat& blob, cv::Rect blob_box) {
   // not a stretch of this one.
   cv::Mat joined = faint | mask;
   cv::Mat labels;
-  cv::connectedComponents(joined, labels, 8, CV_32S);
-  std::vector<uint8_t> of_blob(static_cast<size_t>(r.grey.total()) + 1, 0);
+  const int count = cv::connectedComponents(joined, labels, 8, CV_32S);
+  std::vector<uint8_t> of_blob(static_cast<size_t>(std::max(count, 1)), 0);
   for (int y = 0; y < mask.rows; ++y) {
     const uint8_t* m = mask.ptr<uint8_t>(y);
     const int* l = labels.ptr<int>(y);
