@@ -136,8 +136,11 @@ void ResultFeed::run(zmq::context_t& context) {
       if (result.changed()) {
         if (on_change_ && !ownClient(result.client())) on_change_(result);
         // A change that worked on no frame (TOLERANCE, FORGET...) is the
-        // trail's, not a result for the page to draw.
-        if (result.frame_width() == 0) continue;
+        // trail's, not a result for the page to draw; but a job loaded
+        // changes what every part drawn was found with (models, settings,
+        // calibration): the page then draws nothing from before it, and its
+        // binarized view takes the job's settings.
+        if (result.frame_width() == 0 && result.request() != "JOB") continue;
       }
       accept(std::move(result));
     }

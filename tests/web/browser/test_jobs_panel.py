@@ -37,6 +37,13 @@ def models(cell):
     return [int(fields[1 + 5 * i]) for i in range(int(fields[0]))]
 
 
+# The page's latest result is the load, and nothing is drawn.
+CLEARED_BY_LOAD = """
+    const r = window.picksight.latest[window.picksight.app];
+    return r && (r.request_line || '').startsWith('JOB LOAD 1-bracket') &&
+           document.getElementById('overlay').dataset.parts === '0';"""
+
+
 def row_button(browser, job, action):
     click_css(browser, f'#jobs-list tr[data-job="{job}"] .job-{action}')
 
@@ -56,9 +63,16 @@ def test_jobs_panel_saves_loads_exports_and_imports(cell, browser, tmp_path):
     assert cell.say("FORGET 1") == "OK"
     assert cell.say("LEARN 4 other").startswith("OK 4 other ")
     assert models(cell) == [4]
+    # A LOCATE's part drawn before the load...
+    assert cell.say("LOCATE ALL").startswith("OK 1 4 ")
+    wait_until(lambda: browser.js("return document.getElementById('overlay').dataset.parts") == "1",
+               what="the part found with the other model drawn")
     row_button(browser, "1-bracket", "load")
     wait_until(lambda: last_reply(browser).startswith("< OK 1-bracket "), what="the JOB LOAD reply")
     assert models(cell) == [1]
+    # ...is no longer drawn once the job is loaded: it was found with
+    # models and settings that are not in force.
+    wait_until(lambda: browser.js(CLEARED_BY_LOAD), what="the overlay cleared by the load")
     wait_until(lambda: browser.js("return document.getElementById('jobs-current').textContent") == "1-bracket",
                what="the job in force")
 
