@@ -2,8 +2,11 @@
 #include "picksight/web/result_feed.hpp"
 
 #include <algorithm>
+#include <sstream>
+#include <string>
 
 #include "picksight/common/log.hpp"
+#include "picksight/common/text.hpp"
 #include "picksight/web/idle_priority.hpp"
 #include "picksight/web/proto_json.hpp"
 #include "picksight/web/web_errors.hpp"
@@ -13,6 +16,16 @@ namespace picksight::web {
 using tool_support::LineClient;
 
 namespace {
+// Whether the change is a job loaded (`JOB LOAD <name>`, any case): what
+// every part drawn before it was found with is no longer in force.
+bool jobLoad(const proto::VisionResult& result) {
+  if (result.request() != "JOB") return false;
+  std::istringstream words(result.request_line());
+  std::string command;
+  std::string sub;
+  words >> command >> sub;
+  return toUpper(sub) == "LOAD";
+}
 using namespace std::chrono_literals;
 
 constexpr auto kConnectTimeout = 2s;
@@ -140,7 +153,7 @@ void ResultFeed::run(zmq::context_t& context) {
         // changes what every part drawn was found with (models, settings,
         // calibration): the page then draws nothing from before it, and its
         // binarized view takes the job's settings.
-        if (result.frame_width() == 0 && result.request() != "JOB") continue;
+        if (result.frame_width() == 0 && !jobLoad(result)) continue;
       }
       accept(std::move(result));
     }
