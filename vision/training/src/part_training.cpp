@@ -14,6 +14,7 @@
 
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/blob_search/touching_parts.hpp"
+#include "picksight/vision/segmentation/shadows.hpp"
 
 namespace picksight::vision {
 namespace {
@@ -120,23 +121,17 @@ constexpr double kFullContrastShare = 0.6;
 constexpr double kMinEdgeWeight = 0.1;
 constexpr int kMinContrastSamples = 4;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
 void weighByContrast(PartModel& m, const cv::Mat& grey, cv::Point2d origin) {
   cv::Mat smooth;
   grey.convertTo(smooth, CV_32F);
   cv::blur(smooth, smooth, cv::Size(3, 3));
   const cv::Point2d last(smooth.cols - 1, smooth.rows - 1);
   const auto level = [&](cv::Point2d p) { return bilinearAt(smooth, p.x, p.y, last, -1.f); };
-  std::vector<std::vector<double>> per_primitive;
-  std::vector<double> all;
+  std::vector<std::vector<float>> per_primitive;
+  std::vector<float> all;
   for (const auto& loop : m.loops) {
     for (const auto& p : loop.primitives) {
-      std::vector<double> contrast;
+      std::vector<float> contrast;
       const int steps = static_cast<int>(std::floor(p.length()));
       for (int i = 1; i < steps; ++i) {
         const double t = static_cast<double>(i) / steps;
@@ -156,14 +151,14 @@ void weighByContrast(PartModel& m, const cv::Mat& grey, cv::Point2d origin) {
       per_primitive.push_back(std::move(contrast));
     }
   }
-  const double whole = median(all);
+  const double whole = medianOf(all);
   if (!(whole > 0)) return;
   size_t k = 0;
   for (auto& loop : m.loops) {
     for (auto& p : loop.primitives) {
-      const auto& contrast = per_primitive[k++];
+      auto& contrast = per_primitive[k++];
       if (static_cast<int>(contrast.size()) < kMinContrastSamples) continue;
-      const double share = median(contrast) / whole;
+      const double share = medianOf(contrast) / whole;
       p.weight = std::clamp(share / kFullContrastShare, kMinEdgeWeight, 1.0);
     }
   }
