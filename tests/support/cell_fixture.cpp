@@ -98,6 +98,19 @@ LineClient VisionProcess::connect() const {
   return std::move(*c);
 }
 
+PhotographCell::PhotographCell(const std::string& scene_file)
+    : server({"--source",
+              "cam0=file:" + std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + scene_file,
+              "--mode", "trigger"}),
+      vision(server),
+      robot(vision.connect()) {}
+
+std::string PhotographCell::ask(const std::string& line) {
+  auto reply = robot.request(line, 20s);
+  REQUIRE(reply);
+  return *reply;
+}
+
 CommandResult run(const std::vector<std::string>& argv) {
   Subprocess p(argv);
   CommandResult r;

@@ -44,6 +44,17 @@ struct VisionProcess {
   tool_support::LineClient connect() const;
 };
 
+// A cell whose camera is one photograph of tests/data/scenes (a file
+// camera in trigger mode), and a robot's connection to its vision app.
+struct PhotographCell {
+  explicit PhotographCell(const std::string& scene_file);
+  // The reply to `line`; REQUIREs one within 20 s.
+  std::string ask(const std::string& line);
+  VideoServerProcess server;
+  VisionProcess vision;
+  tool_support::LineClient robot;
+};
+
 struct CommandResult {
   int exit_code = -1;
   std::string out;

@@ -16,7 +16,6 @@
 
 using namespace picksight;
 using namespace picksight::e2e;
-using namespace std::chrono_literals;
 
 namespace {
 struct Located {
@@ -57,16 +56,8 @@ struct Photograph {
 
 void check(const Photograph& photo) {
   INFO(photo.file);
-  VideoServerProcess server{
-      {"--source", "cam0=file:" + std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + photo.file,
-       "--mode", "trigger"}};
-  VisionProcess vision(server);
-  auto robot = vision.connect();
-  const auto ask = [&](const std::string& request) {
-    auto reply = robot.request(request, 20s);
-    REQUIRE(reply);
-    return *reply;
-  };
+  PhotographCell cell(photo.file);
+  const auto ask = [&](const std::string& request) { return cell.ask(request); };
   for (const auto& line : photo.setup) {
     const std::string reply = ask(line);
     INFO(line << " -> " << reply);

@@ -423,15 +423,8 @@ TEST_CASE("Coins on a dark table: VISION hints at polarity light, then LOCATE fi
           "[vision_app][vision_settings][e2e]") {
   // The photograph of the issue (tests/data/scenes/coins.png, scikit-image):
   // 24 light coins on a darker, unevenly lit table.
-  const std::string coins = std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/coins.png";
-  VideoServerProcess server{{"--source", "cam0=file:" + coins, "--mode", "trigger"}};
-  VisionProcess vision(server);
-  LineClient robot = vision.connect();
-  const auto ask = [&](const std::string& request) {
-    auto reply = robot.request(request, 20s);
-    REQUIRE(reply);
-    return *reply;
-  };
+  PhotographCell cell("coins.png");
+  const auto ask = [&](const std::string& request) { return cell.ask(request); };
   // Dark parts: pieces of the table, not a coin.
   CHECK(located(ask("LOCATE ALL")) != 24);
   const std::string before = ask("VISION");
