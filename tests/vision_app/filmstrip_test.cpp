@@ -22,9 +22,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A LOCATE that answered `reply`, on a frame with a grey level of `level`.
-Take locateTake(const std::string& reply, int level = 100) {
+// A LOCATE that answered `reply`, on a frame with a grey level of `level`,
+// with the cell's `geometry` when given.
+Take locateTake(const std::string& reply, int level = 100,
+                std::optional<store::CellGeometry> geometry = std::nullopt) {
   auto record = std::make_shared<results::RequestRecord>();
+  record->geometry = std::move(geometry);
   record->request = "LOCATE";
   record->request_line = "LOCATE 1";
   record->reply = reply;
@@ -78,6 +81,44 @@ TEST_CASE("filmstrip entries keep the frame lossless and the request, reply and 
   CHECK(cv::countNonZero(stored->second != 77) == 0);
   CHECK(fs::exists(dir.file("strip/0000000001.png")));
   CHECK(fs::exists(dir.file("strip/0000000001.json")));
+}
+
+TEST_CASE("a filmstrip entry records the frame its reply's poses are in",
+          "[vision_app][filmstrip]") {
+  test::TempDir dir;
+  auto strip = openStrip(in(dir.file("strip")));
+  // Robot millimetres once a transform is computed; vision pixels before
+  // any calibration; no frame for a request with no cell geometry.
+  store::CellGeometry computed;
+  computed.transform = calibration::PlaneTransform{};
+  const uint64_t in_robot = strip->reserve();
+  REQUIRE(strip->record(in_robot, locateTake("OK 1 1.000 2.000 3.000", 100, computed)));
+  const uint64_t in_pixels = strip->reserve();
+  REQUIRE(
+      strip->record(in_pixels, locateTake("OK 1 1.000 2.000 3.000", 100, store::CellGeometry{})));
+  const uint64_t none = strip->reserve();
+  REQUIRE(strip->record(none, locateTake("ERROR 21 no frame")));
+  strip->flush();
+  CHECK(strip->entry(in_robot)->reply_frame == "robot_mm");
+  CHECK(strip->entry(in_pixels)->reply_frame == "pixels");
+  CHECK(strip->entry(none)->reply_frame.empty());
+
+  // A sidecar written before the frame was recorded has none; one naming
+  // a frame that does not exist is damaged.
+  auto text = readFile(dir.file("strip/0000000001.json"));
+  REQUIRE(text);
+  const std::string key = "\"reply_frame\":\"robot_mm\",";
+  REQUIRE(text->find(key) != std::string::npos);
+  std::string older = *text;
+  older.erase(older.find(key), key.size());
+  auto parsed = parseEntryJson(older);
+  REQUIRE(parsed);
+  CHECK(parsed->reply_frame.empty());
+  std::string unknown = *text;
+  unknown.replace(unknown.find("robot_mm"), 8, "robot_in");
+  auto refused = parseEntryJson(unknown);
+  REQUIRE_FALSE(refused);
+  CHECK(refused.error().message.find("reply_frame") != std::string::npos);
 }
 
 TEST_CASE("filmstrip bounds evict the oldest successes and keep the failures apart",

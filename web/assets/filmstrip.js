@@ -80,10 +80,13 @@
       "> " + e.request_line,
       "< " + e.reply,
     ];
+    // The frame the recorded reply's poses are in (none recorded by older
+    // entries, nor for replies without poses).
+    if (e.reply_frame) lines.push("reply in " + ps.replyFrame(e.reply_frame).text);
     if (e.why && e.why !== e.reply) lines.push("why: " + e.why);
     if (e.camera) lines.push("camera " + e.camera + ", frame " + e.sequence + (e.width ? ", " + e.width + "x" + e.height + " px" : ""));
     // The parts as found on the image (the orange circles); the reply's
-    // numbers above are in the frame the app replied in then (STATUS frame=).
+    // numbers above are in the frame named under it.
     const parts = e.parts || [];
     if (parts.length) lines.push("parts found (sensor px, y down; angle \u00b0 clockwise on the screen):");
     for (const p of parts.slice(0, 16)) {

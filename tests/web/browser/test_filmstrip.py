@@ -40,7 +40,11 @@ def test_the_filmstrip_shows_a_locate_and_replays_it(cell, browser):
         what="the recorded parts on the frame")
     assert recorded == found
     assert browser.js("return document.getElementById('filmstrip-frame').naturalWidth") == 640
-    assert f"< {located}" in browser.js("return document.getElementById('filmstrip-detail').textContent")
+    detail = browser.js("return document.getElementById('filmstrip-detail').textContent")
+    assert f"< {located}" in detail
+    # The frame the recorded reply's poses are in, as the app recorded it
+    # (this cell has no calibration: vision pixels).
+    assert f"< {located}\nreply in vision px (y up; no CALCAM yet)\n" in detail
 
     click(browser, "filmstrip-replay")
     reply = wait_until(lambda: browser.js(

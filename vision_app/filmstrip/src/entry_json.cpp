@@ -44,6 +44,7 @@ std::string entryJson(const Entry& e) {
       {"request", e.request},
       {"request_line", e.request_line},
       {"reply", e.reply},
+      {"reply_frame", e.reply_frame},
       {"client", e.client},
       {"failure", e.failure},
       {"asked_type", e.asked_type},
@@ -117,6 +118,8 @@ Result<Entry> parseEntryJson(const std::string& text) {
   read(e.image, "image");
   read(e.width, "width");
   read(e.height, "height");
+  // Sidecars written before the reply's frame was recorded have none.
+  if (j.contains("reply_frame")) read(e.reply_frame, "reply_frame");
   nlohmann::json mapping;
   nlohmann::json parts;
   read(mapping, "mapping");
@@ -151,6 +154,9 @@ Result<Entry> parseEntryJson(const std::string& text) {
   if (bad) return *bad;
   if (!(e.mapping.scale_x > 0) || !(e.mapping.scale_y > 0))
     return makeError(FilmstripErrc::kDamaged, "\"mapping\" has a scale that is not positive");
+  if (!e.reply_frame.empty() && e.reply_frame != "pixels" && e.reply_frame != "vision_mm" &&
+      e.reply_frame != "robot_mm")
+    return makeError(FilmstripErrc::kDamaged, "\"reply_frame\" names no frame");
   // The image is a file of the filmstrip's directory, never a path.
   if (!e.image.empty() && (e.image.find('/') != std::string::npos || e.image[0] == '.'))
     return makeError(FilmstripErrc::kDamaged, "\"image\" is not a file name");

@@ -71,6 +71,7 @@ Entry describe(const Take& take) {
   if (!r) return e;
   e.request_line = r->request_line;
   e.reply = r->reply;
+  e.reply_frame = r->replyFrame();
   e.client = r->client;
   e.asked_type = r->asked_type;
   e.elapsed_ms = r->elapsed_ms;

@@ -72,6 +72,19 @@ std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type
 
 }  // namespace
 
+std::string RequestRecord::replyFrame() const {
+  if (!geometry) return "";
+  switch (geometry->frame()) {
+    case store::CoordinateFrame::kVisionPixels:
+      return "pixels";
+    case store::CoordinateFrame::kVisionMm:
+      return "vision_mm";
+    case store::CoordinateFrame::kRobot:
+      return "robot_mm";
+  }
+  return "";
+}
+
 std::optional<FrameInfo> RequestRecord::frameInfo() const {
   if (locate) return locate->frame;
   if (frame) return frame->info;

@@ -17,7 +17,6 @@ using cell::LocateOutcome;
 using cell::LocateScene;
 using cell::modelOf;
 using cell::partPoseInVisionFrame;
-using store::CoordinateFrame;
 using store::GraspSetup;
 namespace {
 
@@ -28,18 +27,6 @@ constexpr size_t kMaxReply = 4096;
 void setPoint(proto::Point2* out, cv::Point2d p) {
   out->set_x(p.x);
   out->set_y(p.y);
-}
-
-const char* replyFrameName(CoordinateFrame frame) {
-  switch (frame) {
-    case CoordinateFrame::kVisionPixels:
-      return "pixels";
-    case CoordinateFrame::kVisionMm:
-      return "vision_mm";
-    case CoordinateFrame::kRobot:
-      return "robot_mm";
-  }
-  return "pixels";
 }
 
 const char* methodName(vision::ThresholdMethod method) {
@@ -239,7 +226,7 @@ void buildVisionResult(const RequestRecord& record, const std::string& app, uint
     out.set_scale_x(mapping->scale_x);
     out.set_scale_y(mapping->scale_y);
   }
-  if (record.geometry) out.set_reply_frame(replyFrameName(record.geometry->frame()));
+  out.set_reply_frame(record.replyFrame());
   if (record.locate) {
     addRegions(out, record.locate->scene.regions, record.locate->scene.mapping);
     addParts(out, record);

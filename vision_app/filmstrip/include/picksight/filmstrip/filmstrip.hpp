@@ -88,6 +88,10 @@ struct Entry {
   std::string request;       // "LOCATE", "WHY", "PLC"
   std::string request_line;  // as received ("PLC TRIGGER 3" for a PLC)
   std::string reply;
+  // The frame of the reply's poses (RequestRecord::replyFrame): "pixels",
+  // "vision_mm", "robot_mm", or "" for a reply with no pose frame (and in
+  // sidecars written before it was recorded).
+  std::string reply_frame;
   std::string client;
   bool failure = false;
   int asked_type = -1;  // -1: every type

@@ -75,6 +75,10 @@ class RequestRecord {
 
   // The frame the request worked on, if any.
   std::optional<FrameInfo> frameInfo() const;
+  // The frame of the reply's poses, as results (VisionResult.reply_frame)
+  // and the filmstrip name it: "pixels", "vision_mm" or "robot_mm"; ""
+  // for a request that replies no pose (no cell geometry with it).
+  std::string replyFrame() const;
   // Every region of a LOCATE not reported as a part of the asked type, in
   // region order; empty for other requests.
   const std::vector<RegionRejection>& rejections() const;
