@@ -88,7 +88,7 @@ TEST_CASE("a filmstrip entry records the frame its reply's poses are in",
   test::TempDir dir;
   auto strip = openStrip(in(dir.file("strip")));
   // Robot millimetres once a transform is computed; vision pixels before
-  // any calibration; no frame for a request with no cell geometry.
+  // any calibration; no frame for a reply without poses.
   store::CellGeometry computed;
   computed.transform = calibration::PlaneTransform{};
   const uint64_t in_robot = strip->reserve();
@@ -97,11 +97,14 @@ TEST_CASE("a filmstrip entry records the frame its reply's poses are in",
   REQUIRE(
       strip->record(in_pixels, locateTake("OK 1 1.000 2.000 3.000", 100, store::CellGeometry{})));
   const uint64_t none = strip->reserve();
-  REQUIRE(strip->record(none, locateTake("ERROR 21 no frame")));
+  REQUIRE(strip->record(none, locateTake("ERROR 21 no frame", 100, computed)));
+  const uint64_t nothing = strip->reserve();
+  REQUIRE(strip->record(nothing, locateTake("OK 0", 100, computed)));
   strip->flush();
   CHECK(strip->entry(in_robot)->reply_frame == "robot_mm");
   CHECK(strip->entry(in_pixels)->reply_frame == "pixels");
   CHECK(strip->entry(none)->reply_frame.empty());
+  CHECK(strip->entry(nothing)->reply_frame.empty());
 
   // A sidecar written before the frame was recorded has none; one naming
   // a frame that does not exist is damaged.

@@ -71,11 +71,13 @@ Entry describe(const Take& take) {
   if (!r) return e;
   e.request_line = r->request_line;
   e.reply = r->reply;
-  e.reply_frame = r->replyFrame();
   e.client = r->client;
   e.asked_type = r->asked_type;
   e.elapsed_ms = r->elapsed_ms;
   e.failure = take.request == "WHY" || isFailureReply(r->reply);
+  // Only a reply with poses has a frame (an ERROR or "OK 0" has none, though
+  // the cell's geometry went with the request).
+  if (!e.failure) e.reply_frame = r->replyFrame();
   if (take.request == "WHY") e.why = r->reply;
   if (r->locate) {
     const auto& parts = r->locate->parts;
