@@ -96,6 +96,10 @@ class BlobSearch {
   std::vector<Match> matches() const;
 
  private:
+  // Whether more of the boundary of `m` at `pose` than a part can show lies
+  // off the edges on the background, and not on a faint part the mask lost
+  // (kMaxOnBackground, FaintPart).
+  bool crossesBackground(const PartModel& m, const ImagePose& pose);
   // The share of the boundary of `m` at `pose` on the blob's outline (see
   // kMinOnOutline).
   double onOutline(const PartModel& m, const ImagePose& pose);
@@ -123,7 +127,7 @@ class BlobSearch {
   cv::Rect blob_box_;
   cv::Mat blob_;  // 255 on the blob's pixels, over blob_box_
   std::optional<Coverage> coverage_;
-  std::optional<FaintPart> faint_;  // made when a candidate is first placed
+  std::optional<FaintPart> faint_;  // made when a pose first crosses without it
   // Distance to the blob's outline and large holes (see onOutline): empty
   // when that is every edge (edges_); made when first asked.
   std::optional<EdgeDistance> outline_;

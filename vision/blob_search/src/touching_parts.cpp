@@ -134,15 +134,6 @@ double boundaryShare(const PartModel& m, const ImagePose& pose, Where where) {
   return total > 0 ? share / total : 0;
 }
 
-// Whether more of the boundary at the pose than a part can show lies off
-// the edges on the background (and not on a faint part the mask lost).
-bool crossesBackground(const PartModel& m, const ImagePose& pose, const EdgeDistance& edges,
-                       const Coverage& coverage, const FaintPart& faint) {
-  return boundaryShare(m, pose, [&](cv::Point2d p) {
-           return edges.at(p) > m.edge_tolerance && coverage.at(p) < 0.5 && !faint.at(p);
-         }) > kMaxOnBackground;
-}
-
 bool samePose(const PartModel& m, const ImagePose& a, const ImagePose& b, double px, double deg) {
   if (a.mirrored != b.mirrored) return false;
   if (std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) > px) return false;
@@ -500,6 +491,23 @@ double BlobSearch::onOutline(const PartModel& m, const ImagePose& pose) {
   return boundaryShare(m, pose, [&](cv::Point2d p) { return outline.at(p) <= m.edge_tolerance; });
 }
 
+bool BlobSearch::crossesBackground(const PartModel& m, const ImagePose& pose) {
+  const auto share = [&](const FaintPart* faint) {
+    return boundaryShare(m, pose, [&](cv::Point2d p) {
+      return edges_->at(p) > m.edge_tolerance && coverage_->at(p) < 0.5 && !(faint && faint->at(p));
+    });
+  };
+  // The faint part only takes points out of the share: under the limit
+  // without it, under it with it. It costs more than the rest of placing
+  // (connected components over the blob's box), so it is made only for a
+  // blob where a pose crosses without it: on evenly lit parts it never is
+  // (touching silhouettes, 15 types: the recognition 9.3 ms median with
+  // it made first, 14.6 ms with it made for every blob).
+  if (share(nullptr) <= kMaxOnBackground) return false;
+  if (!faint_) faint_.emplace(region_, blob_, blob_box_);
+  return share(&*faint_) > kMaxOnBackground;
+}
+
 bool BlobSearch::place(const Candidate& c) {
   const PartModel& m = *c.model;
   // Below the verify fraction, a part may be partly hidden (kMinVisible,
@@ -508,8 +516,7 @@ bool BlobSearch::place(const Candidate& c) {
   if (!verified && c.score < kMinVisible &&
       (c.score < kMinVisibleTight || !(c.rms <= kWholeFitRmsPx)))
     return false;
-  if (!faint_) faint_.emplace(region_, blob_, blob_box_);
-  const bool crosses = crossesBackground(m, c.pose, *edges_, *coverage_, *faint_);
+  const bool crosses = crossesBackground(m, c.pose);
   if (!verified && crosses) return false;
   if (onOutline(m, c.pose) < kMinOnOutline) return false;
   const auto outline = placedOutline(m, c.pose);
