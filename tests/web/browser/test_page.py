@@ -21,10 +21,15 @@ def ok_fields(reply):
 
 
 def poses(reply):
-    """LOCATE's `OK n x y rz ...` as [(x, y, rz)] (vision-px: y up)."""
+    """LOCATE's `OK n x y rz ...`, or LOCATE ALL's `OK n type x y rz ...`,
+    as [(x, y, rz)] (vision-px: y up). The two differ in length for any n
+    but 0."""
     f = ok_fields(reply)
     n = int(f[0])
-    return [tuple(float(v) for v in f[1 + 3 * i:4 + 3 * i]) for i in range(n)]
+    step = 4 if len(f) == 1 + 4 * n and n > 0 else 3
+    assert len(f) == 1 + step * n, reply
+    return [tuple(float(v) for v in f[2 + 4 * i:5 + 4 * i]) if step == 4 else
+            tuple(float(v) for v in f[1 + 3 * i:4 + 3 * i]) for i in range(n)]
 
 
 def frame_box(browser):
