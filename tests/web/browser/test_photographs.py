@@ -11,6 +11,7 @@ no restart and no line typed to the app:
   panel (six types), their tolerances widened there, then LOCATE ALL: every
   coin, once."""
 
+import contextlib
 import os
 
 import pytest
@@ -21,6 +22,7 @@ from selenium.webdriver.support.ui import Select
 
 from test_page import check_overlay_matches, click, drag_a_rectangle, locate_on_page, overlay_after, poses, \
     select_tab, teach_on_page
+from test_vision_panel import set_field
 
 DATA = os.environ.get("PICKSIGHT_TEST_DATA_DIR",
                       os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "data"))
@@ -31,22 +33,35 @@ WHOLE_SWEETS = [(377, 81), (269, 117), (205, 211), (287, 213), (347, 238), (33, 
                 (152, 271), (219, 306), (294, 320), (134, 327)]
 
 
-@pytest.fixture(scope="module")
-def sweets(tmp_path_factory):
-    c = Cell(tmp_path_factory.mktemp("sweets"), source=f"{CAMERA}=file:{SWEETS}")
-    yield c
-    c.stop()
+@contextlib.contextmanager
+def photograph_in_page(tmp_path_factory, name, path):
+    """A cell whose camera is the photograph at `path`, and an admin's
+    browser on its page: (cell, browser)."""
+    cell = Cell(tmp_path_factory.mktemp(name), source=f"{CAMERA}=file:{path}")
+    try:
+        browser = admin_browser(cell, tmp_path_factory.mktemp(f"chromium-{name}"))
+        try:
+            yield cell, browser
+        finally:
+            browser.quit()
+    finally:
+        cell.stop()
 
 
 @pytest.fixture(scope="module")
-def sweets_browser(sweets, tmp_path_factory):
-    b = admin_browser(sweets, tmp_path_factory.mktemp("chromium-sweets"))
-    yield b
-    b.quit()
+def sweets_page(tmp_path_factory):
+    with photograph_in_page(tmp_path_factory, "sweets", SWEETS) as page:
+        yield page
 
 
-def test_every_whole_sweet_from_one_taught_in_the_page(sweets, sweets_browser):
-    browser = sweets_browser
+@pytest.fixture(scope="module")
+def coins_page(tmp_path_factory):
+    with photograph_in_page(tmp_path_factory, "coins", COINS) as page:
+        yield page
+
+
+def test_every_whole_sweet_from_one_taught_in_the_page(sweets_page):
+    sweets, browser = sweets_page
     camera = wait_until(lambda: (lambda c: c if c.get("width") == 413 else None)(sweets.camera()),
                         what="the photograph's frames")
     select_tab(browser, "teach")
@@ -77,28 +92,8 @@ COIN_BOXES = [("small", (80, 102, 46, 46)), ("medium", (185, 165, 55, 55)), ("la
               ("largest", (312, 152, 72, 68)), ("mid", (78, 170, 50, 50)), ("small2", (20, 30, 50, 50))]
 
 
-@pytest.fixture(scope="module")
-def coins(tmp_path_factory):
-    c = Cell(tmp_path_factory.mktemp("coins"), source=f"{CAMERA}=file:{COINS}")
-    yield c
-    c.stop()
-
-
-@pytest.fixture(scope="module")
-def coins_browser(coins, tmp_path_factory):
-    b = admin_browser(coins, tmp_path_factory.mktemp("chromium-coins"))
-    yield b
-    b.quit()
-
-
-def set_field(browser, element_id, value):
-    """A value put in a field as typing it does: an input event follows."""
-    browser.js("const e = document.getElementById(arguments[0]); e.value = arguments[1];"
-               "e.dispatchEvent(new Event('input', {bubbles: true}));", element_id, value)
-
-
-def test_every_coin_from_six_taught_in_the_page(coins, coins_browser):
-    browser = coins_browser
+def test_every_coin_from_six_taught_in_the_page(coins_page):
+    coins, browser = coins_page
     camera = wait_until(lambda: (lambda c: c if c.get("width") == 384 else None)(coins.camera()),
                         what="the photograph's frames")
     # Light coins on a darker table; their relief binarizes as holes that
