@@ -154,8 +154,7 @@ Result<Entry> parseEntryJson(const std::string& text) {
   if (bad) return *bad;
   if (!(e.mapping.scale_x > 0) || !(e.mapping.scale_y > 0))
     return makeError(FilmstripErrc::kDamaged, "\"mapping\" has a scale that is not positive");
-  if (!e.reply_frame.empty() && e.reply_frame != "pixels" && e.reply_frame != "vision_mm" &&
-      e.reply_frame != "robot_mm")
+  if (!e.reply_frame.empty() && !results::isReplyFrameName(e.reply_frame))
     return makeError(FilmstripErrc::kDamaged, "\"reply_frame\" names no frame");
   // The image is a file of the filmstrip's directory, never a path.
   if (!e.image.empty() && (e.image.find('/') != std::string::npos || e.image[0] == '.'))

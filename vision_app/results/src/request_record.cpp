@@ -72,9 +72,9 @@ std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type
 
 }  // namespace
 
-std::string RequestRecord::replyFrame() const {
-  if (!geometry) return "";
-  switch (geometry->frame()) {
+namespace {
+const char* replyFrameName(store::CoordinateFrame frame) {
+  switch (frame) {
     case store::CoordinateFrame::kVisionPixels:
       return "pixels";
     case store::CoordinateFrame::kVisionMm:
@@ -83,6 +83,19 @@ std::string RequestRecord::replyFrame() const {
       return "robot_mm";
   }
   return "";
+}
+}  // namespace
+
+std::string RequestRecord::replyFrame() const {
+  return geometry ? replyFrameName(geometry->frame()) : "";
+}
+
+bool isReplyFrameName(const std::string& name) {
+  for (const auto frame : {store::CoordinateFrame::kVisionPixels, store::CoordinateFrame::kVisionMm,
+                           store::CoordinateFrame::kRobot}) {
+    if (name == replyFrameName(frame)) return true;
+  }
+  return false;
 }
 
 std::optional<FrameInfo> RequestRecord::frameInfo() const {

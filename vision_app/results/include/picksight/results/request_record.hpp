@@ -94,6 +94,10 @@ class RequestRecord {
   mutable std::string why_;
 };
 
+// Whether `name` is one of the names RequestRecord::replyFrame gives to a
+// frame ("" is none of them).
+bool isReplyFrameName(const std::string& name);
+
 // A LOCATE's record (robot port or PLC trigger), the outcome moved in
 // (`located` may be an error); the caller fills in the request line and
 // the client, the reply and the time once they are known. Its settings are
