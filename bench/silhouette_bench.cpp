@@ -6,7 +6,9 @@
 // with every model) beside a plain OpenCV pass on the same frames,
 // precision, recall and the position and angle errors. Never fails on them.
 // --types trains any other drawings instead (shapes never tuned on);
-// --from-edges locates every part the way touching parts are.
+// --from-edges locates every part the way touching parts are; --models
+// trains fewer types, or more (drawings never put in a scene), for what
+// LOCATE ALL costs against the number of types a cell has taught.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +16,7 @@
 #include <ctime>
 #include <exception>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -210,7 +213,7 @@ void printRow(const std::string& name, const Stats& s) {
 }
 
 void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
-           const std::vector<TypeSpec>& specs) {
+           const std::vector<TypeSpec>& specs, size_t models) {
   std::printf("\n%s: %d frames, %.1f parts per frame, %.1f of them distractors\n",
               ps::arrangementName(arrangement), t.frames,
               t.frames ? static_cast<double>(t.parts) / t.frames : 0.0,
@@ -243,7 +246,7 @@ void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
   std::printf(
       "  LOCATE-equivalent (binarize+regions+recognize, %zu models) median %.2f ms p99 %.2f ms "
       "max %.2f ms\n",
-      specs.size(), ours, picksight::bench::nearestRank(t.ours_ms, 99),
+      models, ours, picksight::bench::nearestRank(t.ours_ms, 99),
       picksight::bench::nearestRank(t.ours_ms, 100));
   std::printf("  of which binarize %.2f ms, regions %.2f ms, recognize %.2f ms (medians)\n",
               picksight::bench::nearestRank(t.binarize_ms, 50),
@@ -258,6 +261,31 @@ void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
   std::printf("  plain OpenCV pass (Otsu+findContours+moments) median %.2f ms p99 %.2f ms\n", plain,
               picksight::bench::nearestRank(t.plain_ms, 99));
   std::printf("  ratio of medians (vision / plain OpenCV) %.2fx\n", plain > 0 ? ours / plain : 0);
+}
+// Drawings for --models beyond the scene's types: classes of the two sets
+// that no scene type comes from (the first drawing of each, then the fifth,
+// a different drawing of the same class), at sizes spread over the scene
+// types' range. Trained, never drawn: every part they are reported on is
+// a false report.
+std::vector<TypeSpec> extraSpecs(const std::vector<TypeSpec>& scene, size_t count) {
+  std::set<std::string> used;
+  for (const auto& s : scene) {
+    if (!s.file.empty()) used.insert(s.file.substr(0, s.file.rfind('_')));
+  }
+  std::vector<std::string> classes;
+  for (int i = 1; i <= 50; ++i) classes.push_back("shapes/tari1000/obj" + std::to_string(i));
+  for (int i = 1; i <= 9; ++i) classes.push_back("shapes/kimia99/trainimage" + std::to_string(i));
+  std::vector<TypeSpec> extra;
+  for (const char* drawing : {"_1.png", "_5.png"}) {
+    for (const auto& c : classes) {
+      if (extra.size() >= count) return extra;
+      if (used.count(c)) continue;
+      const std::string name = c.substr(c.rfind('/') + 1) + drawing;
+      const double size = 160 + static_cast<double>((extra.size() * 37) % 120);
+      extra.push_back({name.substr(0, name.rfind('.')), c + drawing, "untaught", size});
+    }
+  }
+  return extra;
 }
 }  // namespace
 
@@ -317,6 +345,12 @@ int main(int argc, char** argv) {
                  "train these drawings instead of the default 15 (family \"other\"): "
                  "FILE[:SIZE_PX] under the data directory, e.g. "
                  "shapes/tari1000/obj3_1.png:220 (size default 220)");
+  int model_count = 0;
+  app.add_option("--models", model_count,
+                 "train this many types (0: the scene's): fewer, the first of the scene's; more, "
+                 "the scene's and drawings never put in a scene (false reports if found)")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
   // What the camera delivers of a rendered image.
   const auto delivered = [jpeg_quality](const cv::Mat& image) {
@@ -359,6 +393,14 @@ int main(int argc, char** argv) {
       specs.push_back({name, file, "other", size});
     }
   }
+  // The scene's types (every one drawn) come first; the models trained are
+  // the first `trained` of them, then the extra drawings.
+  const size_t scene_types = specs.size();
+  const size_t trained = model_count > 0 ? static_cast<size_t>(model_count) : scene_types;
+  if (trained > scene_types) {
+    const auto extra = extraSpecs(specs, trained - scene_types);
+    specs.insert(specs.end(), extra.begin(), extra.end());
+  }
   std::vector<ps::SilhouetteType> types;
   if (!picksight::bench::loadSilhouetteTypes(specs, data_dir, &types)) return 1;
 
@@ -366,8 +408,8 @@ int main(int argc, char** argv) {
   std::vector<pv::PartModel> models;
   std::vector<bool> chiral;
   std::vector<cv::Point2d> reference;  // per type: trained centroid - drawn centroid
-  std::printf("training %zu types (adaptive window %d px):\n", types.size(),
-              binarize.adaptive_window);
+  std::printf("training %zu types (adaptive window %d px), %zu of them LOCATE's models:\n",
+              types.size(), binarize.adaptive_window, std::min(trained, types.size()));
   for (size_t i = 0; i < types.size(); ++i) {
     const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;
     const cv::Mat image = delivered(ps::renderSilhouetteAlone(types[i], side, look, 7 + i, nullptr,
@@ -408,7 +450,11 @@ int main(int argc, char** argv) {
     models.push_back(outcome.value());
   }
   std::vector<const pv::PartModel*> list;
-  for (const auto& m : models) list.push_back(&m);
+  for (size_t i = 0; i < models.size() && i < trained; ++i) list.push_back(&models[i]);
+  // Only the scene's types are drawn (the extra drawings' models are
+  // trained above; scored as other types wherever they are reported).
+  types.resize(scene_types);
+  chiral.resize(scene_types);
 
   for (const auto& name : which) {
     const ps::Arrangement arrangement = name == "separated"  ? ps::Arrangement::kSeparated
@@ -464,7 +510,7 @@ int main(int argc, char** argv) {
         if (sink == 0) std::printf("!");
       }
     }
-    print(arrangement, tally, per_type, specs);
+    print(arrangement, tally, per_type, specs, list.size());
     std::fflush(stdout);
   }
   return 0;
