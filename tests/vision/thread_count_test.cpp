@@ -94,10 +94,8 @@ TEST_CASE("a frame's parts are the same to the last bit whatever the number of t
     ps::Arrangement arrangement;
   };
   const Case cases[] = {
-      {"clean", ps::Arrangement::kTouching},
-      {"clean", ps::Arrangement::kOverlapping},
-      {"shadow", ps::Arrangement::kTouching},
-      {"glossy", ps::Arrangement::kSeparated},
+      {"clean", ps::Arrangement::kTouching},        {"clean", ps::Arrangement::kOverlapping},
+      {"shadow", ps::Arrangement::kTouching},       {"glossy", ps::Arrangement::kSeparated},
       {"low-contrast", ps::Arrangement::kTouching},
   };
   // Taught under even light (the parts alone: one region each, whatever
@@ -106,8 +104,8 @@ TEST_CASE("a frame's parts are the same to the last bit whatever the number of t
   for (const Case& c : cases) {
     CAPTURE(c.light, static_cast<int>(c.arrangement));
     ps::SilhouetteSceneOptions look;
-    REQUIRE(ps::frontLightCondition(c.light, &look.front, &look.part_level,
-                                    &look.background_level));
+    REQUIRE(
+        ps::frontLightCondition(c.light, &look.front, &look.part_level, &look.background_level));
     const ps::SilhouetteScene scene(trained.types, trained.chiral,
                                     pt::smallScene(look, 31, 10, 0.2, c.arrangement));
     const cv::Mat grey = scene.render(0);
