@@ -393,3 +393,51 @@ TEST_CASE("blob search: a part placed on the relief inside a larger part is refu
   Candidate touching{&discModel(), {beside, 0, false}, 0.9};
   CHECK(pair_search.place(touching));
 }
+
+TEST_CASE("blob search: a patch of the surface's light is not searched, a faint pair of parts is",
+          "[vision][blob_search][front]") {
+  const auto models_list = all();
+  {
+    // A vignetted corner or a blotch of a belt: the surface 10 levels darker
+    // at the patch's middle, fading over 60 px, with the sensor's noise.
+    // The threshold takes it in as one blob as large as the L and the bar.
+    cv::Mat grey(480, 640, CV_32F);
+    for (int y = 0; y < grey.rows; ++y) {
+      for (int x = 0; x < grey.cols; ++x) {
+        const double r2 = (x - 320.0) * (x - 320.0) + (y - 240.0) * (y - 240.0);
+        grey.at<float>(y, x) = static_cast<float>(200 - 10 * std::exp(-r2 / (2 * 60.0 * 60.0)));
+      }
+    }
+    cv::Mat noise(grey.size(), CV_32F);
+    cv::RNG(5).fill(noise, cv::RNG::NORMAL, 0, 3);
+    grey += noise;
+    grey.convertTo(grey, CV_8U);
+    cv::Mat mask;
+    cv::compare(grey, 195, mask, cv::CMP_LT);
+    cv::medianBlur(mask, mask, 5);
+    const auto regions = findRegions(mask, {}, grey);
+    REQUIRE(!regions.empty());
+    CAPTURE(regions[0].area);
+    REQUIRE(regions[0].area > models().l.body.area * 1.5);
+    const BlobSearch search(regions, 0, models_list, nullptr);
+    CHECK(search.fitting().empty());
+    CHECK(locateInBlob(regions, 0, models_list).empty());
+  }
+  {
+    // The L and the bar touching, 13 grey levels darker than their surface
+    // (the faintest parts of the front-light benchmark's low contrast),
+    // with noise of 3 levels: their outline steps, and they are searched.
+    const Scene scene = touchingPair(false);
+    cv::Mat faint;
+    scene.grey.convertTo(faint, CV_32F, 13.0 / 155.0, 200.0 * (1 - 13.0 / 155.0));
+    cv::Mat noise(faint.size(), CV_32F);
+    cv::RNG(7).fill(noise, cv::RNG::NORMAL, 0, 3);
+    faint += noise;
+    faint.convertTo(faint, CV_8U);
+    const auto regions = findRegions(binarize(faint, {}), {}, faint);
+    REQUIRE(!regions.empty());
+    CAPTURE(regions[0].area);
+    const BlobSearch search(regions, 0, models_list, nullptr);
+    CHECK(search.fitting().size() == 2);
+  }
+}

@@ -57,7 +57,8 @@ class BlobSearch {
   // The stages in order; the parts found, best score first.
   std::vector<Match> run();
 
-  // The models no larger than the blob (empty: nothing to search).
+  // The models no larger than the blob (empty: nothing to search, also
+  // where the blob's outline is nowhere a step: a patch of the surface).
   const std::vector<const PartModel*>& fitting() const { return fitting_; }
   // The blob's corners and arcs the next screening starts from.
   const BlobCorners& corners() const { return *corners_; }
