@@ -333,8 +333,8 @@ bool outlineSteps(const Region& r) {
   int read = 0;
   int stepped = 0;
   for (int i = 0; i < n; i += kStepEveryPx) {
-    const cv::Point d = r.outer[static_cast<size_t>((i + 2) % n)] -
-                        r.outer[static_cast<size_t>((i - 2 + n) % n)];
+    const cv::Point d =
+        r.outer[static_cast<size_t>((i + 2) % n)] - r.outer[static_cast<size_t>((i - 2 + n) % n)];
     const double length = std::hypot(d.x, d.y);
     if (length == 0) continue;
     const cv::Point2d across(-d.y / length * kStepReachPx, d.x / length * kStepReachPx);
