@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -76,9 +77,13 @@ double processCpuSeconds(pid_t pid) {
 // frame's host timestamp to the end of the decode).
 class Viewer {
  public:
-  Viewer(int port, std::string camera, bool decode)
+  // `cookie`: the session a browser's login gave it ("name=value").
+  Viewer(int port, std::string cookie, std::string camera, bool decode)
       : client_("127.0.0.1", port),
-        thread_([this, camera = std::move(camera), decode] { run(camera, decode); }) {}
+        thread_([this, cookie = std::move(cookie), camera = std::move(camera), decode] {
+          client_.set_default_headers({{"Cookie", cookie}});
+          run(camera, decode);
+        }) {}
   // Closes the connection at once: a viewer of the triggered camera waits
   // for its next frame, which may not come for seconds.
   ~Viewer() {
@@ -197,7 +202,11 @@ class IdleBusyThread {
 // viewers' low priority.
 class EventsClient {
  public:
-  explicit EventsClient(int port) : client_("127.0.0.1", port), thread_([this] { run(); }) {}
+  EventsClient(int port, std::string cookie)
+      : client_("127.0.0.1", port), thread_([this, cookie = std::move(cookie)] {
+          client_.set_default_headers({{"Cookie", cookie}});
+          run();
+        }) {}
   ~EventsClient() {
     stop_ = true;
     client_.stop();
@@ -232,9 +241,9 @@ class EventsClient {
 };
 
 // The value of a metric line "name{labels} value" in /metrics, or -1.
-double metric(int port, const std::string& series) {
+double metric(int port, const std::string& cookie, const std::string& series) {
   httplib::Client client("127.0.0.1", port);
-  auto res = client.Get("/metrics");
+  auto res = client.Get("/metrics", {{"Cookie", cookie}});
   if (!res) return -1;
   const size_t at = res->body.find(series + " ");
   return at == std::string::npos ? -1 : std::stod(res->body.substr(at + series.size() + 1));
@@ -243,6 +252,9 @@ double metric(int port, const std::string& series) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A connection the server closed is a failed write, not the end of the
+  // bench (and of its processes' cleanup).
+  std::signal(SIGPIPE, SIG_IGN);
   // --requests: LOCATEs per condition, over kRounds rounds.
   const auto args = picksight::bench::parseLocateArgs(argc, argv, {240, 1920, 1080, 20});
   constexpr int kRounds = 6;
@@ -282,15 +294,31 @@ int main(int argc, char** argv) {
   picksight::tool_support::Subprocess web({bin + "/picksight-web", "--listen", "127.0.0.1:0",
                                            "--video-server", server.frames + "," + server.control,
                                            "--vision-app", "cam0," + results + ",127.0.0.1:9"});
+  const auto password = web.waitForLine("admin-password ", 10s);
   const auto url = web.waitForLine("web http://127.0.0.1:", 10s);
-  if (!url) return 1;
+  if (!password || !url) return 1;
   const int port = std::stoi(*url);
+  // Every browser logs in (the page is served to sessions only): one
+  // session for all of them, the first user's.
+  std::string cookie;
+  {
+    httplib::Client client("127.0.0.1", port);
+    auto res =
+        client.Post("/api/login", {{"X-PickSight", "1"}},
+                    "{\"user\":\"admin\",\"password\":\"" + *password + "\"}", "application/json");
+    if (!res || res->status != 200) {
+      std::fprintf(stderr, "web: login refused\n");
+      return 1;
+    }
+    const std::string set = res->get_header_value("Set-Cookie");
+    cookie = set.substr(0, set.find(';'));
+  }
   {
     // Wait until the web server knows both cameras.
     httplib::Client client("127.0.0.1", port);
     const auto deadline = Clock::now() + 10s;
     while (Clock::now() < deadline) {
-      auto res = client.Get("/api/cameras");
+      auto res = client.Get("/api/cameras", {{"Cookie", cookie}});
       if (res && res->body.find("\"cam1\"") != std::string::npos &&
           res->body.find("\"cam0\"") != std::string::npos)
         break;
@@ -326,7 +354,8 @@ int main(int argc, char** argv) {
   setParts(args.parts);
   // A browser: an MJPEG viewer and the page's event stream.
   struct Browser {
-    Browser(int port, const char* camera) : viewer(port, camera, false), events(port) {}
+    Browser(int port, const std::string& cookie, const char* camera)
+        : viewer(port, cookie, camera, false), events(port, cookie) {}
     Viewer viewer;
     EventsClient events;
   };
@@ -334,7 +363,7 @@ int main(int argc, char** argv) {
     std::vector<std::unique_ptr<Browser>> browsers;
     for (const char* camera : {"cam0", "cam1"})
       for (int v = 0; v < kViewersPerCamera; ++v)
-        browsers.push_back(std::make_unique<Browser>(port, camera));
+        browsers.push_back(std::make_unique<Browser>(port, cookie, camera));
     // Measure once the free-running camera's viewers receive frames.
     const auto deadline = Clock::now() + 10s;
     while (browsers.back()->viewer.frames() < 2 && Clock::now() < deadline)
@@ -355,8 +384,8 @@ int main(int argc, char** argv) {
     (void)client.call(trigger);
     const auto deadline = Clock::now() + 10s;
     while (Clock::now() < deadline &&
-           (metric(port, "picksight_web_viewers{camera=\"cam0\"}") != 0 ||
-            metric(port, "picksight_web_viewers{camera=\"cam1\"}") != 0))
+           (metric(port, cookie, "picksight_web_viewers{camera=\"cam0\"}") != 0 ||
+            metric(port, cookie, "picksight_web_viewers{camera=\"cam1\"}") != 0))
       std::this_thread::sleep_for(20ms);
   };
   // Warm-up of both conditions: the first requests after start are slower
@@ -447,14 +476,15 @@ int main(int argc, char** argv) {
                              int* frames_out) {
     std::vector<std::unique_ptr<Viewer>> viewers;
     for (int v = 0; v < viewers_count; ++v)
-      viewers.push_back(std::make_unique<Viewer>(port, "cam1", latencies != nullptr && v == 0));
+      viewers.push_back(
+          std::make_unique<Viewer>(port, cookie, "cam1", latencies != nullptr && v == 0));
     std::this_thread::sleep_for(1s);  // settle: connections, first frames
-    const double encode0 = metric(port, encode_series);
+    const double encode0 = metric(port, cookie, encode_series);
     const double cpu0 = processCpuSeconds(web.pid());
     const int frames0 = viewers[0]->frames();
     std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
     const double cpu = processCpuSeconds(web.pid()) - cpu0;
-    const double encode = metric(port, encode_series) - encode0;
+    const double encode = metric(port, cookie, encode_series) - encode0;
     if (frames_out) *frames_out = viewers[0]->frames() - frames0;
     if (latencies) *latencies = viewers[0]->latencies();
     return std::make_pair(cpu / seconds, encode / seconds);
