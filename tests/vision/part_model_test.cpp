@@ -270,3 +270,40 @@ TEST_CASE("verification fails when the model is off the part", "[vision][model]"
         0.6);
   CHECK(verifyScore(l.model.samples, c, 0, edges, l.model.edge_tolerance, true) < 0.8);
 }
+
+TEST_CASE("a boundary's distance is its nearest primitive's, of lines and arcs alike",
+          "[vision][model]") {
+  // The distance skips primitives whose box lies farther than the nearest
+  // found so far: it must still be the least over every primitive, for
+  // points on, inside, outside and far from trained boundaries (a gear's
+  // arcs, an L's lines, a disc's holes).
+  std::vector<BoundaryLoop> loops;
+  for (const auto& [type, id] :
+       std::vector<std::pair<std::string, int>>{{"gear", 1}, {"l_shape", 2}, {"disc_holes", 3}}) {
+    const Trained t = train(type, id);
+    loops.insert(loops.end(), t.model.loops.begin(), t.model.loops.end());
+  }
+  // Arcs whose bulge lies beyond their ends, so that a box of the ends
+  // alone would be wrong.
+  size_t arcs = 0;
+  for (const auto& loop : loops)
+    for (const auto& p : loop.primitives) arcs += p.kind == PrimitiveKind::kArc ? 1 : 0;
+  REQUIRE(arcs >= 3);
+  cv::RNG rng(3);
+  for (int i = 0; i < 4000; ++i) {
+    // Half near a boundary point, half anywhere around the parts.
+    cv::Point2d p(rng.uniform(-150.0, 150.0), rng.uniform(-150.0, 150.0));
+    if (i % 2 == 0) {
+      const auto& loop = loops[static_cast<size_t>(rng.uniform(0, static_cast<int>(loops.size())))];
+      const auto& prim = loop.primitives[static_cast<size_t>(
+          rng.uniform(0, static_cast<int>(loop.primitives.size())))];
+      p = prim.pointAt(rng.uniform(0.0, 1.0)) +
+          cv::Point2d(rng.uniform(-6.0, 6.0), rng.uniform(-6.0, 6.0));
+    }
+    double every = std::numeric_limits<double>::infinity();
+    for (const auto& loop : loops)
+      for (const auto& prim : loop.primitives) every = std::min(every, primitiveDistance(prim, p));
+    INFO(p.x << ", " << p.y);
+    REQUIRE(boundaryDistance(loops, p) == every);
+  }
+}
