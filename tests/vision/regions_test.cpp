@@ -8,6 +8,7 @@
 
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
+#include "same_region.hpp"
 
 using picksight::angleDiffDeg;
 using picksight::vision::findRegions;
@@ -393,33 +394,6 @@ TEST_CASE("a defocused part is placed as well as a sharp one", "[vision][regions
   }
 }
 
-namespace {
-// Every field of two regions, to the bit.
-void checkSame(const Region& a, const Region& b) {
-  CHECK(a.area == b.area);
-  CHECK(a.centroid == b.centroid);
-  CHECK(a.angle_deg == b.angle_deg);
-  CHECK(a.elongation == b.elongation);
-  CHECK(a.holes == b.holes);
-  CHECK(a.bbox == b.bbox);
-  CHECK(a.touches_border == b.touches_border);
-  CHECK(a.moments.m00 == b.moments.m00);
-  CHECK(a.moments.m10 == b.moments.m10);
-  CHECK(a.moments.m01 == b.moments.m01);
-  CHECK(a.moments.mu20 == b.moments.mu20);
-  CHECK(a.moments.mu11 == b.moments.mu11);
-  CHECK(a.moments.mu02 == b.moments.mu02);
-  CHECK(a.moments.mu30 == b.moments.mu30);
-  CHECK(a.moments.mu03 == b.moments.mu03);
-  CHECK(a.outer == b.outer);
-  CHECK(a.hole_boundaries == b.hole_boundaries);
-  CHECK(a.coverage_origin == b.coverage_origin);
-  REQUIRE(a.coverage.size() == b.coverage.size());
-  CHECK(cv::norm(a.coverage, b.coverage, cv::NORM_INF) == 0);
-  CHECK(cv::countNonZero(a.covered.toMask() != b.covered.toMask()) == 0);
-}
-}  // namespace
-
 TEST_CASE("a one-pixel speck in a part's box changes nothing of the part", "[vision][regions]") {
   // A speck inside the box a part's grey levels are read over, beyond the
   // band and the background ring, makes the part share its box: its pixels
@@ -445,7 +419,7 @@ TEST_CASE("a one-pixel speck in a part's box changes nothing of the part", "[vis
       const auto shared = findRegions(specked, {}, use_grey ? specked_grey : cv::Mat());
       REQUIRE(alone.size() == 1);  // the speck is noise
       REQUIRE(shared.size() == 1);
-      checkSame(alone[0], shared[0]);
+      picksight::test::checkSameRegion(alone[0], shared[0]);
       CHECK(alone[0].holes == 1);
     }
   }

@@ -17,6 +17,7 @@
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/recognition/recognition_pass.hpp"
+#include "same_region.hpp"
 #include "silhouette_support.hpp"
 
 namespace ps = picksight::synthetic;
@@ -45,15 +46,8 @@ void requireSame(const PassResult& serial, const PassResult& parallel) {
   REQUIRE(cv::countNonZero(serial.mask != parallel.mask) == 0);
   REQUIRE(serial.regions.size() == parallel.regions.size());
   for (size_t i = 0; i < serial.regions.size(); ++i) {
-    const pv::Region& a = serial.regions[i];
-    const pv::Region& b = parallel.regions[i];
     CAPTURE(i);
-    CHECK(a.area == b.area);
-    CHECK(a.centroid.x == b.centroid.x);
-    CHECK(a.centroid.y == b.centroid.y);
-    CHECK(a.angle_deg == b.angle_deg);
-    CHECK(a.holes == b.holes);
-    CHECK(a.outer == b.outer);
+    pt::checkSameRegion(serial.regions[i], parallel.regions[i]);
   }
   REQUIRE(serial.matches.size() == parallel.matches.size());
   for (size_t i = 0; i < serial.matches.size(); ++i) {
