@@ -306,4 +306,21 @@ TEST_CASE("a boundary's distance is its nearest primitive's, of lines and arcs a
     INFO(p.x << ", " << p.y);
     REQUIRE(boundaryDistance(loops, p) == every);
   }
+  // Asked in order along the boundary turned and mirrored, as the symmetry
+  // and hand tests ask it, from the last point's nearest primitive.
+  for (const double turn : {0.0, 37.0, 180.0}) {
+    const double c = std::cos(turn * M_PI / 180);
+    const double s = std::sin(turn * M_PI / 180);
+    PrimitiveIndex nearest;
+    for (const auto& sample : sampleBoundary(loops, 1.0)) {
+      const cv::Point2d u(c * sample.point.x + s * sample.point.y,
+                          s * sample.point.x - c * sample.point.y);
+      double every = std::numeric_limits<double>::infinity();
+      for (const auto& loop : loops)
+        for (const auto& prim : loop.primitives)
+          every = std::min(every, primitiveDistance(prim, u));
+      INFO(turn << ": " << u.x << ", " << u.y);
+      REQUIRE(boundaryDistance(loops, u, &nearest) == every);
+    }
+  }
 }

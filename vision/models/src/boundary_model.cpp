@@ -449,15 +449,31 @@ double squaredBoxDistance(const Primitive& prim, cv::Point2d p) {
 }  // namespace
 
 double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p) {
+  PrimitiveIndex nearest;
+  return boundaryDistance(loops, p, &nearest);
+}
+
+double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p,
+                        PrimitiveIndex* nearest) {
   // The exact distance of only those primitives whose box may hold a nearer
   // point: the same minimum, in a fraction of the arithmetic (training asks
   // it of every boundary sample, turned, for the symmetry and hand tests:
-  // most of a model's training time).
+  // most of a model's training time). The last point's nearest primitive
+  // first: the next point along a boundary is most often nearest to it too,
+  // and every other box then lies farther.
   double best = std::numeric_limits<double>::infinity();
-  for (const auto& loop : loops) {
-    for (const auto& prim : loop.primitives) {
-      if (squaredBoxDistance(prim, p) >= best * best) continue;
-      best = std::min(best, primitiveDistance(prim, p));
+  const bool hinted =
+      nearest->loop < loops.size() && nearest->primitive < loops[nearest->loop].primitives.size();
+  if (hinted) best = primitiveDistance(loops[nearest->loop].primitives[nearest->primitive], p);
+  for (size_t l = 0; l < loops.size(); ++l) {
+    const auto& primitives = loops[l].primitives;
+    for (size_t k = 0; k < primitives.size(); ++k) {
+      if (squaredBoxDistance(primitives[k], p) >= best * best) continue;
+      const double d = primitiveDistance(primitives[k], p);
+      if (d < best) {
+        best = d;
+        *nearest = {l, k};
+      }
     }
   }
   return best;

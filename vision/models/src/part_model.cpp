@@ -42,6 +42,7 @@ HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const Image
   const BoundaryDistanceMap* map =
       m.boundary_map && m.boundary_map->reach() >= clip ? m.boundary_map.get() : nullptr;
   HandEvidence e;
+  PrimitiveIndex nearest;
   for (const auto& sample : m.samples) {
     const double py = pose.mirrored ? -sample.point.y : sample.point.y;
     const cv::Point2d x =
@@ -50,7 +51,7 @@ HandEvidence handEvidence(const PartModel& m, const ImagePose& pose, const Image
     const cv::Point2d d = x - other.centre;
     cv::Point2d u(oc * d.x + os * d.y, -os * d.x + oc * d.y);
     if (other.mirrored) u.y = -u.y;
-    const double separation = map ? map->at(u) : boundaryDistance(m.loops, u);
+    const double separation = map ? map->at(u) : boundaryDistance(m.loops, u, &nearest);
     const double w = sample.weight * handednessWeight(separation, m.edge_tolerance);
     if (w <= 0) continue;
     const double at = edges.at(x);
@@ -112,10 +113,12 @@ double chiralLength(const PartModel& m, double turn_deg) {
   const double c = std::cos(turn_deg * kRadPerDeg);
   const double s = std::sin(turn_deg * kRadPerDeg);
   double length = 0;
+  PrimitiveIndex nearest;
   for (const auto& sample : m.samples) {
     const cv::Point2d p = sample.point;
     const cv::Point2d u(c * p.x + s * p.y, -(-s * p.x + c * p.y));
-    length += sample.weight * handednessWeight(boundaryDistance(m.loops, u), m.edge_tolerance);
+    length +=
+        sample.weight * handednessWeight(boundaryDistance(m.loops, u, &nearest), m.edge_tolerance);
   }
   return length;
 }
@@ -245,10 +248,11 @@ double turnedShare(const PartModel& m, double turn_deg, double reach) {
   const double s = std::sin(turn_deg * kRadPerDeg);
   double on = 0;
   double total = 0;
+  PrimitiveIndex nearest;
   for (const auto& sample : m.samples) {
     const cv::Point2d p = sample.point;
     total += sample.weight;
-    if (boundaryDistance(m.loops, {c * p.x - s * p.y, s * p.x + c * p.y}) <= reach)
+    if (boundaryDistance(m.loops, {c * p.x - s * p.y, s * p.x + c * p.y}, &nearest) <= reach)
       on += sample.weight;
   }
   return total > 0 ? on / total : 0;

@@ -85,6 +85,17 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
 // for comparing a model with itself turned or mirrored.
 double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p);
 
+// The same, for points asked in order along a boundary: `nearest` names the
+// primitive nearest to the last point asked (loop, then primitive; start
+// with {0, 0}), whose distance is read first, and is set to this point's.
+// Only faster: the distance is the same to the bit.
+struct PrimitiveIndex {
+  size_t loop = 0;
+  size_t primitive = 0;
+};
+double boundaryDistance(const std::vector<BoundaryLoop>& loops, cv::Point2d p,
+                        PrimitiveIndex* nearest);
+
 // Distance (pixels) from `p` to one primitive.
 double primitiveDistance(const Primitive& prim, cv::Point2d p);
 
