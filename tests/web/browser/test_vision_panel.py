@@ -7,7 +7,6 @@ them the app's, and the next LOCATE finds the six discs, without a restart."""
 
 import numpy as np
 import pytest
-from PIL import Image
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import Select
 
@@ -29,12 +28,17 @@ def table_image(path):
     for cx, cy in CENTRES:
         image[(xx - cx) ** 2 + (yy - cy) ** 2 < 40 ** 2] = 210
     image += rng.normal(0, 3, image.shape)
-    Image.fromarray(np.clip(image, 0, 255).astype(np.uint8)).save(path)
+    # A binary PGM: the file camera reads it as it reads a PNG (OpenCV's
+    # imread), and numpy writes it without an imaging library.
+    pixels = np.clip(image, 0, 255).astype(np.uint8)
+    with open(path, "wb") as f:
+        f.write(b"P5 %d %d 255\n" % (WIDTH, HEIGHT))
+        f.write(pixels.tobytes())
 
 
 @pytest.fixture(scope="module")
 def cell(tmp_path_factory):
-    scene = tmp_path_factory.mktemp("scene") / "table.png"
+    scene = tmp_path_factory.mktemp("scene") / "table.pgm"
     table_image(scene)
     c = Cell(tmp_path_factory.mktemp("data"), source=f"{CAMERA}=file:{scene}")
     yield c
