@@ -68,17 +68,22 @@ cv::Mat visionImage(const Frame& frame, const ModelList& models) {
   return axes.empty() ? greyImage(frame) : vision::projectOnColourAxes(frame.image, axes);
 }
 
+vision::RegionOptions locateRegionOptions(const VisionOptions& options,
+                                          const ModelList& models) {
+  vision::RegionOptions region_options = vision::regionOptionsFor(options.regions, models);
+  if (options.min_area_follows_models) {
+    region_options.min_area = std::max(region_options.min_area, vision::speckAreaFor(models));
+  }
+  return region_options;
+}
+
 std::vector<LocatedPart> locateInImage(const cv::Mat& grey, const SensorMapping& mapping,
                                        const VisionOptions& options, const ModelList& models,
                                        int type, LocateScene* scene) {
   LocateScene local;
   LocateScene& s = scene ? *scene : local;
   s.mask = vision::binarize(grey, options.binarize);
-  vision::RegionOptions region_options = vision::regionOptionsFor(options.regions, models);
-  if (options.min_area_follows_models) {
-    region_options.min_area = std::max(region_options.min_area, vision::speckAreaFor(models));
-  }
-  s.regions = vision::findRegions(s.mask, region_options, grey);
+  s.regions = vision::findRegions(s.mask, locateRegionOptions(options, models), grey);
   s.mapping = mapping;
   const auto& regions = s.regions;
   std::vector<LocatedPart> parts;

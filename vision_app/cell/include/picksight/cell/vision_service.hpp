@@ -119,6 +119,12 @@ struct VisionOptions {
   std::chrono::milliseconds frame_timeout{3000};
 };
 
+// The region options LOCATE finds regions with in a frame whose models
+// (in frame pixels) are `models`: the cell's, each model's own smallest
+// hole and region, and the speck area when the smallest region follows them.
+vision::RegionOptions locateRegionOptions(const VisionOptions& options,
+                                          const store::ModelList& models);
+
 // The frame's image as 8-bit grey: the image itself, or a converted copy.
 cv::Mat greyImage(const Frame& frame);
 
