@@ -21,6 +21,7 @@
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/recognition/recognition_pass.hpp"
+#include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 
 using namespace picksight;
@@ -401,4 +402,79 @@ TEST_CASE("the turn of a separated part under a front light is read on its edges
     CAPTURE(rms);
     CHECK(rms < limit);
   }
+}
+
+TEST_CASE("at 30 levels of contrast, parts in the corners of a vignetted frame are found too",
+          "[vision_app][locate][front]") {
+  // The low-contrast condition loses a quarter of its light in the corners:
+  // more than the 30 levels between part and surface. Read against a
+  // background estimate that stood above the surface there, the corners
+  // binarized as thousands of specks, and the parts in them merged into
+  // specks that touch the frame's edge.
+  const ps::SilhouetteSceneOptions look = lookOf("low-contrast");
+  cv::Point2d drawn;
+  const cv::Mat teach = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);
+  const auto learned =
+      learnInImage(teach, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+  INFO((learned.ok() ? std::string() : learned.error().message));
+  REQUIRE(learned.ok());
+  int outer = 0;
+  for (const uint64_t seed : {3, 5, 8}) {
+    ps::SilhouetteSceneOptions o = look;
+    o.width = 1280;
+    o.height = 960;
+    o.parts = 10;
+    o.distractor_share = 0;
+    o.seed = seed;
+    const ps::SilhouetteScene scene({boneType()}, {true}, o);
+    const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+    const LocateOutcome outcome = locateInFrame(frame, cellOptions(), listOf(learned->model), -1);
+    INFO("seed " << seed);
+    CHECK(foundTrue(scene.truth(), outcome.parts) == static_cast<int>(scene.truth().size()));
+    for (const auto& t : scene.truth()) {
+      const double from_edge =
+          std::min({t.centre.x, t.centre.y, o.width - t.centre.x, o.height - t.centre.y});
+      outer += from_edge < 220 ? 1 : 0;
+    }
+  }
+  // The scenes put parts where the light has fallen most.
+  CHECK(outer >= 6);
+}
+
+TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
+          "[vision_app][learn][front]") {
+  // A belt with one dark stain and no part: the stain's rim is nowhere a
+  // step in grey level, however dark its middle. Taught, it would match
+  // stains and tell a robot to pick them.
+  cv::Mat belt(600, 600, CV_32F);
+  cv::Mat noise(belt.size(), CV_32F);
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 3);
+  for (int y = 0; y < belt.rows; ++y) {
+    for (int x = 0; x < belt.cols; ++x) {
+      const double r2 = (x - 300.0) * (x - 300.0) + (y - 300.0) * (y - 300.0);
+      belt.at<float>(y, x) = static_cast<float>(150 - 45 * std::exp(-r2 / (2 * 70.0 * 70.0)));
+    }
+  }
+  cv::Mat image;
+  cv::Mat(belt + noise).convertTo(image, CV_8U);
+  // The stain is one region to the threshold: what LEARN would have taken.
+  const auto regions = pv::findRegions(pv::binarize(image, cellOptions().binarize), {}, image);
+  REQUIRE(!regions.empty());
+  CHECK(regions.front().area > 5000);
+  CHECK(!pv::outlineSteps(regions.front()));
+  const auto learned = learnInImage(image, {}, cellOptions(), noModels(), 1, "stain", std::nullopt);
+  REQUIRE(!learned.ok());
+  CHECK(learned.error().code == pv::PartModelErrc::kNoPart);
+  CHECK_THAT(learned.error().message, Catch::Contains("no edge along its outline"));
+  const auto at = learnInImage(image, {}, cellOptions(), noModels(), 1, "stain",
+                               cv::Rect(150, 150, 300, 300));
+  REQUIRE(!at.ok());
+  CHECK_THAT(at.error().message, Catch::Contains("no edge along its outline"));
+  // A part on the same belt is still taught.
+  cv::Mat with_part = image.clone();
+  cv::circle(with_part, {300, 300}, 60, cv::Scalar(60), cv::FILLED, cv::LINE_AA);
+  const auto part = learnInImage(with_part, {}, cellOptions(), noModels(), 1, "disc", std::nullopt);
+  INFO((part.ok() ? std::string() : part.error().message));
+  CHECK(part.ok());
 }

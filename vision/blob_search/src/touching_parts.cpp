@@ -310,48 +310,6 @@ constexpr int kLevelInsetPx = 2;
 constexpr int kRingFromPx = 3;
 constexpr int kRingToPx = 7;
 
-// A blob whose outline is nowhere a step is a patch of the surface's own
-// light that the threshold took in (a vignetted corner, a blotch of a
-// textured belt, under front light), not parts: read kStepReachPx either
-// side of its outline, a part's levels differ by tens of grey levels (13
-// to 36 on the front-light benchmark's 30-level contrast, touching and
-// separated), such a patch's by 2 to 4. One such patch cost a low-contrast
-// frame 17 ms, the search's 24 edge fits, none placed. A blob is searched
-// when at least kMinSteppedShare of its outline steps by kMinFaintContrast:
-// a part in it takes up more of its outline than that, while noise of 3
-// grey levels steps so across 8 % of a flat patch's.
-constexpr int kStepReachPx = 3;
-constexpr int kStepEveryPx = 4;
-constexpr double kMinSteppedShare = 0.2;
-
-// Whether `r`'s outline steps (see kMinSteppedShare); true without a grey
-// image, where nothing says otherwise.
-bool outlineSteps(const Region& r) {
-  if (r.grey.empty()) return true;
-  const cv::Rect box(r.grey_origin, r.grey.size());
-  const int n = static_cast<int>(r.outer.size());
-  int read = 0;
-  int stepped = 0;
-  for (int i = 0; i < n; i += kStepEveryPx) {
-    const cv::Point d =
-        r.outer[static_cast<size_t>((i + 2) % n)] - r.outer[static_cast<size_t>((i - 2 + n) % n)];
-    const double length = std::hypot(d.x, d.y);
-    if (length == 0) continue;
-    const cv::Point2d across(-d.y / length * kStepReachPx, d.x / length * kStepReachPx);
-    const cv::Point2d at = r.outer[static_cast<size_t>(i)];
-    const cv::Point a(static_cast<int>(std::lround(at.x + across.x)),
-                      static_cast<int>(std::lround(at.y + across.y)));
-    const cv::Point b(static_cast<int>(std::lround(at.x - across.x)),
-                      static_cast<int>(std::lround(at.y - across.y)));
-    if (!box.contains(a) || !box.contains(b)) continue;
-    ++read;
-    const int step = static_cast<int>(r.grey.at<uint8_t>(a - r.grey_origin)) -
-                     static_cast<int>(r.grey.at<uint8_t>(b - r.grey_origin));
-    stepped += std::abs(step) >= kMinFaintContrast ? 1 : 0;
-  }
-  return read == 0 || stepped >= kMinSteppedShare * read;
-}
-
 // The median grey level of `grey` where `mask` is set; -1 for none.
 double medianWhere(const cv::Mat& grey, const cv::Mat& mask) {
   const int channels[] = {0};

@@ -68,8 +68,7 @@ cv::Mat visionImage(const Frame& frame, const ModelList& models) {
   return axes.empty() ? greyImage(frame) : vision::projectOnColourAxes(frame.image, axes);
 }
 
-vision::RegionOptions locateRegionOptions(const VisionOptions& options,
-                                          const ModelList& models) {
+vision::RegionOptions locateRegionOptions(const VisionOptions& options, const ModelList& models) {
   vision::RegionOptions region_options = vision::regionOptionsFor(options.regions, models);
   if (options.min_area_follows_models) {
     region_options.min_area = std::max(region_options.min_area, vision::speckAreaFor(models));
@@ -574,6 +573,23 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
           count + " inside LEARN AT " + sensorRectText(*at) + ", it needs exactly one");
     }
     const vision::Region& r = regions[seen.part];
+    // A region whose outline is nowhere a step in grey level is the
+    // surface's own light taken in by the threshold (a blotch, a vignetted
+    // corner), not a part: such a model would match nothing a robot should
+    // pick. (A green part on a grey belt of its brightness, read in grey,
+    // left one such patch in the frame.)
+    if (!vision::outlineSteps(r)) {
+      const std::string what = "the largest region (" +
+                               formatFixed(mapping.areaToSensor(r.area), 0) +
+                               " px) has no edge along its outline: the surface's own light";
+      if (!at) {
+        return makeError(vision::PartModelErrc::kNoPart,
+                         "no part in the frame: " + what +
+                             " (LEARN ... AT <x> <y> <w> <h> around the part reads its colour)");
+      }
+      return makeError(VisionServiceErrc::kNoPartInRectangle,
+                       "no part inside LEARN AT " + sensorRectText(*at) + ": " + what);
+    }
     // A window narrower than the part (a tight crop, a small image) breaks
     // its middle into phantom holes: binarize again with one that fits it,
     // as LOCATE will once the model exists.

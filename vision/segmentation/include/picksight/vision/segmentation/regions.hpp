@@ -89,6 +89,13 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
 // as such a share; an evenly lit part on its surface has next to none.
 double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& region);
 
+// Whether a region's outline is a step in grey level somewhere (at least a
+// fifth of it steps by 8 levels or more, read 3 px either side): a patch of
+// the surface's own light that the threshold took in (a vignetted corner,
+// a blotch of a textured belt) steps nowhere. True without the region's
+// grey image, where nothing says otherwise.
+bool outlineSteps(const Region& r);
+
 // Orientation of a region from its moments and outer boundary (see Region).
 double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
                       const std::vector<cv::Point>& outer);
