@@ -404,7 +404,7 @@ TEST_CASE("the turn of a separated part under a front light is read on its edges
   }
 }
 
-TEST_CASE("at 30 levels of contrast, parts in the corners of a vignetted frame are found too",
+TEST_CASE("parts in the corners of a vignetted frame at 30 levels of contrast are found too",
           "[vision_app][locate][front]") {
   // The low-contrast condition loses a quarter of its light in the corners:
   // more than the 30 levels between part and surface. Read against a
