@@ -307,3 +307,43 @@ TEST_CASE("a part's lit side, the blur of its tips and its glints are not cut of
     }
   }
 }
+
+TEST_CASE("the corners of a vignetted frame at 30 levels of contrast binarize as its middle",
+          "[vision][binarize][front]") {
+  // The low-contrast condition loses a quarter of its light in the corners,
+  // more than the 30 levels between part and surface. A background read as
+  // the brightest light within a window stands there a half-window up the
+  // slope, and the corners binarized as thousands of specks.
+  ps::SilhouetteSceneOptions look;
+  REQUIRE(ps::frontLightCondition("low-contrast", &look.front, &look.part_level,
+                                  &look.background_level));
+  REQUIRE(look.front.vignette > 0.2);
+  int corners = 0;
+  for (const uint64_t seed : {1, 2, 3, 4, 5, 6}) {
+    look.seed = seed;
+    const ps::SilhouetteScene scene({ps::silhouetteFromPartType("t_shape", 200)}, {true}, look);
+    const cv::Mat frame = scene.render(0);
+    pv::BinarizeOptions b;
+    b.adaptive_window = 400;
+    const cv::Mat mask = pv::binarize(frame, b);
+    constexpr int kCorner = 240;
+    for (const cv::Point corner :
+         {cv::Point(0, 0), cv::Point(frame.cols - kCorner, 0), cv::Point(0, frame.rows - kCorner),
+          cv::Point(frame.cols - kCorner, frame.rows - kCorner)}) {
+      const cv::Rect box(corner, cv::Size(kCorner, kCorner));
+      // Only corners no part reaches (a part lies within 150 px of its centre).
+      bool clear = true;
+      for (const auto& t : scene.truth()) {
+        const cv::Rect reach(static_cast<int>(t.centre.x) - 150, static_cast<int>(t.centre.y) - 150,
+                             300, 300);
+        clear = clear && (reach & box).empty();
+      }
+      if (!clear) continue;
+      ++corners;
+      const double share = cv::countNonZero(mask(box)) / static_cast<double>(box.area());
+      INFO("seed " << seed << " corner " << corner);
+      CHECK(share < 0.01);
+    }
+  }
+  CHECK(corners >= 3);
+}
