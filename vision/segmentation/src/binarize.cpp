@@ -235,9 +235,12 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
   const auto leastOf = [&](int j) {
     const float* back = background_f.ptr<float>(j);
     std::vector<int> least(static_cast<size_t>(width));
-    for (int x = 0; x < width; ++x) {
-      const double step = contrast * back[std::min(cols - 1, x / cell)];
-      least[static_cast<size_t>(x)] = std::max(1, static_cast<int>(std::ceil(step)));
+    // One value a cell, written over the cell's columns (the last cell
+    // reaches the image's right edge).
+    for (int i = 0; i < cols; ++i) {
+      const int value = std::max(1, static_cast<int>(std::ceil(contrast * back[i])));
+      const int end = i == cols - 1 ? width : std::min(width, (i + 1) * cell);
+      std::fill(least.begin() + std::min(width, i * cell), least.begin() + end, value);
     }
     return least;
   };
