@@ -467,6 +467,8 @@ TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
   REQUIRE(!learned.ok());
   CHECK(learned.error().code == pv::PartModelErrc::kNoPart);
   CHECK_THAT(learned.error().message, Catch::Contains("no edge along its outline"));
+  // A grey camera is not told to read a colour.
+  CHECK(learned.error().message.find("colour") == std::string::npos);
   const auto at =
       learnInImage(image, {}, cellOptions(), noModels(), 1, "stain", cv::Rect(150, 150, 300, 300));
   REQUIRE(!at.ok());

@@ -583,9 +583,14 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
                                formatFixed(mapping.areaToSensor(r.area), 0) +
                                " px) has no edge along its outline: the surface's own light";
       if (!at) {
+        // On a colour camera, a part as grey as its surface shows only in
+        // its colour, which LEARN reads around the part.
+        const std::string colour_hint =
+            image.channels() == 3 && !colour
+                ? " (LEARN ... AT <x> <y> <w> <h> around the part reads its colour)"
+                : "";
         return makeError(vision::PartModelErrc::kNoPart,
-                         "no part in the frame: " + what +
-                             " (LEARN ... AT <x> <y> <w> <h> around the part reads its colour)");
+                         "no part in the frame: " + what + colour_hint);
       }
       return makeError(VisionServiceErrc::kNoPartInRectangle,
                        "no part inside LEARN AT " + sensorRectText(*at) + ": " + what);
