@@ -480,34 +480,3 @@ TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
   INFO((part.ok() ? std::string() : part.error().message));
   CHECK(part.ok());
 }
-
-TEST_CASE("a small part taught alone in a low-contrast frame is the part, not the belt's blotches",
-          "[vision_app][learn][front]") {
-  // A part a few percent of the teaching frame, 30 levels under a blotched
-  // belt: splitting the frame's levels in two halves the belt's blotches
-  // rather than telling the part from the belt, and the part was taught
-  // joined to blotches around it.
-  const ps::SilhouetteSceneOptions look = lookOf("low-contrast");
-  for (const char* file : {"shapes/tari1000/obj18_3.png", "shapes/tari1000/obj11_1.png"}) {
-    INFO(file);
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-    REQUIRE(!drawing.empty());
-    const ps::SilhouetteType type = ps::silhouetteFromDrawing(file, drawing, 190);
-    const double area =
-        cv::countNonZero(type.mask) /
-        static_cast<double>(ps::kSilhouetteSupersample * ps::kSilhouetteSupersample);
-    for (const uint64_t seed : {7, 11}) {
-      INFO("seed " << seed);
-      cv::Point2d drawn;
-      const cv::Mat image = ps::renderSilhouetteAlone(type, 585, look, seed, &drawn, 30);
-      const auto learned =
-          learnInImage(image, {}, cellOptions(), noModels(), 1, "part", std::nullopt);
-      INFO((learned.ok() ? std::string() : learned.error().message));
-      REQUIRE(learned.ok());
-      CHECK(learned->model.body.area == Approx(area).epsilon(0.05));
-      CHECK(std::hypot(learned->model.trained_centroid.x - drawn.x,
-                       learned->model.trained_centroid.y - drawn.y) < 2.0);
-    }
-  }
-}

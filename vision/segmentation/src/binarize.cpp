@@ -14,7 +14,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -52,17 +51,6 @@ constexpr double kPriorShare = 0.03;
 // glossy parts or 30 levels of contrast 0.2-0.3. Only uneven ones are
 // split at the parts' edges.
 constexpr double kEvenSurface = 0.075;
-// A part this many spreads of the surface's ratio below its median is a
-// part however few cells it fills (at least kMinOutlierCells, and a 500th
-// of the frame).
-constexpr double kOutlierSpreads = 5;
-constexpr int kMinOutlierCells = 8;
-// A step votes when it stands this many deviations of the noise of a
-// difference of two pixels out of it (see edgeVotes).
-constexpr double kStepNoise = 5;
-// The light's smooth fall-off over the frame is fitted as a polynomial of
-// this degree in x and y (see lightFalloff).
-constexpr int kFalloffDegree = 4;
 
 // The mean of every `reduce` x `reduce` block, rounded as cv::resize
 // INTER_AREA rounds it (the same image where the blocks tile the frame),
@@ -228,59 +216,33 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
   cv::Mat gradient_y;
   cv::Sobel(image, gradient_x, CV_16S, 1, 0, 3);
   cv::Sobel(image, gradient_y, CV_16S, 0, 1, 3);
-  const int width = image.cols;
-  // The least Sobel magnitude (|gx| + |gy|) of a pixel that may vote, per
-  // column of cell row j: Sobel gives 8 for a ramp of one level a pixel, so
-  // a step of `step` over about two pixels gives 4 * step; a quarter of it.
-  const auto leastOf = [&](int j) {
-    const float* back = background_f.ptr<float>(j);
-    std::vector<int> least(static_cast<size_t>(width));
-    // One value a cell, written over the cell's columns (the last cell
-    // reaches the image's right edge).
-    for (int i = 0; i < cols; ++i) {
-      const int value = std::max(1, static_cast<int>(std::ceil(contrast * back[i])));
-      const int end = i == cols - 1 ? width : std::min(width, (i + 1) * cell);
-      std::fill(least.begin() + std::min(width, i * cell), least.begin() + end, value);
-    }
-    return least;
-  };
-  const auto rowEnd = [&](int j) {
-    return j == rows - 1 ? image.rows - 1 : std::min(image.rows - 1, (j + 1) * cell);
-  };
-  // The noise first, off the edges, from every fourth row (plenty of
-  // pixels): the steps that vote stand out of it.
-  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
-    for (int j = range.start; j < range.end; ++j) {
-      const std::vector<int> least = leastOf(j);
-      int64_t residual_sum = 0;
-      int64_t residual_count = 0;
-      for (int y = std::max(1, j * cell); y < rowEnd(j); ++y) {
-        if (y % 4 != 0) continue;
-        addRowNoise(image.ptr<uint8_t>(y - 1), image.ptr<uint8_t>(y), image.ptr<uint8_t>(y + 1),
-                    gradient_x.ptr<int16_t>(y), gradient_y.ptr<int16_t>(y), least, &residual_sum,
-                    &residual_count);
-      }
-      residual_sums[static_cast<size_t>(j)] = residual_sum;
-      residual_counts[static_cast<size_t>(j)] = residual_count;
-    }
-  });
-  *noise = noiseDeviation(residual_sums, residual_counts);
-  // A step of a few levels either way is noise at 30 levels of contrast
-  // (the step's least share of it is 8 levels), and noise votes set the
-  // threshold at the surface's own level over the cells around, the prior
-  // being weak there: half the open surface would be parts. So a step
-  // stands kStepNoise deviations of a difference of two pixels out of the
-  // noise too.
-  const double least_step = kStepNoise * std::sqrt(2.0) * *noise;
   cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
     for (int j = range.start; j < range.end; ++j) {
       std::vector<int64_t> s(static_cast<size_t>(cols), 0);
       std::vector<int64_t> w(static_cast<size_t>(cols), 0);
+      int64_t residual_sum = 0;
+      int64_t residual_count = 0;
+      const int y_end = j == rows - 1 ? image.rows - 1 : std::min(image.rows - 1, (j + 1) * cell);
+      const int width = image.cols;
       const float* back = background_f.ptr<float>(j);
-      const std::vector<int> least = leastOf(j);
-      for (int y = std::max(1, j * cell); y < rowEnd(j); ++y) {
+      // The least Sobel magnitude (|gx| + |gy|) of a pixel that may vote,
+      // per column: Sobel gives 8 for a ramp of one level a pixel, so a step
+      // of `step` over about two pixels gives 4 * step; a quarter of it.
+      std::vector<int> least(static_cast<size_t>(width));
+      for (int x = 0; x < width; ++x) {
+        const double step = contrast * back[std::min(cols - 1, x / cell)];
+        least[static_cast<size_t>(x)] = std::max(1, static_cast<int>(std::ceil(step)));
+      }
+      for (int y = std::max(1, j * cell); y < y_end; ++y) {
+        const uint8_t* up = image.ptr<uint8_t>(y - 1);
+        const uint8_t* mid = image.ptr<uint8_t>(y);
+        const uint8_t* down = image.ptr<uint8_t>(y + 1);
         const int16_t* gxs = gradient_x.ptr<int16_t>(y);
         const int16_t* gys = gradient_y.ptr<int16_t>(y);
+        // The noise, off the edges, from every fourth row: plenty of pixels.
+        if (y % 4 == 0) {
+          addRowNoise(up, mid, down, gxs, gys, least, &residual_sum, &residual_count);
+        }
         for (int x = 1; x + 1 < width; ++x) {
           const int gx = gxs[x];
           const int gy = gys[x];
@@ -300,10 +262,7 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
           // The step's middle, read from its two sides: the same wherever on
           // the ramp this pixel lies.
           const int middle = lo + hi;  // twice the middle level
-          if (hi - lo < kMinStepShare * step || hi - lo < least_step ||
-              middle > 2 * kMaxSeparatedRatio * back[i]) {
-            continue;
-          }
+          if (hi - lo < kMinStepShare * step || middle > 2 * kMaxSeparatedRatio * back[i]) continue;
           // A surface beside a part stays light beyond the edge; the
           // stripes of wood grain or a ribbed belt fall dark again a few
           // pixels on, and their steps do not vote.
@@ -317,6 +276,8 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
           w[static_cast<size_t>(i)] += 1;
         }
       }
+      residual_sums[static_cast<size_t>(j)] = residual_sum;
+      residual_counts[static_cast<size_t>(j)] = residual_count;
       float* so = sums32.ptr<float>(j);
       float* wo = weights32.ptr<float>(j);
       for (int i = 0; i < cols; ++i) {
@@ -327,6 +288,7 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
   });
   level_sums = sums32;
   weights = weights32;
+  *noise = noiseDeviation(residual_sums, residual_counts);
 }
 
 struct GuidedThreshold {
@@ -400,31 +362,6 @@ struct RatioSplit {
   double contrast = 0;
 };
 
-// The median of an 8-bit image's levels and their spread (the median
-// absolute deviation, scaled to a standard deviation).
-void medianSpread(const cv::Mat& image8, double* median, double* spread) {
-  std::array<int, 256> histogram{};
-  for (int y = 0; y < image8.rows; ++y) {
-    const uint8_t* p = image8.ptr<uint8_t>(y);
-    for (int x = 0; x < image8.cols; ++x) ++histogram[p[x]];
-  }
-  const auto nth = [](const std::array<int, 256>& h, size_t n) {
-    size_t seen = 0;
-    for (size_t v = 0; v < h.size(); ++v) {
-      seen += static_cast<size_t>(h[v]);
-      if (seen > n) return static_cast<int>(v);
-    }
-    return 255;
-  };
-  const size_t half = image8.total() / 2;
-  const int m = nth(histogram, half);
-  std::array<int, 256> deviations{};
-  for (int v = 0; v < 256; ++v)
-    deviations[static_cast<size_t>(std::abs(v - m))] += histogram[static_cast<size_t>(v)];
-  *median = m;
-  *spread = 1.4826 * nth(deviations, half);
-}
-
 // The split of the ratio image (200 = the background's level) of `small_f`
 // to `background_f`, both at low resolution.
 RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
@@ -438,132 +375,27 @@ RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
   // sits on the edge of the darker one. Split halfway between the two class
   // means instead, where noise on either side is least likely to cross.
   RatioSplit split;
-  struct Classes {
-    double bright = 0, bright_sd = 0, dark = 0, dark_sd = 0;
-    bool separated = false;
-  };
-  const auto classes = [&](const cv::Mat& bright_mask) {
+  const int bright = cv::countNonZero(upper);
+  if (bright > 0 && bright < upper.rows * upper.cols) {
     cv::Scalar mean_bright;
     cv::Scalar sd_bright;
     cv::Scalar mean_dark;
     cv::Scalar sd_dark;
-    cv::meanStdDev(ratio8, mean_bright, sd_bright, bright_mask);
-    cv::meanStdDev(ratio8, mean_dark, sd_dark, ~bright_mask);
-    Classes c{mean_bright[0], sd_bright[0], mean_dark[0], sd_dark[0]};
-    const double spread = std::sqrt(0.5 * (c.bright_sd * c.bright_sd + c.dark_sd * c.dark_sd));
-    c.separated = c.bright - c.dark > kMinSeparation * std::max(spread, 1.0);
-    return c;
-  };
-  const int cells = upper.rows * upper.cols;
-  const int bright = cv::countNonZero(upper);
-  if (bright > 0 && bright < cells) {
-    Classes c = classes(upper);
-    if (!c.separated) {
-      // Otsu favours classes of like size: one part on a blotched belt, a
-      // few percent of the frame, is outweighed by the belt's blotches,
-      // which it splits instead. The part is then what lies far below the
-      // surface's own spread.
-      double median = 0;
-      double spread = 0;
-      medianSpread(ratio8, &median, &spread);
-      cv::Mat surface;
-      cv::compare(ratio8, median - kOutlierSpreads * std::max(spread, 1.0), surface, cv::CMP_GE);
-      const int outliers = cells - cv::countNonZero(surface);
-      if (outliers >= std::max(kMinOutlierCells, cells / 500)) {
-        const Classes minority = classes(surface);
-        if (minority.separated) c = minority;
-      }
-    }
-    split.k_ratio = std::clamp(0.5 * (c.bright + c.dark) / 200.0, kMinRatio,
-                               c.separated ? kMaxSeparatedRatio : kMaxRatio);
+    cv::meanStdDev(ratio8, mean_bright, sd_bright, upper);
+    cv::meanStdDev(ratio8, mean_dark, sd_dark, ~upper);
+    const double spread = std::sqrt(0.5 * (sd_bright[0] * sd_bright[0] + sd_dark[0] * sd_dark[0]));
+    const bool separated = mean_bright[0] - mean_dark[0] > kMinSeparation * std::max(spread, 1.0);
+    split.k_ratio = std::clamp(0.5 * (mean_bright[0] + mean_dark[0]) / 200.0, kMinRatio,
+                               separated ? kMaxSeparatedRatio : kMaxRatio);
     // An even surface (its spread a small share of the contrast: a back
     // light, a plain tray) is split exactly by the ratio, at no further cost.
-    if (c.bright_sd > kEvenSurface * (c.bright - c.dark)) {
-      split.contrast = (c.bright - c.dark) / 200.0;
+    if (sd_bright[0] > kEvenSurface * (mean_bright[0] - mean_dark[0])) {
+      split.contrast = (mean_bright[0] - mean_dark[0]) / 200.0;
     }
   } else {
     split.k_ratio = std::clamp(otsu / 200.0, kMinRatio, kMaxRatio);
   }
   return split;
-}
-
-// The light's smooth fall-off over the frame (vignetting, a gradient): a
-// polynomial of degree kFalloffDegree in x and y fitted by least squares to
-// the levels of `small_f` where `surface` is set, CV_32F the size of
-// `small_f`; empty where too few cells are surface or the fit is not
-// positive everywhere.
-cv::Mat lightFalloff(const cv::Mat& small_f, const cv::Mat& surface) {
-  constexpr int kPowers = kFalloffDegree + 1;
-  constexpr int kTerms = kPowers * (kPowers + 1) / 2;
-  // Powers of x per column and of y per row, each in [-1, 1].
-  const auto powers = [](int n) {
-    std::vector<std::array<double, kPowers>> p(static_cast<size_t>(n));
-    for (size_t i = 0; i < p.size(); ++i) {
-      const double u = 2.0 * (static_cast<double>(i) + 0.5) / n - 1;
-      p[i][0] = 1;
-      for (size_t d = 1; d < kPowers; ++d) p[i][d] = p[i][d - 1] * u;
-    }
-    return p;
-  };
-  const auto xs = powers(small_f.cols);
-  const auto ys = powers(small_f.rows);
-  // Term (a, b) is x^a y^b, a + b <= kFalloffDegree.
-  std::array<std::pair<size_t, size_t>, kTerms> exponents;
-  size_t n = 0;
-  for (size_t a = 0; a < kPowers; ++a) {
-    for (size_t b = 0; a + b < kPowers; ++b) exponents[n++] = {a, b};
-  }
-  cv::Matx<double, kTerms, kTerms> normal = cv::Matx<double, kTerms, kTerms>::zeros();
-  cv::Matx<double, kTerms, 1> right = cv::Matx<double, kTerms, 1>::zeros();
-  int count = 0;
-  int cells = 0;
-  std::array<double, kTerms> t;
-  // Every third cell each way: thousands of equations for 15 unknowns.
-  constexpr int kStride = 3;
-  for (int y = kStride / 2; y < small_f.rows; y += kStride) {
-    const float* level = small_f.ptr<float>(y);
-    const uint8_t* kept = surface.ptr<uint8_t>(y);
-    for (int x = kStride / 2; x < small_f.cols; x += kStride) {
-      ++cells;
-      if (!kept[x]) continue;
-      for (size_t k = 0; k < kTerms; ++k) {
-        t[k] = xs[static_cast<size_t>(x)][exponents[k].first] *
-               ys[static_cast<size_t>(y)][exponents[k].second];
-      }
-      for (size_t a = 0; a < kTerms; ++a) {
-        right(static_cast<int>(a)) += t[a] * level[x];
-        for (size_t b = a; b < kTerms; ++b)
-          normal(static_cast<int>(a), static_cast<int>(b)) += t[a] * t[b];
-      }
-      ++count;
-    }
-  }
-  // A quarter of the frame at least: the fall-off of the light is read from
-  // the surface around the parts, not extrapolated from a corner.
-  if (count < 4 * kTerms || 4 * count < cells) return {};
-  for (int a = 0; a < kTerms; ++a) {
-    for (int b = 0; b < a; ++b) normal(a, b) = normal(b, a);
-  }
-  cv::Matx<double, kTerms, 1> c;
-  if (!cv::solve(normal, right, c, cv::DECOMP_CHOLESKY)) return {};
-  cv::Mat fitted(small_f.size(), CV_32F);
-  for (int y = 0; y < small_f.rows; ++y) {
-    // The row's polynomial in x: its coefficient of x^a sums the terms
-    // x^a y^b over b.
-    std::array<double, kPowers> row{};
-    for (size_t k = 0; k < kTerms; ++k) {
-      row[exponents[k].first] +=
-          c(static_cast<int>(k)) * ys[static_cast<size_t>(y)][exponents[k].second];
-    }
-    float* f = fitted.ptr<float>(y);
-    for (int x = 0; x < small_f.cols; ++x) {
-      double level = 0;
-      for (size_t a = 0; a < kPowers; ++a) level += row[a] * xs[static_cast<size_t>(x)][a];
-      if (!(level > 1)) return {};
-      f[x] = static_cast<float>(level);
-    }
-  }
-  return fitted;
 }
 
 cv::Mat adaptive(const cv::Mat& grey, int window) {
@@ -586,40 +418,7 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
   cv::Mat background_f;
   small.convertTo(small_f, CV_32F);
   background.convertTo(background_f, CV_32F);
-  RatioSplit split = splitRatio(small_f, background_f);
-  if (split.contrast > 0) {
-    // On an uneven surface, the light's smooth fall-off (a lens's
-    // vignetting, a lamp's gradient) is divided out before the maximum
-    // filter: across a slope, the brightest cell of a window lies a
-    // half-window up the slope, and the estimate stands above the surface
-    // by the slope's drop. Towards the corners of a vignetted frame it stood
-    // 20 levels above a surface 30 levels above its parts, and the open
-    // threshold met the surface: thousands of specks, parts merged into
-    // them (a low-contrast frame of the front-light benchmark: 4901
-    // boundaries traced, 177 so and with kStepNoise). The fall-off is
-    // fitted to the cells on the surface's side of the split, twice: the
-    // second fit reads the surface through the first. A part filling most
-    // of the frame leaves too little surface to fit (lightFalloff), and the
-    // maximum filter alone reads it as before.
-    cv::Mat flat_background = background_f;
-    RatioSplit flat_split = split;
-    for (int round = 0; round < 2; ++round) {
-      cv::Mat surface;
-      cv::compare(small_f, flat_background * flat_split.k_ratio, surface, cv::CMP_GE);
-      const cv::Mat light = lightFalloff(small_f, surface);
-      if (light.empty()) break;
-      const double mean = cv::mean(light)[0];
-      const cv::Mat flat = small_f / light * mean;
-      cv::dilate(flat, flat_background, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)),
-                 cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
-      cv::blur(flat_background, flat_background, cv::Size(k, k), cv::Point(-1, -1),
-               cv::BORDER_REPLICATE);
-      flat_background = flat_background.mul(light) / mean;
-      flat_split = splitRatio(small_f, flat_background);
-    }
-    background_f = flat_background;
-    split = flat_split;
-  }
+  const RatioSplit split = splitRatio(small_f, background_f);
   const double k_ratio = split.k_ratio;
   const double contrast = split.contrast;
 
@@ -652,7 +451,7 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
       compared = &smoothed;
     }
   } else {
-    background_f.convertTo(threshold_small, CV_16U, 16 * k_ratio);
+    background.convertTo(threshold_small, CV_16U, 16 * k_ratio);
   }
   const cv::Mat rows = widen(threshold_small, grey.cols);
   cv::Mat mask(grey.size(), CV_8UC1);
