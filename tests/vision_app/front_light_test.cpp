@@ -407,10 +407,11 @@ TEST_CASE("the turn of a separated part under a front light is read on its edges
 TEST_CASE("parts in the corners of a vignetted frame at 30 levels of contrast are found too",
           "[vision_app][locate][front]") {
   // The low-contrast condition loses a quarter of its light in the corners:
-  // more than the 30 levels between part and surface. Read against a
-  // background estimate that stood above the surface there, the corners
-  // binarized as thousands of specks, and the parts in them merged into
-  // specks that touch the frame's edge.
+  // more than the 30 levels between part and surface, and the corners of
+  // its frames still binarize as specks of the surface (the background
+  // estimate stands above the surface there). Parts drawn near the frame's
+  // edge must be found all the same: a guard for any change to the
+  // binarization or the speck handling.
   const ps::SilhouetteSceneOptions look = lookOf("low-contrast");
   cv::Point2d drawn;
   const cv::Mat teach = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);

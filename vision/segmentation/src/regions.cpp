@@ -669,8 +669,9 @@ double departure(const cv::Mat& grey, const RowRuns& ring, Keep&& keep, const cv
 // are near; a value already set there (>= 0, beside a shadow) is kept.
 // Made when empty, and then only the band's pixels are written: the band
 // is all that is read of it, and filling the whole box with -1 first took
-// a tenth of the region pass at 30 levels of contrast. The sums are made on a grid of kLocalCellPx
-// cells, summed over the cells around and interpolated between cell centres:
+// a tenth of the region pass at 30 levels of contrast. The sums are made
+// on a grid of kLocalCellPx cells, summed over the cells around and
+// interpolated between cell centres:
 // the level beside an edge changes over several pixels, and full-size sums
 // over the box cost more than the rest of the region's reading.
 template <class Keep>
