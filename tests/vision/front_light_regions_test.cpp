@@ -283,7 +283,12 @@ TEST_CASE("a part's lit side, the blur of its tips and its glints are not cut of
                                        {"gear", ps::silhouetteFromPartType("gear", 200)},
                                        {"t_shape", ps::silhouetteFromPartType("t_shape", 200)}};
     for (const Shape& shape : shapes) {
-      for (const uint64_t seed : {7U, 11U, 17U}) {
+      // Seeds 1 and 16: a glossy obj1 and a low-contrast obj8 whose
+      // outlines' noise alone once sent them to the shadow search, which
+      // cut 0.3 % of them. Of seeds 1 to 24, 5 images of 240 are still cut
+      // (obj25 and t_shape, 21 and 23): a blotch of the belt darker than the
+      // surface's texture beside the part, cut as a thin shadow would be.
+      for (const uint64_t seed : {1U, 7U, 11U, 16U, 17U}) {
         CAPTURE(look.name, shape.name, seed);
         const cv::Mat image =
             ps::renderSilhouetteAlone(shape.type, 645, look.look, seed, nullptr, 30);

@@ -202,6 +202,19 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   return shadow;
 }
 
+// The noise of samples read in turn along an outline (a standard
+// deviation): from the differences of neighbours, which a shadow changes
+// only where it starts and ends, while it may take half of the samples
+// and would widen their spread about any one level until it hid itself.
+double noiseAlong(const std::vector<float>& values) {
+  if (values.size() < 2) return 0;
+  std::vector<float> steps(values.size() - 1);
+  for (size_t k = 1; k < values.size(); ++k) steps[k - 1] = std::abs(values[k] - values[k - 1]);
+  // The median absolute difference of two independent readings is
+  // 0.6745 * sqrt(2) of their standard deviation.
+  return medianOf(steps) / (0.6745 * std::sqrt(2.0));
+}
+
 // Whether the levels a few pixels in and out of the region's outline
 // (sideSamples) leave room for a shadow: some inside lighter than the part
 // by kLighterShare of the contrast, or outside darker than the surface by
@@ -212,14 +225,24 @@ bool mayHaveShadow(const cv::Mat& mask, const cv::Mat& grey, const std::vector<c
   std::vector<float> in;
   sideSamples(grey, mask, outer, &out, &in);
   if (out.size() < 8 || in.size() < 8) return false;
-  // (medianOf reorders the samples; the counts below need no order.)
+  // The noise first, while the samples are in their order along the
+  // outline (medianOf reorders them; the counts below need no order).
+  // Odd only beyond that noise, as the search asks of a layer and of the
+  // ring (thickLayer, cutRegion): at 30 grey levels of contrast a quarter of
+  // it is within two or three of the noise's spreads, and every region was
+  // searched (a third of the region pass of such a frame, where nothing is
+  // cut).
+  const double in_noise = noiseAlong(in);
+  const double out_noise = noiseAlong(out);
   const double part = medianOf(in);
   const double surface = medianOf(out);
   const double contrast = surface - part;
   if (contrast < kMinContrast) return false;
+  const double lighter = std::max(kLighterShare * contrast, kSpreadsApart * in_noise);
+  const double darker = std::max(kBelowSurface * contrast, kTextureSpreads * out_noise);
   size_t odd = 0;
-  for (const float v : in) odd += v > part + kLighterShare * contrast ? 1 : 0;
-  for (const float v : out) odd += v < surface - kBelowSurface * contrast ? 1 : 0;
+  for (const float v : in) odd += v > part + lighter ? 1 : 0;
+  for (const float v : out) odd += v < surface - darker ? 1 : 0;
   return odd >= std::max<size_t>(kMinOddSides, (in.size() + out.size()) / 20);
 }
 
