@@ -257,7 +257,8 @@ int main(int argc, char** argv) {
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
                "costs)");
   app.add_option("--save-frames", save_frames,
-                 "write each scene's first frame, its binarization (-mask) and each teach image here (PNG), to look at");
+                 "write each scene's first frame, its binarization (-mask) and each teach image "
+                 "here (PNG), to look at");
   app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
   if (!save_frames.empty() && !std::filesystem::is_directory(save_frames)) {
@@ -390,9 +391,9 @@ int main(int argc, char** argv) {
                                           {&row.locate_ms, &row.plain_ms});
           if (!save_frames.empty() && r == 0 && !outcome.scene.mask.empty()) {
             // What the vision pass took for parts: to look at beside the frame.
-            cv::imwrite(save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) +
-                            "-mask.png",
-                        outcome.scene.mask);
+            cv::imwrite(
+                save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) + "-mask.png",
+                outcome.scene.mask);
           }
           if (stages && !models->empty()) {
             // As locateInFrame prepares them: the vision image (a colour

@@ -25,6 +25,12 @@ constexpr int kCoreDepth = 2;
 // were placed 0.12 px off instead of 0.08: thin stretches of shadow along
 // the parts' flanks stayed on them.)
 constexpr double kMinLayerThickness = 1.5;
+// Where a layer meets the rest of the part, the levels are read this far
+// either side (pixels), and must differ by this share of the levels
+// between the layer and the part: a step (a shadow, beside the part's own
+// edge) and not a slope (the part's lit side).
+constexpr int kStepReadPx = 3;
+constexpr double kMinStepShare = 0.4;
 // Fewer pixels than these are noise, or a corner of the blur.
 constexpr int kMinShadowPixels = 30;
 constexpr int kMinCorePixels = 12;
@@ -199,6 +205,24 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
       l.surface - level < kBelowSurface * l.contrast()) {
     return {};
   }
+  // A shadow meets the part at the part's own edge, a step within the
+  // edge's blur; the lit side of a part shaded across its face (a light
+  // from one side) meets the rest of it at a slope. Read a few pixels either
+  // side of where they meet, a shadow's two sides differ by most of the
+  // levels between the part and the layer, a lit side's by a small share.
+  cv::Mat rest;
+  cv::bitwise_and(own, ~shadow, rest);
+  cv::Mat near;
+  cv::dilate(rest, near, disc(kStepReadPx));
+  cv::Mat layer_side;
+  cv::bitwise_and(near, shadow, layer_side);
+  cv::dilate(shadow, near, disc(kStepReadPx));
+  cv::Mat part_side;
+  cv::bitwise_and(near, rest, part_side);
+  if (cv::countNonZero(layer_side) < kMinCorePixels || cv::countNonZero(part_side) < kMinCorePixels)
+    return {};
+  const double step = cv::mean(g, layer_side)[0] - cv::mean(g, part_side)[0];
+  if (step < kMinStepShare * (level - l.part)) return {};
   return shadow;
 }
 
