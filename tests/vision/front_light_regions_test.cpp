@@ -345,7 +345,10 @@ TEST_CASE("beside a cast shadow, a part's lit side and the blur of its tips stay
         {"obj8", drawn("shapes/tari1000/obj8_3.png", 230)},
         {"obj25", drawn("shapes/tari1000/obj25_3.png", 210)},
         {"obj1", drawn("shapes/tari1000/obj1_3.png", 220)}};
-    for (const auto& [name, type] : shapes) {
+    // (Named, not a structured binding: C++17 lambdas cannot capture those.)
+    for (const auto& shape : shapes) {
+      const char* name = shape.first;
+      const ps::SilhouetteType& type = shape.second;
       for (const double light_deg : {30.0, 160.0, 250.0}) {
         for (const uint64_t seed : {7U, 11U}) {
           CAPTURE(condition, name, light_deg, seed);
