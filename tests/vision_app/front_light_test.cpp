@@ -481,3 +481,60 @@ TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
   INFO((part.ok() ? std::string() : part.error().message));
   CHECK(part.ok());
 }
+
+TEST_CASE("touching parts whose corners the light blurs are found from what their blob leaves",
+          "[vision_app][locate][front]") {
+  // Public silhouettes (Tari-1000) the blob search was not written on,
+  // touching by pairs, on a textured belt, on wood and at 30 levels of
+  // contrast. There a noisy outline's corners open tens of degrees away from
+  // the model's, and no pose was proposed for one part in 30 to 50 (7 of
+  // these 144 parts were missed); what the parts found leave is that part.
+  const auto drawn = [](const char* file, double size) {
+    const cv::Mat drawing =
+        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+    REQUIRE(!drawing.empty());
+    return ps::silhouetteFromDrawing(file, drawing, size);
+  };
+  const std::vector<std::pair<std::string, ps::SilhouetteType>> shapes = {
+      {"obj8", drawn("shapes/tari1000/obj8_3.png", 230)},
+      {"obj5", drawn("shapes/tari1000/obj5_3.png", 240)},
+      {"obj18", drawn("shapes/tari1000/obj18_3.png", 190)},
+      {"obj1", drawn("shapes/tari1000/obj1_3.png", 220)}};
+  for (const char* condition : {"low-contrast", "textured", "wood"}) {
+    const ps::SilhouetteSceneOptions look = lookOf(condition);
+    // Each type taught as a user does: LEARN ... AT a box around it, alone
+    // under the same light.
+    auto models = std::make_shared<ModelList>();
+    std::vector<ps::SilhouetteType> types;
+    for (const auto& shape : shapes) {
+      cv::Point2d at;
+      const cv::Mat teach = ps::renderSilhouetteAlone(shape.second, 645, look, 7, &at, 30);
+      auto learned =
+          learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
+                       shape.first, boxAround(at, 240));
+      INFO(condition << " " << shape.first << ": "
+                     << (learned.ok() ? std::string() : learned.error().message));
+      REQUIRE(learned.ok());
+      models->push_back(learned->model);
+      types.push_back(shape.second);
+    }
+    for (uint64_t seed = 1; seed <= 12; ++seed) {
+      ps::SilhouetteSceneOptions o = look;
+      o.width = 1000;
+      o.height = 800;
+      o.parts = 4;
+      o.distractor_share = 0;
+      o.arrangement = ps::Arrangement::kTouching;
+      o.seed = seed;
+      const ps::SilhouetteScene scene(types, std::vector<bool>(types.size(), true), o);
+      const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+      const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
+      const int truths = static_cast<int>(scene.truth().size());
+      int reported = 0;
+      for (const auto& p : outcome.parts) reported += p.type >= 0 ? 1 : 0;
+      INFO(condition << ", seed " << seed);
+      CHECK(foundTrue(scene.truth(), outcome.parts) == truths);
+      CHECK(reported == truths);
+    }
+  }
+}

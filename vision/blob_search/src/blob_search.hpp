@@ -14,9 +14,14 @@
 //   explainsWhole()     whether the parts taken are the whole blob
 //   narrowToRest()      the anchors the full search starts from: those near
 //                       what the parts taken leave unexplained
+//   searchRestMiddle()  each model the size of what is left unexplained,
+//                       put on its middle and turned (proposeAbout): a part
+//                       whose corners its outline does not show as the
+//                       model's
 //   run()               the stages in order: a quick search of every model,
 //                       then while the blob is not explained whole the full
-//                       search, model by model
+//                       search, model by model, and the search of the rest's
+//                       middle
 #pragma once
 
 #include <deque>
@@ -111,6 +116,7 @@ class BlobSearch {
   // The full search after the quick one: `order` holds per model (index
   // into fitting()) what the quick search saw of it.
   void fullSearch(std::vector<std::pair<double, size_t>> order);
+  void searchRestMiddle();
 
   const Region& region_;
   size_t index_;

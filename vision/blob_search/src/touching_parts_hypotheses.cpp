@@ -423,6 +423,35 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
   proposer.fromCorners();
   proposer.fromArcs();
 }
+void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
+                  const EdgeDistance& edges, std::vector<Candidate>* out) {
+  const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
+  const double radius = std::max(model.radius, 1.0);
+  // The coarse scan at the first look's loose tolerance (a step half off
+  // still screens), then the fine one about its best turn.
+  const double coarse = kCoarseScanStepPx / radius / kRadPerDeg;
+  const int steps = static_cast<int>(std::ceil(360.0 / coarse));
+  const double step = 360.0 / steps;
+  const double loose = kLooseScreenFactor * model.edge_tolerance;
+  double best_turn = 0;
+  double best = -1;
+  for (int k = 0; k < steps; ++k) {
+    const double score = verifyScore(search.sparse, centre, k * step, edges, loose, false);
+    if (score > best) {
+      best = score;
+      best_turn = k * step;
+    }
+  }
+  if (best < threshold) return;
+  const double fine = kScanStepPx / radius / kRadPerDeg;
+  Candidate chosen{&model, ImagePose{centre, 0, false}, -1, 0};
+  for (double a = best_turn - step; a <= best_turn + step; a += fine) {
+    const double score = verifyScore(search.sparse, centre, a, edges, model.edge_tolerance, false);
+    if (score > chosen.score)
+      chosen = Candidate{&model, ImagePose{centre, normalizeDeg(a), false}, score, 0};
+  }
+  if (chosen.score >= threshold) out->push_back(chosen);
+}
 }  // namespace touching
 
 using namespace touching;
