@@ -487,8 +487,9 @@ TEST_CASE("touching parts whose corners the light blurs are found from what thei
   // Public silhouettes (Tari-1000) the blob search was not written on,
   // touching by pairs, on a textured belt, on wood and at 30 levels of
   // contrast. There a noisy outline's corners open tens of degrees away from
-  // the model's, and no pose was proposed for one part in 30 to 50 (7 of
-  // these 144 parts were missed); what the parts found leave is that part.
+  // the model's, and no pose was proposed for one part in 30 to 50 (6 of
+  // these 144 parts were missed, one in each of 6 scenes); what the parts
+  // found leave is that part.
   const auto drawn = [](const char* file, double size) {
     const cv::Mat drawing =
         cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
