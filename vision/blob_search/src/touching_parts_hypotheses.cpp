@@ -423,6 +423,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
   proposer.fromCorners();
   proposer.fromArcs();
 }
+
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
                   const EdgeDistance& edges, std::vector<Candidate>* out) {
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
