@@ -71,6 +71,10 @@ constexpr double kCoarseScanStepPx = 6.0;
 constexpr double kCoarseSlack = 0.25;
 // Rotation scan about an arc's centre: the largest step at the model's rim.
 constexpr double kScanStepPx = 1.5;
+// proposeAbout's reference points: a grid this far apart (pixels), this
+// far either way of the middle it is given.
+constexpr double kAboutStepPx = 4.0;
+constexpr double kAboutReachPx = 12.0;
 
 using picksight::normalizeDeg;
 using picksight::signedDeg;
@@ -428,28 +432,49 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
                   const EdgeDistance& edges, std::vector<Candidate>* out) {
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double radius = std::max(model.radius, 1.0);
+  // The reference points about `centre`, nearest first: of poses that
+  // screen alike, the nearest is kept.
+  std::vector<cv::Point2d> grid;
+  const int reach = static_cast<int>(std::lround(kAboutReachPx / kAboutStepPx));
+  for (int j = -reach; j <= reach; ++j) {
+    for (int i = -reach; i <= reach; ++i) grid.emplace_back(i * kAboutStepPx, j * kAboutStepPx);
+  }
+  std::stable_sort(grid.begin(), grid.end(), [](cv::Point2d a, cv::Point2d b) {
+    return a.x * a.x + a.y * a.y < b.x * b.x + b.y * b.y;
+  });
   // The coarse scan at the first look's loose tolerance (a step half off
-  // still screens), then the fine one about its best turn.
+  // still screens), each pose first glanced at, over the turn and the
+  // grid; then the fine one about its best.
   const double coarse = kCoarseScanStepPx / radius / kRadPerDeg;
   const int steps = static_cast<int>(std::ceil(360.0 / coarse));
   const double step = 360.0 / steps;
   const double loose = kLooseScreenFactor * model.edge_tolerance;
   double best_turn = 0;
+  cv::Point2d best_at = centre;
   double best = -1;
-  for (int k = 0; k < steps; ++k) {
-    const double score = verifyScore(search.sparse, centre, k * step, edges, loose, false);
-    if (score > best) {
-      best = score;
-      best_turn = k * step;
+  for (const cv::Point2d& offset : grid) {
+    const cv::Point2d at = centre + offset;
+    for (int k = 0; k < steps; ++k) {
+      const double a = k * step * kRadPerDeg;
+      if (!verifiesAtLeast(search.glance, search.glance_weight, at, std::cos(a), std::sin(a), 1.0,
+                           edges, loose, threshold - kGlanceSlack)) {
+        continue;
+      }
+      const double score = verifyScore(search.sparse, at, k * step, edges, loose, false);
+      if (score > best) {
+        best = score;
+        best_turn = k * step;
+        best_at = at;
+      }
     }
   }
   if (best < threshold) return;
   const double fine = kScanStepPx / radius / kRadPerDeg;
-  Candidate chosen{&model, ImagePose{centre, 0, false}, -1, 0};
+  Candidate chosen{&model, ImagePose{best_at, 0, false}, -1, 0};
   for (double a = best_turn - step; a <= best_turn + step; a += fine) {
-    const double score = verifyScore(search.sparse, centre, a, edges, model.edge_tolerance, false);
+    const double score = verifyScore(search.sparse, best_at, a, edges, model.edge_tolerance, false);
     if (score > chosen.score)
-      chosen = Candidate{&model, ImagePose{centre, normalizeDeg(a), false}, score, 0};
+      chosen = Candidate{&model, ImagePose{best_at, normalizeDeg(a), false}, score, 0};
   }
   if (chosen.score >= threshold) out->push_back(chosen);
 }

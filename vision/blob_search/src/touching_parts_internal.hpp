@@ -149,11 +149,11 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
              const BlobCorners& image_corners, const std::vector<ArcAnchor>& image_arcs,
              const EdgeDistance& edges, std::vector<Candidate>* out);
 
-// The pose of `model` with its reference point at `centre` (image
-// coordinates) whose turn screens best on `edges`, scanned over the whole
-// circle coarse to fine as an arc's turn is: appended to `out` when it
-// screens as well as propose() asks. For a part whose corners and arcs the
-// blob's outline does not show as the model's.
+// The pose of `model` with its reference point at or within a dozen pixels
+// of `centre` (image coordinates) that screens best on `edges`, the turn
+// scanned over the whole circle coarse to fine as an arc's turn is:
+// appended to `out` when it screens as well as propose() asks. For a part
+// whose corners and arcs the blob's outline does not show as the model's.
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
                   const EdgeDistance& edges, std::vector<Candidate>* out);
 
