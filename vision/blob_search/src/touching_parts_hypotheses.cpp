@@ -433,21 +433,30 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double radius = std::max(model.radius, 1.0);
   // The reference points about `centre`, nearest first: of poses that
-  // screen alike, the nearest is kept.
-  std::vector<cv::Point2d> grid;
-  const int reach = static_cast<int>(std::lround(kAboutReachPx / kAboutStepPx));
-  for (int j = -reach; j <= reach; ++j) {
-    for (int i = -reach; i <= reach; ++i) grid.emplace_back(i * kAboutStepPx, j * kAboutStepPx);
-  }
-  std::stable_sort(grid.begin(), grid.end(), [](cv::Point2d a, cv::Point2d b) {
-    return a.x * a.x + a.y * a.y < b.x * b.x + b.y * b.y;
-  });
+  // screen alike, the nearest is kept. The same for every call.
+  static const std::vector<cv::Point2d> grid = [] {
+    std::vector<cv::Point2d> g;
+    const int reach = static_cast<int>(std::lround(kAboutReachPx / kAboutStepPx));
+    for (int j = -reach; j <= reach; ++j) {
+      for (int i = -reach; i <= reach; ++i) g.emplace_back(i * kAboutStepPx, j * kAboutStepPx);
+    }
+    std::stable_sort(g.begin(), g.end(), [](cv::Point2d a, cv::Point2d b) {
+      return a.x * a.x + a.y * a.y < b.x * b.x + b.y * b.y;
+    });
+    return g;
+  }();
   // The coarse scan at the first look's loose tolerance (a step half off
   // still screens), each pose first glanced at, over the turn and the
-  // grid; then the fine one about its best.
+  // grid; then the fine one about its best. The turns' cosines and sines
+  // once, not once per reference point.
   const double coarse = kCoarseScanStepPx / radius / kRadPerDeg;
   const int steps = static_cast<int>(std::ceil(360.0 / coarse));
   const double step = 360.0 / steps;
+  std::vector<cv::Point2d> turns(static_cast<size_t>(steps));
+  for (int k = 0; k < steps; ++k) {
+    const double a = k * step * kRadPerDeg;
+    turns[static_cast<size_t>(k)] = {std::cos(a), std::sin(a)};
+  }
   const double loose = kLooseScreenFactor * model.edge_tolerance;
   double best_turn = 0;
   cv::Point2d best_at = centre;
@@ -455,9 +464,9 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
   for (const cv::Point2d& offset : grid) {
     const cv::Point2d at = centre + offset;
     for (int k = 0; k < steps; ++k) {
-      const double a = k * step * kRadPerDeg;
-      if (!verifiesAtLeast(search.glance, search.glance_weight, at, std::cos(a), std::sin(a), 1.0,
-                           edges, loose, threshold - kGlanceSlack)) {
+      const cv::Point2d& cs = turns[static_cast<size_t>(k)];
+      if (!verifiesAtLeast(search.glance, search.glance_weight, at, cs.x, cs.y, 1.0, edges, loose,
+                           threshold - kGlanceSlack)) {
         continue;
       }
       const double score = verifyScore(search.sparse, at, k * step, edges, loose, false);
