@@ -117,6 +117,8 @@ class BlobSearch {
   // into fitting()) what the quick search saw of it.
   void fullSearch(std::vector<std::pair<double, size_t>> order);
   void searchRestMiddle();
+  // The distance map of the blob's outline, exact up to `reach`.
+  EdgeDistance edgeMap(double reach) const;
 
   const Region& region_;
   size_t index_;

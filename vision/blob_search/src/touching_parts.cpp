@@ -406,14 +406,7 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
   std::vector<std::vector<cv::Point>> contours{region_.outer};
   contours.insert(contours.end(), region_.hole_boundaries.begin(), region_.hole_boundaries.end());
   // Read at no more than the loose screening tolerance (and clipped there).
-  if (!built_edges) {
-    const double screen_reach = kLooseScreenFactor * tolerance_;
-    const int margin = static_cast<int>(std::ceil(screen_reach)) + 2;
-    own_edges_.emplace(contours,
-                       cv::Rect(region_.bbox.x - margin, region_.bbox.y - margin,
-                                region_.bbox.width + 2 * margin, region_.bbox.height + 2 * margin),
-                       screen_reach);
-  }
+  if (!built_edges) own_edges_.emplace(edgeMap(kLooseScreenFactor * tolerance_));
   edges_ = built_edges ? built_edges : &*own_edges_;
   std::vector<std::vector<cv::Point2d>> loops2d;
   for (const auto& c : contours) loops2d.emplace_back(c.begin(), c.end());
@@ -734,28 +727,39 @@ void BlobSearch::fullSearch(std::vector<std::pair<double, size_t>> order) {
 constexpr double kRestMinArea = 0.7;
 constexpr double kRestMaxArea = 2.0;
 
+EdgeDistance BlobSearch::edgeMap(double reach) const {
+  std::vector<std::vector<cv::Point>> contours{region_.outer};
+  contours.insert(contours.end(), region_.hole_boundaries.begin(), region_.hole_boundaries.end());
+  const int margin = static_cast<int>(std::ceil(reach)) + 2;
+  return EdgeDistance(contours,
+                      cv::Rect(region_.bbox.x - margin, region_.bbox.y - margin,
+                               region_.bbox.width + 2 * margin, region_.bbox.height + 2 * margin),
+                      reach);
+}
+
 void BlobSearch::searchRestMiddle() {
   cv::Mat rest = unexplained();
   cv::erode(rest, rest, seam_);
-  cv::Mat labels;
-  cv::Mat stats;
-  cv::Mat centroids;
-  const int n = cv::connectedComponentsWithStats(rest, labels, stats, centroids, 8, CV_32S);
-  int largest = 0;
-  for (int k = 1; k < n; ++k) {
-    if (largest == 0 ||
-        stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA)) {
-      largest = k;
-    }
+  // The largest piece, from its outline: labelling the pieces' pixels took
+  // eight times as long on a blob of two parts (0.5 ms).
+  std::vector<std::vector<cv::Point>> pieces;
+  cv::findContours(rest, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  cv::Moments largest;
+  for (const auto& piece : pieces) {
+    const cv::Moments m = cv::moments(piece);
+    if (m.m00 > largest.m00) largest = m;
   }
-  if (largest == 0) return;
-  const double area = stats.at<int>(largest, cv::CC_STAT_AREA);
-  const cv::Point2d middle(blob_box_.x + centroids.at<double>(largest, 0),
-                           blob_box_.y + centroids.at<double>(largest, 1));
+  if (largest.m00 <= 0) return;
+  const double area = largest.m00;
+  const cv::Point2d middle(blob_box_.x + largest.m10 / area, blob_box_.y + largest.m01 / area);
   std::vector<Candidate> proposed;
+  // The map proposeAbout's first look reads, built for the first model it
+  // is asked of.
+  std::optional<EdgeDistance> wide;
   for (const PartModel* m : fitting_) {
     if (m->body.area < kRestMinArea * area || m->body.area > kRestMaxArea * area) continue;
-    proposeAbout(*m, *searchOf(*m), middle, *edges_, &proposed);
+    if (!wide) wide.emplace(edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx));
+    proposeAbout(*m, *searchOf(*m), middle, *edges_, *wide, &proposed);
   }
   std::stable_sort(proposed.begin(), proposed.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });

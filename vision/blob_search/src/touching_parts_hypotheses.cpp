@@ -75,6 +75,23 @@ constexpr double kScanStepPx = 1.5;
 // far either way of the middle it is given.
 constexpr double kAboutStepPx = 4.0;
 constexpr double kAboutReachPx = 12.0;
+// Its first look: reference points this far apart (read kAboutWidePx more
+// loosely); the poses kept from it.
+constexpr double kAboutCoarsePx = 8.0;
+constexpr size_t kAboutKept = 4;
+
+// Points `step` apart within `reach` of (0, 0) either way, nearest first.
+std::vector<cv::Point2d> aboutGrid(double step, double reach = kAboutReachPx) {
+  std::vector<cv::Point2d> g;
+  const int n = static_cast<int>(std::floor(reach / step + 1e-9));
+  for (int j = -n; j <= n; ++j) {
+    for (int i = -n; i <= n; ++i) g.emplace_back(i * step, j * step);
+  }
+  std::stable_sort(g.begin(), g.end(), [](cv::Point2d a, cv::Point2d b) {
+    return a.x * a.x + a.y * a.y < b.x * b.x + b.y * b.y;
+  });
+  return g;
+}
 
 using picksight::normalizeDeg;
 using picksight::signedDeg;
@@ -428,59 +445,104 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
   proposer.fromArcs();
 }
 
+namespace {
+// A pose of proposeAbout's first, coarse look: its score and where.
+struct AboutPose {
+  double score;
+  cv::Point2d at;
+  double turn_deg;
+};
+}  // namespace
+
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
-                  const EdgeDistance& edges, std::vector<Candidate>* out) {
+                  const EdgeDistance& edges, const EdgeDistance& wide,
+                  std::vector<Candidate>* out) {
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double radius = std::max(model.radius, 1.0);
-  // The reference points about `centre`, nearest first: of poses that
-  // screen alike, the nearest is kept. The same for every call.
-  static const std::vector<cv::Point2d> grid = [] {
-    std::vector<cv::Point2d> g;
-    const int reach = static_cast<int>(std::lround(kAboutReachPx / kAboutStepPx));
-    for (int j = -reach; j <= reach; ++j) {
-      for (int i = -reach; i <= reach; ++i) g.emplace_back(i * kAboutStepPx, j * kAboutStepPx);
-    }
-    std::stable_sort(g.begin(), g.end(), [](cv::Point2d a, cv::Point2d b) {
-      return a.x * a.x + a.y * a.y < b.x * b.x + b.y * b.y;
-    });
-    return g;
-  }();
-  // The coarse scan at the first look's loose tolerance (a step half off
-  // still screens), each pose first glanced at, over the turn and the
-  // grid; then the fine one about its best. The turns' cosines and sines
-  // once, not once per reference point.
-  const double coarse = kCoarseScanStepPx / radius / kRadPerDeg;
-  const int steps = static_cast<int>(std::ceil(360.0 / coarse));
-  const double step = 360.0 / steps;
-  std::vector<cv::Point2d> turns(static_cast<size_t>(steps));
-  for (int k = 0; k < steps; ++k) {
-    const double a = k * step * kRadPerDeg;
-    turns[static_cast<size_t>(k)] = {std::cos(a), std::sin(a)};
-  }
   const double loose = kLooseScreenFactor * model.edge_tolerance;
-  double best_turn = 0;
-  cv::Point2d best_at = centre;
-  double best = -1;
-  for (const cv::Point2d& offset : grid) {
-    const cv::Point2d at = centre + offset;
+  // The turns of a scan `step_px` apart at the model's rim, their cosines
+  // and sines computed once.
+  const auto turnsOf = [&](double step_px, double* step_deg) {
+    const int steps = static_cast<int>(std::ceil(360.0 / (step_px / radius / kRadPerDeg)));
+    *step_deg = 360.0 / steps;
+    std::vector<cv::Point2d> turns(static_cast<size_t>(steps));
     for (int k = 0; k < steps; ++k) {
-      const cv::Point2d& cs = turns[static_cast<size_t>(k)];
-      if (!verifiesAtLeast(search.glance, search.glance_weight, at, cs.x, cs.y, 1.0, edges, loose,
-                           threshold - kGlanceSlack)) {
+      const double a = k * *step_deg * kRadPerDeg;
+      turns[static_cast<size_t>(k)] = {std::cos(a), std::sin(a)};
+    }
+    return turns;
+  };
+  // The first look: reference points kAboutCoarsePx apart, turns twice as
+  // far apart as an arc's first scan, on the wide map at a tolerance that
+  // much wider: a part's true pose is within half a step of one of these
+  // either way, and screens there at the wider tolerance.
+  static const std::vector<cv::Point2d> coarse_grid = aboutGrid(kAboutCoarsePx);
+  double coarse_deg = 0;
+  const std::vector<cv::Point2d> coarse_turns = turnsOf(2 * kCoarseScanStepPx, &coarse_deg);
+  const double wide_tolerance = loose + kAboutWidePx;
+  std::vector<AboutPose> first;
+  for (const cv::Point2d& offset : coarse_grid) {
+    const cv::Point2d at = centre + offset;
+    for (size_t k = 0; k < coarse_turns.size(); ++k) {
+      const cv::Point2d& cs = coarse_turns[k];
+      if (!verifiesAtLeast(search.glance, search.glance_weight, at, cs.x, cs.y, 1.0, wide,
+                           wide_tolerance, threshold - kGlanceSlack)) {
         continue;
       }
-      const double score = verifyScore(search.sparse, at, k * step, edges, loose, false);
-      if (score > best) {
-        best = score;
-        best_turn = k * step;
-        best_at = at;
+      // Scored in full only when it may be kept: at the threshold, and
+      // once kAboutKept are kept, as well as the last of them (the first
+      // kept of poses that score alike stays).
+      const double needed =
+          first.size() < kAboutKept ? threshold : std::max(threshold, first.back().score);
+      if (!verifiesAtLeast(search.sparse, search.sparse_weight, at, cs.x, cs.y, 1.0, wide,
+                           wide_tolerance, needed)) {
+        continue;
+      }
+      const double turn = static_cast<double>(k) * coarse_deg;
+      const double score = verifyScore(search.sparse, at, turn, wide, wide_tolerance, false);
+      if (score < needed || (first.size() == kAboutKept && score <= first.back().score)) continue;
+      auto after = std::upper_bound(first.begin(), first.end(), score,
+                                    [](double s, const AboutPose& p) { return s > p.score; });
+      first.insert(after, {score, at, turn});
+      if (first.size() > kAboutKept) first.pop_back();
+    }
+  }
+  if (first.empty()) return;
+  // Then about each pose kept: reference points kAboutStepPx apart within
+  // half a coarse step, turns an arc's first scan apart within a coarse
+  // step, at the first look's loose tolerance; of poses that screen alike,
+  // the nearest to `centre` is kept.
+  static const std::vector<cv::Point2d> fine_grid = aboutGrid(kAboutStepPx, kAboutCoarsePx / 2);
+  const double fine_step = coarse_deg / 2;
+  double best = -1;
+  double best_turn = 0;
+  cv::Point2d best_at = centre;
+  double best_off = 0;
+  for (const AboutPose& pose : first) {
+    for (const cv::Point2d& offset : fine_grid) {
+      const cv::Point2d at = pose.at + offset;
+      const double off = cv::norm(at - centre);
+      for (int k = -2; k <= 2; ++k) {
+        const double turn = pose.turn_deg + k * fine_step;
+        const double a = turn * kRadPerDeg;
+        if (!verifiesAtLeast(search.glance, search.glance_weight, at, std::cos(a), std::sin(a), 1.0,
+                             edges, loose, threshold - kGlanceSlack)) {
+          continue;
+        }
+        const double score = verifyScore(search.sparse, at, turn, edges, loose, false);
+        if (score > best || (score == best && off < best_off)) {
+          best = score;
+          best_turn = turn;
+          best_at = at;
+          best_off = off;
+        }
       }
     }
   }
   if (best < threshold) return;
   const double fine = kScanStepPx / radius / kRadPerDeg;
   Candidate chosen{&model, ImagePose{best_at, 0, false}, -1, 0};
-  for (double a = best_turn - step; a <= best_turn + step; a += fine) {
+  for (double a = best_turn - fine_step; a <= best_turn + fine_step; a += fine) {
     const double score = verifyScore(search.sparse, best_at, a, edges, model.edge_tolerance, false);
     if (score > chosen.score)
       chosen = Candidate{&model, ImagePose{best_at, normalizeDeg(a), false}, score, 0};
@@ -498,6 +560,7 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   b->sparse = sparseSamples(model.samples, kSparseSamples);
   b->glance = sparseSamples(model.samples, kGlanceSamples);
   for (const auto& g : b->glance) b->glance_weight += g.weight;
+  for (const auto& g : b->sparse) b->sparse_weight += g.weight;
   const auto farthestFirst = [&](cv::Point2d from) {
     std::vector<BoundarySample> order = b->glance;
     std::stable_sort(order.begin(), order.end(),

@@ -106,6 +106,9 @@ struct Candidate {
 // A corner's first look counts boundary samples within this many edge
 // tolerances: the blob's distance map must reach that far.
 constexpr double kLooseScreenFactor = 2.0;
+// proposeAbout's first look reads its map this much more loosely than the
+// loose screening tolerance, so a map it reads reaches that much further.
+constexpr double kAboutWidePx = 4.0;
 
 }  // namespace touching
 
@@ -125,6 +128,7 @@ struct BlobSearchModel {
   std::vector<std::vector<BoundarySample>> arc_glance;
   std::vector<touching::EdgeSample> edges;  // poses are refined on these, 1 px apart
   double glance_weight = 0;                 // the glance samples' total
+  double sparse_weight = 0;                 // the sparse samples' total
 };
 
 namespace touching {
@@ -155,7 +159,7 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
 // appended to `out` when it screens as well as propose() asks. For a part
 // whose corners and arcs the blob's outline does not show as the model's.
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
-                  const EdgeDistance& edges, std::vector<Candidate>* out);
+                  const EdgeDistance& edges, const EdgeDistance& wide, std::vector<Candidate>* out);
 
 }  // namespace touching
 }  // namespace picksight::vision
