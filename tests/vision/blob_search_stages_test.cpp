@@ -15,6 +15,7 @@
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 #include "picksight/vision/training/part_training.hpp"
+#include "touching_parts_internal.hpp"
 
 using namespace picksight::vision;
 using picksight::angleDiffDeg;
@@ -439,5 +440,59 @@ TEST_CASE("blob search: a patch of the surface's light is not searched, a faint 
     CAPTURE(regions[0].area);
     const BlobSearch search(regions, 0, models_list, nullptr);
     CHECK(search.fitting().size() == 2);
+  }
+}
+
+namespace {
+// proposeAbout (the search of what the parts found leave) over the whole
+// turn: `shape` alone, drawn sharp at each turn, searched about middles 4
+// and 12 px from its reference point; how many of the searches proposed
+// its pose, within 4.5 px and 4 degrees.
+std::pair<int, int> aboutEveryTurn(const PartModel& model, const ps::Shape& shape) {
+  const auto search = touching::searchOf(model);
+  const double loose = touching::kLooseScreenFactor * model.edge_tolerance;
+  int found = 0;
+  int tried = 0;
+  for (double turn = 3.7; turn < 360; turn += 5.3) {
+    const cv::Point2d at(260.3, 220.6);
+    const cv::Mat grey = pt::drawParts(520, 440, {{shape, at.x, at.y, turn}}, 3);
+    const auto regions = findRegions(binarize(grey, {}), {}, grey);
+    REQUIRE(regions.size() == 1);
+    const std::vector<std::vector<cv::Point>> contours{regions[0].outer};
+    const cv::Rect box = regions[0].bbox + cv::Size(40, 40) - cv::Point(20, 20);
+    const EdgeDistance edges(contours, box, loose);
+    const EdgeDistance wide(contours, box, loose + touching::kAboutWidePx);
+    for (const cv::Point2d off : {cv::Point2d(4, 4), cv::Point2d(-4, 4), cv::Point2d(4, -4),
+                                  cv::Point2d(-4, -4), cv::Point2d(12, -4), cv::Point2d(-4, 12)}) {
+      std::vector<Candidate> proposed;
+      touching::proposeAbout(model, *search, at - off, edges, wide, &proposed);
+      ++tried;
+      INFO("turn " << turn << ", middle " << off.x << " " << off.y << " px off");
+      if (proposed.size() != 1) continue;
+      const ImagePose& got = proposed[0].pose;
+      INFO("proposed " << got.centre.x - at.x << " " << got.centre.y - at.y << " px off, turned "
+                       << got.angle_deg);
+      if (near(got, {at, turn, false}, model, 4.5, 4.0)) ++found;
+    }
+  }
+  return {found, tried};
+}
+}  // namespace
+
+TEST_CASE("blob search: searched about a middle a part between the first look's poses is found",
+          "[vision][blob_search]") {
+  // The rest search's first look reads reference points 8 px apart and
+  // turns 12 px apart at the rim, more loosely than the second: a part
+  // whose reference point lies between four of those points and whose turn
+  // lies between two of those turns must still be found, in every turn;
+  // also with the model's edge tolerance set tighter than taught
+  // (TOLERANCE ... edge_tolerance_px 1), where the first look's wider
+  // reading is what finds it.
+  for (const double tolerance : {0.0, 1.0}) {
+    PartModel model = models().l;
+    if (tolerance > 0) model.edge_tolerance = tolerance;
+    INFO("edge tolerance " << model.edge_tolerance << " px");
+    const auto [found, tried] = aboutEveryTurn(model, lShape());
+    CHECK(found == tried);
   }
 }

@@ -76,9 +76,8 @@ constexpr double kScanStepPx = 1.5;
 constexpr double kAboutStepPx = 4.0;
 constexpr double kAboutReachPx = 12.0;
 // Its first look: reference points this far apart (read kAboutWidePx more
-// loosely); the poses kept from it.
+// loosely).
 constexpr double kAboutCoarsePx = 8.0;
-constexpr size_t kAboutKept = 4;
 
 // Points `step` apart within `reach` of (0, 0) either way, nearest first.
 std::vector<cv::Point2d> aboutGrid(double step, double reach = kAboutReachPx) {
@@ -480,66 +479,64 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
   double coarse_deg = 0;
   const std::vector<cv::Point2d> coarse_turns = turnsOf(2 * kCoarseScanStepPx, &coarse_deg);
   const double wide_tolerance = loose + kAboutWidePx;
-  std::vector<AboutPose> first;
+  // The first look's best pose (the first of poses that score alike: the
+  // nearest to `centre`); a pose is scored in full only when it may be it.
+  AboutPose first{threshold, centre, 0};
+  bool seen = false;
   for (const cv::Point2d& offset : coarse_grid) {
     const cv::Point2d at = centre + offset;
     for (size_t k = 0; k < coarse_turns.size(); ++k) {
       const cv::Point2d& cs = coarse_turns[k];
       if (!verifiesAtLeast(search.glance, search.glance_weight, at, cs.x, cs.y, 1.0, wide,
-                           wide_tolerance, threshold - kGlanceSlack)) {
-        continue;
-      }
-      // Scored in full only when it may be kept: at the threshold, and
-      // once kAboutKept are kept, as well as the last of them (the first
-      // kept of poses that score alike stays).
-      const double needed =
-          first.size() < kAboutKept ? threshold : std::max(threshold, first.back().score);
-      if (!verifiesAtLeast(search.sparse, search.sparse_weight, at, cs.x, cs.y, 1.0, wide,
-                           wide_tolerance, needed)) {
+                           wide_tolerance, threshold - kGlanceSlack) ||
+          !verifiesAtLeast(search.sparse, search.sparse_weight, at, cs.x, cs.y, 1.0, wide,
+                           wide_tolerance, first.score)) {
         continue;
       }
       const double turn = static_cast<double>(k) * coarse_deg;
       const double score = verifyScore(search.sparse, at, turn, wide, wide_tolerance, false);
-      if (score < needed || (first.size() == kAboutKept && score <= first.back().score)) continue;
-      auto after = std::upper_bound(first.begin(), first.end(), score,
-                                    [](double s, const AboutPose& p) { return s > p.score; });
-      first.insert(after, {score, at, turn});
-      if (first.size() > kAboutKept) first.pop_back();
+      if (score < first.score || (seen && score == first.score)) continue;
+      first = {score, at, turn};
+      seen = true;
     }
   }
-  if (first.empty()) return;
-  // Then about each pose kept: reference points kAboutStepPx apart within
-  // half a coarse step, turns an arc's first scan apart within a coarse
-  // step, at the first look's loose tolerance; of poses that screen alike,
-  // the nearest to `centre` is kept.
+  if (!seen) return;
+  // Then about it: reference points kAboutStepPx apart within half a
+  // coarse step, turns an arc's first scan apart within a coarse step, at
+  // the first look's loose tolerance.
   static const std::vector<cv::Point2d> fine_grid = aboutGrid(kAboutStepPx, kAboutCoarsePx / 2);
   const double fine_step = coarse_deg / 2;
   double best = -1;
   double best_turn = 0;
   cv::Point2d best_at = centre;
   double best_off = 0;
-  for (const AboutPose& pose : first) {
-    for (const cv::Point2d& offset : fine_grid) {
-      const cv::Point2d at = pose.at + offset;
-      const double off = cv::norm(at - centre);
-      for (int k = -2; k <= 2; ++k) {
-        const double turn = pose.turn_deg + k * fine_step;
-        const double a = turn * kRadPerDeg;
-        if (!verifiesAtLeast(search.glance, search.glance_weight, at, std::cos(a), std::sin(a), 1.0,
-                             edges, loose, threshold - kGlanceSlack)) {
-          continue;
-        }
-        const double score = verifyScore(search.sparse, at, turn, edges, loose, false);
-        if (score > best || (score == best && off < best_off)) {
-          best = score;
-          best_turn = turn;
-          best_at = at;
-          best_off = off;
-        }
+  for (const cv::Point2d& offset : fine_grid) {
+    const cv::Point2d at = first.at + offset;
+    const double off = cv::norm(at - centre);
+    for (int k = -2; k <= 2; ++k) {
+      const double turn = first.turn_deg + k * fine_step;
+      const double a = turn * kRadPerDeg;
+      if (!verifiesAtLeast(search.glance, search.glance_weight, at, std::cos(a), std::sin(a), 1.0,
+                           edges, loose, threshold - kGlanceSlack)) {
+        continue;
+      }
+      const double score = verifyScore(search.sparse, at, turn, edges, loose, false);
+      if (score < threshold) continue;
+      // At the loose tolerance a sharp part screens whole a few pixels off
+      // (4 px: the turn scan below then fails at the model's tolerance):
+      // the share within that tolerance tells those poses apart; of poses
+      // still alike, the nearest to `centre`.
+      const double sharp =
+          score + verifyScore(search.sparse, at, turn, edges, model.edge_tolerance, false);
+      if (sharp > best || (sharp == best && off < best_off)) {
+        best = sharp;
+        best_turn = turn;
+        best_at = at;
+        best_off = off;
       }
     }
   }
-  if (best < threshold) return;
+  if (best < 0) return;
   const double fine = kScanStepPx / radius / kRadPerDeg;
   Candidate chosen{&model, ImagePose{best_at, 0, false}, -1, 0};
   for (double a = best_turn - fine_step; a <= best_turn + fine_step; a += fine) {
