@@ -154,10 +154,12 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
              const EdgeDistance& edges, std::vector<Candidate>* out);
 
 // The pose of `model` with its reference point at or within a dozen pixels
-// of `centre` (image coordinates) that screens best on `edges`, the turn
-// scanned over the whole circle coarse to fine as an arc's turn is:
-// appended to `out` when it screens as well as propose() asks. For a part
-// whose corners and arcs the blob's outline does not show as the model's.
+// of `centre` (image coordinates) that screens best, over the whole turn:
+// a first look on `wide` (a map of the same outline reaching kAboutWidePx
+// further than `edges`) at poses twice as far apart as the second, which
+// reads `edges` about the first look's best; appended to `out` when it
+// screens as well as propose() asks. For a part whose corners and arcs the
+// blob's outline does not show as the model's.
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
                   const EdgeDistance& edges, const EdgeDistance& wide, std::vector<Candidate>* out);
 
