@@ -267,45 +267,82 @@ TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blo
   CHECK(beside.front().touching);
 }
 
-TEST_CASE("blob search: a stretch of a part the mask lost is read from the grey levels",
-          "[vision][blob_search]") {
-  // The touching pair with the end of the L's short arm cut out of the mask,
-  // as a threshold loses a thin limb whose light is uneven at low contrast.
-  const Scene pair = touchingPair(false);
+namespace {
+// The touching pair with the end of the L's short arm, from `from_y` (in
+// the L's drawing) to past its end, cut out of the mask, as a threshold
+// loses a thin limb whose light is uneven at low contrast; the grey levels
+// where they still show the arm faint (darker than the surface by
+// `faint_share` of the contrast), and where the arm is truly missing (the surface's
+// level there).
+struct ArmCut {
+  Scene pair;
+  cv::Mat mask;
+  cv::Mat faint;
+  cv::Mat missing;
+};
+
+ArmCut armCut(double from_y, double faint_share) {
+  ArmCut cut{touchingPair(false), {}, {}, {}};
+  const Scene& pair = cut.pair;
   const ps::ShapeMoments lm = ps::shapeMoments(lDrawing());
   const double c = std::cos(25 * M_PI / 180);
   const double s = std::sin(25 * M_PI / 180);
   std::vector<cv::Point> tip;
-  for (const cv::Point2d d :
-       {cv::Point2d(-3, 65), cv::Point2d(33, 65), cv::Point2d(33, 74), cv::Point2d(-3, 74)}) {
+  for (const cv::Point2d d : {cv::Point2d(-3, from_y), cv::Point2d(33, from_y), cv::Point2d(33, 74),
+                              cv::Point2d(-3, 74)}) {
     const cv::Point2d q(d.x - lm.cx, d.y - lm.cy);
     tip.emplace_back(static_cast<int>(std::lround(pair.l_pose.centre.x + c * q.x - s * q.y)),
                      static_cast<int>(std::lround(pair.l_pose.centre.y + s * q.x + c * q.y)));
   }
-  cv::Mat mask = binarize(pair.grey, {});
-  cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(0));
+  cut.mask = binarize(pair.grey, {});
+  cv::fillPoly(cut.mask, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(0));
+  cv::Mat in_tip(cut.mask.size(), CV_8UC1, cv::Scalar(0));
+  cv::fillPoly(in_tip, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(255));
+  cut.faint = pair.grey.clone();
+  cut.faint.setTo(cv::Scalar(200 - faint_share * 155), in_tip & (pair.grey < 190));
+  cut.missing = pair.grey.clone();
+  cv::fillPoly(cut.missing, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(200));
+  return cut;
+}
+}  // namespace
+
+TEST_CASE("blob search: a stretch of a part the mask lost is read from the grey levels",
+          "[vision][blob_search]") {
+  // The arm's last 5 px, faint at 0.6 of the contrast: the L's boundary
+  // there is on a part, not the background; truly missing, the L's model
+  // crosses the background there, as a look-alike would.
+  const ArmCut cut = armCut(65, 0.6);
   const auto lFound = [&](const cv::Mat& grey) {
-    const auto regions = findRegions(mask, {}, grey);
+    const auto regions = findRegions(cut.mask, {}, grey);
     REQUIRE(regions.size() == 1);
     for (const auto& m : locateInBlob(regions, 0, {&models().l, &models().b})) {
-      if (m.model == &models().l &&
-          std::hypot(m.centroid.x - pair.l_pose.centre.x, m.centroid.y - pair.l_pose.centre.y) < 2)
+      if (m.model == &models().l && std::hypot(m.centroid.x - cut.pair.l_pose.centre.x,
+                                               m.centroid.y - cut.pair.l_pose.centre.y) < 2)
         return true;
     }
     return false;
   };
-  // The grey levels still show the arm, darker than the surface by 0.6 of
-  // the contrast: the L's boundary there is on a part, not the background.
-  cv::Mat in_tip(mask.size(), CV_8UC1, cv::Scalar(0));
-  cv::fillPoly(in_tip, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(255));
-  cv::Mat faint = pair.grey.clone();
-  faint.setTo(cv::Scalar(200 - 0.6 * 155), in_tip & (pair.grey < 122));
-  CHECK(lFound(faint));
-  // The arm truly missing (the surface's level where it was): the L's model
-  // crosses the background there, as a look-alike would.
-  cv::Mat missing = pair.grey.clone();
-  cv::fillPoly(missing, std::vector<std::vector<cv::Point>>{tip}, cv::Scalar(200));
-  CHECK_FALSE(lFound(missing));
+  CHECK(lFound(cut.faint));
+  CHECK_FALSE(lFound(cut.missing));
+}
+
+TEST_CASE("blob search: a part lying off its blob where the grey levels show it is placed",
+          "[vision][blob_search]") {
+  // The arm's last 9.5 px lost: 6.8 % of the L lies off its blob, more
+  // than a placed part may (kMaxOutside, 6 %). Where the grey levels show
+  // that stretch (at 0.9 of the contrast) it is the part's, not off it: the
+  // L verified at its pose is placed. Truly missing, it is not.
+  const ArmCut cut = armCut(60.5, 0.45);
+  const auto placed = [&](const cv::Mat& grey) {
+    const auto regions = findRegions(cut.mask, {}, grey);
+    REQUIRE(regions.size() == 1);
+    const std::vector<const PartModel*> list{&models().l, &models().b};
+    BlobSearch search(regions, 0, list, nullptr);
+    const Candidate verified{&models().l, cut.pair.l_pose, 0.9, 0.1, 0};
+    return search.place(verified);
+  };
+  CHECK(placed(cut.faint));
+  CHECK_FALSE(placed(cut.missing));
 }
 
 namespace {

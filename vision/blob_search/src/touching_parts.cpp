@@ -389,6 +389,14 @@ bool FaintPart::at(cv::Point2d p) const {
   return faint_.at<uint8_t>(y, x) != 0;
 }
 
+int FaintPart::countIn(const cv::Mat& drawn, cv::Rect box) const {
+  const cv::Rect both = box & cv::Rect(origin_, faint_.size());
+  if (faint_.empty() || both.empty()) return 0;
+  cv::Mat faint;
+  cv::bitwise_and(drawn(both - box.tl()), faint_(both - origin_), faint);
+  return cv::countNonZero(faint);
+}
+
 BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
                        const std::vector<const PartModel*>& models, const EdgeDistance* built_edges)
     : region_(regions[index]), index_(index) {
@@ -528,11 +536,22 @@ bool BlobSearch::place(const Candidate& c) {
   // blob without the part lying off it. Counted in, it put a good pose of
   // a part 90 px long 6.8 % off its blob.
   const int seam = std::max(0, p.area - static_cast<int>(std::lround(m.body.area)));
-  const int off_blob = p.area - coveredIn(p.drawn, box);
-  if (off_blob - seam > kMaxOutside * p.area) return false;
+  const int covered = coveredIn(p.drawn, box);
+  int off_blob = p.area - covered;
+  // Off the blob but where the grey levels show the part faint (a thin limb
+  // the threshold dropped at low contrast): not off the part. Made only
+  // for a pose that would otherwise be refused (see crossesBackground).
+  if (off_blob - seam > kMaxOutside * p.area) {
+    if (!faint_) faint_.emplace(region_, blob_, blob_box_);
+    const cv::Rect both = box & blob_box_;
+    cv::Mat drawn_off = p.drawn.clone();
+    if (!both.empty()) drawn_off(both - box.tl()).setTo(0, blob_(both - blob_box_.tl()));
+    off_blob -= faint_->countIn(drawn_off, box);
+    if (off_blob - seam > kMaxOutside * p.area) return false;
+  }
   // Crossing the background, only a candidate that is its blob whole
   // stays (kMaxOnBackground).
-  if (crosses && blob_pixels_ - (p.area - off_blob) > kMaxOutside * p.area) return false;
+  if (crosses && blob_pixels_ - covered > kMaxOutside * p.area) return false;
   placed_.push_back(std::move(p));
   changed_ = true;
   return true;

@@ -89,6 +89,9 @@ class FaintPart {
   // `blob`: 255 on the blob's pixels, over `blob_box` (image coordinates).
   FaintPart(const Region& r, const cv::Mat& blob, cv::Rect blob_box);
   bool at(cv::Point2d p) const;
+  // How many of the pixels `drawn` (255 on them, over `box`, image
+  // coordinates) covers are faint.
+  int countIn(const cv::Mat& drawn, cv::Rect box) const;
 
  private:
   cv::Mat faint_;  // 255 where faint, over the region's grey box
