@@ -48,11 +48,14 @@ struct SilhouetteModels {
   }
 };
 
+// `front`: under a front light, binarized as LOCATE binarizes by default,
+// each type taught from the largest region of its image (a textured belt's
+// blotches are regions too), as LEARN takes the dominant part.
 inline SilhouetteModels trainSilhouettes(const std::vector<SilhouetteSpec>& specs,
                                          const synthetic::SilhouetteSceneOptions& look,
-                                         uint64_t first_seed = 7) {
+                                         uint64_t first_seed = 7, bool front = false) {
   vision::TrainOptions train;
-  train.binarize = silhouetteBinarization();
+  if (!front) train.binarize = silhouetteBinarization();
   SilhouetteModels out;
   for (size_t i = 0; i < specs.size(); ++i) {
     const SilhouetteSpec& spec = specs[i];
@@ -68,7 +71,18 @@ inline SilhouetteModels trainSilhouettes(const std::vector<SilhouetteSpec>& spec
     const int side = static_cast<int>(spec.size_px * 1.5) + 300;
     const cv::Mat image =
         synthetic::renderSilhouetteAlone(out.types.back(), side, look, first_seed + i, nullptr);
-    auto outcome = vision::trainModel(image, static_cast<int>(i), spec.name, train);
+    const auto outcome = [&] {
+      if (!front) return vision::trainModel(image, static_cast<int>(i), spec.name, train);
+      const auto regions =
+          vision::findRegions(vision::binarize(image, train.binarize), train.regions, image);
+      REQUIRE_FALSE(regions.empty());
+      size_t largest = 0;
+      for (size_t k = 1; k < regions.size(); ++k) {
+        if (regions[k].area > regions[largest].area) largest = k;
+      }
+      return vision::trainModelFromRegion(image, regions[largest], static_cast<int>(i), spec.name,
+                                          train);
+    }();
     INFO(spec.name << ": " << (outcome ? std::string() : outcome.error().message));
     REQUIRE(outcome.ok());
     out.chiral.push_back(!outcome.value().body.mirror_symmetric);
@@ -93,13 +107,16 @@ inline synthetic::SilhouetteSceneOptions smallScene(
 }
 
 // Frame `frame` of a scene recognized with every model.
+// `front`: binarized as LOCATE binarizes by default (see trainSilhouettes).
 inline std::vector<vision::Match> recognizeSilhouettes(const synthetic::SilhouetteScene& scene,
                                                        uint64_t frame,
-                                                       const SilhouetteModels& models) {
+                                                       const SilhouetteModels& models,
+                                                       bool front = false) {
   const cv::Mat grey = scene.render(frame);
-  return vision::recognize(
-      vision::findRegions(vision::binarize(grey, silhouetteBinarization()), {}, grey),
-      models.list());
+  const vision::BinarizeOptions binarization =
+      front ? vision::BinarizeOptions{} : silhouetteBinarization();
+  return vision::recognize(vision::findRegions(vision::binarize(grey, binarization), {}, grey),
+                           models.list());
 }
 
 // The drawn part a report is about: the one whose centroid lies within
