@@ -104,7 +104,8 @@ class BlobSearch {
  private:
   // Whether more of the boundary of `m` at `pose` than a part can show lies
   // off the edges on the background, and not on a faint part the mask lost
-  // (kMaxOnBackground, FaintPart).
+  // nor on a stretch of the part too thin to show (kMaxOnBackground,
+  // FaintPart, kThinHalfWidthPx).
   bool crossesBackground(const PartModel& m, const ImagePose& pose);
   // The share of the boundary of `m` at `pose` on the blob's outline (see
   // kMinOnOutline).
