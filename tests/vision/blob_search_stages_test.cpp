@@ -279,6 +279,12 @@ struct ArmCut {
   cv::Mat mask;
   cv::Mat faint;
   cv::Mat missing;
+  // The one blob of the mask, read with `grey`'s levels.
+  std::vector<Region> regions(const cv::Mat& grey) const {
+    auto found = findRegions(mask, {}, grey);
+    REQUIRE(found.size() == 1);
+    return found;
+  }
 };
 
 ArmCut armCut(double from_y, double faint_share) {
@@ -313,9 +319,7 @@ TEST_CASE("blob search: a stretch of a part the mask lost is read from the grey 
   // crosses the background there, as a look-alike would.
   const ArmCut cut = armCut(65, 0.6);
   const auto lFound = [&](const cv::Mat& grey) {
-    const auto regions = findRegions(cut.mask, {}, grey);
-    REQUIRE(regions.size() == 1);
-    for (const auto& m : locateInBlob(regions, 0, {&models().l, &models().b})) {
+    for (const auto& m : locateInBlob(cut.regions(grey), 0, {&models().l, &models().b})) {
       if (m.model == &models().l && std::hypot(m.centroid.x - cut.pair.l_pose.centre.x,
                                                m.centroid.y - cut.pair.l_pose.centre.y) < 2)
         return true;
@@ -334,8 +338,7 @@ TEST_CASE("blob search: a part lying off its blob where the grey levels show it 
   // L verified at its pose is placed. Truly missing, it is not.
   const ArmCut cut = armCut(60.5, 0.45);
   const auto placed = [&](const cv::Mat& grey) {
-    const auto regions = findRegions(cut.mask, {}, grey);
-    REQUIRE(regions.size() == 1);
+    const auto regions = cut.regions(grey);
     const std::vector<const PartModel*> list{&models().l, &models().b};
     BlobSearch search(regions, 0, list, nullptr);
     const Candidate verified{&models().l, cut.pair.l_pose, 0.9, 0.1, 0};

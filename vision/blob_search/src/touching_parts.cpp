@@ -225,6 +225,19 @@ std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const Imag
   return polys;
 }
 
+// `m` drawn at `pose` (255 on it) over `*box`, its outline's box widened by
+// `margin` pixels all round (image coordinates).
+cv::Mat drawnPart(const PartModel& m, const ImagePose& pose, int margin, cv::Rect* box) {
+  const auto outline = placedOutline(m, pose);
+  cv::Rect around;
+  for (const auto& poly : outline) around |= cv::boundingRect(poly);
+  *box = cv::Rect(around.x - margin, around.y - margin, around.width + 2 * margin + 1,
+                  around.height + 2 * margin + 1);
+  cv::Mat drawn(box->size(), CV_8UC1, cv::Scalar(0));
+  cv::fillPoly(drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box->tl());
+  return drawn;
+}
+
 // Pixels two placed candidates share.
 int sharedPixels(const Placed& a, const Placed& b) {
   const cv::Rect both = a.box & b.box;
@@ -511,11 +524,15 @@ double BlobSearch::onOutline(const PartModel& m, const ImagePose& pose) {
 }
 
 bool BlobSearch::crossesBackground(const PartModel& m, const ImagePose& pose) {
-  const auto share = [&](const FaintPart* faint) {
+  // The share of boundary samples off the edges on the background, less
+  // those on a faint part and those `thin` leaves out.
+  const auto share = [&](const FaintPart* faint, const auto& thin) {
     return boundaryShare(m, pose, [&](cv::Point2d p) {
-      return edges_->at(p) > m.edge_tolerance && coverage_->at(p) < 0.5 && !(faint && faint->at(p));
+      return edges_->at(p) > m.edge_tolerance && coverage_->at(p) < 0.5 &&
+             !(faint && faint->at(p)) && !thin(p);
     });
   };
+  const auto none = [](cv::Point2d) { return false; };
   // The faint part only takes points out of the share: under the limit
   // without it, under it with it. It costs more than the rest of placing
   // (connected components over the blob's box), so it is made only for a
@@ -523,20 +540,15 @@ bool BlobSearch::crossesBackground(const PartModel& m, const ImagePose& pose) {
   // (touching silhouettes, 15 types, recognition median: 9.3 ms before
   // the faint part, 14.6 ms with it made for every blob, 9.5-10.2 ms
   // made only when needed).
-  if (share(nullptr) <= kMaxOnBackground) return false;
+  if (share(nullptr, none) <= kMaxOnBackground) return false;
   if (!faint_) faint_.emplace(region_, blob_, blob_box_);
-  if (share(&*faint_) <= kMaxOnBackground) return false;
+  if (share(&*faint_, none) <= kMaxOnBackground) return false;
   // Then without the part's thin stretches (kThinHalfWidthPx): the part
   // drawn at its pose, each pixel's distance from its outline.
-  const auto outline = placedOutline(m, pose);
   cv::Rect box;
-  for (const auto& poly : outline) box |= cv::boundingRect(poly);
-  box = cv::Rect(box.x - kThinReachPx, box.y - kThinReachPx, box.width + 2 * kThinReachPx + 1,
-                 box.height + 2 * kThinReachPx + 1);
-  cv::Mat drawn(box.size(), CV_8UC1, cv::Scalar(0));
-  cv::fillPoly(drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
   cv::Mat depth;
-  cv::distanceTransform(drawn, depth, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(drawnPart(m, pose, kThinReachPx, &box), depth, cv::DIST_L2,
+                        cv::DIST_MASK_PRECISE);
   const auto thin = [&](cv::Point2d p) {
     const int x = static_cast<int>(std::lround(p.x)) - box.x;
     const int y = static_cast<int>(std::lround(p.y)) - box.y;
@@ -548,10 +560,7 @@ bool BlobSearch::crossesBackground(const PartModel& m, const ImagePose& pose) {
     cv::minMaxLoc(depth(near), nullptr, &deepest);
     return deepest < kThinHalfWidthPx;
   };
-  return boundaryShare(m, pose, [&](cv::Point2d p) {
-           return edges_->at(p) > m.edge_tolerance && coverage_->at(p) < 0.5 && !faint_->at(p) &&
-                  !thin(p);
-         }) > kMaxOnBackground;
+  return share(&*faint_, thin) > kMaxOnBackground;
 }
 
 bool BlobSearch::place(const Candidate& c) {
@@ -565,12 +574,9 @@ bool BlobSearch::place(const Candidate& c) {
   const bool crosses = crossesBackground(m, c.pose);
   if (!verified && crosses) return false;
   if (onOutline(m, c.pose) < kMinOnOutline) return false;
-  const auto outline = placedOutline(m, c.pose);
   cv::Rect box;
-  for (const auto& poly : outline) box |= cv::boundingRect(poly);
-  box += cv::Size(1, 1);
-  Placed p{&c, box, cv::Mat(box.size(), CV_8UC1, cv::Scalar(0)), 0};
-  cv::fillPoly(p.drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box.tl());
+  cv::Mat drawn = drawnPart(m, c.pose, 0, &box);
+  Placed p{&c, box, std::move(drawn), 0};
   p.area = cv::countNonZero(p.drawn);
   if (p.area <= 0) return false;
   // The outline drawn whole covers its boundary's pixels (about half a
