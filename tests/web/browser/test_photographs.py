@@ -125,8 +125,15 @@ def test_every_coin_from_six_taught_in_the_page(coins_page):
         wait_until(lambda: field("area_tolerance").get_attribute("value") == "0.1",
                    what=f"type {n}'s tolerances in the page")
         for key, value in (("area_tolerance", "0.35"), ("verify_percent", "55")):
-            field(key).clear()
-            field(key).send_keys(value)
+            # Typed again until the field holds it: on a loaded machine (the
+            # sanitizer build's CI) a field cleared by the test was once sent
+            # empty (`area_tolerance none`), the typing lost.
+            def typed(key=key, value=value):
+                if field(key).get_attribute("value") != value:
+                    field(key).clear()
+                    field(key).send_keys(value)
+                return field(key).get_attribute("value") == value
+            wait_until(typed, what=f"type {n}'s {key} typed")
         browser.driver.find_element(By.CSS_SELECTOR, f"{row_css} .tolerance-save").click()
         wait_until(lambda: f"< OK {n} " in browser.driver.find_element(By.ID, "tolerance-reply").text,
                    what=f"the TOLERANCE reply of type {n}")
