@@ -225,6 +225,7 @@ int main(int argc, char** argv) {
   bool stages = false;
   std::string save_frames;
   bool keep_shadows = false;
+  double blur_sigma = ps::SilhouetteSceneOptions{}.blur_sigma;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> conditions = {"clean",        "textured", "shadow", "glossy",
                                          "low-contrast", "colour",   "wood",   "metal"};
@@ -253,6 +254,11 @@ int main(int argc, char** argv) {
   app.add_flag("--stages", stages,
                "also time binarization and the region pass alone (medians, ms): where the time "
                "goes");
+  app.add_option("--blur", blur_sigma,
+                 "the lens's blur (Gaussian sigma, px) of scenes and teach images: a camera out "
+                 "of focus")
+      ->check(CLI::Range(0.0, 5.0))
+      ->capture_default_str();
   app.add_flag("--keep-shadows", keep_shadows,
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
                "costs)");
@@ -275,6 +281,7 @@ int main(int argc, char** argv) {
   for (const auto& condition : conditions) {
     ps::SilhouetteSceneOptions look;
     ps::frontLightCondition(condition, &look.front, &look.part_level, &look.background_level);
+    look.blur_sigma = blur_sigma;
     // The vision app's defaults, with the window a user sets for these parts.
     pc::VisionOptions options;
     options.binarize.adaptive_window = kWindow;
