@@ -801,12 +801,13 @@ bool readLocally(int reach, const RowRuns& interior, Dilations& dilations, BandP
 // (see shadows.hpp): there each band pixel is read against the shadow's
 // level beside it (outsideLevels), not the surface's.
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
-                 const cv::Mat& set, const cv::Mat& zone, const cv::Rect& box, cv::Moments* moments,
-                 cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin, RowRuns* covered) {
+                 const cv::Mat& set, const cv::Mat& zone, double blur_px, const cv::Rect& box,
+                 cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin,
+                 RowRuns* covered) {
   std::vector<float> raw_row(static_cast<size_t>(box.width));
   BandPixels pixels{grey_box, own, set, raw_row.data(), {}, {}};
   if (!zone.empty() && cv::countNonZero(zone) > 0) {
-    pixels.local = outsideLevels(grey_box, own, set == 0, zone);
+    pixels.local = outsideLevels(grey_box, own, set == 0, zone, blur_px);
   }
   Dilations dilations(own_runs);
   BandReading kept;
@@ -921,7 +922,7 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
 // where they can be trusted), orientation and elongation. Moves its
 // contours out. False, nothing written, for a region smaller than
 // options.min_area.
-bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone,
+bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone, double blur_px,
                    const RegionOptions& options, std::vector<std::vector<cv::Point>>& contours,
                    const std::vector<cv::Vec4i>& hierarchy, const std::vector<cv::Rect>& boxes,
                    int i, Region* region) {
@@ -973,7 +974,7 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   r.glints = static_cast<int>(glints.size());
 
   if (!grey.empty() &&
-      greyMoments(grey(box), own, own_runs, set, zone.empty() ? cv::Mat() : zone(box), box,
+      greyMoments(grey(box), own, own_runs, set, zone.empty() ? cv::Mat() : zone(box), blur_px, box,
                   &r.moments, &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
     r.area = r.moments.m00;
   } else {
@@ -1108,8 +1109,8 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
     for (int k = range.start; k < range.end; ++k) {
       const int i = outers[static_cast<size_t>(k)];
       kept[static_cast<size_t>(k)] =
-          measureRegion(cut, grey, shadows.zone, options, contours, hierarchy, boxes, i,
-                        &found[static_cast<size_t>(k)])
+          measureRegion(cut, grey, shadows.zone, shadows.blur_px, options, contours, hierarchy,
+                        boxes, i, &found[static_cast<size_t>(k)])
               ? 1
               : 0;
     }

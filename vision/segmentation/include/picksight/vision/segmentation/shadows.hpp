@@ -32,6 +32,10 @@ struct ShadowCut {
   // empty when no shadow was cut.
   cv::Mat zone;
   int shadows = 0;  // regions a shadow was cut from
+  // The lens's blur (a Gaussian's sigma, px) read at the edges of the
+  // regions a shadow was cut from (their median): how far out the level
+  // beside a part is read past its own edge's blur (outsideLevels).
+  double blur_px = 0;
 };
 
 ShadowCut cutShadows(const cv::Mat& mask, const cv::Mat& grey,
@@ -39,13 +43,15 @@ ShadowCut cutShadows(const cv::Mat& mask, const cv::Mat& grey,
                      const std::vector<cv::Vec4i>& hierarchy, double min_area);
 
 // The level just outside a part, where `where` is set (CV_32F over the
-// part's box; -1 elsewhere): the levels of a ring 2 to 5 pixels out of
-// `own` (past the edge's blur, within a shadow) over `free` pixels (not
-// another region's), averaged with Gaussian weights of 2.5 px, so that each
-// stretch of edge is read against what lies beside it, a shadow whose
-// level changes along the part with its width, or the lit surface.
+// part's box; -1 elsewhere): the levels of a ring 1 to 2 pixels out of
+// `own` (past a sharp edge's blur, within a shadow; further out for a lens
+// blurring by `blur_px`, a Gaussian's sigma) over `free` pixels (not
+// another region's), averaged with Gaussian weights of 1.5 px (more
+// further out), so that each stretch of edge is read against what lies
+// beside it, a shadow whose level changes along the part with its width,
+// or the lit surface.
 cv::Mat outsideLevels(const cv::Mat& grey, const cv::Mat& own, const cv::Mat& free,
-                      const cv::Mat& where);
+                      const cv::Mat& where, double blur_px);
 
 // The median of `values` (reordered); 0 when empty.
 double medianOf(std::vector<float>& values);
