@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "picksight/vision/segmentation/colour_axis.hpp"
 
@@ -49,4 +50,32 @@ TEST_CASE("types taught in one colour on one surface are projected once", "[visi
   // An axis of another colour still counts.
   const cv::Mat with_red = pv::projectOnColourAxes(image, {first, again, {kRed, kSurface}});
   CHECK(with_red.at<uint8_t>(40, 130) == Approx(pv::kColourPartLevel).margin(2));
+}
+
+TEST_CASE("over a whole frame darkened towards its rim a part is set apart by its hue",
+          "[vision][colour]") {
+  // The surface's colour is read on the rectangle's rim; over a whole frame
+  // under a vignette the rim is darker than the lit middle, which the whole
+  // colour difference then set apart instead of the part.
+  cv::Mat bgr(300, 400, CV_8UC3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    for (int x = 0; x < bgr.cols; ++x) {
+      const double u = (x + 0.5) / bgr.cols - 0.5;
+      const double v = (y + 0.5) / bgr.rows - 0.5;
+      const double light = 1.0 - 0.6 * (u * u + v * v);
+      bgr.at<cv::Vec3b>(y, x) = cv::Vec3b::all(cv::saturate_cast<uint8_t>(kSurface[0] * light));
+    }
+  }
+  cv::circle(bgr, {200, 150}, 25, cv::Scalar(kGreen[0], kGreen[1], kGreen[2]), cv::FILLED);
+  cv::Mat noisy;
+  bgr.convertTo(noisy, CV_32FC3);
+  cv::Mat noise(bgr.size(), CV_32FC3);
+  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(3));
+  noisy += noise;
+  noisy.convertTo(bgr, CV_8UC3);
+  const auto axis = pv::colourAxisIn(bgr, cv::Rect(0, 0, bgr.cols, bgr.rows));
+  REQUIRE(axis.has_value());
+  CAPTURE(axis->part, axis->background);
+  CHECK(cv::norm(axis->part - kGreen) < 15);
+  CHECK(pv::colourSeparatesBetter(*axis));
 }

@@ -6,14 +6,19 @@
 // taught beside its shadow is found beside shadows falling elsewhere.
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "picksight/app/offline_commands.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/angles.hpp"
 #include "picksight/common/frame.hpp"
@@ -230,6 +235,43 @@ TEST_CASE("a green part on a grey belt of the same brightness is taught and foun
   const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
   const LocateOutcome located = locateInFrame(frame, cellOptions(), listOf(learned->model), -1);
   CHECK(foundTrue(scene.truth(), located.parts) == static_cast<int>(scene.truth().size()));
+}
+
+TEST_CASE("a green part on a grey belt is taught from a colour image file without a rectangle",
+          "[vision_app][colour][front][offline]") {
+  // A camera's colour image saved to a file is read in colour by the offline
+  // commands, as the live frame is (they read every file in grey, where this
+  // part is the belt's level). Over the whole frame, the surface's colour
+  // read on its rim (darkened by the vignette) set the frame's lit middle
+  // apart, not the part: the part is told by its hue.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("picksight-offline-colour-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  ps::SilhouetteSceneOptions o = lookOf("colour");
+  const cv::Mat alone = ps::renderSilhouetteAlone(boneType(), 630, o, 13, nullptr, 30);
+  REQUIRE(cv::imwrite((dir / "part.png").string(), alone));
+  o.width = 1280;
+  o.height = 960;
+  o.parts = 8;
+  o.distractor_share = 0;
+  const ps::SilhouetteScene scene({boneType()}, {true}, o);
+  REQUIRE(cv::imwrite((dir / "scene.png").string(), scene.render(0)));
+  const auto run = [&](const std::string& command, const std::string& image) {
+    std::vector<std::string> args{command, "--data-dir", (dir / "data").string(), "--window",
+                                  "400"};
+    if (command == "learn") args.insert(args.end(), {"--type", "1", "--name", "tee"});
+    args.push_back((dir / image).string());
+    std::ostringstream out, err;
+    const int status = app::runOfflineCommand(args, out, err);
+    INFO(err.str());
+    CHECK(status == 0);
+    return out.str();
+  };
+  CHECK_THAT(run("learn", "part.png"), Catch::StartsWith("OK 1 tee "));
+  const std::string located = run("locate", "scene.png");
+  CHECK_THAT(located, Catch::StartsWith("OK " + std::to_string(scene.truth().size()) + " "));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("a model's colour survives its file, and a damaged colour is refused",

@@ -82,6 +82,46 @@ cv::Mat projectOnColourAxes(const cv::Mat& bgr, const std::vector<ColourAxis>& a
   return out;
 }
 
+namespace {
+// How far each pixel of `box` lies from `background` (saturated to 8 bits):
+// its whole colour difference, or (`hue_only`) only the part of it across
+// the background's own colour, which a change of light along the surface
+// (the lamp's fall-off, a vignette, a blotch of the belt's grey) does not
+// move, since it scales a colour along itself.
+cv::Mat distanceFrom(const cv::Mat& box, const cv::Vec3d& background, bool hue_only) {
+  const double b2 = background.dot(background);
+  cv::Mat distance(box.size(), CV_8UC1);
+  for (int y = 0; y < box.rows; ++y) {
+    const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
+    uint8_t* d = distance.ptr<uint8_t>(y);
+    for (int x = 0; x < box.cols; ++x) {
+      const cv::Vec3d c(p[x][0], p[x][1], p[x][2]);
+      const cv::Vec3d v =
+          hue_only && b2 > 0 ? c - background * (c.dot(background) / b2) : c - background;
+      d[x] = cv::saturate_cast<uint8_t>(std::sqrt(v.dot(v)));
+    }
+  }
+  return distance;
+}
+
+// The part's colour in `box`: the median of the pixels Otsu's split of
+// `distance` sets apart; none when it sets none apart.
+std::optional<cv::Vec3d> farColour(const cv::Mat& box, const cv::Mat& distance) {
+  cv::Mat far;
+  cv::threshold(distance, far, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  std::vector<cv::Vec3b> part;
+  for (int y = 0; y < box.rows; ++y) {
+    const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
+    const uint8_t* f = far.ptr<uint8_t>(y);
+    for (int x = 0; x < box.cols; ++x) {
+      if (f[x]) part.push_back(p[x]);
+    }
+  }
+  if (part.empty()) return std::nullopt;
+  return medianColour(part, nullptr);
+}
+}  // namespace
+
 std::optional<ColourAxis> colourAxisIn(const cv::Mat& bgr, const cv::Rect& rect) {
   CV_Assert(bgr.type() == CV_8UC3);
   const cv::Rect r = rect & cv::Rect(0, 0, bgr.cols, bgr.rows);
@@ -99,31 +139,18 @@ std::optional<ColourAxis> colourAxisIn(const cv::Mat& bgr, const cv::Rect& rect)
   double spread = 0;
   ColourAxis axis;
   axis.background = medianColour(rim, &spread);
-  // Distance from the surface's colour, on 8 bits for Otsu.
-  cv::Mat distance(box.size(), CV_8UC1);
-  for (int y = 0; y < box.rows; ++y) {
-    const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
-    uint8_t* d = distance.ptr<uint8_t>(y);
-    for (int x = 0; x < box.cols; ++x) {
-      const cv::Vec3d v = cv::Vec3d(p[x][0], p[x][1], p[x][2]) - axis.background;
-      d[x] = cv::saturate_cast<uint8_t>(std::sqrt(v.dot(v)));
-    }
+  const double min_apart = std::max(kMinColourDistance, kMinDistanceOverSpread * spread);
+  // Split on the whole colour difference first; where that sets apart the
+  // surface's own light (a whole frame's rim, darkened by the vignette, set
+  // its lit middle apart, and the part was a few percent of it), on the
+  // difference across the surface's colour alone.
+  for (const bool hue_only : {false, true}) {
+    const auto part = farColour(box, distanceFrom(box, axis.background, hue_only));
+    if (!part) continue;
+    axis.part = *part;
+    if (cv::norm(axis.part - axis.background) >= min_apart) return axis;
   }
-  cv::Mat far;
-  cv::threshold(distance, far, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
-  std::vector<cv::Vec3b> part;
-  for (int y = 0; y < box.rows; ++y) {
-    const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
-    const uint8_t* f = far.ptr<uint8_t>(y);
-    for (int x = 0; x < box.cols; ++x) {
-      if (f[x]) part.push_back(p[x]);
-    }
-  }
-  if (part.empty()) return std::nullopt;
-  axis.part = medianColour(part, nullptr);
-  const double apart = cv::norm(axis.part - axis.background);
-  if (apart < std::max(kMinColourDistance, kMinDistanceOverSpread * spread)) return std::nullopt;
-  return axis;
+  return std::nullopt;
 }
 
 bool colourSeparatesBetter(const ColourAxis& axis, double factor) {

@@ -2,6 +2,7 @@
 #include "picksight/app/offline_commands.hpp"
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <filesystem>
@@ -145,6 +146,15 @@ int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 }  // namespace
 
 namespace {
+// An image file as a camera delivers it: 8-bit grey, or 8-bit BGR for a
+// colour one (a colour camera's frame is read in colour where a model was
+// taught by its colour); empty when it cannot be read.
+cv::Mat readFrameImage(const std::string& path) {
+  cv::Mat image = cv::imread(path, cv::IMREAD_ANYCOLOR);
+  if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+  return image;
+}
+
 // learn, locate or blobs as the command line asks them.
 struct OfflineRequest {
   std::string command;
@@ -300,13 +310,13 @@ int testRun(const OfflineRequest& r, int expect, ModelLibrary& library,
   size_t passed = 0;
   for (const auto& path : r.images) {
     const std::string name = std::filesystem::path(path).filename().string();
-    const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (grey.empty()) {
+    const cv::Mat image = readFrameImage(path);
+    if (image.empty()) {
       row(name, "-", "FAIL not an image");
       continue;
     }
     const auto located = locateAndPick(calibration, &library, [&]() -> Result<LocateOutcome> {
-      return locateInFrame(frameFromImage(grey, path, 1), r.options.vision, library.snapshot(),
+      return locateInFrame(frameFromImage(image, path, 1), r.options.vision, library.snapshot(),
                            r.type);
     });
     if (!located) {
@@ -325,7 +335,7 @@ int testRun(const OfflineRequest& r, int expect, ModelLibrary& library,
 
 // picksight-vision learn on its one image: the model stored as LEARN
 // stores it. The exit status.
-int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string& path,
+int learnOffline(const OfflineRequest& r, const cv::Mat& image, const std::string& path,
                  ModelLibrary& library, std::ostream& out, std::ostream& err) {
   const std::string name = r.name.empty() ? "type" + std::to_string(r.type) : r.name;
   if (!validModelName(name)) {
@@ -335,7 +345,7 @@ int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string
   // As LEARN does it: the whole image binarized the way LOCATE will see it.
   const SensorMapping full;
   const auto learned =
-      learnInImage(grey, full, r.options.vision, library.snapshot(), r.type, name, r.at);
+      learnInImage(image, full, r.options.vision, library.snapshot(), r.type, name, r.at);
   if (!learned) {
     out << errorReply(learned.error()) << "\n";
     return 1;
@@ -346,7 +356,7 @@ int learnOffline(const OfflineRequest& r, const cv::Mat& grey, const std::string
     change += " --at " + std::to_string(r.at->x) + " " + std::to_string(r.at->y) + " " +
               std::to_string(r.at->width) + " " + std::to_string(r.at->height);
   }
-  auto stored = library.store(learned->model, change + " " + path, teachImagePng(grey));
+  auto stored = library.store(learned->model, change + " " + path, teachImagePng(image));
   if (!stored) {
     out << errorReply(VisionServiceErrc::kStorageFailed,
                       "cannot store the model: " + stored.error().message)
@@ -400,8 +410,8 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
   if (expect) return testRun(r, *expect, library, calibration, out);
   int status = 0;
   for (const auto& path : r.images) {
-    const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (grey.empty()) {
+    const cv::Mat image = readFrameImage(path);
+    if (image.empty()) {
       out << errorReply(ProtocolErrc::kBadArguments,
                         "cannot read image '" + printable(path, 200) + "'")
           << "\n";
@@ -409,13 +419,13 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       continue;
     }
     if (r.command == "learn") {
-      if (const int learned = learnOffline(r, grey, path, library, out, err); learned != 0)
+      if (const int learned = learnOffline(r, image, path, library, out, err); learned != 0)
         return learned;
     } else if (r.command == "locate") {
       // The robot's LOCATE path on the image: same frame (calibration of
       // the data dir), same grasps.
       const auto located = locateAndPick(calibration, &library, [&]() -> Result<LocateOutcome> {
-        return locateInFrame(frameFromImage(grey, path, 1), r.options.vision, library.snapshot(),
+        return locateInFrame(frameFromImage(image, path, 1), r.options.vision, library.snapshot(),
                              r.type);
       });
       if (!located) {
@@ -424,7 +434,8 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
       }
       out << locateReply(located->pick) << "\n";
     } else {
-      const auto blobs = blobsInImage(grey, r.options.vision);
+      const auto blobs =
+          blobsInImage(cell::greyImage(frameFromImage(image, path, 1)), r.options.vision);
       std::string line = "OK " + std::to_string(blobs.size());
       for (const auto& b : blobs) line += " " + blobSummary(b);
       out << line << "\n";
