@@ -56,13 +56,16 @@ TEST_CASE("over a whole frame darkened towards its rim a part is set apart by it
           "[vision][colour]") {
   // The surface's colour is read on the rectangle's rim; over a whole frame
   // under a vignette the rim is darker than the lit middle, which the whole
-  // colour difference then set apart instead of the part.
+  // colour difference then set apart instead of the part. And with the
+  // light falling off across the frame the rim's brightness spreads by
+  // more than a third of the part's colour difference, which is no doubt
+  // about the part's hue.
   cv::Mat bgr(300, 400, CV_8UC3);
   for (int y = 0; y < bgr.rows; ++y) {
     for (int x = 0; x < bgr.cols; ++x) {
       const double u = (x + 0.5) / bgr.cols - 0.5;
       const double v = (y + 0.5) / bgr.rows - 0.5;
-      const double light = 1.0 - 0.6 * (u * u + v * v);
+      const double light = (1.0 + 0.5 * u) * (1.0 - 0.6 * (u * u + v * v));
       bgr.at<cv::Vec3b>(y, x) = cv::Vec3b::all(cv::saturate_cast<uint8_t>(kSurface[0] * light));
     }
   }

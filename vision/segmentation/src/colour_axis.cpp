@@ -21,9 +21,8 @@ constexpr int kMinSide = 8;
 
 double luma(const cv::Vec3d& bgr) { return 0.114 * bgr[0] + 0.587 * bgr[1] + 0.299 * bgr[2]; }
 
-// The per-channel median of `pixels` (BGR), and their spread: the root mean
-// square distance from it.
-cv::Vec3d medianColour(std::vector<cv::Vec3b>& pixels, double* spread) {
+// The per-channel median of `pixels` (BGR).
+cv::Vec3d medianColour(std::vector<cv::Vec3b>& pixels) {
   cv::Vec3d m;
   for (int c = 0; c < 3; ++c) {
     std::vector<uint8_t> channel(pixels.size());
@@ -31,14 +30,6 @@ cv::Vec3d medianColour(std::vector<cv::Vec3b>& pixels, double* spread) {
     const auto mid = channel.begin() + static_cast<std::ptrdiff_t>(channel.size() / 2);
     std::nth_element(channel.begin(), mid, channel.end());
     m[c] = *mid;
-  }
-  if (spread) {
-    double sum = 0;
-    for (const auto& p : pixels) {
-      const cv::Vec3d d = cv::Vec3d(p[0], p[1], p[2]) - m;
-      sum += d.dot(d);
-    }
-    *spread = pixels.empty() ? 0 : std::sqrt(sum / static_cast<double>(pixels.size()));
   }
   return m;
 }
@@ -88,17 +79,21 @@ namespace {
 // the background's own colour, which a change of light along the surface
 // (the lamp's fall-off, a vignette, a blotch of the belt's grey) does not
 // move, since it scales a colour along itself.
-cv::Mat distanceFrom(const cv::Mat& box, const cv::Vec3d& background, bool hue_only) {
+double distanceOf(const cv::Vec3d& c, const cv::Vec3d& background, bool hue_only) {
   const double b2 = background.dot(background);
+  const cv::Vec3d v =
+      hue_only && b2 > 0 ? c - background * (c.dot(background) / b2) : c - background;
+  return std::sqrt(v.dot(v));
+}
+
+cv::Mat distanceFrom(const cv::Mat& box, const cv::Vec3d& background, bool hue_only) {
   cv::Mat distance(box.size(), CV_8UC1);
   for (int y = 0; y < box.rows; ++y) {
     const cv::Vec3b* p = box.ptr<cv::Vec3b>(y);
     uint8_t* d = distance.ptr<uint8_t>(y);
     for (int x = 0; x < box.cols; ++x) {
-      const cv::Vec3d c(p[x][0], p[x][1], p[x][2]);
-      const cv::Vec3d v =
-          hue_only && b2 > 0 ? c - background * (c.dot(background) / b2) : c - background;
-      d[x] = cv::saturate_cast<uint8_t>(std::sqrt(v.dot(v)));
+      d[x] = cv::saturate_cast<uint8_t>(
+          distanceOf(cv::Vec3d(p[x][0], p[x][1], p[x][2]), background, hue_only));
     }
   }
   return distance;
@@ -118,7 +113,7 @@ std::optional<cv::Vec3d> farColour(const cv::Mat& box, const cv::Mat& distance) 
     }
   }
   if (part.empty()) return std::nullopt;
-  return medianColour(part, nullptr);
+  return medianColour(part);
 }
 }  // namespace
 
@@ -136,19 +131,27 @@ std::optional<ColourAxis> colourAxisIn(const cv::Mat& bgr, const cv::Rect& rect)
     rim.push_back(box.at<cv::Vec3b>(y, 0));
     rim.push_back(box.at<cv::Vec3b>(y, box.cols - 1));
   }
-  double spread = 0;
   ColourAxis axis;
-  axis.background = medianColour(rim, &spread);
-  const double min_apart = std::max(kMinColourDistance, kMinDistanceOverSpread * spread);
+  axis.background = medianColour(rim);
   // Split on the whole colour difference first; where that sets apart the
   // surface's own light (a whole frame's rim, darkened by the vignette, set
   // its lit middle apart, and the part was a few percent of it), on the
-  // difference across the surface's colour alone.
+  // difference across the surface's colour alone. Each against the rim's
+  // own spread in that difference: a vignette spreads the rim's
+  // brightness, not its hue.
   for (const bool hue_only : {false, true}) {
+    double squares = 0;
+    for (const auto& p : rim) {
+      squares += std::pow(distanceOf(cv::Vec3d(p[0], p[1], p[2]), axis.background, hue_only), 2);
+    }
+    const double spread = std::sqrt(squares / static_cast<double>(rim.size()));
     const auto part = farColour(box, distanceFrom(box, axis.background, hue_only));
     if (!part) continue;
     axis.part = *part;
-    if (cv::norm(axis.part - axis.background) >= min_apart) return axis;
+    if (distanceOf(axis.part, axis.background, hue_only) >=
+        std::max(kMinColourDistance, kMinDistanceOverSpread * spread)) {
+      return axis;
+    }
   }
   return std::nullopt;
 }
