@@ -92,12 +92,23 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
   if (!light_.empty()) {
     base_ = light_ * o.background_level;
   }
+  // Under a front light the parts are drawn as coverage first, then lit with
+  // the surface's texture, their shading, shadows and glints.
+  const bool front = o.front.any();
+  if (front && o.front.colour) {
+    throw std::invalid_argument("SceneRenderer: a colour front light is not rendered in grey");
+  }
+  cv::Mat coverage = front ? cv::Mat::zeros(o.height, o.width, CV_32F) : cv::Mat();
   truth_.reserve(part_types.size());
   for (std::size_t i = 0; i < part_types.size(); ++i) {
     const SizedPartType& info = infos.at(part_types[i]);
     const Placement& p = placed[i];
-    drawPart(base_, light_, placedShape(info.shape, p.x, p.y, p.angle_deg),
-             o.part_level - o.background_level);
+    if (front) {
+      drawPart(coverage, cv::Mat(), placedShape(info.shape, p.x, p.y, p.angle_deg), 1.0);
+    } else {
+      drawPart(base_, light_, placedShape(info.shape, p.x, p.y, p.angle_deg),
+               o.part_level - o.background_level);
+    }
     PartTruth t;
     t.type = part_types[i];
     t.x = p.x;
@@ -107,6 +118,13 @@ SceneRenderer::SceneRenderer(SceneOptions options) : options_(std::move(options)
     t.area_px = info.area;
     t.touching = touching[i];
     truth_.push_back(std::move(t));
+  }
+  if (front) {
+    cv::min(coverage, 1.0, coverage);
+    const cv::Mat lamp =
+        light_.empty() ? cv::Mat(o.height, o.width, CV_32F, cv::Scalar(1)) : light_;
+    base_ = detail::shadeFrontLit(coverage, lamp, o.front, o.part_level, o.background_level, o.seed)
+                .front();
   }
   renderClean(nullptr, nullptr, std::nullopt);
 

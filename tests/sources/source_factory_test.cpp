@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <opencv2/imgproc.hpp>
+
 #include "picksight/sources/source.hpp"
 
 using namespace std::chrono_literals;
@@ -82,4 +84,45 @@ TEST_CASE("makeSource synthetic: with no options uses the defaults", "[video_ser
   REQUIRE((*source)->open());
   CHECK((*source)->info().sensor_width > 0);
   CHECK((*source)->info().sensor_height > 0);
+}
+
+TEST_CASE("makeSource synthetic: a front light's scene with its belt and shadows",
+          "[video_server]") {
+  // The front lights the vision app is measured under, for trying a cell's
+  // settings without its camera; grey only, as this camera is.
+  CHECK_THAT(badConfigMessage("synthetic:light=colour"),
+             Catch::StartsWith("synthetic: light must be") && Catch::Contains("low-contrast"));
+  const auto frameUnder = [](const std::string& light) {
+    auto source =
+        makeSource("synthetic:width=640,height=480,parts=3,seed=7,noise=0,light=" + light);
+    REQUIRE(source);
+    REQUIRE((*source)->open());
+    auto frame = (*source)->grab(1000ms);
+    REQUIRE(frame);
+    REQUIRE(frame->image.type() == CV_8UC1);
+    return *frame;
+  };
+  const auto uneven = frameUnder("uneven");
+  const auto textured = frameUnder("textured");
+  const auto shadow = frameUnder("shadow");
+  // The same parts under every light: the truth is the part.
+  REQUIRE(textured.truth.size() == uneven.truth.size());
+  REQUIRE(shadow.truth.size() == uneven.truth.size());
+  for (size_t i = 0; i < uneven.truth.size(); ++i) {
+    CHECK(textured.truth[i].x == uneven.truth[i].x);
+    CHECK(shadow.truth[i].y == uneven.truth[i].y);
+  }
+  // The belt's grain and blotches: detail a smooth light has not.
+  cv::Mat smooth;
+  cv::Mat grainy;
+  cv::Laplacian(uneven.image, smooth, CV_32F);
+  cv::Laplacian(textured.image, grainy, CV_32F);
+  CHECK(cv::mean(cv::abs(grainy))[0] > 4 * cv::mean(cv::abs(smooth))[0]);
+  // A cast shadow only darkens the surface beside each part.
+  cv::Mat darker;
+  cv::Mat lighter;
+  cv::subtract(textured.image, shadow.image, darker);
+  cv::subtract(shadow.image, textured.image, lighter);
+  CHECK(cv::countNonZero(darker > 20) > 300);
+  CHECK(cv::countNonZero(lighter > 1) == 0);
 }

@@ -45,8 +45,22 @@ Result<SyntheticSourceOptions> parseSyntheticOptions(const std::string& text) {
       if (!number || *number < 8 || *number > 4000) return bad("a number in [8, 4000]");
       o.scene.part_size = *number;
     } else if (key == "light") {
-      if (value != "uneven" && value != "flat") return bad("uneven or flat");
-      o.scene.uneven_light = value == "uneven";
+      // A front light's scene: the parts on a textured surface, shaded,
+      // beside their shadows, glossy, or faint (front_light.hpp); grey, as
+      // this camera is.
+      const std::string name(value);
+      o.scene.front = {};
+      if (name == "uneven" || name == "flat") {
+        o.scene.uneven_light = name == "uneven";
+      } else if (name == "clean" || name == "colour" ||
+                 !synthetic::frontLightCondition(name, &o.scene.front, &o.scene.part_level,
+                                                 &o.scene.background_level)) {
+        return bad(
+            "uneven, flat, or a front light: textured, shadow, glossy, low-contrast, wood "
+            "or metal");
+      } else {
+        o.scene.uneven_light = true;
+      }
     } else if (key == "types") {
       o.scene.types.clear();
       const auto& known = synthetic::allPartTypes();

@@ -22,7 +22,8 @@ struct SyntheticSourceOptions {
 };
 
 // Parses the part after "synthetic:", comma-separated key=value pairs:
-// width, height, parts, seed, noise, size (part size px), light (uneven|flat),
+// width, height, parts, seed, noise, size (part size px), light (uneven, flat,
+// or a front light: textured, shadow, glossy, low-contrast, wood, metal),
 // types (names joined by '+'), touching, blur, scene_every; the simulated
 // robot: mm_per_px, rz, dx, dy (mm), tilt_x, tilt_y (degrees); its target:
 // target (disc|grid), target_radius (mm), grid (COLSxROWS), grid_pitch (mm).

@@ -13,6 +13,7 @@
 #include <string>
 #include <utility>
 #include <vector>
+#include "picksight/synthetic/front_light.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -57,6 +58,9 @@ struct SceneOptions {
   bool touching = false;
   // Gaussian blur of the rendered image (optics), sigma in pixels; 0 = none.
   double blur_sigma = 0;
+  // The light of a front-lit cell (front_light.hpp; off: parts lit as from
+  // behind). Grey only: a colour front light is refused.
+  FrontLight front;
 };
 
 // Options for a scene of `parts` parts of `types` (empty = all) in a
