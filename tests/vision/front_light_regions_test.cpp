@@ -32,6 +32,15 @@ pv::Region onlyPart(const cv::Mat& image, pv::RegionOptions r = {}) {
   return regions.front();
 }
 
+// A public silhouette of this repository's test data (`file` under
+// tests/data), `size` px across.
+ps::SilhouetteType drawn(const char* file, double size) {
+  const cv::Mat drawing =
+      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+  REQUIRE(!drawing.empty());
+  return ps::silhouetteFromDrawing(file, drawing, size);
+}
+
 // The largest region of `image` (dark parts on light) as the front-light
 // benchmark binarizes it: the belt's own blotches may make regions too.
 pv::Region largestPart(const cv::Mat& image, pv::RegionOptions r = {}) {
@@ -303,12 +312,6 @@ TEST_CASE("a part's lit side, the blur of its tips and its glints are not cut of
       const char* name;
       ps::SilhouetteType type;
     };
-    const auto drawn = [](const char* file, double size) {
-      const cv::Mat drawing =
-          cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-      REQUIRE(!drawing.empty());
-      return ps::silhouetteFromDrawing(file, drawing, size);
-    };
     const std::vector<Shape> shapes = {{"obj8", drawn("shapes/tari1000/obj8_3.png", 230)},
                                        {"obj25", drawn("shapes/tari1000/obj25_3.png", 210)},
                                        {"obj1", drawn("shapes/tari1000/obj1_3.png", 220)},
@@ -352,12 +355,6 @@ TEST_CASE("beside a cast shadow, a part's lit side and the blur of its tips stay
                                     &shaded.background_level));
     ps::SilhouetteSceneOptions plain = shaded;
     plain.front.shadow_offset_px = 0;
-    const auto drawn = [](const char* file, double size) {
-      const cv::Mat drawing =
-          cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-      REQUIRE(!drawing.empty());
-      return ps::silhouetteFromDrawing(file, drawing, size);
-    };
     const std::vector<std::pair<const char*, ps::SilhouetteType>> shapes = {
         {"obj8", drawn("shapes/tari1000/obj8_3.png", 230)},
         {"obj25", drawn("shapes/tari1000/obj25_3.png", 210)},
@@ -403,12 +400,6 @@ TEST_CASE("a sharp part on a blotched belt is read over its blur, not over the b
   ps::SilhouetteSceneOptions exact;
   exact.uneven_light = false;
   exact.noise_sigma = 0;
-  const auto drawn = [](const char* file, double size) {
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-    REQUIRE(!drawing.empty());
-    return ps::silhouetteFromDrawing(file, drawing, size);
-  };
   const std::vector<ps::SilhouetteType> shapes = {
       drawn("shapes/tari1000/obj2_3.png", 220),  drawn("shapes/tari1000/obj9_3.png", 210),
       drawn("shapes/tari1000/obj14_3.png", 230), drawn("shapes/tari1000/obj20_3.png", 200),
@@ -443,12 +434,6 @@ TEST_CASE("a part out of focus beside its shadow keeps its edge", "[vision][regi
   // halfway to it: read 1-2 px out, that cut the part's blurred edge off
   // all round, 2-7 % of its area, and moved it 0.4 px (RMS; 0.17 now).
   // Public silhouettes the shadow code was not written on, and a gear.
-  const auto drawn = [](const char* file, double size) {
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-    REQUIRE(!drawing.empty());
-    return ps::silhouetteFromDrawing(file, drawing, size);
-  };
   const std::vector<ps::SilhouetteType> shapes = {
       drawn("shapes/tari1000/obj2_3.png", 220), drawn("shapes/tari1000/obj14_3.png", 230),
       drawn("shapes/tari1000/obj30_3.png", 220), ps::silhouetteFromPartType("gear", 200)};
