@@ -262,31 +262,6 @@ void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
               picksight::bench::nearestRank(t.plain_ms, 99));
   std::printf("  ratio of medians (vision / plain OpenCV) %.2fx\n", plain > 0 ? ours / plain : 0);
 }
-// Drawings for --models beyond the scene's types: classes of the two sets
-// that no scene type comes from (the first drawing of each, then the fifth,
-// a different drawing of the same class), at sizes spread over the scene
-// types' range. Trained, never drawn: every part they are reported on is
-// a false report.
-std::vector<TypeSpec> extraSpecs(const std::vector<TypeSpec>& scene, size_t count) {
-  std::set<std::string> used;
-  for (const auto& s : scene) {
-    if (!s.file.empty()) used.insert(s.file.substr(0, s.file.rfind('_')));
-  }
-  std::vector<std::string> classes;
-  for (int i = 1; i <= 50; ++i) classes.push_back("shapes/tari1000/obj" + std::to_string(i));
-  for (int i = 1; i <= 9; ++i) classes.push_back("shapes/kimia99/trainimage" + std::to_string(i));
-  std::vector<TypeSpec> extra;
-  for (const char* drawing : {"_1.png", "_5.png"}) {
-    for (const auto& c : classes) {
-      if (extra.size() >= count) return extra;
-      if (used.count(c)) continue;
-      const std::string name = c.substr(c.rfind('/') + 1) + drawing;
-      const double size = 160 + static_cast<double>((extra.size() * 37) % 120);
-      extra.push_back({name.substr(0, name.rfind('.')), c + drawing, "untaught", size});
-    }
-  }
-  return extra;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -398,7 +373,7 @@ int main(int argc, char** argv) {
   const size_t scene_types = specs.size();
   const size_t trained = model_count > 0 ? static_cast<size_t>(model_count) : scene_types;
   if (trained > scene_types) {
-    const auto extra = extraSpecs(specs, trained - scene_types);
+    const auto extra = picksight::bench::untaughtTypeSpecs(specs, trained - scene_types);
     specs.insert(specs.end(), extra.begin(), extra.end());
   }
   std::vector<ps::SilhouetteType> types;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdio>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,33 @@ inline const std::vector<TypeSpec>& silhouetteTypeSpecs() {
       {"slot", "", "own", 170},
   };
   return specs;
+}
+
+// Drawings for types a cell knows beyond the scene's (a product line's
+// variants: what recognition costs as a cell learns more types): classes of the two sets
+// that no scene type comes from (the first drawing of each, then the fifth,
+// a different drawing of the same class), at sizes spread over the scene
+// types' range. Trained, never drawn: every part they are reported on is
+// a false report.
+inline std::vector<TypeSpec> untaughtTypeSpecs(const std::vector<TypeSpec>& scene, size_t count) {
+  std::set<std::string> used;
+  for (const auto& s : scene) {
+    if (!s.file.empty()) used.insert(s.file.substr(0, s.file.rfind('_')));
+  }
+  std::vector<std::string> classes;
+  for (int i = 1; i <= 50; ++i) classes.push_back("shapes/tari1000/obj" + std::to_string(i));
+  for (int i = 1; i <= 9; ++i) classes.push_back("shapes/kimia99/trainimage" + std::to_string(i));
+  std::vector<TypeSpec> extra;
+  for (const char* drawing : {"_1.png", "_5.png"}) {
+    for (const auto& c : classes) {
+      if (extra.size() >= count) return extra;
+      if (used.count(c)) continue;
+      const std::string name = c.substr(c.rfind('/') + 1) + drawing;
+      const double size = 160 + static_cast<double>((extra.size() * 37) % 120);
+      extra.push_back({name.substr(0, name.rfind('.')), c + drawing, "untaught", size});
+    }
+  }
+  return extra;
 }
 
 // The types of `specs`, drawings read under `data_dir`. False, with a

@@ -167,3 +167,36 @@ TEST_CASE("the skeleton of a bar is its middle line", "[vision][blob]") {
   CHECK(max_x - min_x > 130);
   CHECK(f.skeleton.size() < 160);  // one pixel wide
 }
+
+TEST_CASE("a shape's extent is its length and its narrowest width at any turn", "[vision][blob]") {
+  // A 100 x 40 rectangle with a notch (the hull closes it), and points
+  // inside that change nothing, turned by several angles.
+  const std::vector<cv::Point2d> shape = {{0, 0},   {100, 0}, {100, 40}, {60, 40},
+                                          {50, 20}, {40, 40}, {0, 40},   {30, 10}};
+  for (const double turn : {0.0, 17.0, 30.0, 90.0, 143.0}) {
+    CAPTURE(turn);
+    const double c = std::cos(turn * picksight::kRadPerDeg);
+    const double s = std::sin(turn * picksight::kRadPerDeg);
+    std::vector<cv::Point2f> points;
+    for (const auto& p : shape) {
+      points.emplace_back(static_cast<float>(500 + c * p.x - s * p.y),
+                          static_cast<float>(300 + s * p.x + c * p.y));
+    }
+    const Extent e = extentOf(points);
+    CHECK(e.diameter == Approx(std::hypot(100.0, 40.0)).margin(1e-3));
+    CHECK(e.width == Approx(40.0).margin(1e-3));
+  }
+  // A disc's width is its diameter; a segment has no width; a point nothing.
+  std::vector<cv::Point2f> disc;
+  for (int k = 0; k < 360; ++k) {
+    disc.emplace_back(static_cast<float>(50 * std::cos(k * picksight::kRadPerDeg)),
+                      static_cast<float>(50 * std::sin(k * picksight::kRadPerDeg)));
+  }
+  const Extent round = extentOf(disc);
+  CHECK(round.diameter == Approx(100.0).margin(0.01));
+  CHECK(round.width == Approx(100.0).margin(0.05));
+  const Extent segment = extentOf({{0, 0}, {30, 40}});
+  CHECK(segment.diameter == Approx(50.0));
+  CHECK(segment.width == 0);
+  CHECK(extentOf({{3, 4}}).diameter == 0);
+}

@@ -133,6 +133,24 @@ constexpr int kThinReachPx = 4;
 constexpr double kMinOnOutline = 0.25;
 constexpr double kOutlineHoleShare = 0.25;
 
+// A part lies inside its blob (parts that touch or overlap make one blob
+// of them all), so it is no longer and no wider than the blob, whatever
+// their turns: a look-up that leaves out the models that cannot be there
+// before any pose is proposed. The blob's outline runs through its
+// boundary pixels' centres, half a pixel inside its edges either side; a
+// slack of kExtentSlackPx for that and the threshold's place on a soft
+// edge, and kExtentSlackShare of the part for a thin limb the threshold
+// dropped at low contrast (placed all the same: see FaintPart).
+constexpr double kExtentSlackPx = 4.0;
+constexpr double kExtentSlackShare = 0.1;
+
+bool fitsIn(const Extent& part, const Extent& blob) {
+  const auto within = [](double p, double b) {
+    return p <= b + kExtentSlackPx + kExtentSlackShare * p;
+  };
+  return within(part.diameter, blob.diameter) && within(part.width, blob.width);
+}
+
 // The share of the model's boundary, placed at the pose, whose points
 // satisfy `where` (image coordinates), by the samples' weights.
 template <typename Where>
@@ -431,9 +449,12 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
     : region_(regions[index]), index_(index) {
   // Nothing to place parts on in a patch of the surface's light.
   if (!outlineSteps(region_)) return;
+  const Extent blob_extent =
+      extentOf(std::vector<cv::Point2f>(region_.outer.begin(), region_.outer.end()));
   for (const PartModel* m : models) {
     // A part in the blob is no larger than the blob.
     if (m->loops.empty() || m->body.area * (1 - m->body.area_tolerance) > region_.area) continue;
+    if (!region_.touches_border && !fitsIn(searchOf(*m)->extent, blob_extent)) continue;
     fitting_.push_back(m);
     tolerance_ = std::max(tolerance_, m->edge_tolerance);
     conformity_ = std::min(conformity_, m->conformity);

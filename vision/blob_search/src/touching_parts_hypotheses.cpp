@@ -584,6 +584,10 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   for (const auto& c : b->corners) b->corner_glance.push_back(farthestFirst(c.at));
   for (const auto& a : b->arcs) b->arc_glance.push_back(farthestFirst(a.centre));
   b->edges = edgeSamples(model, 1.0);
+  std::vector<cv::Point2f> boundary;
+  boundary.reserve(model.samples.size());
+  for (const auto& sample : model.samples) boundary.emplace_back(sample.point);
+  b->extent = extentOf(boundary);
   return b;
 }
 

@@ -12,6 +12,7 @@
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/models/boundary_model.hpp"
 #include "picksight/vision/models/part_model.hpp"
+#include "picksight/vision/segmentation/blob_features.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 
 namespace picksight::vision {
@@ -132,6 +133,7 @@ struct BlobSearchModel {
   std::vector<touching::EdgeSample> edges;  // poses are refined on these, 1 px apart
   double glance_weight = 0;                 // the glance samples' total
   double sparse_weight = 0;                 // the sparse samples' total
+  Extent extent;                            // of the boundary samples (fitsIn)
 };
 
 namespace touching {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <type_traits>
 #include <vector>
 
@@ -25,6 +26,33 @@ HuArray logHu(const HuArray& hu) {
     h[i] = hu[i] == 0 ? 0.0 : -std::copysign(1.0, hu[i]) * std::log10(std::abs(hu[i]));
   }
   return h;
+}
+
+Extent extentOf(const std::vector<cv::Point2f>& points) {
+  Extent e;
+  if (points.size() < 2) return e;
+  std::vector<cv::Point2f> hull;
+  cv::convexHull(points, hull);
+  const size_t n = hull.size();
+  // Both are reached at the hull's vertices (the width with one side of
+  // the strip on a hull edge): all pairs, a few hundred vertices at most.
+  e.width = n < 3 ? 0 : std::numeric_limits<double>::max();
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point2d a = hull[i];
+    const cv::Point2d b = hull[(i + 1) % n];
+    const double length = cv::norm(b - a);
+    double farthest = 0;
+    for (size_t j = 0; j < n; ++j) {
+      const cv::Point2d p = hull[j];
+      e.diameter = std::max(e.diameter, cv::norm(p - a));
+      if (length > 0) {
+        farthest = std::max(farthest, std::abs((b - a).cross(p - a)) / length);
+      }
+    }
+    if (n >= 3 && length > 0) e.width = std::min(e.width, farthest);
+  }
+  if (e.width == std::numeric_limits<double>::max()) e.width = 0;
+  return e;
 }
 
 double boundaryLength(const std::vector<cv::Point>& closed) {

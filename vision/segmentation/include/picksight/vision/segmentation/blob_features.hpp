@@ -56,6 +56,16 @@ HuArray logHu(const HuArray& hu);
 // 2% short on lines along a pixel axis.
 double boundaryLength(const std::vector<cv::Point>& closed);
 
+// The extent of a point set whatever its turn: its diameter (the longest
+// distance between two of its points) and its width (the narrowest strip
+// that holds it). A shape inside another is neither longer nor wider,
+// however the two are turned: what a blob of touching parts may hold.
+struct Extent {
+  double diameter = 0;
+  double width = 0;
+};
+Extent extentOf(const std::vector<cv::Point2f>& points);
+
 // Eccentricity of the moments' equivalent ellipse.
 double eccentricity(const cv::Moments& m);
 
