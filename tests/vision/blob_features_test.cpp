@@ -200,3 +200,38 @@ TEST_CASE("a shape's extent is its length and its narrowest width at any turn", 
   CHECK(segment.width == 0);
   CHECK(extentOf({{3, 4}}).diameter == 0);
 }
+
+TEST_CASE("a shape's extent is that of every pair of its hull's points", "[vision][blob]") {
+  // Random clouds, round and long, and pixel outlines (many points in a row,
+  // parallel edges): the one-pass calipers against every pair.
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    CAPTURE(trial);
+    std::vector<cv::Point2f> points;
+    const int count = 3 + trial % 40;
+    const double stretch = 1 + trial % 5;
+    for (int k = 0; k < count; ++k) {
+      const double x = rng.uniform(-50.0, 50.0) * stretch;
+      const double y = rng.uniform(-50.0, 50.0);
+      // Every third cloud on the pixel grid.
+      points.emplace_back(trial % 3 == 0 ? std::round(x) : x, trial % 3 == 0 ? std::round(y) : y);
+    }
+    std::vector<cv::Point2f> hull;
+    cv::convexHull(points, hull);
+    double diameter = 0;
+    double width = hull.size() < 3 ? 0 : 1e300;
+    for (size_t i = 0; i < hull.size(); ++i) {
+      const cv::Point2d a = hull[i];
+      const cv::Point2d b = hull[(i + 1) % hull.size()];
+      double farthest = 0;
+      for (const cv::Point2d p : hull) {
+        diameter = std::max(diameter, cv::norm(p - a));
+        farthest = std::max(farthest, std::abs((b - a).cross(p - a)) / cv::norm(b - a));
+      }
+      if (hull.size() >= 3) width = std::min(width, farthest);
+    }
+    const Extent e = extentOf(points);
+    CHECK(e.diameter == Approx(diameter).margin(1e-9));
+    CHECK(e.width == Approx(width).margin(1e-9));
+  }
+}
