@@ -225,6 +225,7 @@ int main(int argc, char** argv) {
   bool stages = false;
   std::string save_frames;
   bool keep_shadows = false;
+  bool teach_on_plain = false;
   double blur_sigma = ps::SilhouetteSceneOptions{}.blur_sigma;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> conditions = {"clean",        "textured", "shadow", "glossy",
@@ -262,6 +263,10 @@ int main(int argc, char** argv) {
   app.add_flag("--keep-shadows", keep_shadows,
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
                "costs)");
+  app.add_flag("--teach-on-plain", teach_on_plain,
+               "teach each type on a plain surface, evenly lit (a sheet of card under the cell), "
+               "the part's and the surface's levels and colours kept; the scenes keep the "
+               "condition's light");
   app.add_option("--save-frames", save_frames,
                  "write each scene's first frame, its binarization (-mask) and each teach image "
                  "here (PNG), to look at");
@@ -290,7 +295,8 @@ int main(int argc, char** argv) {
       options.binarize.polarity = pv::Polarity::kLightOnDark;
     }
     // Teach every type as a user would: LEARN on an image of the part alone
-    // under the same light; when LEARN refuses, LEARN ... AT a box around it.
+    // under the same light (or, --teach-on-plain, on a plain surface); when
+    // LEARN refuses, LEARN ... AT a box around it.
     auto models = std::make_shared<pst::ModelList>();
     std::vector<int> type_of_model;
     std::vector<bool> chiral(types.size(), true);
@@ -299,9 +305,18 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < types.size(); ++i) {
       const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;
       cv::Point2d drawn;
-      const cv::Mat image = delivered(ps::renderSilhouetteAlone(types[i], side, look, 7 + i, &drawn,
-                                                                picksight::bench::kTrainAngleDeg),
-                                      jpeg_quality);
+      ps::SilhouetteSceneOptions teach_look = look;
+      if (teach_on_plain) {
+        ps::FrontLight plain;
+        plain.colour = look.front.colour;
+        plain.part_bgr = look.front.part_bgr;
+        plain.background_bgr = look.front.background_bgr;
+        teach_look.front = plain;
+      }
+      const cv::Mat image =
+          delivered(ps::renderSilhouetteAlone(types[i], side, teach_look, 7 + i, &drawn,
+                                              picksight::bench::kTrainAngleDeg),
+                    jpeg_quality);
       if (!save_frames.empty()) {
         cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + ".png", image);
       }
