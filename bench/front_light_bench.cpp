@@ -90,6 +90,9 @@ struct Row {
   int other = 0;
   int nothing = 0;
   double pos2 = 0;
+  // Per type: the sum of the errors on the part (turned back with it) and
+  // their count, for the scatter about each type's own offset.
+  std::map<size_t, std::pair<cv::Point2d, int>> on_part;
   double ang2 = 0;
   int angles = 0;
   std::vector<double> locate_ms;
@@ -186,6 +189,13 @@ void score(const std::vector<ps::SilhouettePart>& truth, const pc::LocateOutcome
                                                    o.x * std::sin(a) + o.y * std::cos(a));
     const double pos = std::hypot(p.x - ref.x, p.y - ref.y);
     row.pos2 += pos * pos;
+    {
+      const cv::Point2d e(p.x - ref.x, p.y - ref.y);
+      auto& sum = row.on_part[t.type];
+      sum.first += cv::Point2d(e.x * std::cos(a) + e.y * std::sin(a),
+                               -e.x * std::sin(a) + e.y * std::cos(a));
+      sum.second += 1;
+    }
     // Parts placed well beyond the position goal, to look at: the error in
     // the image and on the part (turned back with it; the same there for
     // every part of a type is the taught model's own error).
@@ -452,25 +462,35 @@ int main(int argc, char** argv) {
       "\n%zu types (%s), %d scenes x %d frames per row, 1920x1080, 20 parts, %s\n", specs.size(),
       standard_types ? "the silhouette benchmark's" : "unseen", scenes, rounds,
       jpeg_quality > 0 ? ("JPEG quality " + std::to_string(jpeg_quality)).c_str() : "lossless");
-  std::printf("%-13s %-10s %5s %5s %5s %7s %9s %6s %5s %5s %8s %8s %8s %8s %8s\n", "condition",
+  std::printf("%-13s %-10s %5s %5s %5s %7s %9s %6s %5s %5s %8s %8s %8s %8s %8s %8s\n", "condition",
               "arrange", "LEARN", "AT", "none", "recall", "precision", "mirror", "size", "other",
-              "pos RMS", "ang RMS", "median", "p99", "plain");
+              "pos RMS", "scatter", "ang RMS", "median", "p99", "plain");
   for (const auto& r : rows) {
-    std::printf("%-13s %-10s %5d %5d %5d %7.3f %9.3f %6d %5d %5d %8.4f %8.4f %8.2f %8.2f %8.2f\n",
-                r.condition.c_str(), r.arrangement.c_str(), r.learn_ok, r.learn_at_ok, r.untaught,
-                r.truths ? static_cast<double>(r.found) / r.truths : 0.0,
-                r.reported ? static_cast<double>(r.correct) / r.reported : 1.0, r.mirror, r.size,
-                r.other, r.found ? std::sqrt(r.pos2 / r.found) : 0.0,
-                r.angles ? std::sqrt(r.ang2 / r.angles) : 0.0,
-                picksight::bench::nearestRank(r.locate_ms, 50),
-                picksight::bench::nearestRank(r.locate_ms, 99),
-                picksight::bench::nearestRank(r.plain_ms, 50));
+    // The error less each type's mean on the part: what is left when every
+    // type's own offset (taught with its model) is taken out.
+    double held = 0;
+    for (const auto& [type, sum] : r.on_part) {
+      const cv::Point2d mean = sum.first / sum.second;
+      held += sum.second * mean.dot(mean);
+    }
+    const double scatter = r.found ? std::sqrt(std::max(0.0, r.pos2 - held) / r.found) : 0.0;
+    std::printf(
+        "%-13s %-10s %5d %5d %5d %7.3f %9.3f %6d %5d %5d %8.4f %8.4f %8.4f %8.2f %8.2f %8.2f\n",
+        r.condition.c_str(), r.arrangement.c_str(), r.learn_ok, r.learn_at_ok, r.untaught,
+        r.truths ? static_cast<double>(r.found) / r.truths : 0.0,
+        r.reported ? static_cast<double>(r.correct) / r.reported : 1.0, r.mirror, r.size, r.other,
+        r.found ? std::sqrt(r.pos2 / r.found) : 0.0, scatter,
+        r.angles ? std::sqrt(r.ang2 / r.angles) : 0.0,
+        picksight::bench::nearestRank(r.locate_ms, 50),
+        picksight::bench::nearestRank(r.locate_ms, 99),
+        picksight::bench::nearestRank(r.plain_ms, 50));
   }
   std::printf(
       "goals: every type taught by LEARN or LEARN AT; recall >= 0.98; precision 1.0 (no mirror or "
       "size confusion); position RMS <= 0.05 px (<= 0.1 beside shadows, <= 0.03 clean); angle RMS "
       "<= 0.05 deg; LOCATE median <= 10 ms, p99 <= 20 ms (times here: the vision pass in process, "
-      "ms, beside the plain OpenCV pass)\n");
+      "ms, beside the plain OpenCV pass); scatter: the position RMS less each type's own mean "
+      "error on the part (the offset a model is taught with; what is left varies part to part)\n");
   if (stages) {
     std::printf(
         "\nwhere the time goes (medians, ms): binarize, regions (shadows cut), of which "
