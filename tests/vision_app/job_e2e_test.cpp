@@ -181,10 +181,19 @@ TEST_CASE("a damaged job file is refused by name and changes nothing", "[e2e][jo
     std::vector<std::string> out;
     // The filmstrip is left out: it records the LOCATEs of state() by
     // itself, on a writer thread at idle priority that a busy machine
-    // holds back for seconds (a half-written frame seen in CI).
-    for (const auto& e : fs::recursive_directory_iterator(cell.data_dir)) {
-      if (e.is_regular_file() && *fs::relative(e.path(), cell.data_dir).begin() != "filmstrip")
-        out.push_back(e.path().string() + "=" + test::readFileText(e.path()));
+    // holds back for seconds (a half-written frame seen in CI). So are the
+    // models a JOB LOAD replaced (`models.job-replaced.<n>`), which a
+    // cleaner removes after the reply (seen half removed in CI): not even
+    // entered, as they may go while they are listed.
+    for (auto it = fs::recursive_directory_iterator(cell.data_dir);
+         it != fs::recursive_directory_iterator(); ++it) {
+      const std::string top = fs::relative(it->path(), cell.data_dir).begin()->string();
+      if (top == "filmstrip" || top.find(".job-replaced.") != std::string::npos) {
+        if (it->is_directory()) it.disable_recursion_pending();
+        continue;
+      }
+      if (it->is_regular_file())
+        out.push_back(it->path().string() + "=" + test::readFileText(it->path()));
     }
     std::sort(out.begin(), out.end());
     return out;
