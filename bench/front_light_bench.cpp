@@ -187,22 +187,18 @@ void score(const std::vector<ps::SilhouettePart>& truth, const pc::LocateOutcome
     const double a = t.angle_deg * M_PI / 180.0;
     const cv::Point2d ref = t.centre + cv::Point2d(o.x * std::cos(a) - o.y * std::sin(a),
                                                    o.x * std::sin(a) + o.y * std::cos(a));
-    const double pos = std::hypot(p.x - ref.x, p.y - ref.y);
+    // The error in the image and on the part (turned back with it; the same
+    // there for every part of a type is the taught model's own error).
+    const cv::Point2d e(p.x - ref.x, p.y - ref.y);
+    const cv::Point2d on_part(e.x * std::cos(a) + e.y * std::sin(a),
+                              -e.x * std::sin(a) + e.y * std::cos(a));
+    const double pos = std::hypot(e.x, e.y);
     row.pos2 += pos * pos;
-    {
-      const cv::Point2d e(p.x - ref.x, p.y - ref.y);
-      auto& sum = row.on_part[t.type];
-      sum.first += cv::Point2d(e.x * std::cos(a) + e.y * std::sin(a),
-                               -e.x * std::sin(a) + e.y * std::cos(a));
-      sum.second += 1;
-    }
-    // Parts placed well beyond the position goal, to look at: the error in
-    // the image and on the part (turned back with it; the same there for
-    // every part of a type is the taught model's own error).
+    auto& sum = row.on_part[t.type];
+    sum.first += on_part;
+    sum.second += 1;
+    // Parts placed well beyond the position goal, to look at.
     if (list && pos > kListOffPx) {
-      const cv::Point2d e(p.x - ref.x, p.y - ref.y);
-      const cv::Point2d on_part(e.x * std::cos(a) + e.y * std::sin(a),
-                                -e.x * std::sin(a) + e.y * std::cos(a));
       std::printf(
           "    placed %.2f px off (%+.2f %+.2f, on the part %+.2f %+.2f): %s at %.1f %.1f%s\n", pos,
           e.x, e.y, on_part.x, on_part.y, specs[t.type].name.c_str(), ref.x, ref.y,
