@@ -34,6 +34,7 @@
 #include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/training/part_training.hpp"
 #include "silhouette_types.hpp"
 
 namespace {
@@ -80,6 +81,7 @@ struct Row {
   int learn_ok = 0;     // taught by LEARN on the image of the part alone
   int learn_at_ok = 0;  // taught by LEARN ... AT after LEARN refused
   int untaught = 0;
+  int views_refused = 0;      // --teach-views: LEARNVIEWs refused, every type
   std::string first_refusal;  // what LEARN answered first when it refused
   int truths = 0;
   int found = 0;
@@ -232,6 +234,7 @@ int main(int argc, char** argv) {
   std::string save_frames;
   bool keep_shadows = false;
   bool teach_on_plain = false;
+  int teach_views = 1;
   double blur_sigma = ps::SilhouetteSceneOptions{}.blur_sigma;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> conditions = {"clean",        "textured", "shadow", "glossy",
@@ -273,6 +276,11 @@ int main(int argc, char** argv) {
                "teach each type on a plain surface, evenly lit (a sheet of card under the cell), "
                "the part's and the surface's levels and colours kept; the scenes keep the "
                "condition's light");
+  app.add_option("--teach-views", teach_views,
+                 "teach each type from this many images of it (LEARN, then LEARNVIEW on the part "
+                 "lying elsewhere, turned), each under the teach light")
+      ->check(CLI::Range(1, 33))
+      ->capture_default_str();
   app.add_option("--save-frames", save_frames,
                  "write each scene's first frame, its binarization (-mask) and each teach image "
                  "here (PNG), to look at");
@@ -375,6 +383,33 @@ int main(int argc, char** argv) {
       reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
                       offset.x * std::sin(back) + offset.y * std::cos(back)};
       chiral[i] = !learned->model.body.mirror_symmetric;
+      // More views (LEARNVIEW): the part alone again, turned and lying on
+      // another stretch of the surface, each read with the model so far.
+      for (int v = 1; v < teach_views; ++v) {
+        auto trial = std::make_shared<pst::ModelList>(*models);
+        trial->push_back(learned->model);
+        cv::Point2d unused;
+        const cv::Mat view = delivered(
+            ps::renderSilhouetteAlone(types[i], side, teach_look, 1000 * v + 7 + i, &unused,
+                                      picksight::bench::kTrainAngleDeg + 47.0 * v),
+            jpeg_quality);
+        auto seen =
+            pc::viewInFrame(frameOf(view), options, trial, learned->model.type, std::nullopt);
+        if (!seen) {
+          taught.views_refused += 1;
+          if (list_errors) {
+            std::printf("  %s %s: view %d refused: %s\n", condition.c_str(), specs[i].name.c_str(),
+                        v, seen.error().message.c_str());
+          }
+          continue;
+        }
+        learned->model = std::move(seen->model);
+      }
+      if (list_errors && teach_views > 1) {
+        std::printf("  %s %s: %zu views, origin at %+.3f %+.3f\n", condition.c_str(),
+                    specs[i].name.c_str(), learned->model.views.size() + 1,
+                    learned->model.origin_shift.x, learned->model.origin_shift.y);
+      }
       auto next = std::make_shared<pst::ModelList>(*models);
       next->push_back(std::move(learned->model));
       models = next;
@@ -504,6 +539,10 @@ int main(int argc, char** argv) {
     }
   }
   for (const auto& r : rows) {
+    if (teach_views > 1 && r.arrangement == rows.front().arrangement) {
+      std::printf("  %s: %d views per type, %d LEARNVIEWs refused\n", r.condition.c_str(),
+                  teach_views, r.views_refused);
+    }
     if (r.arrangement == rows.front().arrangement && !r.first_refusal.empty()) {
       std::printf("  %s: LEARN first refused with \"%s\"\n", r.condition.c_str(),
                   r.first_refusal.c_str());

@@ -225,3 +225,86 @@ TEST_CASE("LEARN refuses a frame with no part or several", "[e2e][locate][models
   CHECK(reply->rfind("ERROR 30 ", 0) == 0);
   CHECK(*robot_none.request("MODELS", 5s) == "OK 0");
 }
+
+TEST_CASE("LEARNVIEW reads a taught part again where it lies and moves the origin by the median",
+          "[e2e][locate][models]") {
+  // One L per frame, in a new pose on every trigger: each view lies elsewhere.
+  VideoServerProcess server(
+      {"--source", "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=5,scene_every=1",
+       "--mode", "trigger"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+
+  auto reply = robot.request("LEARNVIEW 1", 10s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("ERROR 32 ", 0) == 0);  // nothing taught yet
+  REQUIRE(robot.request("LEARN 1 bracket", 10s)->rfind("OK 1 bracket ", 0) == 0);
+  double shift = 0;
+  for (int views = 2; views <= 4; ++views) {
+    reply = robot.request("LEARNVIEW 1", 10s);
+    REQUIRE(reply);
+    INFO("LEARNVIEW reply: " << *reply);
+    const std::string head = reply->substr(0, reply->find(" ; "));
+    const auto fields = splitFields(head, " ");
+    REQUIRE(fields.size() == 7);
+    CHECK(fields[0] == "OK");
+    CHECK(fields[1] == "1");
+    CHECK(fields[2] == "bracket");
+    CHECK(fields[3] == std::to_string(views));
+    shift = std::hypot(std::stod(std::string(fields[4])), std::stod(std::string(fields[5])));
+    CHECK(shift <= 1.0);
+    CHECK(std::stod(std::string(fields[6])) >= 0);
+    CHECK(reply->find(" ; note: this view read the centroid at ") != std::string::npos);
+  }
+  // The model still finds the part where it is (the synthetic truth is its
+  // centroid).
+  zmq::context_t context;
+  FrameSubscriber watcher(context, server.frames, "cam0", 16);
+  waitForSubscription(server, watcher);
+  reply = robot.request("LOCATE 1", 10s);
+  REQUIRE(reply);
+  const auto poses = imagePoses(*reply);
+  const auto sequence = usedFrame(robot).sequence;
+  auto frame = receiveUntil(watcher, [&](const Frame& f) { return f.info.sequence == sequence; });
+  REQUIRE(frame);
+  REQUIRE(frame->truth.size() == 1);
+  REQUIRE(poses.size() == 1);
+  CHECK(std::hypot(poses[0].x - frame->truth[0].x, poses[0].y - frame->truth[0].y) < 0.1);
+
+  // UNDO takes back one view: the next LEARNVIEW counts 4 again.
+  reply = robot.request("UNDO", 5s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("OK 1 restored ", 0) == 0);
+  reply = robot.request("LEARNVIEW 1", 10s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("OK 1 bracket 4 ", 0) == 0);
+
+  // Bad requests change nothing.
+  for (const char* line : {"LEARNVIEW", "LEARNVIEW x", "LEARNVIEW 1 AT 1 2 3",
+                           "LEARNVIEW 1 IN 0 0 9 9", "LEARNVIEW 1 AT 0 0 0 9"}) {
+    reply = robot.request(line, 5s);
+    REQUIRE(reply);
+    INFO(line << " -> " << *reply);
+    CHECK(reply->rfind("ERROR 11 ", 0) == 0);
+  }
+  reply = robot.request("LEARNVIEW 1 AT 0 0 4 4", 10s);  // a corner of the frame, no part there
+  REQUIRE(reply);
+  CHECK(reply->rfind("ERROR 35 ", 0) == 0);
+  reply = robot.request("LEARNVIEW 1", 10s);
+  REQUIRE(reply);
+  CHECK(reply->rfind("OK 1 bracket 5 ", 0) == 0);
+
+  // A part that looks alike turned has its origin at its centre of symmetry.
+  VideoServerProcess bars(
+      {"--source",
+       "cam0=synthetic:width=640,height=480,parts=1,types=rectangle,seed=5,scene_every=1", "--mode",
+       "trigger"});
+  VisionProcess bar_cell(bars);
+  auto bar_robot = bar_cell.connect();
+  REQUIRE(bar_robot.request("LEARN 2 bar", 10s)->rfind("OK 2 bar ", 0) == 0);
+  reply = bar_robot.request("LEARNVIEW 2", 10s);
+  REQUIRE(reply);
+  INFO("LEARNVIEW of a bar: " << *reply);
+  CHECK(reply->rfind("ERROR 39 ", 0) == 0);
+  CHECK(reply->find("symmetry") != std::string::npos);
+}

@@ -4,6 +4,7 @@
 // would then find, drawn on the overlay, and any warning), Save stores it,
 // after a confirmation naming the model it replaces; Undo takes back the
 // last change to models (UNDO). The type defaults to the next free one.
+// Each model's Add view reads the part again where it lies now (LEARNVIEW).
 // Also the model list (MODELS, FORGET), each model's tolerances
 // (TOLERANCE), and a type's grasp styles and gripper fingers (GRASP,
 // GRIPPER) with their footprint drawn live on the latest located part of
@@ -141,6 +142,25 @@
     }
   }
 
+  // LEARNVIEW: the part of `type` read once more where it lies now.
+  async function addView(type) {
+    clearPreview();
+    const r = ps.rect.teach;
+    let line = "LEARNVIEW " + type;
+    if (r) line += " AT " + r.x + " " + r.y + " " + r.width + " " + r.height;
+    const reply = await say("teach-reply", line);
+    $("teach-reply").dataset.lastReply = reply;
+    const f = ps.okFields(reply.split(" ; ")[0]);
+    if (f && f.length >= 6) {
+      $("teach-preview-text").textContent =
+        "Type " + f[0] + " '" + f[1] + "': " + f[2] + " views; origin " + Number(f[3]).toFixed(3) + " " +
+        Number(f[4]).toFixed(3) + " px from the first teach's centroid, views " + Number(f[5]).toFixed(3) +
+        " px apart (median). Lay the part elsewhere and Add view again, or Undo.";
+      $("teach-warnings").textContent = "";
+      $("teach-preview").hidden = false;
+    }
+  }
+
   async function undo() {
     clearPreview();
     const reply = await say("teach-reply", "UNDO");
@@ -162,6 +182,16 @@
         refreshModels();
       });
       row.dataset.type = m[0];
+      // Another view of the part (LEARNVIEW), inside the rectangle when one
+      // is drawn: the part laid elsewhere under the camera, alone.
+      const view = document.createElement("button");
+      view.type = "button";
+      view.className = "model-view";
+      view.textContent = "Add view";
+      view.title = "lay the part elsewhere under the camera, alone (or draw a rectangle around it), " +
+                   "then Add view: the model's origin is read again there (LEARNVIEW)";
+      view.addEventListener("click", (e) => { e.stopPropagation(); addView(Number(m[0])); });
+      row.lastChild.prepend(view);
       row.addEventListener("click", () => { ps.setField("grasp-type", m[0], true); loadGrasp(); });
     }
     await refreshTolerances(groups(reply, 5).map((m) => m[0]));

@@ -136,3 +136,36 @@ def test_teach_flow_confirms_replacing_and_undo_restores(cell, browser):
         cell.say("FORGET 1")
         cell.set_parts(4)
     assert browser.severe() == []
+
+
+def test_add_view_reads_the_part_again_and_undo_takes_it_back(cell, browser):
+    """A model's Add view sends LEARNVIEW <type> (AT the rectangle when one
+    is drawn) and shows how many views the model has; the file keeps the
+    readings; Undo takes the view back byte for byte."""
+    cell.set_parts(1)
+    try:
+        wait_until(lambda: ok_fields(cell.say("BLOBS"))[0] == "1", what="one part on the table")
+        browser.js("window.picksight.rect.teach = null; window.picksight.drawTool();")
+        select_tab(browser, "teach")
+        assert cell.say("LEARN 1 bracket").startswith("OK 1 bracket")
+        taught = model_file(cell, 1)
+        click(browser, "models-refresh")
+        button = "#models-list tr[data-type=\"1\"] button.model-view"
+        wait_until(lambda: browser.js(f"return !!document.querySelector('{button}')"), what="the Add view button")
+        browser.js(f"document.querySelector('{button}').click()")
+        wait_until(lambda: last_reply(browser).startswith("OK 1 bracket 2 "), what="the LEARNVIEW reply")
+        wait_until(lambda: not browser.js("return document.getElementById('teach-preview').hidden"),
+                   what="the views shown")
+        assert "2 views" in text(browser, "teach-preview-text")
+        assert b"views:" in model_file(cell, 1)
+        # Type 1's model is not touched by a LEARN-like Save: nothing pending.
+        assert browser.js("return document.getElementById('teach-save').disabled")
+        browser.screenshot("teach-add-view")
+        click(browser, "teach-undo")
+        wait_until(lambda: last_reply(browser).startswith("OK 1 restored"), what="the UNDO reply")
+        assert "undid: LEARNVIEW 1" in last_reply(browser)
+        assert model_file(cell, 1) == taught
+    finally:
+        cell.say("FORGET 1")
+        cell.set_parts(4)
+    assert browser.severe() == []

@@ -7,11 +7,13 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "picksight/common/angles.hpp"
+#include "picksight/common/text.hpp"
 
 namespace picksight::vision {
 namespace {
@@ -197,6 +199,21 @@ std::string modelProblem(const PartModel& m) {
   if (!finite(m.verify_percent) || m.verify_percent <= 0 || m.verify_percent > 100) {
     return "verify percent must be in (0, 100]";
   }
+  if (m.views.size() > kMaxModelViews)
+    return "at most " + std::to_string(kMaxModelViews) + " views beyond the teach image";
+  for (const auto& v : m.views) {
+    if (!finite(v.x) || !finite(v.y) || std::hypot(v.x, v.y) > kMaxViewReadingPx)
+      return "a view's centroid must lie within " + formatFixed(kMaxViewReadingPx, 1) +
+             " px of the teach image's";
+  }
+  if (!finite(m.origin_shift.x) || !finite(m.origin_shift.y) ||
+      std::hypot(m.origin_shift.x, m.origin_shift.y) > kMaxOriginShiftPx)
+    return "the origin must lie within " + formatFixed(kMaxOriginShiftPx, 1) +
+           " px of the teach image's centroid";
+  if (cv::norm(m.origin_shift - originFromViews(m.views)) > 1e-9)
+    return "the origin must be the median of the views' centroids";
+  if (!m.views.empty() && m.symmetry_order != 1)
+    return "views move the origin of a part without rotational symmetry only";
   if (m.loops.empty() || m.loops[0].hole) return "the boundary needs an outer loop first";
   for (const auto& loop : m.loops) {
     if (loop.primitives.empty()) return "a boundary loop has no primitives";
@@ -280,6 +297,18 @@ Result<void> checkSymmetry(const PartModel& model) {
     }
   }
   return {};
+}
+
+cv::Point2d originFromViews(const std::vector<cv::Point2d>& views) {
+  if (views.empty()) return {0, 0};
+  const auto median = [&](double cv::Point2d::*axis) {
+    std::vector<double> v{0.0};  // the teach image's own reading
+    for (const auto& p : views) v.push_back(p.*axis);
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  };
+  return {median(&cv::Point2d::x), median(&cv::Point2d::y)};
 }
 
 Result<void> validateModel(const PartModel& model) {

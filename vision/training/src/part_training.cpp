@@ -90,20 +90,7 @@ void centreOnEdges(PartModel& m, const Region& r) {
   const cv::Point2d delta = fit.pose.centre - r.centroid;
   const double e = signedDeg(fit.pose.angle_deg);
   if (std::hypot(delta.x, delta.y) > kMaxCentringPx || std::abs(e) > kMaxCentringDeg) return;
-  const double c = std::cos(e * kRadPerDeg);
-  const double s = std::sin(e * kRadPerDeg);
-  const auto move = [&](cv::Point2d p) {
-    return cv::Point2d(c * p.x - s * p.y, s * p.x + c * p.y) + delta;
-  };
-  for (auto& loop : m.loops) {
-    for (auto& p : loop.primitives) {
-      p.start = move(p.start);
-      p.end = move(p.end);
-      p.centre = move(p.centre);
-    }
-  }
-  m.corners = findCorners(m.loops, m.conformity);
-  prepareModel(m);
+  moveBoundary(m, e, delta);
 }
 
 // A stretch of the trained boundary is trusted as far as the training
@@ -316,6 +303,32 @@ Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& n
         std::to_string(regions.size()) + " parts in the image, training needs exactly one");
   }
   return trainModelFromRegion(grey, regions.front(), type, name, options);
+}
+
+void moveBoundary(PartModel& m, double turn_deg, cv::Point2d shift) {
+  const double c = std::cos(turn_deg * kRadPerDeg);
+  const double s = std::sin(turn_deg * kRadPerDeg);
+  const auto move = [&](cv::Point2d p) {
+    return cv::Point2d(c * p.x - s * p.y, s * p.x + c * p.y) + shift;
+  };
+  for (auto& loop : m.loops) {
+    for (auto& p : loop.primitives) {
+      p.start = move(p.start);
+      p.end = move(p.end);
+      p.centre = move(p.centre);
+    }
+  }
+  m.corners = findCorners(m.loops, m.conformity);
+  prepareModel(m);
+}
+
+void addViewReading(PartModel& m, cv::Point2d reading) {
+  m.views.push_back(reading);
+  const cv::Point2d origin = originFromViews(m.views);
+  // Boundary points are held about the current origin: about the new one
+  // they lie (new - old) the other way.
+  moveBoundary(m, 0.0, m.origin_shift - origin);
+  m.origin_shift = origin;
 }
 
 Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int type,

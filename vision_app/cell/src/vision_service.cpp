@@ -12,6 +12,7 @@
 
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/cell/vision_settings.hpp"
+#include "picksight/common/angles.hpp"
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/vision/recognition/recognition_pass.hpp"
@@ -43,6 +44,8 @@ const char* errorName(VisionServiceErrc e) {
       return "no part in the rectangle";
     case VisionServiceErrc::kSeveralPartsInRectangle:
       return "several parts in the rectangle";
+    case VisionServiceErrc::kViewRefused:
+      return "view refused";
   }
   return "unknown";
 }
@@ -279,6 +282,32 @@ Result<LearnOutcome> VisionService::learn(int type, const std::string& name,
     return makeError(VisionServiceErrc::kStorageFailed,
                      "cannot store the model: " + stored.error().message);
   return learned;
+}
+
+Result<ViewOutcome> VisionService::learnView(int type, const std::optional<cv::Rect>& at,
+                                             std::string_view change) {
+  if (!models_) return makeError(VisionServiceErrc::kUnknownType, "no model library");
+  const auto settings = requestSettings();
+  if (!settings) return settings.error();
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto frame = freshFrame();
+  if (!frame) return frame.error();
+  auto view = viewInFrame(**frame, **settings, models_->snapshot(), type, at, scaled_models_.get());
+  if (!view) return view.error();
+  // The reading is added to the model as it is now (a TOLERANCE or GRASP
+  // since the snapshot kept), under the library's lock.
+  auto stored = models_->update(
+      type, [&](vision::PartModel& m) { vision::addViewReading(m, view->reading); }, change);
+  if (!stored) {
+    if (stored.error().code == store::ModelErrc::kUnknownType)
+      return makeError(VisionServiceErrc::kUnknownType, stored.error().message);
+    if (stored.error().code == store::ModelErrc::kInvalidModel)
+      return makeError(VisionServiceErrc::kViewRefused, stored.error().message);
+    return makeError(VisionServiceErrc::kStorageFailed,
+                     "cannot store the model: " + stored.error().message);
+  }
+  view->model = std::move(*stored);
+  return view;
 }
 
 std::optional<std::string> teachImagePng(const cv::Mat& frame) {
@@ -518,6 +547,87 @@ std::optional<std::string> lookAlikeWarning(const vision::Region& region,
          " and " + std::to_string(type) + " (teach it as type " + other + ", or UNDO)";
 }
 }  // namespace
+
+Result<ViewOutcome> viewInFrame(const Frame& frame, const VisionOptions& options,
+                                std::shared_ptr<const ModelList> models, int type,
+                                const std::optional<cv::Rect>& at, ScaledModelCache* cache) {
+  const vision::PartModel* model = nullptr;
+  for (const auto& m : *models) {
+    if (m.type == type) model = &m;
+  }
+  if (!model) {
+    return makeError(VisionServiceErrc::kUnknownType,
+                     "no model for type " + std::to_string(type) + ": LEARN it first");
+  }
+  const std::string word = at ? "LEARNVIEW AT " + sensorRectText(*at) : "LEARNVIEW";
+  const auto refuse = [&](const std::string& why) {
+    return makeError(VisionServiceErrc::kViewRefused, word + ": " + why);
+  };
+  if (model->symmetry_order != 1) {
+    return refuse("type " + std::to_string(type) + " looks alike turned (symmetry order " +
+                  std::to_string(model->symmetry_order) +
+                  "): its origin is its centre of symmetry, which views do not move");
+  }
+  if (model->views.size() >= vision::kMaxModelViews) {
+    return refuse("type " + std::to_string(type) + " has " +
+                  std::to_string(model->views.size() + 1) + " views already (at most " +
+                  std::to_string(vision::kMaxModelViews + 1) + "; LEARN it again to start over)");
+  }
+  LocateOutcome located = locateInFrame(frame, options, models, type, cache);
+  std::vector<const LocatedPart*> parts;
+  for (const auto& p : located.parts) {
+    if (p.type == type && (!at || cv::Rect2d(*at).contains({p.x, p.y}))) parts.push_back(&p);
+  }
+  if (parts.empty()) {
+    const std::string what = "no part of type " + std::to_string(type);
+    if (!at) return makeError(vision::PartModelErrc::kNoPart, what + " in the frame");
+    return makeError(VisionServiceErrc::kNoPartInRectangle, what + " inside " + word);
+  }
+  if (parts.size() > 1) {
+    const std::string what =
+        std::to_string(parts.size()) + " parts of type " + std::to_string(type);
+    if (!at) {
+      return makeError(vision::PartModelErrc::kSeveralParts,
+                       what + " in the frame, LEARNVIEW reads one (or LEARNVIEW " +
+                           std::to_string(type) + " AT <x> <y> <w> <h> around one)");
+    }
+    return makeError(VisionServiceErrc::kSeveralPartsInRectangle,
+                     what + " inside " + word + ", it reads one");
+  }
+  const LocatedPart& part = *parts.front();
+  if (part.touching || part.region < 0) {
+    return refuse("the part of type " + std::to_string(type) +
+                  " touches another part: a view is read on a part lying apart");
+  }
+  const SensorMapping& mapping = located.scene.mapping;
+  const cv::Point2d centroid =
+      mapping.toSensor(located.scene.regions[static_cast<size_t>(part.region)].centroid);
+  // Into the model's frame: back by the part's turn, then about the teach
+  // image's centroid rather than the current origin.
+  const double back = -part.angle_deg * kRadPerDeg;
+  const cv::Point2d d = centroid - cv::Point2d(part.x, part.y);
+  ViewOutcome out;
+  out.reading = cv::Point2d(d.x * std::cos(back) - d.y * std::sin(back),
+                            d.x * std::sin(back) + d.y * std::cos(back)) +
+                model->origin_shift;
+  if (std::hypot(out.reading.x, out.reading.y) > vision::kMaxViewReadingPx) {
+    return refuse("this view read the part's centroid " +
+                  formatFixed(std::hypot(out.reading.x, out.reading.y), 2) +
+                  " px from the teach image's (at most " +
+                  formatFixed(vision::kMaxViewReadingPx, 1) +
+                  "): a part of another shape, or a shadow or glint joined to it");
+  }
+  out.model = *model;
+  vision::addViewReading(out.model, out.reading);
+  out.moved = out.model.origin_shift - model->origin_shift;
+  std::vector<double> distances{cv::norm(out.model.origin_shift)};
+  for (const auto& v : out.model.views) distances.push_back(cv::norm(v - out.model.origin_shift));
+  std::sort(distances.begin(), distances.end());
+  const size_t n = distances.size();
+  out.spread_px = n % 2 == 1 ? distances[n / 2] : 0.5 * (distances[n / 2 - 1] + distances[n / 2]);
+  if (auto valid = vision::validateModel(out.model); !valid) return refuse(valid.error().message);
+  return out;
+}
 
 Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& mapping,
                                   const VisionOptions& options,

@@ -1,4 +1,4 @@
-// LEARN, MODELS, TOLERANCE, FORGET, UNDO and BLOBS.
+// LEARN, LEARNVIEW, MODELS, TOLERANCE, FORGET, UNDO and BLOBS.
 #include "picksight/protocol/model_commands.hpp"
 
 #include <algorithm>
@@ -238,6 +238,37 @@ Result<LearnArgs> parseLearnArgs(const std::string& word, const Request& r) {
   return out;
 }
 
+// LEARNVIEW <type> [AT <x> <y> <w> <h>] and its reply.
+std::string learnView(VisionService& vision, const Request& r) {
+  constexpr const char* kUsage = "usage: LEARNVIEW <type> [AT <x> <y> <w> <h>]";
+  if (r.args.size() != 1 && r.args.size() != 6)
+    return errorReply(ProtocolErrc::kBadArguments, kUsage);
+  const auto type = parseType(r.args[0]);
+  if (!type) {
+    return errorReply(
+        ProtocolErrc::kBadArguments,
+        "LEARNVIEW: type must be an integer in [0, 9999], got '" + printable(r.args[0]) + "'");
+  }
+  std::optional<cv::Rect> at;
+  if (r.args.size() == 6) {
+    if (toUpper(r.args[1]) != "AT") return errorReply(ProtocolErrc::kBadArguments, kUsage);
+    at = parseRect(r.args, 2);
+    if (!at) {
+      return errorReply(ProtocolErrc::kBadArguments,
+                        "LEARNVIEW: AT x y in [0, " + std::to_string(kMaxSensorPx) +
+                            "], w h in [1, " + std::to_string(kMaxSensorPx) + "] sensor pixels");
+    }
+  }
+  auto view = vision.learnView(*type, at, r.line);
+  if (!view) return errorReply(view.error());
+  const vision::PartModel& m = view->model;
+  return "OK " + std::to_string(m.type) + " " + m.name + " " + std::to_string(m.views.size() + 1) +
+         " " + formatFixed(m.origin_shift.x) + " " + formatFixed(m.origin_shift.y) + " " +
+         formatFixed(view->spread_px) + " ; note: this view read the centroid at " +
+         formatFixed(view->reading.x) + " " + formatFixed(view->reading.y) + "; the origin moved " +
+         formatFixed(cv::norm(view->moved)) + " px";
+}
+
 std::string tolerance(VisionService& vision, const Request& r) {
   constexpr const char* kUsage = "usage: TOLERANCE <type> [<key> <value>]...";
   if (r.args.empty() || r.args.size() % 2 == 0)
@@ -306,6 +337,10 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         return learnReply(*learned);
       },
       alwaysChanges, Publishes::kFrame);
+  table.add(
+      "LEARNVIEW", "LEARNVIEW <type> [AT <x> <y> <w> <h>]",
+      [&vision](const Request& r) { return learnView(vision, r); }, alwaysChanges,
+      Publishes::kFrame);
   table.add(
       "TRYLEARN", "TRYLEARN <type> [name] [AT <x> <y> <w> <h>]",
       [&vision](const Request& r) {

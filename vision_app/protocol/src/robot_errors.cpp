@@ -60,6 +60,7 @@ const std::pair<std::error_code, int> kTable[] = {
     {VisionServiceErrc::kSeveralPartsInRectangle, 36},
     {ModelErrc::kNothingToUndo, 37},
     {ModelErrc::kUndoRefused, 38},
+    {VisionServiceErrc::kViewRefused, 39},
     {CellCalibrationErrc::kNoSuchPoint, 40},
     {CalibrationErrc::kTooFewPoints, 41},
     {CalibrationErrc::kDegeneratePoints, 42},

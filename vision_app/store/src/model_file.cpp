@@ -156,6 +156,15 @@ std::string modelToYaml(const PartModel& m, const GraspSetup& grasp) {
   out << YAML::Key << "trained" << YAML::Value << YAML::BeginMap;
   point(out, "centroid", m.trained_centroid);
   out << YAML::Key << "angle_deg" << YAML::Value << m.trained_angle_deg;
+  // Optional on reading: a model of one view has none.
+  if (!m.views.empty()) {
+    out << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
+    for (const auto& v : m.views) {
+      out << YAML::Flow << YAML::BeginSeq << v.x << v.y << YAML::EndSeq;
+    }
+    out << YAML::EndSeq;
+    point(out, "origin_shift", m.origin_shift);
+  }
   out << YAML::EndMap;
 
   // Optional on reading: files written before it count every region and hole.
@@ -371,6 +380,24 @@ Result<ModelRecord> modelRecordFromYaml(const std::string& text) {
     const YAML::Node trained = need(root, "trained");
     m.trained_centroid = asPoint(trained, "centroid");
     m.trained_angle_deg = as<double>(trained, "angle_deg");
+    if (trained["views"]) {
+      const YAML::Node views = trained["views"];
+      if (!views.IsSequence()) throw FieldError{"'trained.views' must be a list of [x, y]"};
+      // Bounded before reading: the model's own check counts them after.
+      if (views.size() > vision::kMaxModelViews)
+        throw FieldError{"'trained.views' holds more than " +
+                         std::to_string(vision::kMaxModelViews) + " views"};
+      for (const auto& v : views) {
+        if (!v.IsSequence() || v.size() != 2)
+          throw FieldError{"each of 'trained.views' must be [x, y]"};
+        try {
+          m.views.emplace_back(v[0].as<double>(), v[1].as<double>());
+        } catch (const YAML::Exception&) {
+          throw FieldError{"each of 'trained.views' must hold two numbers"};
+        }
+      }
+      m.origin_shift = asPoint(trained, "origin_shift");
+    }
 
     if (root["regions"]) {
       const YAML::Node regions = root["regions"];

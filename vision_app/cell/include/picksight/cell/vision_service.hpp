@@ -40,6 +40,7 @@ enum class VisionServiceErrc {
   kOutsideFrame,             // LEARN AT: the rectangle holds no pixel of the frame
   kNoPartInRectangle,        // LEARN AT: no part inside the rectangle
   kSeveralPartsInRectangle,  // LEARN AT: more than one
+  kViewRefused,              // LEARNVIEW: the view cannot refine the model
 };
 const char* errorName(VisionServiceErrc e);
 PICKSIGHT_ERROR_DOMAIN(VisionServiceErrc, "vision")
@@ -176,6 +177,34 @@ struct TryLearnOutcome {
   int found = 0;  // parts of the taught type among located.parts
 };
 
+// A further view of a taught part (LEARNVIEW): where the view read the
+// part's centroid and the model with that reading added.
+struct ViewOutcome {
+  vision::PartModel model;  // sensor pixels, the origin moved (addViewReading)
+  cv::Point2d reading;      // this view's centroid, teach image's frame, sensor px
+  cv::Point2d moved;        // how far the origin moved with this view, sensor px
+  // The median distance of every reading (the teach image's included) from
+  // the new origin: what one view's light puts a centroid off by.
+  double spread_px = 0;
+};
+
+// LEARNVIEW on one frame: finds the one part of `type` (inside `at`, sensor
+// pixels, when given) with the cell's models, as LOCATE does, and reads
+// where its centroid lies in the model's frame (the model placed on the
+// part's edges, the centroid measured on its grey levels): the teach
+// image's light put the model's origin off by what that image read, and
+// each view lying elsewhere reads it again. The part must lie apart
+// (a part that touches another is placed by its outline alone). Errors:
+// kUnknownType, kNoPart / kNoPartInRectangle, kSeveralParts /
+// kSeveralPartsInRectangle, kViewRefused (a part with rotational symmetry,
+// whose origin is its centre of symmetry; a part touching another; a
+// reading further than vision::kMaxViewReadingPx from the teach image's;
+// views full).
+Result<ViewOutcome> viewInFrame(const Frame& frame, const VisionOptions& options,
+                                std::shared_ptr<const store::ModelList> models, int type,
+                                const std::optional<cv::Rect>& at,
+                                ScaledModelCache* cache = nullptr);
+
 // LEARN on one grey frame: binarizes the whole frame as LOCATE would (with
 // `models`, sensor pixels, widening the window), then trains from the one
 // part inside `at` (sensor pixels; none: the whole frame): the largest
@@ -244,6 +273,10 @@ class VisionService {
   // would teach and what LOCATE would then find, for a person to judge first.
   Result<TryLearnOutcome> tryLearn(int type, const std::string& name,
                                    const std::optional<cv::Rect>& at = std::nullopt);
+  // Adds a fresh frame's view of the part of `type` (viewInFrame) to its
+  // model and stores it (`change`: the request, for the undo history).
+  Result<ViewOutcome> learnView(int type, const std::optional<cv::Rect>& at = std::nullopt,
+                                std::string_view change = {});
   // Blob features of every region in a fresh frame, sensor pixels.
   Result<std::vector<vision::BlobFeatures>> blobs();
   // The single calibration target in a fresh frame.

@@ -68,6 +68,15 @@ struct PartModel {
   // frame is the trained pose with the centroid at the origin).
   cv::Point2d trained_centroid;
   double trained_angle_deg = 0;
+  // More views of the part than the teach image (LEARNVIEW): where each
+  // read the part's centroid, in the teach image's frame (its own reading
+  // at 0, 0), and where the model's origin now lies in that frame (the
+  // median of every reading, the teach image's included; see
+  // addViewReading). One image's texture, glints and noise put its centroid
+  // a tenth of a pixel off, and every part found afterwards inherited it;
+  // readings of the part lying elsewhere average it out.
+  std::vector<cv::Point2d> views;
+  cv::Point2d origin_shift;
   // The region settings it was trained with (pixels): regions and holes
   // smaller than these were not part of the image it learned from.
   double min_region_area = 0;
@@ -116,6 +125,21 @@ struct PartModel {
 // [0, S) this replaced had its edge at the taught pose itself, and a bar
 // lying still there came out 0.0 or 179.9 frame by frame.
 double reportedTurnDeg(const PartModel& model, double turn_deg);
+
+// At most this many views beyond the teach image; a reading or an origin
+// further than these from the teach image's centroid is not the same part's
+// centroid (a part of another type, a speck joined), and a model that says
+// so is damaged.
+constexpr size_t kMaxModelViews = 32;
+constexpr double kMaxViewReadingPx = 2.0;
+constexpr double kMaxOriginShiftPx = 1.0;
+
+// Where a model's origin lies in its teach image's frame given the
+// centroids its views read there: the median of each coordinate over them
+// and the teach image's own (0, 0). A median, not a mean: a view whose
+// threshold clipped a limb or took in a speck reads its centroid half a
+// pixel off, and must not drag the origin with it.
+cv::Point2d originFromViews(const std::vector<cv::Point2d>& views);
 
 // Why a model could not be trained, or is not valid.
 enum class PartModelErrc {

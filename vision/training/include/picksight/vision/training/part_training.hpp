@@ -36,6 +36,16 @@ Result<PartModel> trainModel(const cv::Mat& grey, int type, const std::string& n
 Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& region, int type,
                                        const std::string& name, const TrainOptions& options = {});
 
+// Turns the model's boundary by `turn_deg` about its origin, then moves it
+// by `shift` (model frame), and prepares it again.
+void moveBoundary(PartModel& model, double turn_deg, cv::Point2d shift);
+
+// Adds a view's reading of the part's centroid (the teach image's frame,
+// see PartModel::views) and moves the origin to the median of them all:
+// the boundary is moved the other way, so that a part is found where it
+// was and reported at the new origin.
+void addViewReading(PartModel& model, cv::Point2d reading);
+
 // Fills the derived members; call after training or loading.
 void prepareModel(PartModel& model);
 
