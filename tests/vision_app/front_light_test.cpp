@@ -755,17 +755,23 @@ TEST_CASE("views move the origin to the median of their readings and survive the
   CHECK(back->views[2] == m.views[2]);
   CHECK(back->origin_shift == m.origin_shift);
   CHECK(cv::norm(placed(*back) - after) < 1e-9);
-  // A damaged reading or origin is refused by name, never taken as it reads.
-  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
-           {"origin_shift: [", "origin_shift: [0.5, 0.5, "},
-           {"origin_shift: [", "origin_shift: [0.01"},
-           {"views:\n", "views:\n    - [9, 9]\n"}}) {
+  // A damaged reading or origin is refused, saying what is wrong, never
+  // taken as it reads: each line replaced whole.
+  const auto replaced = [&](const std::string& key, const std::string& line) {
     std::string damaged = yaml;
-    const auto at = damaged.find(from);
+    const auto at = damaged.find(key);
     REQUIRE(at != std::string::npos);
-    damaged.replace(at, from.size(), to);
+    // From the key on: the line keeps its indentation.
+    damaged.replace(at, damaged.find('\n', at) - at, line);
+    return damaged;
+  };
+  for (const auto& [damaged, why] : std::vector<std::pair<std::string, std::string>>{
+           {replaced("origin_shift:", "origin_shift: [0.3, -0.05]"), "median"},
+           {replaced("origin_shift:", "origin_shift: [0.25, -0.05, 1]"), "[x, y]"},
+           {replaced("views:", "views:\n    - [9, 9]"), "within 2.0 px"}}) {
     const auto refused = modelFromYaml(damaged);
-    INFO(to);
-    CHECK_FALSE(refused.ok());
+    INFO(why << " in\n" << damaged.substr(0, 600));
+    REQUIRE_FALSE(refused.ok());
+    CHECK(refused.error().message.find(why) != std::string::npos);
   }
 }
