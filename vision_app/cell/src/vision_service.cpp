@@ -430,6 +430,99 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
 }
 
 // What LEARN left out, for its reply (sensor pixels).
+// Under a front light at low contrast, a stretch of the surface as dark as
+// the part (a blotch of the belt, the shade of a fold) can join the part by
+// a few speckled pixels, and the threshold leaves it full of pinholes: a
+// model taught with it counts its holes (never seen again) and turns its
+// moments, and found no other copy of the part. Such an appendage hangs on
+// by a neck under kNeckPx across and has holes, and is either mostly
+// thinner than that itself (a mesh of specks) or riddled with pinholes
+// (kMinPinholes or more under kNeckPx squared); a part's own pin has no
+// holes, and a lobe with a hole of its own (a ring on a thin stem) is solid
+// round a hole or two.
+constexpr int kNeckPx = 5;
+constexpr double kMaxAppendageShare = 0.2;
+constexpr double kMinSolidShare = 0.5;
+constexpr int kMinPinholes = 3;
+
+// Takes such appendages off region `r` in `mask` (frame pixels, in place);
+// the pixels taken off.
+int cutSpeckledAppendages(const vision::Region& r, cv::Mat& mask) {
+  if (r.holes == 0) return 0;
+  const int margin = kNeckPx;
+  const cv::Rect box = (r.bbox + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
+                       cv::Rect({0, 0}, mask.size());
+  cv::Mat filled = cv::Mat::zeros(box.size(), CV_8U);
+  cv::drawContours(filled, std::vector<std::vector<cv::Point>>{r.outer}, 0, cv::Scalar(255),
+                   cv::FILLED, cv::LINE_8, cv::noArray(), INT_MAX, -box.tl());
+  const cv::Mat own = filled & (mask(box) != 0);
+  // The part's body: what survives an opening by the neck's width, its
+  // largest piece, and the pixels of the region beside it.
+  const cv::Mat neck = cv::getStructuringElement(cv::MORPH_ELLIPSE, {kNeckPx, kNeckPx});
+  cv::Mat opened;
+  cv::morphologyEx(own, opened, cv::MORPH_OPEN, neck);
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(opened, labels, stats, centroids, 8);
+  if (n < 2) return 0;
+  int body = 1;
+  for (int k = 2; k < n; ++k) {
+    if (stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(body, cv::CC_STAT_AREA)) body = k;
+  }
+  cv::Mat kept;
+  cv::dilate(labels == body, kept, neck);
+  kept &= own;
+  // What hangs on beyond it, piece by piece: dropped when holed and small.
+  const cv::Mat rest = own & ~kept;
+  const double own_area = cv::countNonZero(own);
+  cv::Mat pieces;
+  const int m = cv::connectedComponents(rest, pieces, 8);
+  cv::Mat dropped = cv::Mat::zeros(box.size(), CV_8U);
+  std::vector<int> crumbs;  // pieces too small to be a pin: the speckle's crumbs
+  for (int k = 1; k < m; ++k) {
+    const cv::Mat piece = pieces == k;
+    const int area = cv::countNonZero(piece);
+    if (area > kMaxAppendageShare * own_area) continue;
+    if (area < kNeckPx * kNeckPx) crumbs.push_back(k);
+    std::vector<std::vector<cv::Point>> contours;
+    std::vector<cv::Vec4i> hierarchy;
+    cv::findContours(piece.clone(), contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+    int holes = 0;
+    int pinholes = 0;
+    for (size_t i = 0; i < contours.size(); ++i) {
+      if (hierarchy[i][3] < 0) continue;
+      ++holes;
+      if (cv::contourArea(contours[i]) < kNeckPx * kNeckPx) ++pinholes;
+    }
+    // Mostly thinner than the neck too (a mesh of specks), or riddled with
+    // pinholes (a blotch the threshold speckled); a lobe of the part's own
+    // (a ring on a thin stem) is solid round a hole or two.
+    const bool solid = cv::countNonZero(piece & opened) >= kMinSolidShare * area;
+    if (holes > 0 && (!solid || pinholes >= kMinPinholes)) dropped.setTo(255, piece);
+  }
+  if (cv::countNonZero(dropped) == 0) return 0;
+  for (const int k : crumbs) dropped.setTo(255, pieces == k);
+  const int cut = cv::countNonZero(dropped);
+  mask(box).setTo(0, dropped);
+  // Pinholes the appendage closed against the part at its neck: the
+  // surface between specks, not a hole of the part.
+  cv::Mat zone;
+  cv::dilate(dropped, zone,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * kNeckPx + 1, 2 * kNeckPx + 1}));
+  const cv::Mat left = own & ~dropped;
+  std::vector<std::vector<cv::Point>> contours;
+  std::vector<cv::Vec4i> hierarchy;
+  cv::findContours(left.clone(), contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+  for (size_t i = 0; i < contours.size(); ++i) {
+    if (hierarchy[i][3] < 0 || cv::contourArea(contours[i]) >= kNeckPx * kNeckPx) continue;
+    const bool at_neck = std::any_of(contours[i].begin(), contours[i].end(),
+                                     [&](const cv::Point& q) { return zone.at<uint8_t>(q) != 0; });
+    if (at_neck) {
+      cv::drawContours(mask(box), contours, static_cast<int>(i), cv::Scalar(255), cv::FILLED);
+    }
+  }
+  return cut;
+}
+
 std::string specksNote(const std::vector<vision::Region>& regions,
                        const std::vector<size_t>& specks, const SensorMapping& mapping) {
   double largest = 0;
@@ -660,15 +753,31 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
   o.regions.keep_border_regions = true;
   if (colour) o.binarize.polarity = vision::Polarity::kDarkOnLight;
   for (int pass = 0;; ++pass) {
-    const cv::Mat mask = vision::binarize(grey, o.binarize);
-    const auto regions = vision::findRegions(mask, o.regions, grey);
-    const auto inside = regionsInside(regions, rect);
+    cv::Mat mask = vision::binarize(grey, o.binarize);
+    auto regions = vision::findRegions(mask, o.regions, grey);
+    auto inside = regionsInside(regions, rect);
     if (inside.empty()) {
       if (!at) return makeError(vision::PartModelErrc::kNoPart, "no part in the frame");
       return makeError(VisionServiceErrc::kNoPartInRectangle,
                        "no part inside LEARN AT " + sensorRectText(*at));
     }
-    const LearnRegions seen = sortForLearn(regions, inside, grey, mask);
+    LearnRegions seen = sortForLearn(regions, inside, grey, mask);
+    int appendage_px = 0;
+    if (seen.others.empty() && !inside.empty()) {
+      cv::Mat cut = mask.clone();
+      appendage_px = cutSpeckledAppendages(regions[seen.part], cut);
+      auto cut_regions = appendage_px > 0 ? vision::findRegions(cut, o.regions, grey)
+                                          : std::vector<vision::Region>{};
+      auto cut_inside = regionsInside(cut_regions, rect);
+      if (cut_inside.empty()) {
+        appendage_px = 0;  // nothing cut, or nothing left: the region as it was
+      } else {
+        mask = cut;
+        regions = std::move(cut_regions);
+        inside = std::move(cut_inside);
+        seen = sortForLearn(regions, inside, grey, mask);
+      }
+    }
     if (!seen.others.empty()) {
       const std::string count = std::to_string(seen.others.size() + 1) + " parts";
       if (!at) {
@@ -731,6 +840,12 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     out.warnings = learnWarnings(r, grey, mask, mapping, options);
     if (auto alike = lookAlikeWarning(r, *frame_models, type)) out.warnings.push_back(*alike);
     if (!seen.specks.empty()) out.notes.push_back(specksNote(regions, seen.specks, mapping));
+    if (appendage_px > 0) {
+      out.notes.push_back("left out " +
+                          std::to_string(std::lround(mapping.areaToSensor(appendage_px))) +
+                          " px of speckled surface joined to the part by a neck under " +
+                          std::to_string(kNeckPx) + " px (its pinholes are not the part's)");
+    }
     return out;
   }
 }
