@@ -39,6 +39,10 @@ Undone = namedtuple("Undone", "type restored left change")
 # TRYLEARN: the model LEARN would store, the parts of its type and all parts
 # LOCATE ALL then finds on that frame, and LEARN's warnings.
 TriedModel = namedtuple("TriedModel", "model found parts warnings")
+# LEARNVIEW: the model's type and name, the images it is taught from now,
+# where its origin lies from the centroid LEARN read (sensor px, the teach
+# image's axes), the views' spread about it, and this view's reading.
+View = namedtuple("View", "type name views dx dy spread reading")
 # JOB SAVE / LOAD: the job's name, its models, whether it holds a
 # calibration and camera settings, the job file's size (None after a load)
 # and the notes after ';' (e.g. why the camera settings were not kept).
@@ -290,6 +294,24 @@ class RobotClient:
         warnings = [p[len("warning: "):] for p in text.split(" ; ")[1:] if p.startswith("warning: ")]
         model = Model(int(w[0]), w[1], float(w[2]), int(w[3]), float(w[4]), w[5] == "1")
         return TriedModel(model, int(w[6]), int(w[7]), warnings)
+
+    def learn_view(self, part_type, at=None):
+        """Reads the taught part of `part_type` again where it lies now
+        (alone, or inside `at` = (x, y, w, h) sensor pixels), moving the
+        model's origin to the median of the views (LEARNVIEW). RobotError 39
+        when the view cannot refine the model (a symmetric part, a part
+        touching another, a reading far off). Returns a View."""
+        line = f"LEARNVIEW {int(part_type)}"
+        if at is not None:
+            line += " AT " + " ".join(str(int(v)) for v in at)
+        w = self.request(line)
+        text = " ".join(w)
+        reading = None
+        marker = "this view read the centroid at "
+        if marker in text:
+            x, y = text.split(marker, 1)[1].split(";")[0].split()[:2]
+            reading = (float(x), float(y))
+        return View(int(w[0]), w[1], int(w[2]), float(w[3]), float(w[4]), float(w[5]), reading)
 
     def undo(self):
         """Takes back the last change to models (LEARN, FORGET, TOLERANCE,

@@ -122,6 +122,11 @@ def test_tolerances_read_changed_and_refused(cell_factory):
         assert robot.tolerance(1, mirror_symmetric=mirror).values["mirror_symmetric"] == mirror
         assert len(robot.locate(1)) == 1
 
+        # A part that looks alike turned keeps its origin at its centre.
+        with pytest.raises(RobotError) as e:
+            robot.learn_view(1)
+        assert e.value.code == 39 and "symmetry" in e.value.text
+
         # Tried, not stored; then each change taken back, newest first.
         tried = robot.try_learn(2, "again")
         assert (tried.model.type, tried.found, tried.parts) == (2, 1, 1), tried
@@ -297,3 +302,21 @@ def test_jobs_saved_listed_loaded_and_refused(cell_factory, tmp_path):
         assert e.value.code == 54
         robot.job_delete("2-other")
         assert robot.job_list() == ["1-discs"]
+
+
+def test_learn_view_reads_the_part_again_and_undo_takes_it_back(cell_factory):
+    _, vision = cell_factory(
+        "--source", "cam0=synthetic:width=640,height=480,parts=1,types=l_shape,seed=3,scene_every=1",
+        "--mode", "trigger")
+    with RobotClient("127.0.0.1", vision.port) as robot:
+        with pytest.raises(RobotError) as e:
+            robot.learn_view(1)  # nothing taught
+        assert e.value.code == 32
+        robot.learn(1, "bracket")
+        view = robot.learn_view(1)
+        assert (view.type, view.name, view.views) == (1, "bracket", 2), view
+        assert abs(view.dx) < 0.5 and abs(view.dy) < 0.5 and view.spread >= 0, view
+        assert view.reading is not None and abs(view.reading[0]) < 1, view
+        assert robot.learn_view(1, at=(0, 0, 640, 480)).views == 3
+        assert robot.undo().change == "LEARNVIEW 1 AT 0 0 640 480"
+        assert robot.learn_view(1).views == 3
