@@ -21,6 +21,7 @@
 #include "picksight/app/offline_commands.hpp"
 #include "picksight/cell/vision_service.hpp"
 #include "picksight/common/angles.hpp"
+#include "picksight/common/atomic_file.hpp"
 #include "picksight/common/frame.hpp"
 #include "picksight/store/model_file.hpp"
 #include "picksight/synthetic/front_light.hpp"
@@ -880,4 +881,52 @@ TEST_CASE("LEARN leaves out a speckled stretch of the surface hung on the part b
     return n.find("speckled surface") != std::string::npos;
   });
   CHECK_FALSE(cut);
+}
+
+TEST_CASE("picksight-vision learnview reads a part again in each image file and stores the views",
+          "[vision_app][learn][views][offline]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("picksight-offline-views-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const ps::SilhouetteSceneOptions look = lookOf("wood");
+  for (int v = 0; v < 3; ++v) {
+    const cv::Mat image =
+        ps::renderSilhouetteAlone(boneType(), 600, look, 60 + v, nullptr, 30 + 47 * v);
+    REQUIRE(cv::imwrite((dir / ("view" + std::to_string(v) + ".png")).string(), image));
+  }
+  const auto run = [&](std::vector<std::string> args, int expected_status) {
+    args.insert(args.begin() + 1, {"--data-dir", (dir / "data").string(), "--window", "400"});
+    std::ostringstream out, err;
+    const int status = app::runOfflineCommand(args, out, err);
+    INFO(err.str() << out.str());
+    CHECK(status == expected_status);
+    return out.str();
+  };
+  const std::string p0 = (dir / "view0.png").string();
+  const std::string p1 = (dir / "view1.png").string();
+  const std::string p2 = (dir / "view2.png").string();
+  // No model yet: refused by the protocol's code.
+  CHECK_THAT(run({"learnview", "--type", "1", p1}, 1), Catch::StartsWith("ERROR 32 "));
+  CHECK_THAT(run({"learn", "--type", "1", "--name", "tee", p0}, 0), Catch::StartsWith("OK 1 tee "));
+  // Each image a view, in order; one unreadable is said and the next read.
+  const std::string views =
+      run({"learnview", "--type", "1", p1, (dir / "none.png").string(), p2}, 1);
+  std::istringstream lines(views);
+  std::string line;
+  std::vector<std::string> replies;
+  while (std::getline(lines, line)) replies.push_back(line);
+  REQUIRE(replies.size() == 3);
+  CHECK_THAT(replies[0], Catch::StartsWith("OK 1 tee 2 "));
+  CHECK_THAT(replies[1], Catch::StartsWith("ERROR 11 "));
+  CHECK_THAT(replies[2], Catch::StartsWith("OK 1 tee 3 "));
+  const auto stored = readFile((dir / "data" / "models" / "type_1.yaml").string());
+  REQUIRE(stored.ok());
+  const auto model = modelFromYaml(*stored);
+  REQUIRE(model.ok());
+  CHECK(model->views.size() == 2);
+  // --at around nothing: no part of the type inside.
+  CHECK_THAT(run({"learnview", "--type", "1", "--at", "0", "0", "20", "20", p1}, 1),
+             Catch::StartsWith("ERROR 35 "));
+  std::filesystem::remove_all(dir);
 }

@@ -29,6 +29,7 @@ namespace picksight::app {
 using protocol::blobSummary;
 using protocol::errorReply;
 using protocol::learnReply;
+using protocol::learnViewReply;
 using protocol::locateReply;
 using protocol::parseType;
 using protocol::printable;
@@ -51,6 +52,7 @@ using store::ModelLibrary;
 
 std::string offlineUsage() {
   return "usage: picksight-vision learn --type N [--name NAME] [--at X Y W H] [options] IMAGE\n"
+         "       picksight-vision learnview --type N [--at X Y W H] [options] IMAGE...\n"
          "       picksight-vision locate [--type N] [options] IMAGE...\n"
          "       picksight-vision blobs [options] IMAGE...\n"
          "       picksight-vision lens [--data-dir DIR] [--corners 9x6] [--square MM] IMAGE...\n"
@@ -59,6 +61,8 @@ std::string offlineUsage() {
          "\n"
          "  learn   trains type N from the single part in IMAGE into DATA_DIR/models\n"
          "          (with --at, the one part inside that rectangle, as LEARN ... AT)\n"
+         "  learnview reads type N's part again in each IMAGE (alone, or inside --at), as\n"
+         "          LEARNVIEW: the model's origin moves to the median of the views\n"
          "  locate  prints one 'OK <n> x y rz ...' line per image: grasp poses of type N\n"
          "          (all trained types without --type; every region without models), in\n"
          "          the frame the data dir's calibration gives (docs/PROTOCOL.md)\n"
@@ -75,8 +79,8 @@ std::string offlineUsage() {
 }
 
 bool isOfflineCommand(const std::vector<std::string>& args) {
-  return !args.empty() && (args[0] == "learn" || args[0] == "locate" || args[0] == "blobs" ||
-                           args[0] == "lens" || args[0] == "test-run");
+  return !args.empty() && (args[0] == "learn" || args[0] == "learnview" || args[0] == "locate" ||
+                           args[0] == "blobs" || args[0] == "lens" || args[0] == "test-run");
 }
 
 namespace {
@@ -219,11 +223,12 @@ std::variant<OfflineRequest, int> parseOfflineRequest(const std::vector<std::str
         << offlineUsage();
     return 2;
   }
-  if (r.at && command != "learn") {
-    err << "picksight-vision " << command << ": --at is an option of learn\n";
+  if (r.at && command != "learn" && command != "learnview") {
+    err << "picksight-vision " << command << ": --at is an option of learn and learnview\n";
     return 2;
   }
-  if (r.images.empty() || (command == "learn" && (r.images.size() != 1 || r.type < 0))) {
+  if (r.images.empty() || (command == "learn" && (r.images.size() != 1 || r.type < 0)) ||
+      (command == "learnview" && r.type < 0)) {
     err << offlineUsage();
     return 2;
   }
@@ -366,6 +371,29 @@ int learnOffline(const OfflineRequest& r, const cv::Mat& image, const std::strin
   out << learnReply(*learned) << "\n";
   return 0;
 }
+
+// picksight-vision learnview on one of its images: the view added to the
+// stored model as LEARNVIEW adds it. The exit status.
+int learnViewOffline(const OfflineRequest& r, const cv::Mat& image, const std::string& path,
+                     ModelLibrary& library, std::ostream& out) {
+  auto view = cell::viewInFrame(frameFromImage(image, path, 1), r.options.vision,
+                                library.snapshot(), r.type, r.at);
+  if (!view) {
+    out << errorReply(view.error()) << "\n";
+    return 1;
+  }
+  std::string change = "picksight-vision learnview --type " + std::to_string(r.type);
+  if (r.at) {
+    change += " --at " + std::to_string(r.at->x) + " " + std::to_string(r.at->y) + " " +
+              std::to_string(r.at->width) + " " + std::to_string(r.at->height);
+  }
+  if (auto stored = cell::storeView(library, r.type, *view, change + " " + path); !stored) {
+    out << errorReply(stored.error()) << "\n";
+    return 1;
+  }
+  out << learnViewReply(*view) << "\n";
+  return 0;
+}
 }  // namespace
 
 int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -421,6 +449,9 @@ int runOfflineCommand(const std::vector<std::string>& args, std::ostream& out, s
     if (r.command == "learn") {
       if (const int learned = learnOffline(r, image, path, library, out, err); learned != 0)
         return learned;
+    } else if (r.command == "learnview") {
+      // Each image a view; one refused is said and the next read.
+      if (learnViewOffline(r, image, path, library, out) != 0) status = 1;
     } else if (r.command == "locate") {
       // The robot's LOCATE path on the image: same frame (calibration of
       // the data dir), same grasps.

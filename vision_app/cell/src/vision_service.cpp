@@ -294,10 +294,17 @@ Result<ViewOutcome> VisionService::learnView(int type, const std::optional<cv::R
   if (!frame) return frame.error();
   auto view = viewInFrame(**frame, **settings, models_->snapshot(), type, at, scaled_models_.get());
   if (!view) return view.error();
+  auto stored = storeView(*models_, type, *view, change);
+  if (!stored) return stored.error();
+  return view;
+}
+
+Result<void> storeView(store::ModelLibrary& library, int type, ViewOutcome& view,
+                       std::string_view change) {
   // The reading is added to the model as it is now (a TOLERANCE or GRASP
-  // since the snapshot kept), under the library's lock.
-  auto stored = models_->update(
-      type, [&](vision::PartModel& m) { vision::addViewReading(m, view->reading); }, change);
+  // since the view was read kept), under the library's lock.
+  auto stored = library.update(
+      type, [&](vision::PartModel& m) { vision::addViewReading(m, view.reading); }, change);
   if (!stored) {
     if (stored.error().code == store::ModelErrc::kUnknownType)
       return makeError(VisionServiceErrc::kUnknownType, stored.error().message);
@@ -306,8 +313,8 @@ Result<ViewOutcome> VisionService::learnView(int type, const std::optional<cv::R
     return makeError(VisionServiceErrc::kStorageFailed,
                      "cannot store the model: " + stored.error().message);
   }
-  view->model = std::move(*stored);
-  return view;
+  view.model = std::move(*stored);
+  return {};
 }
 
 std::optional<std::string> teachImagePng(const cv::Mat& frame) {

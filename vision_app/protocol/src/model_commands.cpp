@@ -36,6 +36,15 @@ std::string modelSummary(const vision::PartModel& m) {
          std::to_string(m.body.holes) + " " + formatFixed(m.symmetryDeg());
 }
 
+std::string learnViewReply(const cell::ViewOutcome& view) {
+  const vision::PartModel& m = view.model;
+  return "OK " + std::to_string(m.type) + " " + m.name + " " + std::to_string(m.views.size() + 1) +
+         " " + formatFixed(m.origin_shift.x) + " " + formatFixed(m.origin_shift.y) + " " +
+         formatFixed(view.spread_px) + " ; note: this view read the centroid at " +
+         formatFixed(view.reading.x) + " " + formatFixed(view.reading.y) + "; the origin moved " +
+         formatFixed(cv::norm(view.moved)) + " px";
+}
+
 std::string learnReply(const LearnOutcome& learned) {
   std::string reply =
       "OK " + modelSummary(learned.model) + " " + (learned.model.body.mirror_symmetric ? "1" : "0");
@@ -261,12 +270,7 @@ std::string learnView(VisionService& vision, const Request& r) {
   }
   auto view = vision.learnView(*type, at, r.line);
   if (!view) return errorReply(view.error());
-  const vision::PartModel& m = view->model;
-  return "OK " + std::to_string(m.type) + " " + m.name + " " + std::to_string(m.views.size() + 1) +
-         " " + formatFixed(m.origin_shift.x) + " " + formatFixed(m.origin_shift.y) + " " +
-         formatFixed(view->spread_px) + " ; note: this view read the centroid at " +
-         formatFixed(view->reading.x) + " " + formatFixed(view->reading.y) + "; the origin moved " +
-         formatFixed(cv::norm(view->moved)) + " px";
+  return learnViewReply(*view);
 }
 
 std::string tolerance(VisionService& vision, const Request& r) {

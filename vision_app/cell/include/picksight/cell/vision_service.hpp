@@ -205,6 +205,13 @@ Result<ViewOutcome> viewInFrame(const Frame& frame, const VisionOptions& options
                                 const std::optional<cv::Rect>& at,
                                 ScaledModelCache* cache = nullptr);
 
+// Adds `view`'s reading to the stored model of `type` (`change`: the
+// request, for the undo history) and puts the model stored in view.model.
+// Errors: kUnknownType, kViewRefused (the model would not be valid),
+// kStorageFailed.
+Result<void> storeView(store::ModelLibrary& library, int type, ViewOutcome& view,
+                       std::string_view change);
+
 // LEARN on one grey frame: binarizes the whole frame as LOCATE would (with
 // `models`, sensor pixels, widening the window), then trains from the one
 // part inside `at` (sensor pixels; none: the whole frame): the largest

@@ -15,6 +15,9 @@ std::string modelSummary(const vision::PartModel& model);
 // LEARN's reply: "OK <type> <name> <area> <holes> <symmetry> <mirror 0/1>",
 // then " ; warning: <text>" for each warning.
 std::string learnReply(const cell::LearnOutcome& learned);
+// LEARNVIEW's reply: `OK <type> <name> <views> <dx> <dy> <spread> ; note:
+// ...` (docs/PROTOCOL.md).
+std::string learnViewReply(const cell::ViewOutcome& view);
 // TOLERANCE's reply: "OK <type> <name>" then " <key>=<value>" for each
 // tolerance a model file stores (area_tolerance, hu_tolerance,
 // verify_percent, edge_tolerance_px, mirror_symmetric).
