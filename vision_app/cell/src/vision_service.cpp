@@ -436,7 +436,6 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
   return out;
 }
 
-// What LEARN left out, for its reply (sensor pixels).
 // Under a front light at low contrast, a stretch of the surface as dark as
 // the part (a blotch of the belt, the shade of a fold) can join the part by
 // a few speckled pixels, and the threshold leaves it full of pinholes: a
@@ -530,6 +529,7 @@ int cutSpeckledAppendages(const vision::Region& r, cv::Mat& mask) {
   return cut;
 }
 
+// What LEARN left out, for its reply (sensor pixels).
 std::string specksNote(const std::vector<vision::Region>& regions,
                        const std::vector<size_t>& specks, const SensorMapping& mapping) {
   double largest = 0;
