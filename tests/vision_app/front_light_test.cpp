@@ -930,3 +930,36 @@ TEST_CASE("picksight-vision learnview reads a part again in each image file and 
              Catch::StartsWith("ERROR 35 "));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("LEARN takes the part and not a larger speckled blotch of the belt beside it",
+          "[vision_app][learn][front]") {
+  // Beside a glossy part on its belt, the threshold took in a blotch of the
+  // belt whole, speckled, larger than the part: LEARN measured everything
+  // against the largest region and called the part a second part. Here a
+  // stretch of belt 220 px square, 70 % of its pixels 40 levels darker.
+  cv::Point2d drawn;
+  cv::Mat image = ps::renderSilhouetteAlone(boneType(), 600, lookOf("textured"), 11, &drawn, 30);
+  const auto alone = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  REQUIRE(alone.ok());
+  cv::RNG rng(7);
+  for (int y = 370; y < 590; ++y) {
+    for (int x = 10; x < 230; ++x) {
+      if (rng.uniform(0.0, 1.0) < 0.7)
+        image.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(image.at<uint8_t>(y, x) - 40);
+    }
+  }
+  const auto regions = pv::findRegions(pv::binarize(image, cellOptions().binarize), {}, image);
+  double largest = 0;
+  for (const auto& r : regions) largest = std::max(largest, r.area);
+  REQUIRE(largest > 1.2 * alone->model.body.area);  // the blotch, larger than the part
+  const auto learned = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  INFO((learned.ok() ? std::string() : learned.error().message));
+  REQUIRE(learned.ok());
+  CHECK(learned->model.body.area == Approx(alone->model.body.area).epsilon(0.01));
+  CHECK(learned->model.body.holes == 0);
+  CHECK(cv::norm(learned->model.trained_centroid - alone->model.trained_centroid) < 0.1);
+  const bool said = std::any_of(learned->notes.begin(), learned->notes.end(), [](const auto& n) {
+    return n.find("ignored") != std::string::npos;
+  });
+  CHECK(said);
+}

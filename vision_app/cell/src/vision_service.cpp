@@ -422,9 +422,27 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
                           const std::vector<size_t>& inside, const cv::Mat& grey,
                           const cv::Mat& mask) {
   LearnRegions out;
-  out.part = inside.front();
+  // The part: the largest region that is no stain beside the deepest of
+  // those of a part's size. A blotch of a textured belt that the threshold
+  // took in whole can be larger than the part (beside a glossy part, 15800
+  // px of speckle against the part's 13400): taken as the part, it made the
+  // part a second one.
+  double largest = 0;
+  for (const size_t i : inside) largest = std::max(largest, regions[i].area);
+  std::vector<std::pair<size_t, double>> sized;  // regions of a part's size, their depth
+  double deepest = 0;
   for (const size_t i : inside) {
-    if (regions[i].area > regions[out.part].area) out.part = i;
+    if (regions[i].area < kSpeckShare * largest) continue;
+    sized.emplace_back(i, depthOf(regions[i], grey, mask));
+    deepest = std::max(deepest, sized.back().second);
+  }
+  out.part = sized.front().first;
+  double part_area = -1;
+  for (const auto& [i, depth] : sized) {
+    if (depth >= kStainDepthShare * deepest && regions[i].area > part_area) {
+      out.part = i;
+      part_area = regions[i].area;
+    }
   }
   const double part_depth = depthOf(regions[out.part], grey, mask);
   for (const size_t i : inside) {
