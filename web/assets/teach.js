@@ -114,6 +114,7 @@
       list.appendChild(li);
     }
     pending = { type, name: f[1], args, replaces: old ? old[1] : null };
+    $("teach-save").hidden = false;
     $("teach-preview").hidden = false;
     $("teach-save").disabled = false;
   }
@@ -157,6 +158,7 @@
         Number(f[4]).toFixed(3) + " px from the first teach's centroid, views " + Number(f[5]).toFixed(3) +
         " px apart (median). Lay the part elsewhere and Add view again, or Undo.";
       $("teach-warnings").textContent = "";
+      $("teach-save").hidden = true;  // stored already: nothing to save
       $("teach-preview").hidden = false;
     }
   }

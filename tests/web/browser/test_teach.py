@@ -157,9 +157,15 @@ def test_add_view_reads_the_part_again_and_undo_takes_it_back(cell, browser):
         wait_until(lambda: not browser.js("return document.getElementById('teach-preview').hidden"),
                    what="the views shown")
         assert "2 views" in text(browser, "teach-preview-text")
+        # Where the view was read: the model's outline on the part.
+        wait_until(lambda: browser.js("""
+            const r = window.picksight.latest[window.picksight.app];
+            const o = document.getElementById('overlay');
+            return r && (r.request_line || '').startsWith('LEARNVIEW 1') && o.dataset.parts === '1' &&
+                   o.querySelectorAll('path.outline').length === 1;"""), what="the part the view read, outlined")
         assert b"views:" in model_file(cell, 1)
-        # Type 1's model is not touched by a LEARN-like Save: nothing pending.
-        assert browser.js("return document.getElementById('teach-save').disabled")
+        # Stored already: no Save offered.
+        assert browser.js("return document.getElementById('teach-save').hidden")
         browser.screenshot("teach-add-view")
         click(browser, "teach-undo")
         wait_until(lambda: last_reply(browser).startswith("OK 1 restored"), what="the UNDO reply")

@@ -294,6 +294,7 @@ Result<ViewOutcome> VisionService::learnView(int type, const std::optional<cv::R
   if (!frame) return frame.error();
   auto view = viewInFrame(**frame, **settings, models_->snapshot(), type, at, scaled_models_.get());
   if (!view) return view.error();
+  view->located.settings = *settings;
   auto stored = storeView(*models_, type, *view, change);
   if (!stored) return stored.error();
   return view;
@@ -744,6 +745,7 @@ Result<ViewOutcome> viewInFrame(const Frame& frame, const VisionOptions& options
   const size_t n = distances.size();
   out.spread_px = n % 2 == 1 ? distances[n / 2] : 0.5 * (distances[n / 2 - 1] + distances[n / 2]);
   if (auto valid = vision::validateModel(out.model); !valid) return refuse(valid.error().message);
+  out.located = std::move(located);
   return out;
 }
 

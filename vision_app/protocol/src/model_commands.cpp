@@ -270,6 +270,15 @@ std::string learnView(VisionService& vision, const Request& r) {
   }
   auto view = vision.learnView(*type, at, r.line);
   if (!view) return errorReply(view.error());
+  // The part the view was read on goes to the results stream as a LOCATE's
+  // would (the overlay draws the model's outline on it); not kept for WHY.
+  CellLocate located;
+  located.outcome = std::move(view->located);
+  auto record = results::locateRecord(std::move(located), *type, vision.options());
+  record->request = "LEARNVIEW";
+  record->request_line = r.line;
+  record->client = r.session->client;
+  r.session->record = std::move(record);
   return learnViewReply(*view);
 }
 
@@ -344,7 +353,7 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
   table.add(
       "LEARNVIEW", "LEARNVIEW <type> [AT <x> <y> <w> <h>]",
       [&vision](const Request& r) { return learnView(vision, r); }, alwaysChanges,
-      Publishes::kFrame);
+      Publishes::kRecord);
   table.add(
       "TRYLEARN", "TRYLEARN <type> [name] [AT <x> <y> <w> <h>]",
       [&vision](const Request& r) {

@@ -186,6 +186,9 @@ struct ViewOutcome {
   // The median distance of every reading (the teach image's included) from
   // the new origin: what one view's light puts a centroid off by.
   double spread_px = 0;
+  // The LOCATE of the type on the view's frame that found the part, for the
+  // results stream (where the view was read).
+  LocateOutcome located;
 };
 
 // LEARNVIEW on one frame: finds the one part of `type` (inside `at`, sensor
