@@ -963,3 +963,24 @@ TEST_CASE("LEARN takes the part and not a larger speckled blotch of the belt bes
   });
   CHECK(said);
 }
+
+TEST_CASE("LEARN does not pass over a lighter part for a small dark thing beside it",
+          "[vision_app][learn][front]") {
+  // A faint region is passed over for the part only when the threshold
+  // speckled it: a light grey part (40 levels under its belt) beside a
+  // black washer a fifth its size is still the part, and the washer a
+  // second part, refused; not a washer taught in its place.
+  ps::SilhouetteSceneOptions look = lookOf("textured");
+  look.part_level = 160;
+  cv::Point2d drawn;
+  cv::Mat image = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);
+  const auto alone = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  INFO((alone.ok() ? std::string() : alone.error().message));
+  REQUIRE(alone.ok());
+  const double radius = std::sqrt(0.2 * alone->model.body.area / M_PI);
+  cv::circle(image, cv::Point(90, 90), static_cast<int>(std::lround(radius)), cv::Scalar(10),
+             cv::FILLED, cv::LINE_AA);
+  const auto learned = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
+  REQUIRE_FALSE(learned.ok());
+  CHECK(learned.error().code == pv::PartModelErrc::kSeveralParts);
+}

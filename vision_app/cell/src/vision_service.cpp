@@ -389,6 +389,11 @@ constexpr int kRingOuter = 6;
 // beside it gave 15 %.
 constexpr double kShadowShare = 0.05;
 
+// A region of the surface the threshold speckled has pinholes by the
+// dozen; a part, a hole or two of its own. From this many, a faint region
+// (or a stretch hung on the part, below) is the surface's.
+constexpr int kMinPinholes = 3;
+
 // The regions LEARN sees (indices): the one it will train on, the specks it
 // ignores beside it, and the others, which are parts.
 struct LearnRegions {
@@ -437,10 +442,14 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
     sized.emplace_back(i, depthOf(regions[i], grey, mask));
     deepest = std::max(deepest, sized.back().second);
   }
+  // Passed over only when faint and speckled (pinholes): a lighter part of
+  // the user's beside a small dark thing is still the part (and the thing a
+  // second one, refused).
   out.part = sized.front().first;
   double part_area = -1;
   for (const auto& [i, depth] : sized) {
-    if (depth >= kStainDepthShare * deepest && regions[i].area > part_area) {
+    const bool blotch = depth < kStainDepthShare * deepest && regions[i].holes >= kMinPinholes;
+    if (!blotch && regions[i].area > part_area) {
       out.part = i;
       part_area = regions[i].area;
     }
@@ -468,7 +477,6 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
 constexpr int kNeckPx = 5;
 constexpr double kMaxAppendageShare = 0.2;
 constexpr double kMinSolidShare = 0.5;
-constexpr int kMinPinholes = 3;
 
 // Takes such appendages off region `r` in `mask` (frame pixels, in place);
 // the pixels taken off.
