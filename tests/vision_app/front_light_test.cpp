@@ -967,11 +967,11 @@ TEST_CASE("LEARN takes the part and not a larger speckled blotch of the belt bes
 TEST_CASE("LEARN does not pass over a lighter part for a small dark thing beside it",
           "[vision_app][learn][front]") {
   // A faint region is passed over for the part only when the threshold
-  // speckled it: a light grey part (40 levels under its belt) beside a
+  // speckled it: a light grey part (60 levels under its belt) beside a
   // black washer a fifth its size is still the part, and the washer a
   // second part, refused; not a washer taught in its place.
-  ps::SilhouetteSceneOptions look = lookOf("textured");
-  look.part_level = 160;
+  ps::SilhouetteSceneOptions look = lookOf("clean");
+  look.part_level = 140;
   cv::Point2d drawn;
   cv::Mat image = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);
   const auto alone = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
