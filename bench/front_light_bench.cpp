@@ -34,7 +34,6 @@
 #include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
-#include "picksight/vision/training/part_training.hpp"
 #include "silhouette_types.hpp"
 
 namespace {

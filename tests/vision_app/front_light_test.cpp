@@ -635,13 +635,6 @@ cv::Point2d trueCentroid(const ps::SilhouetteType& type, int side, double angle_
   return sharpPart(type, side, angle_deg).centroid;
 }
 
-picksight::Frame frameOf(const cv::Mat& image) {
-  picksight::Frame f;
-  f.image = image;
-  f.info.width = static_cast<uint32_t>(image.cols);
-  f.info.height = static_cast<uint32_t>(image.rows);
-  return f;
-}
 }  // namespace
 
 TEST_CASE("views of a part lying elsewhere take one teach image's offset out of its origin",
@@ -676,7 +669,8 @@ TEST_CASE("views of a part lying elsewhere take one teach image's offset out of 
       for (int v = 1; v < kViews; ++v) {
         const cv::Mat view =
             ps::renderSilhouetteAlone(type, kSide, look, 900 + 31 * i + v, &drawn, 30 + 47 * v);
-        auto seen = viewInFrame(frameOf(view), cellOptions(), listOf(model), 1, std::nullopt);
+        auto seen = viewInFrame(frameFromImage(view, "cam0", 1), cellOptions(), listOf(model), 1,
+                                std::nullopt);
         if (!seen.ok()) {
           // A user lays the part elsewhere and asks again.
           UNSCOPED_INFO(condition << " " << files[i].first << " view " << v
