@@ -298,16 +298,30 @@ Result<void> checkSymmetry(const PartModel& model) {
   return {};
 }
 
+namespace {
+// The median of `values` (reordered), the middle two's mean when even.
+double middleOf(std::vector<double>& values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+}  // namespace
+
 cv::Point2d originFromViews(const std::vector<cv::Point2d>& views) {
   if (views.empty()) return {0, 0};
   const auto median = [&](double cv::Point2d::*axis) {
     std::vector<double> v{0.0};  // the teach image's own reading
     for (const auto& p : views) v.push_back(p.*axis);
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return middleOf(v);
   };
   return {median(&cv::Point2d::x), median(&cv::Point2d::y)};
+}
+
+double viewSpread(const PartModel& model) {
+  if (model.views.empty()) return 0;
+  std::vector<double> distances{cv::norm(model.origin_shift)};  // the teach image's (0, 0)
+  for (const auto& v : model.views) distances.push_back(cv::norm(v - model.origin_shift));
+  return middleOf(distances);
 }
 
 Result<void> validateModel(const PartModel& model) {

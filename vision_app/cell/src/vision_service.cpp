@@ -747,11 +747,7 @@ Result<ViewOutcome> viewInFrame(const Frame& frame, const VisionOptions& options
   out.model = *model;
   vision::addViewReading(out.model, out.reading);
   out.moved = out.model.origin_shift - model->origin_shift;
-  std::vector<double> distances{cv::norm(out.model.origin_shift)};
-  for (const auto& v : out.model.views) distances.push_back(cv::norm(v - out.model.origin_shift));
-  std::sort(distances.begin(), distances.end());
-  const size_t n = distances.size();
-  out.spread_px = n % 2 == 1 ? distances[n / 2] : 0.5 * (distances[n / 2 - 1] + distances[n / 2]);
+  out.spread_px = vision::viewSpread(out.model);
   if (auto valid = vision::validateModel(out.model); !valid) return refuse(valid.error().message);
   out.located = std::move(located);
   return out;

@@ -14,6 +14,7 @@ namespace picksight::protocol {
 
 using cell::CellLocate;
 using cell::LearnOutcome;
+using cell::LocateOutcome;
 using cell::TryLearnOutcome;
 using cell::VisionService;
 using cell::VisionServiceErrc;
@@ -248,6 +249,21 @@ Result<LearnArgs> parseLearnArgs(const std::string& word, const Request& r) {
 }
 
 // LEARNVIEW <type> [AT <x> <y> <w> <h>] and its reply.
+// The parts a teaching request found (LEARNVIEW's view, TRYLEARN's trial)
+// go to the results stream as a LOCATE's would, so that the overlay draws
+// the model's outline on each; not kept for WHY, which explains the last
+// real LOCATE.
+void publishAsLocate(VisionService& vision, const Request& r, const char* request, int type,
+                     LocateOutcome&& outcome) {
+  CellLocate located;
+  located.outcome = std::move(outcome);
+  auto record = results::locateRecord(std::move(located), type, vision.options());
+  record->request = request;
+  record->request_line = r.line;
+  record->client = r.session->client;
+  r.session->record = std::move(record);
+}
+
 std::string learnView(VisionService& vision, const Request& r) {
   constexpr const char* kUsage = "usage: LEARNVIEW <type> [AT <x> <y> <w> <h>]";
   if (r.args.size() != 1 && r.args.size() != 6)
@@ -270,15 +286,7 @@ std::string learnView(VisionService& vision, const Request& r) {
   }
   auto view = vision.learnView(*type, at, r.line);
   if (!view) return errorReply(view.error());
-  // The part the view was read on goes to the results stream as a LOCATE's
-  // would (the overlay draws the model's outline on it); not kept for WHY.
-  CellLocate located;
-  located.outcome = std::move(view->located);
-  auto record = results::locateRecord(std::move(located), *type, vision.options());
-  record->request = "LEARNVIEW";
-  record->request_line = r.line;
-  record->client = r.session->client;
-  r.session->record = std::move(record);
+  publishAsLocate(vision, r, "LEARNVIEW", *type, std::move(view->located));
   return learnViewReply(*view);
 }
 
@@ -362,16 +370,7 @@ void addModelCommands(CommandTable& table, VisionService& vision) {
         auto tried = vision.tryLearn(args->type, args->name, args->at);
         if (!tried) return errorReply(tried.error());
         const std::string reply = tryLearnReply(*tried);
-        // The parts found with the new model go to the results stream as a
-        // LOCATE's would (the overlay draws the model's outline on each);
-        // not kept for WHY, which explains the last real LOCATE.
-        CellLocate located;
-        located.outcome = std::move(tried->located);
-        auto record = results::locateRecord(std::move(located), -1, vision.options());
-        record->request = "TRYLEARN";
-        record->request_line = r.line;
-        record->client = r.session->client;
-        r.session->record = std::move(record);
+        publishAsLocate(vision, r, "TRYLEARN", -1, std::move(tried->located));
         return reply;
       },
       neverChanges, Publishes::kRecord);

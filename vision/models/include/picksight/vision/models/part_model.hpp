@@ -140,6 +140,9 @@ constexpr double kMaxOriginShiftPx = 1.0;
 // threshold clipped a limb or took in a speck reads its centroid half a
 // pixel off, and must not drag the origin with it.
 cv::Point2d originFromViews(const std::vector<cv::Point2d>& views);
+// How far a model's readings (the teach image's and each view's) lie from
+// its origin: the median distance (px), 0 without views.
+double viewSpread(const PartModel& model);
 
 // Why a model could not be trained, or is not valid.
 enum class PartModelErrc {
