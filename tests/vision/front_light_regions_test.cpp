@@ -18,6 +18,7 @@
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
+#include "picksight/vision/segmentation/shadows.hpp"
 #include "silhouette_support.hpp"
 
 namespace ps = picksight::synthetic;
@@ -556,4 +557,77 @@ TEST_CASE("a separated part under front light is placed as repeatably as one tha
     CAPTURE(count, scatter);
     CHECK(scatter < 0.03);
   }
+}
+
+TEST_CASE("outsideLevels reads the ring's levels as a Gaussian blur of the whole box would",
+          "[vision][front_light][shadow]") {
+  // The blur it spares: the ring's levels and its weights each blurred over
+  // the box (cv::GaussianBlur, its kernel and border), their quotient where
+  // the weights reach kMinOutsideWeight (0.02) and `where` is set.
+  const auto blurred = [](const cv::Mat& grey, const cv::Mat& ring, double sigma, cv::Mat* weight) {
+    ring.convertTo(*weight, CV_32F, 1.0 / 255.0);
+    cv::Mat level;
+    grey.convertTo(level, CV_32F);
+    level = level.mul(*weight);
+    cv::GaussianBlur(*weight, *weight, cv::Size(), sigma);
+    cv::GaussianBlur(level, level, cv::Size(), sigma);
+    cv::Mat out;
+    cv::divide(level, *weight, out);
+    return out;
+  };
+  cv::RNG rng(17);
+  int compared = 0;
+  // Boxes down to a pixel (the kernel reaches past both ends, mirrored more
+  // than once) and up to a part's; sharp and blurred edges.
+  for (const cv::Size size :
+       {cv::Size(1, 1), cv::Size(3, 5), cv::Size(12, 7), cv::Size(40, 33), cv::Size(90, 61)}) {
+    for (const double blur_px : {0.0, 1.5, 3.0}) {
+      INFO(size << " blur " << blur_px);
+      cv::Mat grey(size, CV_8UC1);
+      rng.fill(grey, cv::RNG::UNIFORM, 0, 256);
+      cv::Mat own = cv::Mat::zeros(size, CV_8UC1);
+      cv::ellipse(own, cv::Point(size.width / 2, size.height / 2),
+                  cv::Size(size.width / 4, size.height / 4), 20, 0, 360, cv::Scalar(255),
+                  cv::FILLED);
+      cv::Mat free(size, CV_8UC1);
+      rng.fill(free, cv::RNG::UNIFORM, 0, 2);
+      free = (free > 0) | (own == 0);  // some pixels beside the part are another region's
+      free.setTo(0, own);
+      cv::Mat where(size, CV_8UC1);
+      rng.fill(where, cv::RNG::UNIFORM, 0, 4);
+      where = where > 0;
+      const cv::Mat levels = pv::outsideLevels(grey, own, free, where, blur_px);
+      REQUIRE(levels.size() == size);
+      REQUIRE(levels.type() == CV_32F);
+      // The ring as outsideLevels reads it (see shadows.cpp: 1 to 2 px out
+      // of a sharp edge, further out of a blurred one).
+      const int far = std::max(2, static_cast<int>(std::ceil(1.8 * blur_px)));
+      const auto disc = [](int r) {
+        return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+      };
+      cv::Mat inner;
+      cv::Mat ring;
+      cv::dilate(own, inner, disc(far - 1));
+      cv::dilate(own, ring, disc(far));
+      ring.setTo(0, inner);
+      ring &= free & where;
+      cv::Mat weight;
+      const cv::Mat expected = blurred(grey, ring, 1.5 * far / 2, &weight);
+      for (int y = 0; y < size.height; ++y) {
+        for (int x = 0; x < size.width; ++x) {
+          const float w = weight.at<float>(y, x);
+          if (std::abs(w - 0.02f) < 1e-5f) continue;  // on the threshold: either
+          const bool read = where.at<uint8_t>(y, x) != 0 && w >= 0.02f;
+          CAPTURE(x, y, w);
+          if (!read) {
+            CHECK(levels.at<float>(y, x) == -1.0f);
+          } else {
+            CHECK(levels.at<float>(y, x) == Approx(expected.at<float>(y, x)).margin(1e-3));
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  CHECK(compared > 2000);
 }

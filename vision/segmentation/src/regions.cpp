@@ -316,7 +316,9 @@ struct BandReading {
   // (level - background) / (part - background).
   cv::Vec3d plane;
   cv::Vec3d part;
-  Moments10 sums;   // of the coverage: interior and band
+  // Of the coverage: the interior's, and the band's once summed (sumBand;
+  // only for the band width kept).
+  Moments10 sums;
   double tail = 0;  // mean raw coverage of the band's outermost pixels
   // The background ring's spread about its plane, over the contrast: the
   // error one band pixel's coverage may carry (see kTailNoiseShare).
@@ -610,7 +612,10 @@ double bandTail(const BandReading& r, const BandPixels& pixels, const RowRuns& r
 // The ring, the band and the interior are run sets made by square
 // morphology on the region's runs, so the cost follows the boundary's length
 // and not the box's area. `tail` is the mean coverage, not clamped (so that
-// noise averages out), of the band's outermost pixels.
+// noise averages out), of the band's outermost pixels. The band's own
+// moments are left to sumBand: the widths tried before the one kept need
+// only their tail (summing every band tried took a third of the region
+// pass beside cast shadows, where the band widens to 5 or 6 pixels).
 bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
               const std::array<int, 256>& histogram, Dilations& dilations, PartLight* part_light,
               BandReading* reading) {
@@ -653,7 +658,6 @@ bool readBand(int reach, const BandPixels& pixels, const RowRuns& interior,
   // The band: pixels near the region, not deep inside it, never a
   // neighbour's.
   reading->band = near.minus(interior);
-  if (!sumBand(pixels, reading)) return false;
   reading->tail = bandTail(r, pixels, near.minus(nearer));
   reading->level_noise = background.residual / std::abs(contrast);
   return true;
@@ -870,7 +874,10 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
     if (wide_enough) break;
   }
   if (kept_reach == 0) return false;
-  readLocally(kept_reach, kept_interior, dilations, &pixels, &kept);
+  if (!readLocally(kept_reach, kept_interior, dilations, &pixels, &kept) &&
+      !sumBand(pixels, &kept)) {
+    return false;
+  }
 
   // The coverage of the band width kept: 1 in the interior, read in the band,
   // 0 elsewhere; the interior and the band make up the covered runs, so

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace picksight::vision {
@@ -474,6 +476,49 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
 }
 }  // namespace
 
+namespace {
+// How a blur along a line of n pixels (cv::GaussianBlur's kernel for CV_32F
+// and its default border, BORDER_REFLECT_101: an index past an end mirrored
+// about it) carries each input pixel s into the output: into pixels
+// first[s] to first[s] + stride - 1 with the weights at s * stride (zero
+// past the line's end). `stride` is the kernel's size rounded up to four
+// floats, the most pixels one input reaches (reflections included).
+struct LineSpread {
+  int stride = 0;
+  std::vector<int> first;
+  std::vector<float> weights;
+};
+
+LineSpread lineSpread(const std::vector<float>& kernel, int n) {
+  const int r = static_cast<int>(kernel.size()) / 2;
+  LineSpread out;
+  out.stride = (static_cast<int>(kernel.size()) + 3) / 4 * 4;
+  out.first.resize(static_cast<size_t>(n));
+  out.weights.assign(static_cast<size_t>(n) * static_cast<size_t>(out.stride), 0.0f);
+  // An input pixel reaches no output before s - r, nor before 0; its
+  // reflections land within the kernel's reach of it.
+  for (int s = 0; s < n; ++s) {
+    out.first[static_cast<size_t>(s)] = std::max(0, std::min(s - r, n - out.stride));
+  }
+  // cv::borderInterpolate's BORDER_REFLECT_101, inline (a call per product
+  // took as long as the sums).
+  const auto reflect = [n](int i) {
+    if (n == 1) return 0;
+    while (i < 0 || i >= n) i = i < 0 ? -i : 2 * (n - 1) - i;
+    return i;
+  };
+  for (int p = 0; p < n; ++p) {
+    for (int k = -r; k <= r; ++k) {
+      const int s = reflect(p + k);
+      const int at = p - out.first[static_cast<size_t>(s)];
+      CV_DbgAssert(at >= 0 && at < out.stride);
+      out.weights[static_cast<size_t>(s * out.stride + at)] += kernel[static_cast<size_t>(r + k)];
+    }
+  }
+  return out;
+}
+}  // namespace
+
 cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
                       const cv::Mat& where, double blur_px) {
   const Reaches reach = reachesFor(blur_px);
@@ -484,20 +529,81 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
   ring.setTo(0, inner);
   cv::bitwise_and(ring, free, ring);
   cv::bitwise_and(ring, where, ring);
-  cv::Mat weight;
-  ring.convertTo(weight, CV_32F, 1.0 / 255.0);
-  cv::Mat level;
-  g.convertTo(level, CV_32F);
-  level = level.mul(weight);
-  cv::GaussianBlur(weight, weight, cv::Size(), reach.outside_sigma);
-  cv::GaussianBlur(level, level, cv::Size(), reach.outside_sigma);
-  // Whole-image operations (vectorized), not a loop with a branch a pixel.
-  cv::Mat out;
-  cv::divide(level, weight, out);
-  cv::Mat unread;
-  cv::compare(weight, kMinOutsideWeight, unread, cv::CMP_LT);
-  cv::bitwise_or(unread, where == 0, unread);
-  out.setTo(-1, unread);
+  // The ring is a pixel wide: each of its pixels' Gaussian is added where
+  // it reaches (a few hundred products a pixel), which is the blur of the
+  // ring's levels and of its weights (cv::GaussianBlur's kernel and border)
+  // at a fraction of the cost of blurring both over the whole box (those
+  // blurs were a quarter of the shadow cut's work and the region pass's
+  // beside cast shadows).
+  const int ksize = cvRound(reach.outside_sigma * 8 + 1) | 1;
+  const cv::Mat k = cv::getGaussianKernel(ksize, reach.outside_sigma, CV_32F);
+  const std::vector<float> kernel(k.begin<float>(), k.end<float>());
+  const LineSpread along_x = lineSpread(kernel, ring.cols);
+  const LineSpread along_y = lineSpread(kernel, ring.rows);
+  // Sums over the box, wide enough for a whole stride from any first[s].
+  const int width = std::max(ring.cols, along_x.stride);
+  const int height = std::max(ring.rows, along_y.stride);
+  cv::Mat weight = cv::Mat::zeros(height, width, CV_32F);
+  cv::Mat level = cv::Mat::zeros(height, width, CV_32F);
+  const size_t row_floats = weight.step1();
+  for (int y = 0; y < ring.rows; ++y) {
+    const uint8_t* r = ring.ptr<uint8_t>(y);
+    const uint8_t* v = g.ptr<uint8_t>(y);
+    const float* wy = &along_y.weights[static_cast<size_t>(y * along_y.stride)];
+    const int y0 = along_y.first[static_cast<size_t>(y)];
+    float* const weight_rows = weight.ptr<float>(y0);
+    float* const level_rows = level.ptr<float>(y0);
+    for (int x = 0; x < ring.cols; ++x) {
+      if (r[x] == 0) continue;
+      const float* wx = &along_x.weights[static_cast<size_t>(x * along_x.stride)];
+      const int x0 = along_x.first[static_cast<size_t>(x)];
+      const auto value = static_cast<float>(v[x]);
+      for (int j = 0; j < along_y.stride; ++j) {
+        if (wy[j] == 0) continue;
+        float* w = weight_rows + static_cast<size_t>(j) * row_floats + x0;
+        float* l = level_rows + static_cast<size_t>(j) * row_floats + x0;
+#if CV_SIMD128
+        const cv::v_float32x4 across = cv::v_setall_f32(wy[j]);
+        const cv::v_float32x4 bright = cv::v_setall_f32(wy[j] * value);
+        for (int i = 0; i < along_x.stride; i += 4) {
+          const cv::v_float32x4 kx = cv::v_load(wx + i);
+          cv::v_store(w + i, cv::v_fma(across, kx, cv::v_load(w + i)));
+          cv::v_store(l + i, cv::v_fma(bright, kx, cv::v_load(l + i)));
+        }
+#else
+        for (int i = 0; i < along_x.stride; ++i) {
+          w[i] += wy[j] * wx[i];
+          l[i] += wy[j] * value * wx[i];
+        }
+#endif
+      }
+    }
+  }
+  cv::Mat out(g.size(), CV_32F);
+  for (int y = 0; y < out.rows; ++y) {
+    const float* w = weight.ptr<float>(y);
+    const float* l = level.ptr<float>(y);
+    const uint8_t* in = where.ptr<uint8_t>(y);
+    float* o = out.ptr<float>(y);
+    int x = 0;
+#if CV_SIMD128
+    // Where no ring pixel is near, the weight is 0 and the quotient is
+    // never kept.
+    const cv::v_float32x4 least = cv::v_setall_f32(kMinOutsideWeight);
+    const cv::v_float32x4 unread = cv::v_setall_f32(-1.0f);
+    const cv::v_float32x4 none = cv::v_setzero_f32();
+    for (; x + 4 <= out.cols; x += 4) {
+      const cv::v_float32x4 sum = cv::v_load(w + x);
+      const cv::v_float32x4 inside(in[x] ? 1.0f : 0.0f, in[x + 1] ? 1.0f : 0.0f,
+                                   in[x + 2] ? 1.0f : 0.0f, in[x + 3] ? 1.0f : 0.0f);
+      const cv::v_float32x4 kept = (sum >= least) & (inside != none);
+      cv::v_store(o + x, cv::v_select(kept, cv::v_load(l + x) / cv::v_max(sum, least), unread));
+    }
+#endif
+    for (; x < out.cols; ++x) {
+      o[x] = in[x] != 0 && w[x] >= kMinOutsideWeight ? l[x] / w[x] : -1.0f;
+    }
+  }
   return out;
 }
 
