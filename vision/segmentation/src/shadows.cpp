@@ -213,17 +213,17 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   cv::bitwise_xor(own, outline, outline);
   cv::Mat labels;
   const int n = cv::connectedComponents(shadow, labels, 8, CV_32S);
-  // Per layer: its pixels, and those on the outline.
+  // Per layer: its pixels, and those on the outline (label 0, the rest of
+  // the box, counted too and not read: no branch a pixel).
   std::vector<int> pixels(static_cast<size_t>(n), 0);
   std::vector<int> on_outline(static_cast<size_t>(n), 0);
   for (int y = 0; y < labels.rows; ++y) {
     const int* lab = labels.ptr<int>(y);
     const uint8_t* o = outline.ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) {
-      if (lab[x] == 0) continue;
       const auto k = static_cast<size_t>(lab[x]);
       ++pixels[k];
-      on_outline[k] += o[x] ? 1 : 0;
+      on_outline[k] += o[x] != 0 ? 1 : 0;
     }
   }
   // A shadow lies along the outline, a few pixels thick. Not a shadow:
@@ -233,17 +233,17 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   // on its lit side). Counted as one, they took 2 % of a part shaded within
   // a few levels of its belt and moved it 1.1 px; of a glossy part, beside
   // its glints, 1.6 px.
-  std::vector<char> kept(static_cast<size_t>(n), 0);
+  std::vector<uint8_t> kept(static_cast<size_t>(n), 0);  // 255: a shadow's layer
   for (size_t k = 1; k < kept.size(); ++k) {
     kept[k] = on_outline[k] > 0 && pixels[k] >= kMinShadowPixels &&
                       pixels[k] >= kMinLayerThickness * on_outline[k]
-                  ? 1
+                  ? 255
                   : 0;
   }
   for (int y = 0; y < labels.rows; ++y) {
     const int* lab = labels.ptr<int>(y);
     uint8_t* sh = shadow.ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) sh[x] = kept[static_cast<size_t>(lab[x])] ? 255 : 0;
+    for (int x = 0; x < labels.cols; ++x) sh[x] = kept[static_cast<size_t>(lab[x])];
   }
   double level = 0;
   if (!levelsOf(g, shadow, kMinShadowPixels, &level)) return {};
@@ -461,11 +461,12 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
     const uint8_t* v = g.ptr<uint8_t>(y);
     const float* level = outside.ptr<float>(y);
     uint8_t* r = removed.ptr<uint8_t>(y);
+    // Without a branch a pixel: most of the box is not the part, and at
+    // the part's edge the tests go either way.
     for (int x = 0; x < own.cols; ++x) {
-      if (o[x] && level[x] >= 0 && v[x] >= 0.5 * (l.part + level[x])) {
-        r[x] = 255;
-        ++thin;
-      }
+      const bool cut = (o[x] != 0) & (level[x] >= 0) & (v[x] >= 0.5 * (l.part + level[x]));
+      r[x] |= cut ? 255 : 0;
+      thin += cut ? 1 : 0;
     }
   }
   if (layer.empty() && thin == 0) return false;
@@ -546,37 +547,39 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
   cv::Mat weight = cv::Mat::zeros(height, width, CV_32F);
   cv::Mat level = cv::Mat::zeros(height, width, CV_32F);
   const size_t row_floats = weight.step1();
-  for (int y = 0; y < ring.rows; ++y) {
-    const uint8_t* r = ring.ptr<uint8_t>(y);
-    const uint8_t* v = g.ptr<uint8_t>(y);
+  // The ring's pixels found as OpenCV finds non-zero pixels (a test a pixel
+  // of the box, branching unpredictably at the ring, took longer than the
+  // sums).
+  std::vector<cv::Point> ring_pixels;
+  cv::findNonZero(ring, ring_pixels);
+  for (const cv::Point& p : ring_pixels) {
+    const int x = p.x;
+    const int y = p.y;
     const float* wy = &along_y.weights[static_cast<size_t>(y * along_y.stride)];
     const int y0 = along_y.first[static_cast<size_t>(y)];
     float* const weight_rows = weight.ptr<float>(y0);
     float* const level_rows = level.ptr<float>(y0);
-    for (int x = 0; x < ring.cols; ++x) {
-      if (r[x] == 0) continue;
-      const float* wx = &along_x.weights[static_cast<size_t>(x * along_x.stride)];
-      const int x0 = along_x.first[static_cast<size_t>(x)];
-      const auto value = static_cast<float>(v[x]);
-      for (int j = 0; j < along_y.stride; ++j) {
-        if (wy[j] == 0) continue;
-        float* w = weight_rows + static_cast<size_t>(j) * row_floats + x0;
-        float* l = level_rows + static_cast<size_t>(j) * row_floats + x0;
+    const float* wx = &along_x.weights[static_cast<size_t>(x * along_x.stride)];
+    const int x0 = along_x.first[static_cast<size_t>(x)];
+    const auto value = static_cast<float>(g.at<uint8_t>(y, x));
+    for (int j = 0; j < along_y.stride; ++j) {
+      if (wy[j] == 0) continue;
+      float* w = weight_rows + static_cast<size_t>(j) * row_floats + x0;
+      float* l = level_rows + static_cast<size_t>(j) * row_floats + x0;
 #if CV_SIMD128
-        const cv::v_float32x4 across = cv::v_setall_f32(wy[j]);
-        const cv::v_float32x4 bright = cv::v_setall_f32(wy[j] * value);
-        for (int i = 0; i < along_x.stride; i += 4) {
-          const cv::v_float32x4 kx = cv::v_load(wx + i);
-          cv::v_store(w + i, cv::v_fma(across, kx, cv::v_load(w + i)));
-          cv::v_store(l + i, cv::v_fma(bright, kx, cv::v_load(l + i)));
-        }
-#else
-        for (int i = 0; i < along_x.stride; ++i) {
-          w[i] += wy[j] * wx[i];
-          l[i] += wy[j] * value * wx[i];
-        }
-#endif
+      const cv::v_float32x4 across = cv::v_setall_f32(wy[j]);
+      const cv::v_float32x4 bright = cv::v_setall_f32(wy[j] * value);
+      for (int i = 0; i < along_x.stride; i += 4) {
+        const cv::v_float32x4 kx = cv::v_load(wx + i);
+        cv::v_store(w + i, cv::v_fma(across, kx, cv::v_load(w + i)));
+        cv::v_store(l + i, cv::v_fma(bright, kx, cv::v_load(l + i)));
       }
+#else
+      for (int i = 0; i < along_x.stride; ++i) {
+        w[i] += wy[j] * wx[i];
+        l[i] += wy[j] * value * wx[i];
+      }
+#endif
     }
   }
   cv::Mat out(g.size(), CV_32F);
@@ -591,12 +594,11 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
     // never kept.
     const cv::v_float32x4 least = cv::v_setall_f32(kMinOutsideWeight);
     const cv::v_float32x4 unread = cv::v_setall_f32(-1.0f);
-    const cv::v_float32x4 none = cv::v_setzero_f32();
     for (; x + 4 <= out.cols; x += 4) {
       const cv::v_float32x4 sum = cv::v_load(w + x);
-      const cv::v_float32x4 inside(in[x] ? 1.0f : 0.0f, in[x + 1] ? 1.0f : 0.0f,
-                                   in[x + 2] ? 1.0f : 0.0f, in[x + 3] ? 1.0f : 0.0f);
-      const cv::v_float32x4 kept = (sum >= least) & (inside != none);
+      const cv::v_float32x4 inside =
+          cv::v_reinterpret_as_f32(cv::v_load_expand_q(in + x) != cv::v_setzero_u32());
+      const cv::v_float32x4 kept = (sum >= least) & inside;
       cv::v_store(o + x, cv::v_select(kept, cv::v_load(l + x) / cv::v_max(sum, least), unread));
     }
 #endif
