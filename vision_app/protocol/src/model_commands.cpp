@@ -248,7 +248,6 @@ Result<LearnArgs> parseLearnArgs(const std::string& word, const Request& r) {
   return out;
 }
 
-// LEARNVIEW <type> [AT <x> <y> <w> <h>] and its reply.
 // The parts a teaching request found (LEARNVIEW's view, TRYLEARN's trial)
 // go to the results stream as a LOCATE's would, so that the overlay draws
 // the model's outline on each; not kept for WHY, which explains the last
@@ -264,6 +263,7 @@ void publishAsLocate(VisionService& vision, const Request& r, const char* reques
   r.session->record = std::move(record);
 }
 
+// LEARNVIEW <type> [AT <x> <y> <w> <h>] and its reply.
 std::string learnView(VisionService& vision, const Request& r) {
   constexpr const char* kUsage = "usage: LEARNVIEW <type> [AT <x> <y> <w> <h>]";
   if (r.args.size() != 1 && r.args.size() != 6)
