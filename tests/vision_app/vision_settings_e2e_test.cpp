@@ -407,9 +407,10 @@ TEST_CASE("Each LOCATE runs with one whole VISION change and publishes the setti
   // record made with the settings read after the LOCATE was caught by 2 of
   // 3 runs here; a change applied one key at a time, by 3 of 3.)
   // The publisher may drop a record when it falls behind (it keeps the
-  // newest for a viewer, and the changes for the audit trail: on a loaded
-  // machine CI saw LOCATE records go while 60 changes queued), but never
-  // reorders them: the records are the replies in order, some left out.
+  // newest for a viewer, and the changes for the audit trail; the likely
+  // cause of this test's one failure in CI, whose failing check was cut
+  // from the log), but never reorders them: the records are the replies in
+  // order, some left out.
   size_t at = 0;
   int seen = 0;
   int seen_table = 0;
