@@ -2,7 +2,7 @@
 // while and prints what it got, lost and how late (one-way latency from the
 // frame's host timestamp to its arrival, same host clock).
 //   picksight-bench-subscriber --frames E --camera C --seconds S [--bare]
-//                              [--curve-server-key FILE [--curve-key FILE]]
+//                              [--curve-server-key FILE [--curve-key FILE] --control E]
 // --bare reads the benchmark's plain ZeroMQ messages (topic, 16-byte
 // sequence + timestamp, payload) instead of PickSight frames.
 #include <algorithm>
@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   bool bare = false;
   std::string curve_server_key;
   std::string curve_key;
+  std::string control;
   CLI::App app("Receives frames for a while; prints what it got, lost and how late.",
                "picksight-bench-subscriber");
   app.set_help_flag("-h,--help", "print this help");
@@ -40,6 +41,8 @@ int main(int argc, char** argv) {
   app.add_option("--curve-server-key", curve_server_key, "the server's public key: talk CURVE")
       ->type_name("FILE");
   app.add_option("--curve-key", curve_key, "this client's secret key file")->type_name("FILE");
+  app.add_option("--control", control, "the control endpoint (with CURVE: the frames' key)")
+      ->type_name("E");
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
   std::optional<picksight::transport::CurveClientKeys> curve;
   if (!curve_server_key.empty()) {
@@ -83,7 +86,7 @@ int main(int argc, char** argv) {
       latency_ms.push_back(static_cast<double>(now - sent_ns) / 1e6);
     }
   } else {
-    picksight::transport::FrameSubscriber sub(context, endpoint, camera, 4, curve);
+    picksight::transport::FrameSubscriber sub(context, endpoint, camera, 4, curve, control);
     while (picksight::monotonicNs() < end) {
       auto f = sub.receive(std::chrono::milliseconds(100));
       if (!f) continue;

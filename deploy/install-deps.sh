@@ -18,7 +18,8 @@ PACKAGES=(
   # (libusb-1.0-0-dev: aravis-0.8.pc requires it, but libaravis-dev does not pull it in)
   libaravis-dev libusb-1.0-0-dev aravis-tools aravis-tools-cli libv4l-dev
   # Python client (python/) and its tests: Debian's /usr/bin/python3 modules
-  python3-zmq python3-protobuf python3-numpy python3-pytest
+  # (python3-nacl: to open the frames a video server with CURVE seals)
+  python3-zmq python3-protobuf python3-numpy python3-nacl python3-pytest
   # picksight-robot's line editing and history (BSD licence)
   libedit-dev
   # network namespaces and veth pairs: the two-host test (deploy/two-hosts) and

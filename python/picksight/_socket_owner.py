@@ -60,10 +60,17 @@ class TopicSubscriber(SocketOwner):
         """The next message decoded, or None when none came within `timeout`
         seconds (None: wait for ever)."""
         deadline = None if timeout is None else time.monotonic() + timeout
+        once = True
         while True:
             wait_ms = None
             if deadline is not None:
                 wait_ms = max(0, int((deadline - time.monotonic()) * 1000))
+                # Past the deadline after a message that gave nothing: a
+                # stream of skipped messages must not keep the poll from
+                # ever timing out.
+                if not once and wait_ms == 0:
+                    return None
+            once = False
             if not self._socket.poll(wait_ms, zmq.POLLIN):
                 return None
             parts = self._socket.recv_multipart(copy=False)

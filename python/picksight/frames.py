@@ -14,6 +14,10 @@ import numpy as np
 from picksight import picksight_pb2 as pb
 from picksight._socket_owner import TopicSubscriber
 
+# A sealed frame's part 2 beyond the header it seals: "PSF1", the key id,
+# the nonce and the tag.
+_SEALED_OVERHEAD = 4 + 8 + 24 + 16
+
 # Bytes per pixel and channels of each wire pixel format.
 _LAYOUT = {pb.MONO8: (1, None), pb.BGR8: (3, 3)}
 
@@ -74,21 +78,99 @@ class FrameSubscriber(TopicSubscriber):
     `malformed` (messages skipped). One thread uses a subscriber at a time,
     like the ZeroMQ socket inside it."""
 
-    def __init__(self, endpoint, camera="", queue_frames=4, context=None, curve=None):
-        """`curve`: a picksight.CurveKeys for a video server with CURVE."""
-        # The high-water mark counts message parts; a frame is three.
-        super().__init__(endpoint, camera, queue_frames * 3, context, curve)
+    def __init__(self, endpoint, camera="", queue_frames=4, context=None, curve=None,
+                 control=None):
+        """`curve`: a picksight.CurveKeys for a video server with CURVE. Its
+        frames come sealed, once each for every subscriber, on a plain
+        socket; their key is asked at the server's `control` endpoint
+        (required then) with those keys. A plain frame, one that does not
+        open, or one sent again (its sequence not past the last) is counted
+        in `malformed`; sealed frames under a key the server did not give
+        (a refused client gets none) in `unopened`."""
+        if curve is not None and not control:
+            raise ValueError("a CURVE frame subscriber needs the video server's control "
+                             "endpoint (the frames' key)")
+        # The high-water mark counts message parts; a frame is three. The
+        # frames' socket itself is plain.
+        super().__init__(endpoint, camera, queue_frames * 3, context, None)
+        self._keys = curve
+        self._control = control
+        self._key = None  # (key id, key)
+        self._key_asked = None
+        self.unopened = 0
 
-    @staticmethod
-    def _decode(parts):
+    def _decode(self, parts):
         if len(parts) != 3:
             return None
+        header_bytes, pixels = parts[1].bytes, parts[2].buffer
+        if self._keys is not None:
+            opened = self._open(parts)
+            if opened is None:
+                return None
+            header_bytes, pixels = opened
         header = pb.FrameHeader()
         try:
-            header.ParseFromString(parts[1].bytes)
+            header.ParseFromString(header_bytes)
         except Exception:  # a DecodeError, whatever the protobuf backend calls it
             return None
-        return decode_frame(header, parts[2].buffer)
+        frame = decode_frame(header, pixels)
+        if frame is not None and self._keys is not None:
+            # Under one key a sealed frame's sequence only grows: one that
+            # does not is a recorded frame sent again.
+            last = self._last.get(header.camera)
+            if last is not None and header.sequence <= last:
+                return None
+        return frame
+
+    def _open(self, parts):
+        """The header bytes and pixels of a sealed frame (picksight/transport/
+        frame_seal.hpp), or None."""
+        from nacl.bindings import crypto_aead_xchacha20poly1305_ietf_decrypt
+        from nacl.exceptions import CryptoError
+
+        envelope = parts[1].bytes
+        if len(envelope) < _SEALED_OVERHEAD or envelope[:4] != b"PSF1":
+            return None  # a plain frame: not taken from a server that should seal
+        key_id = int.from_bytes(envelope[4:12], "little")
+        if self._key is None or self._key[0] != key_id:
+            self._ask_key()
+            if self._key is None or self._key[0] != key_id:
+                self.unopened += 1
+                self.malformed -= 1  # counted apart, not as malformed
+                return None
+        nonce = envelope[12:36]
+        ad = parts[0].bytes + envelope[:36]
+        # The pixels are sealed under the nonce plus one (little-endian).
+        pixel_nonce = ((int.from_bytes(nonce, "little") + 1) % (1 << 192)).to_bytes(24, "little")
+        try:
+            header = crypto_aead_xchacha20poly1305_ietf_decrypt(envelope[36:], ad, nonce,
+                                                                self._key[1])
+            pixels = crypto_aead_xchacha20poly1305_ietf_decrypt(parts[2].bytes, ad, pixel_nonce,
+                                                                self._key[1])
+        except CryptoError:
+            return None
+        return header, pixels
+
+    def _ask_key(self):
+        # At most once a second: frames under a key the server does not give
+        # must not flood its control socket, nor stall the subscriber.
+        now = time.monotonic()
+        if self._key_asked is not None and now - self._key_asked < 1.0:
+            return
+        self._key_asked = now
+        from picksight.control import CameraControl, ControlError
+
+        request = pb.ControlRequest()
+        request.frame_key.SetInParent()
+        try:
+            with CameraControl(self._control, context=self._context, curve=self._keys) as c:
+                reply = c.call(request)
+        except ControlError:
+            return
+        if len(reply.frame_key.key) == 32:
+            if self._key is None or self._key[0] != reply.frame_key.key_id:
+                self._last.clear()  # a new run of the server
+            self._key = (reply.frame_key.key_id, reply.frame_key.key)
 
     def _count(self, frame):
         frame.received_ns = time.monotonic_ns()

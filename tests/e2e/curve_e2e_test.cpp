@@ -4,13 +4,16 @@
 #include <sys/stat.h>
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "cell_fixture.hpp"
 #include "picksight/transport/control_client.hpp"
 #include "picksight/transport/curve_keys.hpp"
+#include "picksight/transport/frame_seal.hpp"
 #include "temp_dir.hpp"
 
 using namespace picksight;
@@ -78,14 +81,22 @@ TEST_CASE(
   VideoServerProcess server(args, log);
   // Those that must get nothing connect first: they have at least as long
   // as the listed client, whose frames are the test's positive control.
-  FrameSubscriber unlisted(context, server.frames, "cam0", 4, keys.client(keys.strangerSecret()));
+  // The frames' socket is plain (frames are sealed once each, not
+  // encrypted per subscriber): the unlisted and the plain subscribers
+  // receive the sealed messages but cannot open them, and the unlisted one
+  // is refused the key on the control socket.
+  FrameSubscriber unlisted(context, server.frames, "cam0", 4, keys.client(keys.strangerSecret()),
+                           server.control);
   FrameSubscriber plain(context, server.frames, "cam0");
-  FrameSubscriber listed(context, server.frames, "cam0", 4, keys.client(keys.listedSecret()));
+  FrameSubscriber listed(context, server.frames, "cam0", 4, keys.client(keys.listedSecret()),
+                         server.control);
 
   int listed_frames = 0, unlisted_frames = 0, plain_frames = 0;
   bool refusal_logged = false;
   const auto deadline = std::chrono::steady_clock::now() + 20s;
-  while (std::chrono::steady_clock::now() < deadline && (listed_frames < 10 || !refusal_logged)) {
+  while (std::chrono::steady_clock::now() < deadline &&
+         (listed_frames < 10 || !refusal_logged || unlisted.framesUnopened() == 0 ||
+          plain.malformedMessages() == 0)) {
     if (listed.receive(100ms)) ++listed_frames;
     while (unlisted.receive(0ms)) ++unlisted_frames;
     while (plain.receive(0ms)) ++plain_frames;
@@ -93,10 +104,34 @@ TEST_CASE(
   }
   INFO("server log:\n" << fileText(log));
   CHECK(listed_frames >= 10);
+  CHECK(listed.malformedMessages() == 0);
   CHECK(refusal_logged);
   CHECK(unlisted_frames == 0);
+  CHECK(unlisted.framesUnopened() > 0);  // sealed frames reached it, unopened
   CHECK(plain_frames == 0);
+  CHECK(plain.malformedMessages() > 0);
   CHECK_THAT(fileText(log), Catch::Contains("only the clients listed in"));
+
+  // On the wire: no part of a frame's header or pixels in clear. The
+  // synthetic camera's background is one grey level (pixels of one value
+  // over most of the frame); sealed, the bytes look random.
+  zmq::socket_t raw(context, zmq::socket_type::sub);
+  raw.set(zmq::sockopt::subscribe, "cam0");
+  raw.set(zmq::sockopt::linger, 0);
+  raw.set(zmq::sockopt::rcvtimeo, 5000);
+  raw.connect(server.frames);
+  zmq::message_t topic, envelope, pixels;
+  REQUIRE(raw.recv(topic));
+  REQUIRE(raw.recv(envelope));
+  REQUIRE(raw.recv(pixels));
+  CHECK(sealedKeyId(envelope).has_value());
+  REQUIRE(pixels.size() == 320 * 240 + kSealTag);
+  std::map<unsigned char, int> counts;
+  const auto* bytes = static_cast<const unsigned char*>(pixels.data());
+  for (size_t i = 0; i < pixels.size(); ++i) ++counts[bytes[i]];
+  int most = 0;
+  for (const auto& [value, n] : counts) most = std::max(most, n);
+  CHECK(most < static_cast<int>(pixels.size() / 100));  // about 1/256 each
 
   // Control: the listed client is answered; the others time out.
   ControlClient listed_control(context, server.control, 5s, keys.client(keys.listedSecret()));

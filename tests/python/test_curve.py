@@ -3,6 +3,7 @@ listed client gets frames and control replies, an unlisted key gets
 nothing in the same time, and key files are checked as the C++ tools do."""
 
 import os
+import time
 import subprocess
 
 import pytest
@@ -31,8 +32,12 @@ def test_listed_key_gets_frames_and_control_and_others_nothing(cell_factory, tmp
 
     listed = CurveKeys(server_public, listed_secret)
     stranger = CurveKeys(server_public, stranger_secret)
-    with FrameSubscriber(server.frames, "cam0", curve=listed) as good, \
-            FrameSubscriber(server.frames, "cam0", curve=stranger) as bad, \
+    # The frames come sealed on a plain socket: the stranger and the plain
+    # subscriber receive them but cannot open them (the stranger is refused
+    # the key on the control socket).
+    with FrameSubscriber(server.frames, "cam0", curve=listed, control=server.control) as good, \
+            FrameSubscriber(server.frames, "cam0", curve=stranger,
+                            control=server.control) as bad, \
             FrameSubscriber(server.frames, "cam0") as plain:
         frame = good.receive(timeout=10)
         assert frame is not None and frame.image.shape == (240, 320)
@@ -40,8 +45,15 @@ def test_listed_key_gets_frames_and_control_and_others_nothing(cell_factory, tmp
         # others received none.
         for _ in range(5):
             assert good.receive(timeout=5) is not None
-        assert bad.receive(timeout=0.2) is None and bad.received == 0
-        assert plain.receive(timeout=0.2) is None and plain.received == 0
+        assert good.malformed == 0
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and (bad.unopened == 0 or plain.malformed == 0):
+            assert bad.receive(timeout=0.2) is None
+            assert plain.receive(timeout=0.2) is None
+        assert bad.received == 0 and bad.unopened > 0
+        assert plain.received == 0 and plain.malformed > 0
+    with pytest.raises(ValueError, match="control endpoint"):
+        FrameSubscriber(server.frames, "cam0", curve=listed)
 
     with CameraControl(server.control, curve=listed) as control:
         assert [c.name for c in control.list_cameras()] == ["cam0"]

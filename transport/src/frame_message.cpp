@@ -2,10 +2,13 @@
 #include "picksight/transport/frame_message.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
+#include <stdexcept>
 #include <utility>
 
 #include "picksight/common/clock.hpp"
+#include "picksight/transport/control_client.hpp"
 
 namespace picksight::transport {
 namespace {
@@ -118,9 +121,18 @@ std::optional<Frame> decodeFrame(const proto::FrameHeader& h, zmq::message_t pix
 
 FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& endpoint,
                                  const std::string& camera, int queue_frames,
-                                 const std::optional<CurveClientKeys>& curve)
-    : socket_(context, zmq::socket_type::sub), camera_(camera) {
-  secureClientSocket(socket_, curve);
+                                 const std::optional<CurveClientKeys>& curve,
+                                 const std::string& control_endpoint)
+    : context_(context),
+      socket_(context, zmq::socket_type::sub),
+      camera_(camera),
+      curve_(curve),
+      control_endpoint_(control_endpoint) {
+  // The frames' socket itself is plain: with CURVE they come sealed.
+  if (curve_ && control_endpoint_.empty()) {
+    throw std::invalid_argument(
+        "a CURVE frame subscriber needs the video server's control endpoint (the frames' key)");
+  }
   // HWM counts message parts; a frame is three.
   socket_.set(zmq::sockopt::rcvhwm, queue_frames * 3);
   socket_.set(zmq::sockopt::linger, 0);
@@ -130,9 +142,14 @@ FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& end
 
 std::optional<Frame> FrameSubscriber::receive(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  for (;;) {
+  // Past the deadline after a message that gave no frame, give up: a
+  // stream of messages that are all skipped (a plain server's frames to a
+  // CURVE subscriber, or sealed ones whose key is refused) would keep the
+  // poll below from ever timing out.
+  for (bool once = true;; once = false) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
         deadline - std::chrono::steady_clock::now());
+    if (!once && left.count() <= 0) return std::nullopt;
     zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
     if (zmq::poll(&item, 1,
                   std::max<std::chrono::milliseconds>(left, std::chrono::milliseconds(0))) == 0) {
@@ -156,26 +173,89 @@ std::optional<Frame> FrameSubscriber::receive(std::chrono::milliseconds timeout)
     }
     // Subscriptions match prefixes: "cam1" also receives "cam10".
     if (!camera_.empty() && topic.to_string_view() != camera_) continue;
-    proto::FrameHeader header;
     std::optional<Frame> frame;
-    if (parts == 3 &&
-        header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size()))) {
-      frame = decodeFrame(header, std::move(pixels));
-    }
-    if (!frame) {
+    if (parts != 3) {
       ++malformed_;
       continue;
     }
-    frame->info.received_ns = monotonicNs();
-    ++received_;
+    if (curve_) {
+      frame = openSealed(topic, header_bytes, pixels);
+      if (!frame) continue;
+    } else {
+      proto::FrameHeader header;
+      if (header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size()))) {
+        frame = decodeFrame(header, std::move(pixels));
+      }
+      if (!frame) {
+        ++malformed_;
+        continue;
+      }
+    }
     const uint64_t seq = frame->info.sequence;
     auto [last, first] = last_sequence_.try_emplace(frame->info.camera, seq);
     if (!first) {
+      // Under one key a sealed frame's sequence only grows: one that does
+      // not is a recorded frame sent again (a restarted server has a new
+      // key, and the sequences start afresh with it).
+      if (curve_ && seq <= last->second) {
+        ++malformed_;
+        continue;
+      }
       if (seq > last->second + 1) lost_ += seq - last->second - 1;
       last->second = seq;
     }
+    frame->info.received_ns = monotonicNs();
+    ++received_;
     return frame;
   }
+}
+
+FrameSubscriber::~FrameSubscriber() = default;
+
+std::optional<Frame> FrameSubscriber::openSealed(const zmq::message_t& topic,
+                                                 const zmq::message_t& envelope,
+                                                 const zmq::message_t& pixels) {
+  const std::optional<uint64_t> id = sealedKeyId(envelope);
+  if (!id) {
+    ++malformed_;  // a plain frame: not taken from a server that should seal
+    return std::nullopt;
+  }
+  if (!key_ || key_->id != *id) {
+    // Asked at most once a second: frames under a key the server does not
+    // give (a forger's, a refused client's) must not flood the control
+    // socket, nor stall this subscriber for a timeout each.
+    constexpr auto kAskEvery = std::chrono::seconds(1);
+    const auto now = std::chrono::steady_clock::now();
+    if (key_asked_ != std::chrono::steady_clock::time_point{} && now - key_asked_ < kAskEvery) {
+      ++unopened_;
+      return std::nullopt;
+    }
+    key_asked_ = now;
+    ControlClient control(context_, control_endpoint_, kDefaultControlTimeout, curve_);
+    proto::ControlRequest request;
+    request.mutable_frame_key();
+    const auto reply = control.call(request);
+    if (reply && reply->has_frame_key() && reply->frame_key().key().size() == 32) {
+      FrameKey k;
+      std::memcpy(k.key.data(), reply->frame_key().key().data(), k.key.size());
+      k.id = reply->frame_key().key_id();
+      if (!key_ || key_->id != k.id) last_sequence_.clear();  // a new run of the server
+      key_ = k;
+    }
+    if (!key_ || key_->id != *id) {
+      ++unopened_;
+      return std::nullopt;
+    }
+  }
+  auto opened = openSealedFrame(topic, envelope, pixels, *key_);
+  proto::FrameHeader header;
+  std::optional<Frame> frame;
+  if (opened &&
+      header.ParseFromArray(opened->header.data(), static_cast<int>(opened->header.size()))) {
+    frame = decodeFrame(header, std::move(opened->pixels));
+  }
+  if (!frame) ++malformed_;
+  return frame;
 }
 
 }  // namespace picksight::transport

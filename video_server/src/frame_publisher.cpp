@@ -10,22 +10,23 @@
 
 namespace picksight::video {
 
-using transport::CurveServer;
-using transport::secureServerSocket;
+using transport::FrameKey;
 using transport::sendFrame;
+using transport::sendSealedFrame;
 
 namespace {
 std::atomic<int> g_monitor_id{0};
 }  // namespace
 
 FramePublisher::FramePublisher(zmq::context_t& context, const std::string& endpoint,
-                               size_t queue_limit, int subscriber_queue, const CurveServer* curve)
+                               size_t queue_limit, int subscriber_queue,
+                               std::optional<FrameKey> seal)
     : socket_(context, zmq::socket_type::pub),
       monitor_(context, zmq::socket_type::pair),
-      queue_limit_(queue_limit) {
+      queue_limit_(queue_limit),
+      seal_(seal) {
   socket_.set(zmq::sockopt::sndhwm, subscriber_queue * 3);  // HWM counts parts
   socket_.set(zmq::sockopt::linger, 0);
-  secureServerSocket(socket_, curve);
   const std::string monitor_endpoint =
       "inproc://picksight-publisher-monitor-" + std::to_string(g_monitor_id++);
   if (zmq_socket_monitor(socket_.handle(), monitor_endpoint.c_str(),
@@ -96,7 +97,11 @@ void FramePublisher::run() {
       queue_.pop_front();
       lock.unlock();
       try {
-        sendFrame(socket_, frame);
+        if (seal_) {
+          sendSealedFrame(socket_, frame, *seal_);
+        } else {
+          sendFrame(socket_, frame);
+        }
       } catch (const zmq::error_t& e) {
         logError("publisher: send failed: ", e.what());
       }

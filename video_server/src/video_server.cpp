@@ -283,13 +283,14 @@ VideoServer::VideoServer(const ServerConfig& config, const SourceFactory& make_s
     auto curve = CurveServer::start(context_, config.curve_secret_key, config.curve_allow_list);
     if (!curve) throw std::runtime_error("CURVE: " + curve.error().message);
     curve_ = std::move(*curve);
+    frame_key_ = transport::newFrameKey();
     if (curve_->restricted()) {
-      logInfo("CURVE: frames and control encrypted; only the clients listed in ",
-              config.curve_allow_list, " get in");
+      logInfo("CURVE: control encrypted and frames sealed; only the clients listed in ",
+              config.curve_allow_list, " get in and get the frames' key");
     } else {
       logWarning(
-          "CURVE: frames and control encrypted, but without an allow-list every client "
-          "that knows the server's public key gets in");
+          "CURVE: control encrypted and frames sealed, but without an allow-list every client "
+          "that knows the server's public key gets in and gets the frames' key");
     }
   } else if (!config.curve_allow_list.empty()) {
     throw std::runtime_error("a CURVE allow-list needs the server's secret key as well");
@@ -297,7 +298,7 @@ VideoServer::VideoServer(const ServerConfig& config, const SourceFactory& make_s
   // zmq::error_t alone ("Address already in use") would not say which endpoint.
   try {
     publisher_ =
-        std::make_unique<FramePublisher>(context_, config.frames_endpoint, 8, 4, curve_.get());
+        std::make_unique<FramePublisher>(context_, config.frames_endpoint, 8, 4, frame_key_);
   } catch (const zmq::error_t& e) {
     throw std::runtime_error("frames endpoint " + config.frames_endpoint + ": " + e.what());
   }
@@ -387,6 +388,18 @@ proto::ControlReply VideoServer::handle(const proto::ControlRequest& request) {
   using R = proto::ControlRequest;
   if (request.request_case() == R::kListCameras) return listCameras();
   if (request.request_case() == R::kStatistics) return statistics(request.statistics());
+  if (request.request_case() == R::kFrameKey) {
+    // Only clients the control socket's CURVE admitted are asking.
+    if (!frame_key_) {
+      return errorReply(makeError(VideoErrc::kNotSupported,
+                                  "frames are not sealed: this server runs without CURVE"));
+    }
+    proto::ControlReply reply;
+    auto* k = reply.mutable_frame_key();
+    k->set_key(frame_key_->key.data(), frame_key_->key.size());
+    k->set_key_id(frame_key_->id);
+    return reply;
+  }
 
   // Every other request names one camera.
   const std::optional<std::string> name = requestCamera(request);

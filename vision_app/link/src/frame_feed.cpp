@@ -9,11 +9,12 @@ using transport::CurveClientKeys;
 using transport::FrameSubscriber;
 
 FrameFeed::FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
-                     std::optional<CurveClientKeys> curve)
+                     std::optional<CurveClientKeys> curve, std::string control_endpoint)
     : context_(context),
       endpoint_(std::move(endpoint)),
       camera_(std::move(camera)),
-      curve_(std::move(curve)) {}
+      curve_(std::move(curve)),
+      control_endpoint_(std::move(control_endpoint)) {}
 
 FrameFeed::~FrameFeed() { stop(); }
 
@@ -32,7 +33,7 @@ void FrameFeed::run() {
   try {
     // Only the newest frame matters to a locator: a short queue keeps latency
     // low when processing is slower than the camera.
-    FrameSubscriber subscriber(context_, endpoint_, camera_, 2, curve_);
+    FrameSubscriber subscriber(context_, endpoint_, camera_, 2, curve_, control_endpoint_);
     while (!stop_) {
       auto frame = subscriber.receive(std::chrono::milliseconds(100));
       if (!frame) continue;

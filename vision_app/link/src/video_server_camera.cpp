@@ -17,7 +17,7 @@ VideoServerCamera::VideoServerCamera(zmq::context_t& context, const std::string&
                                      const std::optional<CurveClientKeys>& curve)
     : camera_(std::move(camera)),
       frame_timeout_(frame_timeout),
-      feed_(context, frames_endpoint, camera_, curve),
+      feed_(context, frames_endpoint, camera_, curve, control_endpoint),
       control_(context, control_endpoint, kDefaultControlTimeout, curve) {}
 
 Result<proto::ControlReply> VideoServerCamera::call(const proto::ControlRequest& request) {

@@ -16,6 +16,7 @@
 #include "picksight.pb.h"
 #include "picksight/common/frame.hpp"
 #include "picksight/transport/curve_keys.hpp"
+#include "picksight/transport/frame_seal.hpp"
 
 namespace picksight::transport {
 
@@ -49,10 +50,16 @@ class FrameSubscriber {
  public:
   // `queue_frames` bounds the frames ZeroMQ buffers for us: a subscriber that
   // falls behind loses the oldest pending frames beyond it, never slows the server.
-  // With `curve` keys it talks CURVE to a server that does (and nothing to
-  // one that does not, nor a plain subscriber to a CURVE server).
+  // With `curve` keys it takes only sealed frames (frame_seal.hpp), whose
+  // key it asks at `control_endpoint` with those keys (required then: an
+  // empty one throws std::invalid_argument): a plain frame, one that does
+  // not open, or one sent again (its sequence not past the last) is
+  // counted malformed and skipped. The key is asked again, at most once a
+  // second, when frames name another (a restarted server).
   FrameSubscriber(zmq::context_t& context, const std::string& endpoint, const std::string& camera,
-                  int queue_frames = 4, const std::optional<CurveClientKeys>& curve = {});
+                  int queue_frames = 4, const std::optional<CurveClientKeys>& curve = {},
+                  const std::string& control_endpoint = {});
+  ~FrameSubscriber();
 
   // The next frame, decoded and stamped with its local receive time, or
   // nullopt on timeout. Malformed messages are skipped and counted, never
@@ -65,11 +72,24 @@ class FrameSubscriber {
   // goes back (a restarted server) starts counting afresh.
   uint64_t framesLost() const { return lost_; }
   uint64_t framesReceived() const { return received_; }
+  // Sealed frames that named a key the control socket did not give (a
+  // refused client never gets one).
+  uint64_t framesUnopened() const { return unopened_; }
   zmq::socket_t& socket() { return socket_; }
 
  private:
+  // The frame in a sealed message's parts, or nullopt (counted).
+  std::optional<Frame> openSealed(const zmq::message_t& topic, const zmq::message_t& envelope,
+                                  const zmq::message_t& pixels);
+
+  zmq::context_t& context_;
   zmq::socket_t socket_;
   std::string camera_;
+  std::optional<CurveClientKeys> curve_;
+  std::string control_endpoint_;
+  std::optional<FrameKey> key_;
+  std::chrono::steady_clock::time_point key_asked_{};
+  uint64_t unopened_ = 0;
   uint64_t malformed_ = 0;
   uint64_t lost_ = 0;
   uint64_t received_ = 0;

@@ -13,13 +13,14 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include <zmq.hpp>
 
-#include "picksight/transport/curve_server.hpp"
 #include "picksight/transport/frame_message.hpp"
+#include "picksight/transport/frame_seal.hpp"
 #include "picksight/video_server/camera.hpp"
 
 namespace picksight::video {
@@ -33,9 +34,10 @@ class FramePublisher : public FrameSink {
  public:
   // Binds at once so a bad endpoint fails at start-up. `queue_limit` frames
   // wait at most; `subscriber_queue` frames per subscriber in ZeroMQ. With
-  // `curve` the socket is a CURVE server (the object need not outlive this).
+  // `seal` every frame is sealed once with that key (frame_seal.hpp), on
+  // the publisher's thread, for all subscribers: the socket stays plain.
   FramePublisher(zmq::context_t& context, const std::string& endpoint, size_t queue_limit = 8,
-                 int subscriber_queue = 4, const transport::CurveServer* curve = nullptr);
+                 int subscriber_queue = 4, std::optional<transport::FrameKey> seal = {});
   ~FramePublisher() override;
 
   // The endpoint actually bound (a wildcard port resolved).
@@ -56,6 +58,7 @@ class FramePublisher : public FrameSink {
   zmq::socket_t monitor_;  // publisher thread only (after start)
   std::string bound_endpoint_;
   const size_t queue_limit_;
+  const std::optional<transport::FrameKey> seal_;
   std::thread thread_;
   std::atomic<int> subscribers_{0};
 

@@ -5,12 +5,15 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <zmq.hpp>
 
 #include "picksight.pb.h"
+#include "picksight/transport/curve_server.hpp"
+#include "picksight/transport/frame_seal.hpp"
 #include "picksight/video_server/camera.hpp"
 #include "picksight/video_server/control_server.hpp"
 #include "picksight/video_server/frame_publisher.hpp"
@@ -46,13 +49,15 @@ class VideoServer {
   proto::ControlReply listCameras();
   proto::ControlReply statistics(const proto::StatisticsRequest& request);
 
-  // Two I/O threads: with CURVE each subscriber's copy of a frame is
-  // encrypted on the I/O thread of its connection; two spread that work
-  // (8 CURVE subscribers of 1920x1080 at 60 fps: 29 fps each with one
-  // thread, 35 to 47 with two; plain frames do not need them).
+  // Two I/O threads: the control socket's CURVE and the frames' sends.
+  // (Before frames were sealed once each, CURVE encrypted each
+  // subscriber's copy on the I/O thread of its connection.)
   zmq::context_t context_{2};
   // Before the sockets: its ZAP handler's socket closes after theirs.
   std::unique_ptr<transport::CurveServer> curve_;
+  // With CURVE: the key every frame is sealed with, made at start; given
+  // over the control socket (FrameKeyRequest).
+  std::optional<transport::FrameKey> frame_key_;
   std::unique_ptr<FramePublisher> publisher_;
   std::vector<std::unique_ptr<Camera>> cameras_;
   std::unique_ptr<ControlServer> control_;

@@ -19,8 +19,11 @@ namespace picksight::link {
 
 class FrameFeed {
  public:
+  // With `curve` keys, frames come sealed and their key is asked at
+  // `control_endpoint` (see transport::FrameSubscriber).
   FrameFeed(zmq::context_t& context, std::string endpoint, std::string camera,
-            std::optional<transport::CurveClientKeys> curve = std::nullopt);
+            std::optional<transport::CurveClientKeys> curve = std::nullopt,
+            std::string control_endpoint = {});
   ~FrameFeed();
 
   void start();
@@ -42,6 +45,7 @@ class FrameFeed {
   const std::string endpoint_;
   const std::string camera_;
   const std::optional<transport::CurveClientKeys> curve_;
+  const std::string control_endpoint_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<uint64_t> received_{0};
