@@ -174,11 +174,12 @@ double sealedRoundTripMs(int frames) {
   sub.set(zmq::sockopt::subscribe, "");
   sub.connect(pub.get(zmq::sockopt::last_endpoint));
   const picksight::transport::FrameKey key = picksight::transport::newFrameKey();
+  picksight::transport::FrameSealer sealer(key);
   picksight::Frame frame;
   frame.image = cv::Mat(1080, 1920, CV_8UC1, cv::Scalar(128));
   frame.info.camera = "cam0";
   const auto oneWay = [&](bool wait) {
-    picksight::transport::sendSealedFrame(pub, frame, key);
+    sealer.send(pub, frame);
     zmq::message_t topic, envelope, pixels;
     if (!wait) {
       zmq::pollitem_t item{sub.handle(), 0, ZMQ_POLLIN, 0};

@@ -16,7 +16,7 @@ from picksight._socket_owner import TopicSubscriber
 
 # A sealed frame's part 2 beyond the header it seals: "PSF1", the key id,
 # the nonce and the tag.
-_SEALED_OVERHEAD = 4 + 8 + 24 + 16
+_SEALED_OVERHEAD = 4 + 8 + 12 + 16
 
 # Bytes per pixel and channels of each wire pixel format.
 _LAYOUT = {pb.MONO8: (1, None), pb.BGR8: (3, 3)}
@@ -125,7 +125,7 @@ class FrameSubscriber(TopicSubscriber):
     def _open(self, parts):
         """The header bytes and pixels of a sealed frame (picksight/transport/
         frame_seal.hpp), or None."""
-        from nacl.bindings import crypto_aead_xchacha20poly1305_ietf_decrypt
+        from nacl.bindings import crypto_aead_chacha20poly1305_ietf_decrypt as decrypt
         from nacl.exceptions import CryptoError
 
         envelope = parts[1].bytes
@@ -138,15 +138,14 @@ class FrameSubscriber(TopicSubscriber):
                 self.unopened += 1
                 self.malformed -= 1  # counted apart, not as malformed
                 return None
-        nonce = envelope[12:36]
-        ad = parts[0].bytes + envelope[:36]
-        # The pixels are sealed under the nonce plus one (little-endian).
-        pixel_nonce = ((int.from_bytes(nonce, "little") + 1) % (1 << 192)).to_bytes(24, "little")
+        # ChaCha20-Poly1305 (RFC 8439), bound to the topic and the clear
+        # prefix; the pixels under the nonce plus one (little-endian).
+        nonce = envelope[12:24]
+        ad = parts[0].bytes + envelope[:24]
+        pixel_nonce = ((int.from_bytes(nonce, "little") + 1) % (1 << 96)).to_bytes(12, "little")
         try:
-            header = crypto_aead_xchacha20poly1305_ietf_decrypt(envelope[36:], ad, nonce,
-                                                                self._key[1])
-            pixels = crypto_aead_xchacha20poly1305_ietf_decrypt(parts[2].bytes, ad, pixel_nonce,
-                                                                self._key[1])
+            header = decrypt(envelope[24:], ad, nonce, self._key[1])
+            pixels = decrypt(parts[2].bytes, ad, pixel_nonce, self._key[1])
         except CryptoError:
             return None
         return header, pixels

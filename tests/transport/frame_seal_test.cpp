@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <catch2/catch.hpp>
+#include <cstring>
 #include <thread>
 
 #include "picksight.pb.h"
@@ -35,14 +36,14 @@ struct Parts {
   zmq::message_t topic, envelope, pixels;
 };
 
-Parts sealedParts(zmq::context_t& context, const Frame& frame, const FrameKey& key) {
+Parts sealedParts(zmq::context_t& context, const Frame& frame, FrameSealer& sealer) {
   zmq::socket_t out(context, zmq::socket_type::pair);
   zmq::socket_t in(context, zmq::socket_type::pair);
   static int n = 0;
   const std::string endpoint = "inproc://seal-test-" + std::to_string(n++);
   in.bind(endpoint);
   out.connect(endpoint);
-  sendSealedFrame(out, frame, key);
+  sealer.send(out, frame);
   Parts p;
   REQUIRE(in.recv(p.topic));
   REQUIRE(in.recv(p.envelope));
@@ -52,14 +53,16 @@ Parts sealedParts(zmq::context_t& context, const Frame& frame, const FrameKey& k
 
 zmq::message_t copyOf(const zmq::message_t& m) { return zmq::message_t(m.data(), m.size()); }
 
-// The frame in an opened message, or nullopt.
+// The frame in a sealed message, opened on a copy of its pixels (they are
+// opened in place), or nullopt.
 std::optional<Frame> opened(const zmq::message_t& topic, const zmq::message_t& envelope,
                             const zmq::message_t& pixels, const FrameKey& key) {
-  auto o = openSealedFrame(topic, envelope, pixels, key);
-  if (!o) return std::nullopt;
+  zmq::message_t copy = copyOf(pixels);
+  const auto header = openSealedFrame(topic, envelope, copy, key);
+  if (!header) return std::nullopt;
   proto::FrameHeader h;
-  REQUIRE(h.ParseFromString(o->header));
-  return decodeFrame(h, std::move(o->pixels));
+  REQUIRE(h.ParseFromString(*header));
+  return decodeFrame(h, std::move(copy));
 }
 
 bool same(const cv::Mat& a, const cv::Mat& b) {
@@ -71,8 +74,9 @@ bool same(const cv::Mat& a, const cv::Mat& b) {
 TEST_CASE("A sealed frame opens with its key alone, to the frame sealed", "[transport][seal]") {
   zmq::context_t context;
   const FrameKey key = newFrameKey();
+  FrameSealer sealer(key);
   const Frame frame = testFrame("cam0", 7, 1);
-  const Parts p = sealedParts(context, frame, key);
+  const Parts p = sealedParts(context, frame, sealer);
   CHECK(p.topic.to_string() == "cam0");
   REQUIRE(sealedKeyId(p.envelope) == key.id);
   CHECK(p.pixels.size() == frame.image.total() + kSealTag);
@@ -84,13 +88,19 @@ TEST_CASE("A sealed frame opens with its key alone, to the frame sealed", "[tran
   CHECK(got->info.camera == "cam0");
 
   // Another key, or the same key under another id: nothing opens.
-  CHECK_FALSE(openSealedFrame(p.topic, p.envelope, p.pixels, newFrameKey()));
+  CHECK_FALSE(opened(p.topic, p.envelope, p.pixels, newFrameKey()));
   FrameKey other_id = key;
   ++other_id.id;
-  CHECK_FALSE(openSealedFrame(p.topic, p.envelope, p.pixels, other_id));
+  CHECK_FALSE(opened(p.topic, p.envelope, p.pixels, other_id));
   FrameKey other_key = newFrameKey();
   other_key.id = key.id;
-  CHECK_FALSE(openSealedFrame(p.topic, p.envelope, p.pixels, other_key));
+  CHECK_FALSE(opened(p.topic, p.envelope, p.pixels, other_key));
+  // The same frame sealed again by the same sealer: under other nonces
+  // (bytes 12 to 23), and it opens all the same.
+  const Parts again = sealedParts(context, frame, sealer);
+  CHECK(std::memcmp(static_cast<const char*>(again.envelope.data()) + 12,
+                    static_cast<const char*>(p.envelope.data()) + 12, 12) != 0);
+  CHECK(opened(again.topic, again.envelope, again.pixels, key));
   // A plain frame's header names no key.
   const zmq::message_t plain_header(frameHeaderOf(frame).SerializeAsString());
   CHECK_FALSE(sealedKeyId(plain_header));
@@ -100,8 +110,9 @@ TEST_CASE("A sealed frame changed anywhere, or its parts moved, does not open",
           "[transport][seal]") {
   zmq::context_t context;
   const FrameKey key = newFrameKey();
-  const Parts a = sealedParts(context, testFrame("cam0", 1, 1), key);
-  const Parts b = sealedParts(context, testFrame("cam0", 2, 2), key);
+  FrameSealer sealer(key);
+  const Parts a = sealedParts(context, testFrame("cam0", 1, 1), sealer);
+  const Parts b = sealedParts(context, testFrame("cam0", 2, 2), sealer);
   REQUIRE(opened(a.topic, a.envelope, a.pixels, key));
 
   // One bit flipped in each byte position class: nonce, sealed header, tag,
@@ -138,6 +149,7 @@ TEST_CASE("A CURVE subscriber takes sealed frames once each, with the key it ask
   auto curve = CurveServer::start(context, secret, "");
   REQUIRE(curve);
   const FrameKey key = newFrameKey();
+  FrameSealer sealer(key);
 
   // The key's server: a CURVE REP answering FrameKeyRequest (as the video
   // server's control socket does).
@@ -178,7 +190,7 @@ TEST_CASE("A CURVE subscriber takes sealed frames once each, with the key it ask
   // until one comes through.
   std::optional<Frame> first;
   for (int i = 0; i < 100 && !first; ++i) {
-    sendSealedFrame(pub, testFrame("cam0", 1, 1), key);
+    sealer.send(pub, testFrame("cam0", 1, 1));
     first = sub.receive(100ms);
   }
   REQUIRE(first);
@@ -189,7 +201,7 @@ TEST_CASE("A CURVE subscriber takes sealed frames once each, with the key it ask
   const uint64_t malformed_before = sub.malformedMessages();
 
   // Frame 1 sent again (a recorded frame replayed): skipped.
-  sendSealedFrame(pub, testFrame("cam0", 1, 1), key);
+  sealer.send(pub, testFrame("cam0", 1, 1));
   CHECK_FALSE(sub.receive(300ms));
   CHECK(sub.malformedMessages() == malformed_before + 1);
   // A plain frame to a subscriber that expects sealed ones: skipped.
@@ -199,13 +211,14 @@ TEST_CASE("A CURVE subscriber takes sealed frames once each, with the key it ask
   // Under another key (a forger's): not opened, and the key server asked
   // at most once a second, whatever the number of such frames.
   const FrameKey forger = newFrameKey();
-  for (int i = 0; i < 5; ++i) sendSealedFrame(pub, testFrame("cam0", 3 + i, 3), forger);
+  FrameSealer forging(forger);
+  for (int i = 0; i < 5; ++i) forging.send(pub, testFrame("cam0", 3 + i, 3));
   CHECK_FALSE(sub.receive(300ms));
   CHECK(sub.framesUnopened() == 5);
   CHECK(asked <= 2);  // not once per frame
   // The next frame, sealed with the key: taken (positive control).
   const auto next = [&] {
-    sendSealedFrame(pub, testFrame("cam0", 9, 4), key);
+    sealer.send(pub, testFrame("cam0", 9, 4));
     return sub.receive(2s);
   }();
   REQUIRE(next);

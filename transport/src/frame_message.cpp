@@ -138,6 +138,25 @@ FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& end
   socket_.set(zmq::sockopt::linger, 0);
   socket_.set(zmq::sockopt::subscribe, camera);
   socket_.connect(endpoint);
+  // The key asked now, while the subscription reaches the server: asked at
+  // the first frame, the frames that came during the CURVE handshake and
+  // the request queued beyond their bound, and were lost (8 subscribers
+  // starting together lost 10 to 20 frames each).
+  if (curve_) askKey();
+}
+
+void FrameSubscriber::askKey() {
+  key_asked_ = std::chrono::steady_clock::now();
+  ControlClient control(context_, control_endpoint_, kDefaultControlTimeout, curve_);
+  proto::ControlRequest request;
+  request.mutable_frame_key();
+  const auto reply = control.call(request);
+  if (!reply || !reply->has_frame_key() || reply->frame_key().key().size() != 32) return;
+  FrameKey k;
+  std::memcpy(k.key.data(), reply->frame_key().key().data(), k.key.size());
+  k.id = reply->frame_key().key_id();
+  if (!key_ || key_->id != k.id) last_sequence_.clear();  // a new run of the server
+  key_ = k;
 }
 
 std::optional<Frame> FrameSubscriber::receive(std::chrono::milliseconds timeout) {
@@ -214,7 +233,7 @@ FrameSubscriber::~FrameSubscriber() = default;
 
 std::optional<Frame> FrameSubscriber::openSealed(const zmq::message_t& topic,
                                                  const zmq::message_t& envelope,
-                                                 const zmq::message_t& pixels) {
+                                                 zmq::message_t& pixels) {
   const std::optional<uint64_t> id = sealedKeyId(envelope);
   if (!id) {
     ++malformed_;  // a plain frame: not taken from a server that should seal
@@ -226,33 +245,23 @@ std::optional<Frame> FrameSubscriber::openSealed(const zmq::message_t& topic,
     // socket, nor stall this subscriber for a timeout each.
     constexpr auto kAskEvery = std::chrono::seconds(1);
     const auto now = std::chrono::steady_clock::now();
-    if (key_asked_ != std::chrono::steady_clock::time_point{} && now - key_asked_ < kAskEvery) {
+    if (now - key_asked_ < kAskEvery) {
       ++unopened_;
       return std::nullopt;
     }
-    key_asked_ = now;
-    ControlClient control(context_, control_endpoint_, kDefaultControlTimeout, curve_);
-    proto::ControlRequest request;
-    request.mutable_frame_key();
-    const auto reply = control.call(request);
-    if (reply && reply->has_frame_key() && reply->frame_key().key().size() == 32) {
-      FrameKey k;
-      std::memcpy(k.key.data(), reply->frame_key().key().data(), k.key.size());
-      k.id = reply->frame_key().key_id();
-      if (!key_ || key_->id != k.id) last_sequence_.clear();  // a new run of the server
-      key_ = k;
-    }
+    askKey();
     if (!key_ || key_->id != *id) {
       ++unopened_;
       return std::nullopt;
     }
   }
-  auto opened = openSealedFrame(topic, envelope, pixels, *key_);
+  const auto opened = openSealedFrame(topic, envelope, pixels, *key_);
   proto::FrameHeader header;
   std::optional<Frame> frame;
-  if (opened &&
-      header.ParseFromArray(opened->header.data(), static_cast<int>(opened->header.size()))) {
-    frame = decodeFrame(header, std::move(opened->pixels));
+  // The frame is a view on the opened pixels, the tag's bytes after them
+  // left unread.
+  if (opened && header.ParseFromArray(opened->data(), static_cast<int>(opened->size()))) {
+    frame = decodeFrame(header, std::move(pixels));
   }
   if (!frame) ++malformed_;
   return frame;

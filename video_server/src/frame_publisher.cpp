@@ -11,8 +11,8 @@
 namespace picksight::video {
 
 using transport::FrameKey;
+using transport::FrameSealer;
 using transport::sendFrame;
-using transport::sendSealedFrame;
 
 namespace {
 std::atomic<int> g_monitor_id{0};
@@ -24,7 +24,7 @@ FramePublisher::FramePublisher(zmq::context_t& context, const std::string& endpo
     : socket_(context, zmq::socket_type::pub),
       monitor_(context, zmq::socket_type::pair),
       queue_limit_(queue_limit),
-      seal_(seal) {
+      sealer_(seal ? std::make_unique<FrameSealer>(*seal) : nullptr) {
   socket_.set(zmq::sockopt::sndhwm, subscriber_queue * 3);  // HWM counts parts
   socket_.set(zmq::sockopt::linger, 0);
   const std::string monitor_endpoint =
@@ -97,8 +97,8 @@ void FramePublisher::run() {
       queue_.pop_front();
       lock.unlock();
       try {
-        if (seal_) {
-          sendSealedFrame(socket_, frame, *seal_);
+        if (sealer_) {
+          sealer_->send(socket_, frame);
         } else {
           sendFrame(socket_, frame);
         }

@@ -291,7 +291,8 @@ void defineServerOptions(CLI::App& app, ServerArgs& a) {
         return f ? std::string() : f.error().message;
       }));
   app.add_option("--curve-secret-key", a.curve_secret_key,
-                 "encrypt frames and control with CURVE: the server's NAME.key_secret "
+                 "CURVE: encrypt control and seal frames (once each, for every subscriber); "
+                 "the server's NAME.key_secret "
                  "(picksight-keygen; see docs/SECURITY.md)")
       ->type_name("FILE");
   app.add_option("--curve-clients", a.curve_allow_list,

@@ -55,7 +55,8 @@ class FrameSubscriber {
   // empty one throws std::invalid_argument): a plain frame, one that does
   // not open, or one sent again (its sequence not past the last) is
   // counted malformed and skipped. The key is asked again, at most once a
-  // second, when frames name another (a restarted server).
+  // second, when frames name another (a restarted server). It is first
+  // asked here (blocking up to the control timeout when nobody answers).
   FrameSubscriber(zmq::context_t& context, const std::string& endpoint, const std::string& camera,
                   int queue_frames = 4, const std::optional<CurveClientKeys>& curve = {},
                   const std::string& control_endpoint = {});
@@ -78,9 +79,13 @@ class FrameSubscriber {
   zmq::socket_t& socket() { return socket_; }
 
  private:
-  // The frame in a sealed message's parts, or nullopt (counted).
+  // Asks the frames' key on the control socket (blocking up to its
+  // timeout); key_ is left as it was when none comes.
+  void askKey();
+  // The frame in a sealed message's parts (its pixels opened in place),
+  // or nullopt (counted).
   std::optional<Frame> openSealed(const zmq::message_t& topic, const zmq::message_t& envelope,
-                                  const zmq::message_t& pixels);
+                                  zmq::message_t& pixels);
 
   zmq::context_t& context_;
   zmq::socket_t socket_;

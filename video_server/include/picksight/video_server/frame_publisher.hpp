@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <deque>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -58,7 +59,7 @@ class FramePublisher : public FrameSink {
   zmq::socket_t monitor_;  // publisher thread only (after start)
   std::string bound_endpoint_;
   const size_t queue_limit_;
-  const std::optional<transport::FrameKey> seal_;
+  const std::unique_ptr<transport::FrameSealer> sealer_;  // with a key
   std::thread thread_;
   std::atomic<int> subscribers_{0};
 
