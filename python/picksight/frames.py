@@ -98,6 +98,11 @@ class FrameSubscriber(TopicSubscriber):
         self._key = None  # (key id, key)
         self._key_asked = None
         self.unopened = 0
+        if curve is not None:
+            # Asked now, while the subscription reaches the server: asked at
+            # the first frame, the frames that came meanwhile could overflow
+            # the queue.
+            self._ask_key()
 
     def _decode(self, parts):
         if len(parts) != 3:
