@@ -101,7 +101,25 @@ struct Tally {
   int parts = 0;
   int distractors = 0;
   int frames = 0;
+  // --scaling: recognition's time on N cores, simulated (kWorkers), per frame.
+  std::vector<std::vector<double>> simulated_ms;
+  std::vector<double> costliest_share;  // the costliest region's share of the work
 };
+
+// The core counts --scaling simulates.
+constexpr int kWorkers[] = {1, 2, 4, 8, 16};
+
+// The time `workers` cores take for regions costing `ms` each, dealt in
+// their order to the first core free (as a work queue deals them; no cost
+// of dealing counted): what recognition on that many cores can reach.
+double makespanMs(const std::vector<double>& ms, int workers) {
+  std::vector<double> free_at(static_cast<size_t>(workers), 0.0);
+  for (const double m : ms) {
+    auto first = std::min_element(free_at.begin(), free_at.end());
+    *first += m;
+  }
+  return *std::max_element(free_at.begin(), free_at.end());
+}
 
 // Where a part's model reference point truly lies: the drawn mask's centroid
 // plus, turned with the part, the offset from it to the reference point the
@@ -261,6 +279,21 @@ void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
   std::printf("  plain OpenCV pass (Otsu+findContours+moments) median %.2f ms p99 %.2f ms\n", plain,
               picksight::bench::nearestRank(t.plain_ms, 99));
   std::printf("  ratio of medians (vision / plain OpenCV) %.2fx\n", plain > 0 ? ours / plain : 0);
+  if (!t.simulated_ms.empty()) {
+    std::printf(
+        "  recognition on N cores, simulated from each region's time alone on one thread "
+        "(dealt in order to the first free core; %zu frames, medians):\n   ",
+        t.simulated_ms.front().size());
+    const double one = picksight::bench::nearestRank(t.simulated_ms.front(), 50);
+    for (size_t k = 0; k < t.simulated_ms.size(); ++k) {
+      const double m = picksight::bench::nearestRank(t.simulated_ms[k], 50);
+      std::printf(" %d: %.2f ms (x%.2f)", kWorkers[k], m, m > 0 ? one / m : 0.0);
+    }
+    std::printf(
+        "\n  the costliest region's share of a frame's recognition: median %.2f, max %.2f\n",
+        picksight::bench::nearestRank(t.costliest_share, 50),
+        picksight::bench::nearestRank(t.costliest_share, 100));
+  }
 }
 }  // namespace
 
@@ -311,6 +344,10 @@ int main(int argc, char** argv) {
   app.add_flag("--from-edges", from_edges,
                "locate every blob's parts the way touching parts are (hypotheses and the edge "
                "fit), to measure that path on separated parts");
+  bool scaling = false;
+  app.add_flag("--scaling", scaling,
+               "also time each region's recognition alone (first frame of each scene) and "
+               "print the time on 1 to 16 cores it gives, simulated");
   bool list_false = false;
   app.add_flag("--list-errors", list_false,
                "print each false report (the type reported, where, and what is drawn there) and "
@@ -478,6 +515,25 @@ int main(int argc, char** argv) {
              },
              [&] { sink += picksight::bench::competentOpenCvPass(grey); }},
             {&tally.ours_ms, &tally.plain_ms});
+        if (scaling && r == 0 && !from_edges) {
+          // Each region alone, as recognize() does it on a worker thread.
+          const auto regions = pv::findRegions(pv::binarize(grey, binarize), {}, grey);
+          std::vector<double> each;
+          for (const auto& region : regions) {
+            const std::vector<pv::Region> alone{region};
+            const auto t0 = Clock::now();
+            const auto found = pv::recognize(alone, list);
+            each.push_back(Ms(Clock::now() - t0).count());
+            if (found.size() > 1000) std::printf("!");
+          }
+          if (tally.simulated_ms.empty()) tally.simulated_ms.resize(std::size(kWorkers));
+          for (size_t k = 0; k < std::size(kWorkers); ++k)
+            tally.simulated_ms[k].push_back(makespanMs(each, kWorkers[k]));
+          double total = 0;
+          for (const double m : each) total += m;
+          if (total > 0)
+            tally.costliest_share.push_back(*std::max_element(each.begin(), each.end()) / total);
+        }
         score(scene.truth(), matches, reference, list_false ? &specs : nullptr, tally);
         tally.parts += static_cast<int>(scene.truth().size());
         for (const auto& t : scene.truth()) tally.distractors += t.kind != ps::PartKind::kTrue;
