@@ -12,7 +12,7 @@ PACKAGES=(
   # libFuzzer and the sanitizer runtimes for clang (fuzz run in CI)
   libclang-rt-14-dev
   # core libraries
-  libopencv-dev libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
+  libopencv-dev libtbb-dev libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   # camera drivers: GigE/USB3 Vision (and the fake camera used by tests), V4L2
   # (libusb-1.0-0-dev: aravis-0.8.pc requires it, but libaravis-dev does not pull it in)

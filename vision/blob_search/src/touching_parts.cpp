@@ -9,6 +9,8 @@
 // blob unexplained.
 #include "picksight/vision/blob_search/touching_parts.hpp"
 
+#include <tbb/parallel_for.h>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -149,6 +151,24 @@ bool fitsIn(const Extent& part, const Extent& blob) {
     return p <= b + kExtentSlackPx + kExtentSlackShare * p;
   };
   return within(part.diameter, blob.diameter) && within(part.width, blob.width);
+}
+
+// Calls f(k) for k in [0, n), on the cores the blob's own thread leaves
+// idle. Nested in recognize()'s loop over regions (OpenCV's TBB arena),
+// TBB lends a blob's models to threads that have no region left to take:
+// the costliest blob (one a distractor touches, which no model explains
+// and every model is searched in) is a fifth to a quarter of a touching
+// frame's recognition, and on 8 cores and more the frame waits for it
+// alone (picksight-bench-silhouettes --scaling). With one thread
+// (cv::setNumThreads(1)), in turn here. Each f(k) writes its own slot; the
+// callers then use the slots in model order, as the serial search did.
+template <typename F>
+void forEachModel(size_t n, F&& f) {
+  if (n < 2 || cv::getNumThreads() <= 1) {
+    for (size_t k = 0; k < n; ++k) f(k);
+    return;
+  }
+  tbb::parallel_for(size_t{0}, n, [&](size_t k) { f(k); });
 }
 
 // The share of the model's boundary, placed at the pose, whose points
@@ -798,11 +818,23 @@ void BlobSearch::fullSearch(std::vector<std::pair<double, size_t>> order) {
     }
     std::stable_sort(order.begin(), order.end(),
                      [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (const auto& entry : order) {
-      refine(screen(*fitting_[entry.second], false));
-      if (!changed_) continue;
-      choose();
-      if (explainsWhole()) return;
+    // The round's screens read the anchors narrowed above and the edges
+    // only: as many at once as there are threads, then refined in order
+    // until the blob is explained (at most a thread's worth screened in
+    // vain; one by one on one thread).
+    const size_t batch = static_cast<size_t>(std::max(1, cv::getNumThreads()));
+    std::vector<std::vector<Candidate>> screened;
+    for (size_t start = 0; start < order.size(); start += batch) {
+      const size_t n = std::min(batch, order.size() - start);
+      screened.assign(n, {});
+      forEachModel(
+          n, [&](size_t k) { screened[k] = screen(*fitting_[order[start + k].second], false); });
+      for (size_t k = 0; k < n; ++k) {
+        refine(screened[k]);
+        if (!changed_) continue;
+        choose();
+        if (explainsWhole()) return;
+      }
     }
     if (taken_.size() <= found_before || refinements_ >= budget_) return;
   }
@@ -840,15 +872,22 @@ void BlobSearch::searchRestMiddle() {
   if (largest.m00 <= 0) return;
   const double area = largest.m00;
   const cv::Point2d middle(blob_box_.x + largest.m10 / area, blob_box_.y + largest.m01 / area);
-  std::vector<Candidate> proposed;
-  // The map proposeAbout's first look reads, built for the first model it
-  // is asked of.
-  std::optional<EdgeDistance> wide;
+  // The models of the rest's size, each turned about its middle (all at
+  // once, gathered in model order), on the map proposeAbout's first look
+  // reads.
+  std::vector<const PartModel*> sized;
   for (const PartModel* m : fitting_) {
-    if (m->body.area < kRestMinArea * area || m->body.area > kRestMaxArea * area) continue;
-    if (!wide) wide.emplace(edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx));
-    proposeAbout(*m, *searchOf(*m), middle, *edges_, *wide, &proposed);
+    if (m->body.area >= kRestMinArea * area && m->body.area <= kRestMaxArea * area)
+      sized.push_back(m);
   }
+  if (sized.empty()) return;
+  const EdgeDistance wide = edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx);
+  std::vector<std::vector<Candidate>> each(sized.size());
+  forEachModel(sized.size(), [&](size_t k) {
+    proposeAbout(*sized[k], *searchOf(*sized[k]), middle, *edges_, wide, &each[k]);
+  });
+  std::vector<Candidate> proposed;
+  for (const auto& e : each) proposed.insert(proposed.end(), e.begin(), e.end());
   std::stable_sort(proposed.begin(), proposed.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
   refine(proposed);
@@ -860,11 +899,14 @@ std::vector<Match> BlobSearch::run() {
   // arc: the parts that show whole are mostly found there. Then, while the
   // parts found do not explain the blob whole, the full search of each model,
   // those the quick search found something of first.
+  // The screens read the blob's anchors and edges only: all at once, then
+  // refined in model order.
+  std::vector<std::vector<Candidate>> quick(fitting_.size());
+  forEachModel(fitting_.size(), [&](size_t k) { quick[k] = screen(*fitting_[k], true); });
   std::vector<std::pair<double, size_t>> order;
   for (size_t k = 0; k < fitting_.size(); ++k) {
-    const auto screened = screen(*fitting_[k], true);
-    order.emplace_back(screened.empty() ? -1.0 : screened.front().score, k);
-    refine(screened);
+    order.emplace_back(quick[k].empty() ? -1.0 : quick[k].front().score, k);
+    refine(quick[k]);
   }
   choose();
   if (!explainsWhole()) fullSearch(std::move(order));
