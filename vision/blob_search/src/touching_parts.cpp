@@ -10,6 +10,7 @@
 #include "picksight/vision/blob_search/touching_parts.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -162,13 +163,23 @@ bool fitsIn(const Extent& part, const Extent& blob) {
 // alone (picksight-bench-silhouettes --scaling). With one thread
 // (cv::setNumThreads(1)), in turn here. Each f(k) writes its own slot; the
 // callers then use the slots in model order, as the serial search did.
+// Outside OpenCV's arena (it runs a loop of one region on the caller's
+// thread), TBB's default arena would take every core of the machine: an
+// arena of OpenCV's thread count keeps to cv::setNumThreads.
 template <typename F>
 void forEachModel(size_t n, F&& f) {
-  if (n < 2 || cv::getNumThreads() <= 1) {
+  const int allowed = cv::getNumThreads();
+  if (n < 2 || allowed <= 1) {
     for (size_t k = 0; k < n; ++k) f(k);
     return;
   }
-  tbb::parallel_for(size_t{0}, n, [&](size_t k) { f(k); });
+  const auto all = [&] { tbb::parallel_for(size_t{0}, n, [&](size_t k) { f(k); }); };
+  if (tbb::this_task_arena::max_concurrency() <= allowed) {
+    all();
+  } else {
+    tbb::task_arena arena(allowed);
+    arena.execute(all);
+  }
 }
 
 // The share of the model's boundary, placed at the pose, whose points
