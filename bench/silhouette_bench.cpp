@@ -282,7 +282,8 @@ void print(ps::Arrangement arrangement, const Tally& t, bool per_type,
   if (!t.simulated_ms.empty()) {
     std::printf(
         "  recognition on N cores, simulated from each region's time alone on one thread "
-        "(dealt in order to the first free core; %zu frames, medians):\n   ",
+        "(dealt whole, in order, to the first free core; a blob's models are spread over idle "
+        "cores as well, which this leaves out; %zu frames, medians):\n   ",
         t.simulated_ms.front().size());
     const double one = picksight::bench::nearestRank(t.simulated_ms.front(), 50);
     for (size_t k = 0; k < t.simulated_ms.size(); ++k) {
