@@ -139,9 +139,8 @@ FrameSubscriber::FrameSubscriber(zmq::context_t& context, const std::string& end
   socket_.set(zmq::sockopt::subscribe, camera);
   socket_.connect(endpoint);
   // The key asked now, while the subscription reaches the server: asked at
-  // the first frame, the frames that came during the CURVE handshake and
-  // the request queued beyond their bound, and were lost (8 subscribers
-  // starting together lost 10 to 20 frames each).
+  // the first frame, the frames that come during the CURVE handshake and
+  // the request would wait in a queue of `queue_frames`.
   if (curve_) askKey();
 }
 
