@@ -51,6 +51,13 @@ proto::FrameHeader headerOf(const Frame& f, const cv::Mat& img) {
   return h;
 }
 
+// The frame a serialized header and its pixels describe, or nullopt.
+std::optional<Frame> parsedFrame(const void* header, size_t size, zmq::message_t pixels) {
+  proto::FrameHeader h;
+  if (!h.ParseFromArray(header, static_cast<int>(size))) return std::nullopt;
+  return decodeFrame(h, std::move(pixels));
+}
+
 }  // namespace
 
 proto::FrameHeader frameHeaderOf(const Frame& frame) { return headerOf(frame, frame.image); }
@@ -200,10 +207,7 @@ std::optional<Frame> FrameSubscriber::receive(std::chrono::milliseconds timeout)
       frame = openSealed(topic, header_bytes, pixels);
       if (!frame) continue;
     } else {
-      proto::FrameHeader header;
-      if (header.ParseFromArray(header_bytes.data(), static_cast<int>(header_bytes.size()))) {
-        frame = decodeFrame(header, std::move(pixels));
-      }
+      frame = parsedFrame(header_bytes.data(), header_bytes.size(), std::move(pixels));
       if (!frame) {
         ++malformed_;
         continue;
@@ -255,13 +259,10 @@ std::optional<Frame> FrameSubscriber::openSealed(const zmq::message_t& topic,
     }
   }
   const auto opened = openSealedFrame(topic, envelope, pixels, *key_);
-  proto::FrameHeader header;
-  std::optional<Frame> frame;
   // The frame is a view on the opened pixels, the tag's bytes after them
   // left unread.
-  if (opened && header.ParseFromArray(opened->data(), static_cast<int>(opened->size()))) {
-    frame = decodeFrame(header, std::move(pixels));
-  }
+  std::optional<Frame> frame;
+  if (opened) frame = parsedFrame(opened->data(), opened->size(), std::move(pixels));
   if (!frame) ++malformed_;
   return frame;
 }
