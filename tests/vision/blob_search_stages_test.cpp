@@ -601,3 +601,45 @@ TEST_CASE("blob search: a part whose thin stick does not show is placed, a wide 
   CHECK(placedWithoutStick(3));
   CHECK_FALSE(placedWithoutStick(12));
 }
+
+TEST_CASE("blob search: two touching parts no anchor led to are found about their own middles",
+          "[vision][blob_search]") {
+  // A disc and a square whose corner meets its rim: one blob with a neck
+  // where they touch. Nothing taken (as when the noisy corners of a faint
+  // pair lead nowhere), the search about the blob's middle alone lies
+  // between the two, where neither is; the pieces the blob parts into at
+  // the neck each hold one part.
+  const ps::Shape disc{{pt::circleLoop(55)}};
+  const ps::Shape square{{pt::rectLoop(90, 90)}};
+  const PartModel disc_model = trainAlone(disc, 1, "disc");
+  const PartModel square_model = trainAlone(square, 2, "square");
+  const double towards = 20;
+  const cv::Point2d disc_at(220, 240);
+  // The square's corner 2 px inside the rim, on the line at `towards`.
+  const cv::Point2d along(std::cos(towards * M_PI / 180), std::sin(towards * M_PI / 180));
+  const cv::Point2d square_at = disc_at + (55 - 2 + 45 * std::sqrt(2.0)) * along;
+  const double square_turn = towards + 45;
+  const cv::Mat grey = pt::drawParts(
+      640, 480, {{disc, disc_at.x, disc_at.y, 0}, {square, square_at.x, square_at.y, square_turn}},
+      13);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  REQUIRE(regions.size() == 1);
+  const std::vector<const PartModel*> models_list{&disc_model, &square_model};
+  BlobSearch search(regions, 0, models_list, nullptr);
+  REQUIRE(search.fitting().size() == 2);
+  search.searchRestMiddle();
+  search.choose();
+  REQUIRE(search.taken().size() == 2);
+  bool disc_found = false;
+  bool square_found = false;
+  for (const size_t i : search.taken()) {
+    const Candidate& c = *search.placed()[i].candidate;
+    if (c.model == &disc_model) {
+      disc_found = std::hypot(c.pose.centre.x - disc_at.x, c.pose.centre.y - disc_at.y) < 0.5;
+    } else {
+      square_found = near(c.pose, {square_at, square_turn, false}, square_model, 0.5, 0.5);
+    }
+  }
+  CHECK(disc_found);
+  CHECK(square_found);
+}

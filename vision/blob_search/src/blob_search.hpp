@@ -17,7 +17,8 @@
 //   searchRestMiddle()  each model the size of what is left unexplained,
 //                       put on its middle and turned (proposeAbout): a part
 //                       whose corners its outline does not show as the
-//                       model's
+//                       model's; with nothing found, also the pieces the
+//                       blob parts into at its necks, each about its middle
 //   run()               the stages in order: a quick search of every model,
 //                       then while the blob is not explained whole the full
 //                       search, model by model, and the search of the rest's
@@ -93,6 +94,11 @@ class BlobSearch {
   // of a candidate about to be taken; the aligned mirror image is fitted
   // once per candidate).
   bool showsMirror(const Candidate& candidate);
+  // The models of the size of what the parts taken leave, each turned about
+  // its middle; where nothing is taken nor placed there and the blob has
+  // room for two parts, also about the middle of each piece it parts into
+  // at its necks. Refines what it proposes (choose() takes it).
+  void searchRestMiddle();
 
   const std::deque<Candidate>& refined() const { return refined_; }
   const std::vector<Placed>& placed() const { return placed_; }
@@ -117,7 +123,9 @@ class BlobSearch {
   // The full search after the quick one: `order` holds per model (index
   // into fitting()) what the quick search saw of it.
   void fullSearch(std::vector<std::pair<double, size_t>> order);
-  void searchRestMiddle();
+  // Each model turned about its point (proposeAbout), all at once, then the
+  // poses refined best first.
+  void searchAbout(const std::vector<std::pair<const PartModel*, cv::Point2d>>& sized);
   // The distance map of the blob's outline, exact up to `reach`.
   EdgeDistance edgeMap(double reach) const;
 

@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -868,17 +869,141 @@ EdgeDistance BlobSearch::edgeMap(double reach) const {
                       reach);
 }
 
+namespace {
+// A piece of the rest the middle search is run about: its middle (over the
+// blob's box) and area.
+struct RestPiece {
+  cv::Point2d middle;
+  double area = 0;
+};
+
+// The pieces of `piece` (a mask over the blob's box, one 8-connected piece,
+// its bounding box `box`) that meet at necks: two parts whose corners the
+// anchors did not lead to (under a front light at 30 grey levels of
+// contrast, both parts of a touching pair were missed so: the search about
+// the middle of the two, between them, found neither). Its cores deep
+// inside, at the shallowest depth of kSplitDepths (shares of its deepest)
+// that parts it into two or more cores of at least kMinCoreShare of the
+// largest one, grown back over the piece, each pixel to its nearest core;
+// the kMaxSplitPieces largest. Empty when no depth parts it.
+constexpr std::array<double, 6> kSplitDepths = {0.15, 0.25, 0.35, 0.45, 0.55, 0.65};
+constexpr double kMinCoreShare = 0.1;
+constexpr size_t kMaxSplitPieces = 3;
+constexpr double kSplitPixels = 128 * 128;
+// A piece split off at a neck is a part's pixels less the seam, and more or
+// less of the neck: the models whose area less the seam is within this
+// share of it, the nearest few (each costs a turn scan about the piece's
+// middle).
+constexpr double kSplitAreaSlack = 0.15;
+constexpr size_t kSplitModelsPerPiece = 2;
+
+// A part's area less a seam of kSeamPx along its boundary (what the rest's
+// erosion leaves of it).
+double erodedArea(const PartModel& m) {
+  double length = 0;
+  for (const auto& loop : m.loops) {
+    for (const auto& p : loop.primitives) length += p.length();
+  }
+  return std::max(1.0, m.body.area - kSeamPx * length);
+}
+
+std::vector<RestPiece> splitAtNecks(const cv::Mat& piece, const cv::Rect& box) {
+  // Read at a scale of at most kSplitPixels: the middles are searched about
+  // within a dozen pixels (proposeAbout), and at full scale the transforms
+  // and labellings below took 9 ms on a blob of two large parts.
+  const int scale = std::max(1, static_cast<int>(std::ceil(std::sqrt(box.area() / kSplitPixels))));
+  cv::Mat small;
+  cv::resize(piece(box), small,
+             cv::Size((box.width + scale - 1) / scale, (box.height + scale - 1) / scale), 0, 0,
+             cv::INTER_AREA);
+  cv::compare(small, 127, small, cv::CMP_GT);
+  // A rim of background, so that the depth is measured from every side.
+  cv::copyMakeBorder(small, small, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::Mat depth;
+  cv::distanceTransform(small, depth, cv::DIST_L2, cv::DIST_MASK_3, CV_32F);
+  double deepest = 0;
+  cv::minMaxLoc(depth, nullptr, &deepest);
+  for (const double share : kSplitDepths) {
+    cv::Mat cores;
+    cv::compare(depth, share * deepest, cores, cv::CMP_GT);
+    cv::Mat labels;
+    cv::Mat stats;
+    cv::Mat centroids;
+    const int n = cv::connectedComponentsWithStats(cores, labels, stats, centroids, 8, CV_32S);
+    int largest = 0;
+    for (int k = 1; k < n; ++k) largest = std::max(largest, stats.at<int>(k, cv::CC_STAT_AREA));
+    std::vector<int> kept;  // labels of the cores large enough
+    for (int k = 1; k < n; ++k) {
+      if (stats.at<int>(k, cv::CC_STAT_AREA) >= kMinCoreShare * largest) kept.push_back(k);
+    }
+    if (kept.size() < 2) continue;
+    // Every pixel of the piece to its nearest kept core.
+    cv::Mat seeds = cv::Mat::zeros(small.size(), CV_8UC1);
+    for (const int k : kept) seeds.setTo(255, labels == k);
+    cv::Mat nearest;
+    cv::Mat voronoi;
+    cv::distanceTransform(~seeds, nearest, voronoi, cv::DIST_L2, cv::DIST_MASK_3,
+                          cv::DIST_LABEL_CCOMP);
+    std::map<int, cv::Moments> grown;
+    for (int y = 0; y < small.rows; ++y) {
+      const uint8_t* in = small.ptr<uint8_t>(y);
+      const int* to = voronoi.ptr<int>(y);
+      for (int x = 0; x < small.cols; ++x) {
+        if (!in[x]) continue;
+        cv::Moments& m = grown[to[x]];
+        m.m00 += 1;
+        m.m10 += x;
+        m.m01 += y;
+      }
+    }
+    // Back to the rest's box: a reduced pixel i (past the rim) covers the
+    // pixels from (i - 1) * scale on.
+    const double half = 0.5 * (scale - 1);
+    std::vector<RestPiece> out;
+    for (const auto& [label, m] : grown) {
+      const cv::Point2d at(m.m10 / m.m00 - 1, m.m01 / m.m00 - 1);
+      out.push_back({cv::Point2d(box.x + at.x * scale + half, box.y + at.y * scale + half),
+                     m.m00 * scale * scale});
+    }
+    std::stable_sort(out.begin(), out.end(),
+                     [](const RestPiece& a, const RestPiece& b) { return a.area > b.area; });
+    if (out.size() > kMaxSplitPieces) out.resize(kMaxSplitPieces);
+    return out;
+  }
+  return {};
+}
+}  // namespace
+
+void BlobSearch::searchAbout(const std::vector<std::pair<const PartModel*, cv::Point2d>>& sized) {
+  if (sized.empty()) return;
+  const EdgeDistance wide = edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx);
+  std::vector<std::vector<Candidate>> each(sized.size());
+  forEachModel(sized.size(), [&](size_t k) {
+    const PartModel& m = *sized[k].first;
+    proposeAbout(m, *searchOf(m), sized[k].second, *edges_, wide, &each[k]);
+  });
+  std::vector<Candidate> proposed;
+  for (const auto& e : each) proposed.insert(proposed.end(), e.begin(), e.end());
+  std::stable_sort(proposed.begin(), proposed.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  refine(proposed);
+}
+
 void BlobSearch::searchRestMiddle() {
   cv::Mat rest = unexplained();
   cv::erode(rest, rest, seam_);
   // The largest piece, from its outline: labelling the pieces' pixels took
   // eight times as long on a blob of two parts (0.5 ms).
-  std::vector<std::vector<cv::Point>> pieces;
-  cv::findContours(rest, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  std::vector<std::vector<cv::Point>> outlines;
+  cv::findContours(rest, outlines, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   cv::Moments largest;
-  for (const auto& piece : pieces) {
-    const cv::Moments m = cv::moments(piece);
-    if (m.m00 > largest.m00) largest = m;
+  size_t largest_index = 0;
+  for (size_t i = 0; i < outlines.size(); ++i) {
+    const cv::Moments m = cv::moments(outlines[i]);
+    if (m.m00 > largest.m00) {
+      largest = m;
+      largest_index = i;
+    }
   }
   if (largest.m00 <= 0) return;
   const double area = largest.m00;
@@ -886,22 +1011,45 @@ void BlobSearch::searchRestMiddle() {
   // The models of the rest's size, each turned about its middle (all at
   // once, gathered in model order), on the map proposeAbout's first look
   // reads.
-  std::vector<const PartModel*> sized;
+  std::vector<std::pair<const PartModel*, cv::Point2d>> sized;
   for (const PartModel* m : fitting_) {
     if (m->body.area >= kRestMinArea * area && m->body.area <= kRestMaxArea * area)
-      sized.push_back(m);
+      sized.emplace_back(m, middle);
   }
-  if (sized.empty()) return;
-  const EdgeDistance wide = edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx);
-  std::vector<std::vector<Candidate>> each(sized.size());
-  forEachModel(sized.size(), [&](size_t k) {
-    proposeAbout(*sized[k], *searchOf(*sized[k]), middle, *edges_, wide, &each[k]);
-  });
-  std::vector<Candidate> proposed;
-  for (const auto& e : each) proposed.insert(proposed.end(), e.begin(), e.end());
-  std::stable_sort(proposed.begin(), proposed.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  refine(proposed);
+  searchAbout(sized);
+  // Nothing of the blob explained, nor anything placed about its middle,
+  // and room in it for two parts: the parts it may hold where it parts at
+  // its necks, each about its own middle (a whole part each: the models
+  // nearest its size, kSplitAreaSlack). Front-light benchmark, 3 scenes of
+  // 20 parts a condition, clean, textured, 30 grey levels, wood: touching
+  // at 30 levels 0.978 of the parts found before, 0.987 with it; overlapping
+  // 0.963 -> 0.967 there, clean 0.988 -> 0.992; every other figure the
+  // same, nothing falsely reported; medians and p99 within the runs' noise
+  // (the split itself 0.5 to 1.3 ms where it runs: a few blobs in 15 frames).
+  if (!taken_.empty() || changed_) return;
+  double smallest = area;
+  for (const PartModel* m : fitting_) {
+    smallest = std::min(smallest, m->body.area * (1 - m->body.area_tolerance));
+  }
+  if (area < 2 * smallest) return;
+  cv::Mat piece = cv::Mat::zeros(rest.size(), CV_8UC1);
+  cv::drawContours(piece, outlines, static_cast<int>(largest_index), cv::Scalar(255), cv::FILLED);
+  cv::bitwise_and(piece, rest, piece);
+  sized.clear();
+  const cv::Rect piece_box = cv::boundingRect(outlines[largest_index]);
+  for (const RestPiece& part : splitAtNecks(piece, piece_box)) {
+    const cv::Point2d at = part.middle + cv::Point2d(blob_box_.tl());
+    std::vector<std::pair<double, const PartModel*>> near;  // (|area off|, model)
+    for (const PartModel* m : fitting_) {
+      const double off = std::abs(part.area / erodedArea(*m) - 1);
+      if (off <= kSplitAreaSlack) near.emplace_back(off, m);
+    }
+    std::stable_sort(near.begin(), near.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (near.size() > kSplitModelsPerPiece) near.resize(kSplitModelsPerPiece);
+    for (const auto& [off, m] : near) sized.emplace_back(m, at);
+  }
+  searchAbout(sized);
 }
 
 std::vector<Match> BlobSearch::run() {
