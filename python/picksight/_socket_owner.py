@@ -23,10 +23,16 @@ class SocketOwner:
         self.close()
 
 
+# What `_decode` returns for a message skipped and counted apart by the
+# subclass (not malformed: a sealed frame under a key not given, say).
+SKIPPED = object()
+
+
 class TopicSubscriber(SocketOwner):
     """Base of the subscribers of one topic (all topics with topic="") on
     the SUB socket in self._socket: subclasses decode a message's parts
-    (`_decode`, None for a malformed one) and count what they receive
+    (`_decode`, None for a malformed one, SKIPPED for one they counted
+    apart) and count what they receive
     (`_count`)."""
 
     def __init__(self, endpoint, topic, queue_parts, context=None, curve=None):
@@ -78,6 +84,8 @@ class TopicSubscriber(SocketOwner):
             if self._topic and parts[0].bytes != self._topic.encode():
                 continue
             item = self._decode(parts)
+            if item is SKIPPED:
+                continue
             if item is None:
                 self.malformed += 1
                 continue

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from picksight import picksight_pb2 as pb
-from picksight._socket_owner import TopicSubscriber
+from picksight._socket_owner import SKIPPED, TopicSubscriber
 
 # A sealed frame's part 2 beyond the header it seals: "PSF1", the key id,
 # the nonce and the tag.
@@ -110,8 +110,8 @@ class FrameSubscriber(TopicSubscriber):
         header_bytes, pixels = parts[1].bytes, parts[2].buffer
         if self._keys is not None:
             opened = self._open(parts)
-            if opened is None:
-                return None
+            if opened is None or opened is SKIPPED:
+                return opened
             header_bytes, pixels = opened
         header = pb.FrameHeader()
         try:
@@ -129,7 +129,8 @@ class FrameSubscriber(TopicSubscriber):
 
     def _open(self, parts):
         """The header bytes and pixels of a sealed frame (picksight/transport/
-        frame_seal.hpp), or None."""
+        frame_seal.hpp); None when it does not open, SKIPPED (counted in
+        `unopened`) when it is under a key the server did not give."""
         from nacl.bindings import crypto_aead_chacha20poly1305_ietf_decrypt as decrypt
         from nacl.exceptions import CryptoError
 
@@ -141,8 +142,7 @@ class FrameSubscriber(TopicSubscriber):
             self._ask_key()
             if self._key is None or self._key[0] != key_id:
                 self.unopened += 1
-                self.malformed -= 1  # counted apart, not as malformed
-                return None
+                return SKIPPED
         # ChaCha20-Poly1305 (RFC 8439), bound to the topic and the clear
         # prefix; the pixels under the nonce plus one (little-endian).
         nonce = envelope[12:24]
