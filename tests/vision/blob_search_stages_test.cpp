@@ -643,3 +643,32 @@ TEST_CASE("blob search: two touching parts no anchor led to are found about thei
   CHECK(disc_found);
   CHECK(square_found);
 }
+
+TEST_CASE("blob search: a part touching an untaught shape at a point is found about its own middle",
+          "[vision][blob_search]") {
+  // A disc and a larger square no model knows, its corner just meeting the
+  // disc's rim: the rest parts in two under the seam, and the larger piece,
+  // searched first, is the square. Nothing taken there, the disc's piece is
+  // searched about its own middle.
+  const ps::Shape disc{{pt::circleLoop(45)}};
+  const ps::Shape square{{pt::rectLoop(150, 150)}};
+  const PartModel disc_model = trainAlone(disc, 1, "disc");
+  const double towards = 30;
+  const cv::Point2d disc_at(200, 260);
+  const cv::Point2d along(std::cos(towards * M_PI / 180), std::sin(towards * M_PI / 180));
+  const cv::Point2d square_at = disc_at + (45 - 1 + 75 * std::sqrt(2.0)) * along;
+  const cv::Mat grey = pt::drawParts(
+      640, 520, {{disc, disc_at.x, disc_at.y, 0}, {square, square_at.x, square_at.y, towards + 45}},
+      17);
+  const auto regions = findRegions(binarize(grey, {}), {}, grey);
+  REQUIRE(regions.size() == 1);
+  const std::vector<const PartModel*> models_list{&disc_model};
+  BlobSearch search(regions, 0, models_list, nullptr);
+  REQUIRE(search.fitting().size() == 1);
+  search.searchRestMiddle();
+  search.choose();
+  REQUIRE(search.taken().size() == 1);
+  const Candidate& c = *search.placed()[search.taken().front()].candidate;
+  CHECK(c.model == &disc_model);
+  CHECK(std::hypot(c.pose.centre.x - disc_at.x, c.pose.centre.y - disc_at.y) < 0.5);
+}

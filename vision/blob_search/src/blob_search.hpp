@@ -17,8 +17,9 @@
 //   searchRestMiddle()  each model the size of what is left unexplained,
 //                       put on its middle and turned (proposeAbout): a part
 //                       whose corners its outline does not show as the
-//                       model's; with nothing found, also the pieces the
-//                       blob parts into at its necks, each about its middle
+//                       model's; with nothing found, also the rest's other
+//                       pieces and those its largest parts into at its
+//                       necks, each about its own middle
 //   run()               the stages in order: a quick search of every model,
 //                       then while the blob is not explained whole the full
 //                       search, model by model, and the search of the rest's
@@ -94,10 +95,11 @@ class BlobSearch {
   // of a candidate about to be taken; the aligned mirror image is fitted
   // once per candidate).
   bool showsMirror(const Candidate& candidate);
-  // The models of the size of what the parts taken leave, each turned about
-  // its middle; where nothing is taken nor placed there and the blob has
-  // room for two parts, also about the middle of each piece it parts into
-  // at its necks. Refines what it proposes (choose() takes it).
+  // The models of the size of the largest piece the parts taken leave, each
+  // turned about its middle; where nothing is taken then, the two models
+  // nearest the size of each other piece, and of each piece the largest
+  // parts into at its necks (when it has room for two parts), about its
+  // middle. Refines what it proposes (choose() takes it).
   void searchRestMiddle();
 
   const std::deque<Candidate>& refined() const { return refined_; }
