@@ -32,8 +32,7 @@ class TopicSubscriber(SocketOwner):
     """Base of the subscribers of one topic (all topics with topic="") on
     the SUB socket in self._socket: subclasses decode a message's parts
     (`_decode`, None for a malformed one, SKIPPED for one they counted
-    apart) and count what they receive
-    (`_count`)."""
+    apart) and count what they receive (`_count`)."""
 
     def __init__(self, endpoint, topic, queue_parts, context=None, curve=None):
         """Connects a SUB socket to `endpoint` for `topic`; `queue_parts`:
