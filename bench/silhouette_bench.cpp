@@ -323,16 +323,7 @@ int main(int argc, char** argv) {
   // The camera's look, for conditions the defaults do not show: a defocused
   // lens, a noisier sensor, less contrast, light parts on a dark table.
   ps::SilhouetteSceneOptions look;
-  app.add_option("--width", look.width,
-                 "frame width, px (4000 with --height 3000 --parts 80: 12 MP)")
-      ->check(CLI::Range(640, 8192))
-      ->capture_default_str();
-  app.add_option("--height", look.height, "frame height, px")
-      ->check(CLI::Range(480, 8192))
-      ->capture_default_str();
-  app.add_option("--parts", look.parts, "parts a scene (distractors included)")
-      ->check(CLI::Range(1, 400))
-      ->capture_default_str();
+  picksight::bench::addSceneSizeOptions(app, look);
   app.add_option("--blur", look.blur_sigma, "edge blur, sigma in pixels")
       ->check(CLI::Range(0.0, 5.0))
       ->capture_default_str();

@@ -73,16 +73,7 @@ int main(int argc, char** argv) {
                  "never shown: 1-100)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
-  app.add_option("--width", look.width,
-                 "frame width, px (4000 with --height 3000 --parts 80: 12 MP)")
-      ->check(CLI::Range(640, 8192))
-      ->capture_default_str();
-  app.add_option("--height", look.height, "frame height, px")
-      ->check(CLI::Range(480, 8192))
-      ->capture_default_str();
-  app.add_option("--parts", look.parts, "parts a scene (distractors included)")
-      ->check(CLI::Range(1, 400))
-      ->capture_default_str();
+  picksight::bench::addSceneSizeOptions(app, look);
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
 
   const auto& specs = picksight::bench::silhouetteTypeSpecs();

@@ -945,13 +945,15 @@ std::vector<RestPiece> splitAtNecks(const cv::Mat& piece, const cv::Rect& box) {
     cv::Mat voronoi;
     cv::distanceTransform(~seeds, nearest, voronoi, cv::DIST_L2, cv::DIST_MASK_3,
                           cv::DIST_LABEL_CCOMP);
-    std::map<int, cv::Moments> grown;
+    double labels_used = 0;
+    cv::minMaxLoc(voronoi, nullptr, &labels_used);
+    std::vector<cv::Moments> grown(static_cast<size_t>(labels_used) + 1);
     for (int y = 0; y < small.rows; ++y) {
       const uint8_t* in = small.ptr<uint8_t>(y);
       const int* to = voronoi.ptr<int>(y);
       for (int x = 0; x < small.cols; ++x) {
         if (!in[x]) continue;
-        cv::Moments& m = grown[to[x]];
+        cv::Moments& m = grown[static_cast<size_t>(to[x])];
         m.m00 += 1;
         m.m10 += x;
         m.m01 += y;
@@ -961,7 +963,8 @@ std::vector<RestPiece> splitAtNecks(const cv::Mat& piece, const cv::Rect& box) {
     // pixels from (i - 1) * scale on.
     const double half = 0.5 * (scale - 1);
     std::vector<RestPiece> out;
-    for (const auto& [label, m] : grown) {
+    for (const cv::Moments& m : grown) {
+      if (m.m00 <= 0) continue;
       const cv::Point2d at(m.m10 / m.m00 - 1, m.m01 / m.m00 - 1);
       out.push_back({cv::Point2d(box.x + at.x * scale + half, box.y + at.y * scale + half),
                      m.m00 * scale * scale});
