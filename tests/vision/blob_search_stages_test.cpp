@@ -403,15 +403,16 @@ TEST_CASE("blob search: a disc overlapped on both sides still shows enough of it
 
 TEST_CASE("blob search: a part placed on the relief inside a larger part is refused",
           "[vision][blob_search]") {
-  // A large disc whose face shows eight specks (the relief of a coin under
-  // a lamp: small holes in the mask) on a circle as wide as the small disc
-  // taught: a pose of the small disc there has its rim by those specks'
-  // edges, and nowhere on the large disc's outline.
+  // A large disc whose face shows eight specks of 3 x 3 px (the relief of a
+  // coin under a lamp: small holes in the mask, past the pinholes that are
+  // not counted) on a circle as wide as the small disc taught: a pose of the
+  // small disc there has its rim by those specks' edges, and nowhere on the
+  // large disc's outline.
   const cv::Point2d centre(200, 150);
   ps::Shape face{{pt::circleLoop(40, {0, 0})}};
   for (int k = 0; k < 8; ++k) {
     const double a = k * M_PI / 4;
-    face.loops.push_back(pt::rectLoop(2, 2, {15 * std::cos(a), 15 * std::sin(a)}));
+    face.loops.push_back(pt::rectLoop(3, 3, {15 * std::cos(a), 15 * std::sin(a)}));
   }
   const cv::Mat grey = pt::drawParts(400, 300, {{face, centre.x, centre.y, 0}}, 5);
   const auto regions = findRegions(binarize(grey, {}), {}, grey);

@@ -425,6 +425,32 @@ TEST_CASE("a one-pixel speck in a part's box changes nothing of the part", "[vis
   }
 }
 
+TEST_CASE("a pinhole of a pixel or two is no hole of the part, a hole of three is",
+          "[vision][regions]") {
+  // A defective pixel of the sensor, dust or JPEG ringing inside a dark
+  // part (tests/data/scenes/pca_test1.jpg: one pixel of level 107 in a bar
+  // at 10 on a table at 230) is not a hole the part has: filled, as a glint
+  // is, with or without grey levels. A hole 3 x 3 pixels wide is counted.
+  for (const cv::Size hole : {cv::Size(1, 1), cv::Size(2, 1), cv::Size(2, 2), cv::Size(3, 3)}) {
+    cv::Mat grey(240, 260, CV_8UC1, cv::Scalar(220));
+    cv::circle(grey, {130, 120}, 60, cv::Scalar(20), cv::FILLED);
+    grey(cv::Rect(cv::Point(110, 100), hole)).setTo(cv::Scalar(200));
+    const cv::Mat mask = grey < 120;
+    REQUIRE(cv::countNonZero(mask(cv::Rect(cv::Point(110, 100), hole))) == 0);
+    for (const bool use_grey : {false, true}) {
+      INFO("hole " << hole.width << " x " << hole.height << " grey " << use_grey);
+      const auto regions = findRegions(mask, {}, use_grey ? grey : cv::Mat());
+      REQUIRE(regions.size() == 1);
+      const bool counted = hole.width > 2 || hole.height > 2;
+      CHECK(regions[0].holes == (counted ? 1 : 0));
+      CHECK(regions[0].hole_boundaries.size() == (counted ? 1u : 0u));
+      CHECK(regions[0].glints == 0);
+      // Filled: the pinhole's pixels count for the part.
+      if (!counted && !use_grey) CHECK(regions[0].area == cv::countNonZero(mask) + hole.area());
+    }
+  }
+}
+
 TEST_CASE("a part cut by the frame's edge is measured inside the frame", "[vision][regions]") {
   // Kept on request, its box clipped by the frame, the band and the ring
   // meet the edge: the coverage stays a fraction, zero outside the covered

@@ -7,6 +7,7 @@
 // (vision_settings_e2e_test.cpp).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -160,4 +161,52 @@ TEST_CASE("photographs: every whole sweet from one taught in colour", "[e2e][pho
           {1, 294, 320},
           {1, 134, 327}},
          5});
+}
+
+TEST_CASE("photographs: six bars on a light table seen at a slant, the two nearest by WHY's remedy",
+          "[e2e][photographs]") {
+  // pca_test1.jpg (OpenCV samples): six identical bars with a waist on a
+  // light table, five lying across and one upright, photographed at a
+  // slant: the two nearest the camera (lowest in the image) look 14 and 16
+  // percent larger than the top one taught, past the model's default area
+  // tolerance of 10 percent. LOCATE reports the four within it; WHY names
+  // the two others with the tolerance that would accept them, and with it
+  // LOCATE reports all six. (A camera looking straight down, or CALCAM
+  // GRID's rectification, keeps the parts one size.) The nearest bar shows
+  // one pixel of level 107 inside (the bar 10, the table 230): a pinhole,
+  // not a hole of the bar.
+  PhotographCell cell("pca_test1.jpg");
+  const auto ask = [&](const std::string& request) { return cell.ask(request); };
+  REQUIRE(ask("LEARN 1 bar AT 230 60 380 70").rfind("OK 1 bar", 0) == 0);
+  const std::vector<Expected> four{{1, 408, 90}, {1, 421, 169}, {1, 433, 240}, {1, 191, 292}};
+  const std::vector<Expected> nearest{{1, 440, 326}, {1, 431, 408}};
+  const auto count = [](const std::vector<Located>& found, const Expected& e) {
+    return std::count_if(found.begin(), found.end(), [&](const Located& p) {
+      return p.type == e.type && std::hypot(p.x - e.x, p.y - e.y) <= 4;
+    });
+  };
+  const auto first = parts(ask("LOCATE ALL"));
+  CHECK(first.size() == four.size());
+  for (const auto& e : four) CHECK(count(first, e) == 1);
+  // Both left out for their size alone, each with the remedy.
+  const std::string why = ask("WHY");
+  INFO(why);
+  CHECK(why.rfind("OK 2 ", 0) == 0);
+  const std::string remedy = ", area_tolerance ";
+  size_t at = why.find(remedy);
+  double widest = 0;
+  int remedies = 0;
+  for (; at != std::string::npos; at = why.find(remedy, at + 1)) {
+    widest = std::max(widest, std::stod(why.substr(at + remedy.size())));
+    ++remedies;
+  }
+  REQUIRE(remedies == 2);
+  CHECK(widest < 0.25);
+  std::ostringstream set;
+  set << "TOLERANCE 1 area_tolerance " << widest;
+  REQUIRE(ask(set.str()).rfind("OK 1 bar", 0) == 0);
+  const auto all = parts(ask("LOCATE ALL"));
+  CHECK(all.size() == four.size() + nearest.size());
+  for (const auto& e : four) CHECK(count(all, e) == 1);
+  for (const auto& e : nearest) CHECK(count(all, e) == 1);
 }

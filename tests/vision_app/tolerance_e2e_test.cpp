@@ -26,11 +26,19 @@ using namespace std::chrono_literals;
 namespace {
 using test::kPlate;
 
-// A plate 200 x 120 px with one round hole, and the same plate 3 % larger:
-// its area (6 % more) is within the learned tolerance, its shape the same,
-// but its sides lie 1.8 px (long) and 3 px (short) from the model's, so it
-// verifies within an edge tolerance of 6 px and not within 1 px.
-const synthetic::Shape kLargerPlate = test::scaled(kPlate, 1.03);
+// A plate 200 x 120 px with one round hole, and the same plate 6 % longer:
+// its area (6 % more) is within the learned tolerance, but not its shape:
+// verified at its own size (a scale of 1.03 all round), its short sides lie
+// 3 px and its long sides 1.8 px from the model's, so it verifies within an
+// edge tolerance of 6 px and not within 1 px. (A plate larger all round
+// fits its model at its own size, whatever the edge tolerance.)
+synthetic::Shape longer(synthetic::Shape shape, double factor) {
+  for (auto& loop : shape.loops) {
+    for (auto& p : loop) p.x *= factor;
+  }
+  return shape;
+}
+const synthetic::Shape kLongerPlate = longer(kPlate, 1.06);
 
 std::string askRobot(LineClient& robot, const std::string& request) {
   auto reply = robot.request(request, 20s);
@@ -76,9 +84,9 @@ TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next
   // rewrites the file must keep it.
   REQUIRE(cell.ask("GRASP 1 ADD 5 0 90") == "OK 1");
 
-  // The larger plate with a tight edge tolerance: the next LOCATE leaves it
+  // The longer plate with a tight edge tolerance: the next LOCATE leaves it
   // out, and WHY says the boundary failed.
-  cell.scene.show(test::aloneInFrame(kLargerPlate, 30));
+  cell.scene.show(test::aloneInFrame(kLongerPlate, 30));
   CHECK_THAT(cell.ask("TOLERANCE 1 edge_tolerance_px 1"),
              Catch::EndsWith(" verify_percent=80.000 edge_tolerance_px=1.000 mirror_symmetric=1"));
   CHECK(cell.ask("LOCATE 1") == "OK 0");
@@ -86,7 +94,7 @@ TEST_CASE("TOLERANCE reads a model's tolerances and a change is used by the next
   CHECK_THAT(cell.modelFile(), Catch::Contains("edge_tolerance_px: 1"));
 
   // Stored: a restarted vision app has it. Then several keys at once, in
-  // any case, let the larger plate through.
+  // any case, let the longer plate through.
   cell.restart();
   CHECK_THAT(cell.ask("TOLERANCE 1"), Catch::Contains(" edge_tolerance_px=1.000 "));
   CHECK(cell.ask("GRASP 1 LIST") == "OK 1 5.000 0.000 90.000");
@@ -160,8 +168,8 @@ std::string remedyIn(const std::string& why) {
 TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLERANCE",
           "[vision_app][tolerance][why][e2e]") {
   PlateCell cell;
-  // The larger plate with a tight edge tolerance fails verification alone.
-  cell.scene.show(test::aloneInFrame(kLargerPlate, 30));
+  // The longer plate with a tight edge tolerance fails verification alone.
+  cell.scene.show(test::aloneInFrame(kLongerPlate, 30));
   REQUIRE_THAT(cell.ask("TOLERANCE 1 edge_tolerance_px 1"), Catch::StartsWith("OK 1 plate "));
   REQUIRE(cell.ask("LOCATE 1") == "OK 0");
   std::string why = cell.ask("WHY");
@@ -186,7 +194,7 @@ TEST_CASE("the remedy WHY names makes LOCATE accept the region once sent as TOLE
 
   // Refused on its shape and, that relaxed, on its boundary too: no one
   // change accepts it, and WHY names none.
-  cell.scene.show(test::aloneInFrame(kLargerPlate, 30));
+  cell.scene.show(test::aloneInFrame(kLongerPlate, 30));
   REQUIRE_THAT(
       cell.ask("TOLERANCE 1 area_tolerance 0.1 hu_tolerance 0.000001 edge_tolerance_px 0.1 "
                "verify_percent 100"),

@@ -136,24 +136,27 @@ constexpr double kKeepMomentsDeg = 1.0;
 // ... and verified within this fraction of the refined pose's score.
 constexpr double kKeepMomentsSlack = 0.02;
 
-// The best verified of the rotation candidates, unrefined.
-Best bestCandidate(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
+// The best verified of the rotation candidates, unrefined: the model's
+// boundary `samples` (its own, or scaled: see kMinScaledVerify).
+Best bestCandidate(const std::vector<double>& turns, const PartModel& model,
+                   const std::vector<BoundarySample>& samples, cv::Point2d centre,
                    const EdgeDistance& edges, bool mirrored) {
   Best best;
   for (double t : turns) {
-    const double s = verifyScore(model.samples, centre, t, edges, model.edge_tolerance, mirrored);
+    const double s = verifyScore(samples, centre, t, edges, model.edge_tolerance, mirrored);
     if (s > best.score) best = {s, t, t};
   }
   return best;
 }
 
-Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2d centre,
+Best bestOf(const std::vector<double>& turns, const PartModel& model,
+            const std::vector<BoundarySample>& samples, cv::Point2d centre,
             const EdgeDistance& edges, bool mirrored) {
-  Best best = bestCandidate(turns, model, centre, edges, mirrored);
+  Best best = bestCandidate(turns, model, samples, centre, edges, mirrored);
   if (best.score * 100 < model.verify_percent - 100 * kRefineSlack) return best;
   const double clip = 2 * model.edge_tolerance;
   const auto cost = [&](double t) {
-    return meanEdgeDistance(model.samples, centre, t, edges, clip, mirrored);
+    return meanEdgeDistance(samples, centre, t, edges, clip, mirrored);
   };
   double at = best.angle_deg;
   double here = cost(at);
@@ -178,7 +181,7 @@ Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2
   // phase (a spoon's 6th) can be off by most of a degree: the pose that
   // fits is then the one reported, and the hands are always compared at
   // their fitted poses.
-  const double s = verifyScore(model.samples, centre, at, edges, model.edge_tolerance, mirrored);
+  const double s = verifyScore(samples, centre, at, edges, model.edge_tolerance, mirrored);
   if (s <= best.score) return best;
   const bool keep_moments =
       std::abs(at - best.angle_deg) < kKeepMomentsDeg && s - best.score <= kKeepMomentsSlack;
@@ -192,6 +195,18 @@ Best bestOf(const std::vector<double>& turns, const PartModel& model, cv::Point2
 // between these squared scales is checked for a scaled copy of that model.
 constexpr double kMinCopyScale = 0.6;
 constexpr double kMaxCopyScale = 1.6;
+
+// A region whose area puts its scale this far from the model's (within the
+// area tolerance) and that does not verify at the model's size is verified
+// at its own: its boundary at the region's scale. Past a few percent the
+// ends of a long part lie outside the edge tolerance at the taught size
+// (a bar 200 px long, 8 % larger: 8 px at each end, 70 % of its boundary
+// verified). Below it, the area's own reading (the band, the light) moves
+// the scale as much as the part does.
+constexpr double kMinScaledVerify = 0.02;
+// Verified at its own size, a region is left out as a mirror image when
+// the mirror image verifies within this of the part there.
+constexpr double kScaledMirrorMargin = 0.03;
 
 // Whether the region is the model (either hand) scaled by `scale`: its
 // boundary, scaled, verifies on the region's edges.
@@ -281,14 +296,44 @@ Verdict judgeRegion(RegionCache& cache, const PartModel& model, bool check_scale
   const EdgeDistance& edges = cache.edges();
   const int k = model.orientation_order;
   const double phase = cache.phaseDeg(k);
-  const Best direct =
-      bestOf(candidates(phase, model.orientation_phase_deg, k), model, r.centroid, edges, false);
+  const std::vector<double> direct_turns = candidates(phase, model.orientation_phase_deg, k);
+  const std::vector<double> mirror_turns = candidates(phase, -model.orientation_phase_deg, k);
+  Best direct = bestOf(direct_turns, model, model.samples, r.centroid, edges, false);
   Verdict v;
   v.hu_distance = distance;
+  v.low = v.high = model.verify_percent;
+  // A part within the area tolerance but of another size than the one
+  // taught (seen at a slant, nearer the camera, at the lens's edge) is
+  // verified at its own size where it does not verify at the taught one,
+  // and its hands compared there as the unrefined candidates are: a mirror
+  // image that verifies about as well (or alone) leaves the region out.
+  const double scale = std::sqrt(r.area / body.area);
+  if (direct.score * 100 < model.verify_percent && std::abs(scale - 1) > kMinScaledVerify) {
+    std::vector<BoundarySample> sized = model.samples;
+    for (auto& sample : sized) sample.point *= scale;
+    const Best at_size = bestOf(direct_turns, model, sized, r.centroid, edges, false);
+    const bool fits = at_size.score * 100 >= model.verify_percent;
+    const Best mirror = body.mirror_symmetric
+                            ? Best{}
+                            : bestCandidate(mirror_turns, model, sized, r.centroid, edges, true);
+    if (fits && mirror.score < at_size.score - kScaledMirrorMargin) {
+      v.score = at_size.score;
+      v.angle_deg = at_size.angle_deg;
+      v.measured = at_size.score * 100;
+      v.test = RegionTest::kPasses;
+      return v;
+    }
+    if (mirror.score * 100 >= model.verify_percent) {
+      v.test = RegionTest::kMirror;
+      v.score = at_size.score;
+      v.measured = mirror.score * 100;
+      v.low = v.high = std::max(0.0, at_size.score) * 100;
+      return v;
+    }
+  }
   v.score = direct.score;
   v.angle_deg = direct.angle_deg;
   v.measured = std::max(0.0, direct.score) * 100;
-  v.low = v.high = model.verify_percent;
   const bool verified = direct.score * 100 >= model.verify_percent;
   if (body.mirror_symmetric) {
     v.test = verified ? RegionTest::kPasses : RegionTest::kVerify;
@@ -300,9 +345,9 @@ Verdict judgeRegion(RegionCache& cache, const PartModel& model, bool check_scale
   // at one of its candidates (an L's, whose legs swap sides): a whole
   // part, not a blob to search. Unrefined: a region of another type that
   // passes this one's body tests costs a few lookups more, not a search.
-  const std::vector<double> mirror_turns = candidates(phase, -model.orientation_phase_deg, k);
-  const Best mirror = verified ? bestOf(mirror_turns, model, r.centroid, edges, true)
-                               : bestCandidate(mirror_turns, model, r.centroid, edges, true);
+  const Best mirror =
+      verified ? bestOf(mirror_turns, model, model.samples, r.centroid, edges, true)
+               : bestCandidate(mirror_turns, model, model.samples, r.centroid, edges, true);
   if (verified ? showsMirrorImage(model, {r.centroid, direct.fit_deg, false},
                                   {r.centroid, mirror.fit_deg, true}, edges)
                : mirror.score * 100 >= model.verify_percent) {

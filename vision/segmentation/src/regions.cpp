@@ -940,12 +940,27 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
   return glints;
 }
 
+// A hole of at most kMaxPinholePx x kMaxPinholePx pixels is not the part's:
+// a defective pixel of the sensor (a hot pixel in a dark part), a speck of
+// dust on the lens or JPEG ringing at a sharp corner of the part's face.
+// No hole that small can be told from those (the lens's blur alone spreads
+// a point over it), and counted, it refuses the part: a photograph of six
+// bars on a light table (tests/data/scenes/pca_test1.jpg) shows one bar
+// with a single pixel of level 107 inside, the bar at 10 and the table at
+// 230. Its border (the part's pixels round it) lies in a box two pixels
+// larger.
+constexpr int kMaxPinholePx = 2;
+
+bool isPinhole(const std::vector<cv::Point>& border) {
+  const cv::Rect b = cv::boundingRect(border);
+  return b.width <= kMaxPinholePx + 2 && b.height <= kMaxPinholePx + 2;
+}
+
 // Measures the region whose outer boundary is contours[i] (see
 // findRegions) into `region`: its pixels over its box (alone in its box, or
-// the set pixels connected to its boundary), holes (glints left out), moments (grey-level
-// where they can be trusted), orientation and elongation. Moves its
-// contours out. False, nothing written, for a region smaller than
-// options.min_area.
+// the set pixels connected to its boundary), holes (glints and pinholes left out), moments
+// (grey-level where they can be trusted), orientation and elongation. Moves its contours out.
+// False, nothing written, for a region smaller than options.min_area.
 bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone, double blur_px,
                    const RegionOptions& options, std::vector<std::vector<cv::Point>>& contours,
                    const std::vector<cv::Vec4i>& hierarchy, const std::vector<cv::Rect>& boxes,
@@ -960,13 +975,20 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   for (size_t j = 0; j < boxes.size() && alone; ++j) {
     alone = static_cast<int>(j) == i || hierarchy[j][3] >= 0 || (boxes[j] & box).empty();
   }
-  // Glints are not holes: the part is whole under them, and is read so
-  // (filled in the region's mask and in the mask of every region).
+  // Glints and pinholes are not holes: the part is whole under them, and
+  // is read so (filled in the region's mask and in the mask of every
+  // region).
   const std::vector<int> glints = glintHoles(mask, grey, contours, hierarchy, i);
+  std::vector<int> filled = glints;
+  for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
+    if (isPinhole(contours[h]) && std::find(glints.begin(), glints.end(), h) == glints.end()) {
+      filled.push_back(h);
+    }
+  }
   cv::Mat set = mask(box);
-  if (!glints.empty()) {
+  if (!filled.empty()) {
     set = set.clone();
-    for (const int h : glints) {
+    for (const int h : filled) {
       cv::drawContours(set, contours, h, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
                        -box.tl());
     }
@@ -991,7 +1013,7 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   r.outer = std::move(contours[i]);
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
     if (options.min_hole_area > 0 && cv::contourArea(contours[h]) < options.min_hole_area) continue;
-    if (std::find(glints.begin(), glints.end(), h) != glints.end()) continue;
+    if (std::find(filled.begin(), filled.end(), h) != filled.end()) continue;
     r.hole_boundaries.push_back(std::move(contours[h]));
   }
   r.holes = static_cast<int>(r.hole_boundaries.size());

@@ -19,6 +19,8 @@ struct Region {
   double angle_deg = 0;
   // 1 - (minor/major inertia): 0 for a disc or a square, where no axis exists.
   double elongation = 0;
+  // Holes of the part, not counting pinholes (at most 2 x 2 pixels: a
+  // defective pixel, dust), which are filled like glints.
   int holes = 0;
   // Holes read as glints (lighter than the surface beside the part: the lamp
   // reflected, not the surface seen through it), filled and not counted.
