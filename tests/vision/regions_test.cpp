@@ -445,6 +445,7 @@ TEST_CASE("a pinhole of a pixel or two is no hole of the part, a hole of three i
       CHECK(regions[0].holes == (counted ? 1 : 0));
       CHECK(regions[0].hole_boundaries.size() == (counted ? 1u : 0u));
       CHECK(regions[0].glints == 0);
+      CHECK(regions[0].pinholes == (counted ? 0 : 1));
       // Filled: the pinhole's pixels count for the part.
       if (!counted && !use_grey) CHECK(regions[0].area == cv::countNonZero(mask) + hole.area());
     }

@@ -75,10 +75,14 @@ def layout(browser):
 
 
 def settled_layout(browser):
-    """The layout once a camera refresh (event: cameras, once a second: it
-    refits the image and updates the mapping) has left it as it was."""
+    """The layout once the image shows a frame and a camera refresh (event:
+    cameras, once a second: it refits the image and updates the mapping) has
+    left it as it was. (On a loaded machine the first frame may come after a
+    refresh: an image with no frame yet has no natural size to aim by.)"""
     def unchanged_over_a_refresh():
         before = layout(browser)
+        if not before[0]["natural_width"] or not before[0]["natural_height"]:
+            return None
         seen = browser.js("return window.picksight.cameraRefreshes")
         wait_until(lambda: browser.js("return window.picksight.cameraRefreshes") > seen,
                    what="a refresh of the cameras")

@@ -1018,6 +1018,7 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   }
   r.holes = static_cast<int>(r.hole_boundaries.size());
   r.glints = static_cast<int>(glints.size());
+  r.pinholes = static_cast<int>(filled.size() - glints.size());
 
   if (!grey.empty() &&
       greyMoments(grey(box), own, own_runs, set, zone.empty() ? cv::Mat() : zone(box), blur_px, box,

@@ -448,7 +448,8 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
   out.part = sized.front().first;
   double part_area = -1;
   for (const auto& [i, depth] : sized) {
-    const bool blotch = depth < kStainDepthShare * deepest && regions[i].holes >= kMinPinholes;
+    const bool blotch = depth < kStainDepthShare * deepest &&
+                        regions[i].holes + regions[i].pinholes >= kMinPinholes;
     if (!blotch && regions[i].area > part_area) {
       out.part = i;
       part_area = regions[i].area;

@@ -22,6 +22,9 @@ struct Region {
   // Holes of the part, not counting pinholes (at most 2 x 2 pixels: a
   // defective pixel, dust), which are filled like glints.
   int holes = 0;
+  // The pinholes filled: a region of the surface the threshold speckled
+  // has them by the dozen (what LEARN tells a blotch by).
+  int pinholes = 0;
   // Holes read as glints (lighter than the surface beside the part: the lamp
   // reflected, not the surface seen through it), filled and not counted.
   int glints = 0;
