@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -43,11 +44,16 @@ inline synthetic::Shape centred(synthetic::Shape shape) {
   return shape;
 }
 
-inline synthetic::Shape scaled(synthetic::Shape shape, double factor) {
+// Scaled by `fx` along x and `fy` along y (a part longer, not larger).
+inline synthetic::Shape scaled(synthetic::Shape shape, double fx, double fy) {
   for (auto& loop : shape.loops) {
-    for (auto& p : loop) p *= factor;
+    for (auto& p : loop) p = {p.x * fx, p.y * fy};
   }
   return shape;
+}
+
+inline synthetic::Shape scaled(synthetic::Shape shape, double factor) {
+  return scaled(std::move(shape), factor, factor);
 }
 
 struct DrawnPart {

@@ -32,13 +32,7 @@ using test::kPlate;
 // 3 px and its long sides 1.8 px from the model's, so it verifies within an
 // edge tolerance of 6 px and not within 1 px. (A plate larger all round
 // fits its model at its own size, whatever the edge tolerance.)
-synthetic::Shape longer(synthetic::Shape shape, double factor) {
-  for (auto& loop : shape.loops) {
-    for (auto& p : loop) p.x *= factor;
-  }
-  return shape;
-}
-const synthetic::Shape kLongerPlate = longer(kPlate, 1.06);
+const synthetic::Shape kLongerPlate = test::scaled(kPlate, 1.06, 1.0);
 
 std::string askRobot(LineClient& robot, const std::string& request) {
   auto reply = robot.request(request, 20s);

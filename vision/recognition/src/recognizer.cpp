@@ -72,7 +72,7 @@ constexpr double kSettledDeg = 0.05;
 
 EdgePose poseOnEdges(const PartModel& model, const Region& r, double judged_deg) {
   const EdgePose judged{r.centroid, judged_deg};
-  EdgeFit fit =
+  const EdgeFit fit =
       refinePoseOnEdges(model, r, {r.centroid, judged_deg, false}, kEdgeSearchPx, kEdgeIterations);
   if (!fit.ok || fit.inlier_fraction < kMinEdgeInliers) return judged;
   const double turn = signedDeg(fit.pose.angle_deg - judged_deg);
