@@ -242,8 +242,11 @@ int main(int argc, char** argv) {
   CLI::App app("Parts under a front-lit cell's light: teaching, recall, precision, accuracy.",
                argc > 0 ? argv[0] : "picksight-bench-front-light");
   app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--conditions", conditions, "light conditions")
-      ->check(CLI::IsMember(ps::frontLightConditionNames()));
+  std::vector<std::string> condition_names = ps::frontLightConditionNames();
+  for (const auto& name : ps::photographedConditionNames()) condition_names.push_back(name);
+  app.add_option("--conditions", conditions,
+                 "light conditions (brick, gravel: photographed surfaces, not run by default)")
+      ->check(CLI::IsMember(condition_names));
   app.add_option("--arrangements", arrangements, "separated, touching, overlapping")
       ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
   app.add_option("--scenes", scenes, "scenes per condition and arrangement")
@@ -298,7 +301,15 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   for (const auto& condition : conditions) {
     ps::SilhouetteSceneOptions look;
-    ps::frontLightCondition(condition, &look.front, &look.part_level, &look.background_level);
+    if (!ps::frontLightCondition(condition, &look.front, &look.part_level,
+                                 &look.background_level)) {
+      const std::string photo = data_dir + "/surfaces/" + condition + ".png";
+      if (!ps::photographedCondition(condition, cv::imread(photo, cv::IMREAD_GRAYSCALE),
+                                     &look.front, &look.part_level, &look.background_level)) {
+        std::fprintf(stderr, "%s: cannot read %s\n", condition.c_str(), photo.c_str());
+        return 1;
+      }
+    }
     look.blur_sigma = blur_sigma;
     // The vision app's defaults, with the window a user sets for these parts.
     pc::VisionOptions options;

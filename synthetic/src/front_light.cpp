@@ -112,6 +112,8 @@ const char* surfaceName(Surface s) {
       return "wood";
     case Surface::kBrushedMetal:
       return "brushed metal";
+    case Surface::kPhotographed:
+      return "photographed";
   }
   return "?";
 }
@@ -188,6 +190,25 @@ bool frontLightCondition(const std::string& name, FrontLight* light, double* par
   return true;
 }
 
+std::vector<std::string> photographedConditionNames() { return {"brick", "gravel"}; }
+
+bool photographedCondition(const std::string& name, const cv::Mat& photo, FrontLight* light,
+                           double* part_level, double* background_level) {
+  const auto names = photographedConditionNames();
+  if (std::find(names.begin(), names.end(), name) == names.end() || photo.empty()) return false;
+  CV_Assert(photo.type() == CV_8UC1);
+  FrontLight f;
+  double part = 0;
+  double background = 0;
+  frontLightCondition("low-contrast", &f, &part, &background);
+  f.surface = Surface::kPhotographed;
+  f.surface_photo = photo;
+  *light = f;
+  *part_level = part;
+  *background_level = background;
+  return true;
+}
+
 namespace detail {
 
 cv::Mat smoothField(cv::Size size, double scale_px, uint64_t seed) {
@@ -197,7 +218,8 @@ cv::Mat smoothField(cv::Size size, double scale_px, uint64_t seed) {
   return cv::min(cv::max(f * 0.5, -1.0), 1.0);
 }
 
-cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_t seed) {
+cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_t seed,
+                       const cv::Mat& photo) {
   cv::Mat t(size, CV_32F, cv::Scalar(1));
   if (surface == Surface::kPlain || amplitude <= 0) return t;
   std::mt19937_64 rng(splitMix64(seed ^ kTextureStream));
@@ -237,6 +259,27 @@ cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_
       dev = unitSpread(streaks) + 0.6 * lowResolutionNoise(size, 300, rng);
       break;
     }
+    case Surface::kPhotographed: {
+      // Mirrored at its borders as often as the frame needs, from an
+      // offset within the photograph.
+      CV_Assert(photo.type() == CV_8UC1 && !photo.empty());
+      const int ox = static_cast<int>(rng() % static_cast<uint64_t>(photo.cols));
+      const int oy = static_cast<int>(rng() % static_cast<uint64_t>(photo.rows));
+      const auto mirrored = [](int i, int n) {
+        const int k = i % (2 * n);
+        return k < n ? k : 2 * n - 1 - k;
+      };
+      std::vector<int> xs(static_cast<size_t>(size.width));
+      for (int x = 0; x < size.width; ++x)
+        xs[static_cast<size_t>(x)] = mirrored(x + ox, photo.cols);
+      dev = cv::Mat(size, CV_32F);
+      for (int y = 0; y < size.height; ++y) {
+        const uint8_t* in = photo.ptr<uint8_t>(mirrored(y + oy, photo.rows));
+        float* d = dev.ptr<float>(y);
+        for (int x = 0; x < size.width; ++x) d[x] = in[xs[static_cast<size_t>(x)]];
+      }
+      break;
+    }
     case Surface::kPlain:
       break;
   }
@@ -267,7 +310,7 @@ std::vector<cv::Mat> shadeFrontLit(const cv::Mat& coverage, const cv::Mat& light
       }
     }
   }
-  const cv::Mat surface = surfaceTexture(size, f.surface, f.texture, seed);
+  const cv::Mat surface = surfaceTexture(size, f.surface, f.texture, seed, f.surface_photo);
   cv::Mat shading(size, CV_32F, cv::Scalar(1));
   if (f.part_shading != 0) {
     shading = 1.0 + f.part_shading * smoothField(size, 150, seed);

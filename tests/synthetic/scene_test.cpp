@@ -1,6 +1,8 @@
 // Tests of the synthetic scene generator: exact truth, unbiased rendering, placement, noise.
 #include "picksight/synthetic/scene.hpp"
 
+#include "picksight/synthetic/front_light.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -10,6 +12,7 @@
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace ps = picksight::synthetic;
@@ -506,4 +509,62 @@ TEST_CASE("render adds reproducible per-frame noise", "[synthetic]") {
     const ps::SceneRenderer quiet(o);
     CHECK(cv::norm(quiet.render(17), quiet.clean(), cv::NORM_INF) == 0);
   }
+}
+
+TEST_CASE("a photographed surface keeps the photograph's pattern at the condition's strength",
+          "[synthetic][front]") {
+  const cv::Mat photo = cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/brick.png",
+                                   cv::IMREAD_GRAYSCALE);
+  REQUIRE(!photo.empty());
+  ps::FrontLight light;
+  double part = 0;
+  double background = 0;
+  CHECK_FALSE(ps::photographedCondition("marble", photo, &light, &part, &background));
+  CHECK_FALSE(ps::photographedCondition("brick", cv::Mat(), &light, &part, &background));
+  REQUIRE(ps::photographedCondition("brick", photo, &light, &part, &background));
+  CHECK(light.surface == ps::Surface::kPhotographed);
+  CHECK(background - part == 30);
+  // Wider and taller than the photograph: mirrored at its borders.
+  const cv::Size size(3 * photo.cols / 2, 3 * photo.rows / 2);
+  const cv::Mat t =
+      ps::detail::surfaceTexture(size, light.surface, light.texture, 5, light.surface_photo);
+  REQUIRE(t.size() == size);
+  cv::Scalar mean;
+  cv::Scalar sd;
+  cv::meanStdDev(t, mean, sd);
+  CHECK(mean[0] == Approx(1).margin(1e-3));
+  CHECK(sd[0] == Approx(light.texture).epsilon(0.02));
+  const auto correlation = [](const cv::Mat& a, const cv::Mat& b) {
+    cv::Mat fa;
+    cv::Mat fb;
+    a.convertTo(fa, CV_64F);
+    b.convertTo(fb, CV_64F);
+    fa -= cv::mean(fa);
+    fb -= cv::mean(fb);
+    return fa.dot(fb) / std::sqrt(fa.dot(fa) * fb.dot(fb));
+  };
+  // Both far corners of the texture are found in the photograph, mirrored
+  // or not (0.99 unless a corner spans a mirrored seam).
+  const auto inPhoto = [&photo](const cv::Mat& patch) {
+    double best = 0;
+    for (int flip_x = 0; flip_x < 2; ++flip_x) {
+      for (int flip_y = 0; flip_y < 2; ++flip_y) {
+        cv::Mat seen;
+        photo.convertTo(seen, CV_32F);
+        if (flip_x) cv::flip(seen, seen, 1);
+        if (flip_y) cv::flip(seen, seen, 0);
+        cv::Mat score;
+        cv::matchTemplate(seen, patch, score, cv::TM_CCOEFF_NORMED);
+        double hi = 0;
+        cv::minMaxLoc(score, nullptr, &hi);
+        best = std::max(best, hi);
+      }
+    }
+    return best;
+  };
+  CHECK(inPhoto(t(cv::Rect(0, 0, 64, 64))) > 0.95);
+  CHECK(inPhoto(t(cv::Rect(size.width - 64, size.height - 64, 64, 64))) > 0.95);
+  // A drawn belt of the same strength is another pattern altogether.
+  const cv::Mat belt = ps::detail::surfaceTexture(size, ps::Surface::kBelt, light.texture, 5);
+  CHECK(std::abs(correlation(belt, t)) < 0.2);
 }

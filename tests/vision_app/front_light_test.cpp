@@ -448,6 +448,17 @@ TEST_CASE("the turn of a separated part under a front light is read on its edges
   }
 }
 
+// Ten t-shaped parts under `look` in a 1280 x 960 frame, separated, no
+// distractors.
+ps::SilhouetteScene tenTees(ps::SilhouetteSceneOptions look, uint64_t seed) {
+  look.width = 1280;
+  look.height = 960;
+  look.parts = 10;
+  look.distractor_share = 0;
+  look.seed = seed;
+  return ps::SilhouetteScene({boneType()}, {true}, look);
+}
+
 TEST_CASE("parts in the corners of a vignetted frame at 30 levels of contrast are found too",
           "[vision_app][locate][front]") {
   // The low-contrast condition loses a quarter of its light in the corners:
@@ -465,25 +476,66 @@ TEST_CASE("parts in the corners of a vignetted frame at 30 levels of contrast ar
   REQUIRE(learned.ok());
   int outer = 0;
   for (const uint64_t seed : {3, 5, 8}) {
-    ps::SilhouetteSceneOptions o = look;
-    o.width = 1280;
-    o.height = 960;
-    o.parts = 10;
-    o.distractor_share = 0;
-    o.seed = seed;
-    const ps::SilhouetteScene scene({boneType()}, {true}, o);
+    const ps::SilhouetteScene scene = tenTees(look, seed);
     const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
     const LocateOutcome outcome = locateInFrame(frame, cellOptions(), listOf(learned->model), -1);
     INFO("seed " << seed);
     CHECK(foundTrue(scene.truth(), outcome.parts) == static_cast<int>(scene.truth().size()));
     for (const auto& t : scene.truth()) {
       const double from_edge =
-          std::min({t.centre.x, t.centre.y, o.width - t.centre.x, o.height - t.centre.y});
+          std::min({t.centre.x, t.centre.y, 1280 - t.centre.x, 960 - t.centre.y});
       outer += from_edge < 220 ? 1 : 0;
     }
   }
   // The scenes put parts where the light has fallen most.
   CHECK(outer >= 6);
+}
+
+// The look of a condition on a photographed surface (tests/data/surfaces).
+ps::SilhouetteSceneOptions photographedLook(const std::string& condition) {
+  const cv::Mat photo =
+      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/" + condition + ".png",
+                 cv::IMREAD_GRAYSCALE);
+  REQUIRE(!photo.empty());
+  ps::SilhouetteSceneOptions look;
+  REQUIRE(ps::photographedCondition(condition, photo, &look.front, &look.part_level,
+                                    &look.background_level));
+  return look;
+}
+
+TEST_CASE("parts on photographed paving bricks and gravel at 30 levels of contrast are found",
+          "[vision_app][locate][front]") {
+  // Real surfaces (photographs, not drawn here) under the low-contrast
+  // light: the light joints between bricks and the light flecks of gravel
+  // step up from the surface as sharply as a part's edge steps down. When
+  // they set the threshold, each brick darker than the joints beside it
+  // became a region, parts beside them were split or joined to them, and
+  // on gravel 12 of these 30 parts were found.
+  for (const char* condition : {"brick", "gravel"}) {
+    const ps::SilhouetteSceneOptions look = photographedLook(condition);
+    cv::Point2d drawn;
+    const cv::Mat teach = ps::renderSilhouetteAlone(boneType(), 600, look, 11, &drawn, 30);
+    const auto learned =
+        learnInImage(teach, {}, cellOptions(), noModels(), 1, "tee", boxAround(drawn, 200));
+    INFO(condition << ": " << (learned.ok() ? std::string() : learned.error().message));
+    REQUIRE(learned.ok());
+    int truth = 0;
+    int found = 0;
+    for (const uint64_t seed : {3, 5, 8}) {
+      const ps::SilhouetteScene scene = tenTees(look, seed);
+      const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+      const LocateOutcome outcome = locateInFrame(frame, cellOptions(), listOf(learned->model), -1);
+      truth += static_cast<int>(scene.truth().size());
+      const int right = foundTrue(scene.truth(), outcome.parts);
+      found += right;
+      // Nothing else: no brick or stone taken for a part.
+      CHECK(outcome.parts.size() == static_cast<size_t>(right));
+    }
+    // One part on gravel lies in the corner where the light has fallen
+    // most: the gaps between the stones there are as dark as the part, and
+    // join it to the frame's edge.
+    CHECK(found >= truth - 1);
+  }
 }
 
 TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
@@ -930,7 +982,7 @@ TEST_CASE("LEARN takes the part and not a larger speckled blotch of the belt bes
   // Beside a glossy part on its belt, the threshold took in a blotch of the
   // belt whole, speckled, larger than the part: LEARN measured everything
   // against the largest region and called the part a second part. Here a
-  // stretch of belt 220 px square, 70 % of its pixels 40 levels darker.
+  // stretch of belt 220 px square, 80 % of its pixels 40 levels darker.
   cv::Point2d drawn;
   cv::Mat image = ps::renderSilhouetteAlone(boneType(), 600, lookOf("textured"), 11, &drawn, 30);
   const auto alone = learnInImage(image, {}, cellOptions(), noModels(), 1, "tee", std::nullopt);
@@ -938,7 +990,7 @@ TEST_CASE("LEARN takes the part and not a larger speckled blotch of the belt bes
   cv::RNG rng(7);
   for (int y = 370; y < 590; ++y) {
     for (int x = 10; x < 230; ++x) {
-      if (rng.uniform(0.0, 1.0) < 0.7)
+      if (rng.uniform(0.0, 1.0) < 0.8)
         image.at<uint8_t>(y, x) = cv::saturate_cast<uint8_t>(image.at<uint8_t>(y, x) - 40);
     }
   }

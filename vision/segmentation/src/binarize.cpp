@@ -39,6 +39,15 @@ constexpr double kEdgeSpreadPx = 40;
 // the threshold: a part shaded to within ten levels of its belt has such
 // edges on its light side.
 constexpr double kMinStepShare = 0.3;
+// A step whose dark side lies less than kMinStepShare of the contrast, and
+// less than this share of the background, below the surface's typical level
+// is a light mark on the surface, and does not vote (edgeVotes). Ten percent
+// below the surface, a step's dark side is something on it: the soft outer
+// edge of a shadow at 0.65 of the background on a belt at 0.78 (contrast
+// 0.57: a third of it is 0.19) still votes; without it the threshold left a
+// thin layer of such shadows on their parts, too thin to be cut, and 3 of
+// 60 parts beside a shadow were placed 1.6-1.9 px off.
+constexpr double kMarkDepth = 0.1;
 // Far from any edge, the threshold lies this share of the contrast below
 // the middle of part and background.
 constexpr double kOpenShare = 0.25;
@@ -196,9 +205,10 @@ double noiseDeviation(const std::vector<int64_t>& residual_sums,
 // Steps whose middle lies above kMaxSeparatedRatio of the background (a
 // glint on a part, a light mark on the surface) do not vote either. The sums
 // are integers, each cell's written by one worker: the result does not
-// depend on the number of threads.
+// depend on the number of threads. `surface` is the surface's typical level
+// as a fraction of the background estimate (RatioSplit::surface).
 void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, double contrast,
-               cv::Mat& level_sums, cv::Mat& weights, double* noise) {
+               double surface, cv::Mat& level_sums, cv::Mat& weights, double* noise) {
   const int rows = background_f.rows;
   const int cols = background_f.cols;
   cv::Mat sums32(rows, cols, CV_32F, cv::Scalar(0));
@@ -263,6 +273,15 @@ void edgeVotes(const cv::Mat& image, int cell, const cv::Mat& background_f, doub
           // the ramp this pixel lies.
           const int middle = lo + hi;  // twice the middle level
           if (hi - lo < kMinStepShare * step || middle > 2 * kMaxSeparatedRatio * back[i]) continue;
+          // A light mark on the surface (the mortar between paving bricks,
+          // a light fleck of gravel, a scratch) steps up from the surface's
+          // own level: its dark side is the surface. Its middle lies above
+          // the surface's level, and voting there split the surface itself
+          // (photographed brick at 30 grey levels: every brick a region).
+          // A part's edge, even its light side's, steps down below it, and
+          // so does a shadow's (kMarkDepth).
+          if (surface * back[i] - lo < std::min(kMinStepShare * step, kMarkDepth * back[i]))
+            continue;
           // A surface beside a part stays light beyond the edge; the
           // stripes of wood grain or a ribbed belt fall dark again a few
           // pixels on, and their steps do not vote.
@@ -303,7 +322,7 @@ struct GuidedThreshold {
 // their own levels do. Never above kMaxSeparatedRatio of the background: the
 // surface's own blotches stay surface. Also the noise (edgeVotes).
 GuidedThreshold edgeGuidedThreshold(const cv::Mat& grey, int reduce, int k,
-                                    const cv::Mat& background_f, double contrast,
+                                    const cv::Mat& background_f, double contrast, double surface,
                                     const cv::Mat& fallback) {
   cv::Mat image;
   int cell = reduce;
@@ -321,7 +340,7 @@ GuidedThreshold edgeGuidedThreshold(const cv::Mat& grey, int reduce, int k,
   cv::Mat sums;
   cv::Mat weights;
   GuidedThreshold out;
-  edgeVotes(image, cell, background_f, contrast, sums, weights, &out.noise);
+  edgeVotes(image, cell, background_f, contrast, surface, sums, weights, &out.noise);
   out.noise *= noise_scale;
   std::vector<cv::Point> voting;
   for (int j = 0; j < weights.rows; ++j) {
@@ -349,8 +368,8 @@ GuidedThreshold edgeGuidedThreshold(const cv::Mat& grey, int reduce, int k,
   const auto middle = held.begin() + static_cast<std::ptrdiff_t>(held.size() / 2);
   std::nth_element(held.begin(), middle, held.end());
   const double prior = kPriorShare * *middle;
-  const cv::Mat surface = (0.5 * sums + prior * fallback) / (weights + prior);
-  out.level = cv::min(surface, background_f * kMaxSeparatedRatio);
+  const cv::Mat blended = (0.5 * sums + prior * fallback) / (weights + prior);
+  out.level = cv::min(blended, background_f * kMaxSeparatedRatio);
   return out;
 }
 
@@ -360,6 +379,9 @@ struct RatioSplit {
   // Part/background, a fraction of the background level, where the edges
   // set the threshold; 0 where the ratio alone does.
   double contrast = 0;
+  // The surface's typical level, a fraction of the background level: the
+  // background estimate is the local maximum, the surface's lightest marks.
+  double surface = 1;
 };
 
 // The split of the ratio image (200 = the background's level) of `small_f`
@@ -391,6 +413,7 @@ RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
     // light, a plain tray) is split exactly by the ratio, at no further cost.
     if (sd_bright[0] > kEvenSurface * (mean_bright[0] - mean_dark[0])) {
       split.contrast = (mean_bright[0] - mean_dark[0]) / 200.0;
+      split.surface = mean_bright[0] / 200.0;
     }
   } else {
     split.k_ratio = std::clamp(otsu / 200.0, kMinRatio, kMaxRatio);
@@ -434,8 +457,8 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
     // the contrast lower than halfway, since a belt's blotches lie there
     // and a part's middle lies far below it.
     const cv::Mat global_threshold = background_f * (k_ratio - kOpenShare * contrast);
-    const GuidedThreshold guided =
-        edgeGuidedThreshold(grey, reduce, k, background_f, contrast, global_threshold);
+    const GuidedThreshold guided = edgeGuidedThreshold(grey, reduce, k, background_f, contrast,
+                                                       split.surface, global_threshold);
     guided.level.convertTo(threshold_small, CV_16U, 16);
     // Where half the contrast is within six deviations of the noise, single
     // pixels cross the threshold on both sides of the weaker edges (a part's

@@ -1,8 +1,8 @@
 // The light of a front-lit cell for silhouette scenes: a textured surface
-// (belt, wood, brushed metal), a stronger gradient and vignetting, shaded
-// parts, a soft cast shadow beside each part, specular glints on the parts,
-// and colour. Everything is off by default (the back-lit look the scenes had
-// before); the truth is always the part's drawn mask, never its shadow.
+// (belt, wood, brushed metal, or a photograph of a real one), a stronger gradient and vignetting,
+// shaded parts, a soft cast shadow beside each part, specular glints on the parts, and colour.
+// Everything is off by default (the back-lit look the scenes had before); the truth is always the
+// part's drawn mask, never its shadow.
 #pragma once
 
 #include <array>
@@ -14,15 +14,20 @@
 
 namespace picksight::synthetic {
 
-enum class Surface { kPlain, kBelt, kWood, kBrushedMetal };
+enum class Surface { kPlain, kBelt, kWood, kBrushedMetal, kPhotographed };
 const char* surfaceName(Surface s);
 
 struct FrontLight {
   Surface surface = Surface::kPlain;
   // The surface's texture, as a fraction of its grey level: the standard
   // deviation of fine grain plus large blotches (belt), grain and rings
-  // (wood), or streaks along x (brushed metal).
+  // (wood), or streaks along x (brushed metal); a photographed surface's
+  // own pattern (its shape kept) takes this deviation too.
   double texture = 0;
+  // kPhotographed: the photograph of a real surface (CV_8UC1), mirrored
+  // across the frame from an offset the seed picks: a texture nobody here
+  // drew, with the sharp steps, straight lines and clutter of real ones.
+  cv::Mat surface_photo;
   // Light across the frame beyond the scenes' own uneven light: a linear
   // fall-off (fraction of the level from one side to the other) and a
   // vignette (fraction lost in the corners).
@@ -64,9 +69,21 @@ bool frontLightCondition(const std::string& name, FrontLight* light, double* par
                          double* background_level);
 std::vector<std::string> frontLightConditionNames();
 
+// Conditions on a photographed surface (the caller loads the photograph,
+// `surfaces/<name>.png` of the test data): "brick" (paving bricks: straight
+// light joints, each brick its own shade) and "gravel" (sharp stones and
+// dark gaps), both under the light of "low-contrast" (30 grey levels between
+// part and surface, the surface's pattern 4 % of its level). False for an
+// unknown name or an empty photograph.
+bool photographedCondition(const std::string& name, const cv::Mat& photo, FrontLight* light,
+                           double* part_level, double* background_level);
+std::vector<std::string> photographedConditionNames();
+
 namespace detail {
-// The surface's reflectance around 1 (CV_32F), from the seed.
-cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_t seed);
+// The surface's reflectance around 1 (CV_32F), from the seed (and, for
+// kPhotographed, `photo`).
+cv::Mat surfaceTexture(cv::Size size, Surface surface, double amplitude, uint64_t seed,
+                       const cv::Mat& photo = cv::Mat());
 // A smooth field in [-1, 1] varying over about `scale_px` (CV_32F).
 cv::Mat smoothField(cv::Size size, double scale_px, uint64_t seed);
 // Shades `coverage` (CV_32F, 1 on the part) under the front light into one
