@@ -538,6 +538,31 @@ TEST_CASE("parts on photographed paving bricks and gravel at 30 levels of contra
   }
 }
 
+TEST_CASE("LEARN AT takes a small part on paving bricks, not the darker bricks beside it",
+          "[vision_app][learn][front]") {
+  // At 30 grey levels on photographed paving bricks, bricks darker than
+  // their neighbours binarize as regions of half a small part's area,
+  // speckled, and ringed by light joints: read against the joints' mean
+  // they stood off the surface half as deep as the part, and LEARN AT
+  // around the part (Tari-1000 obj18 at 190 px) counted them as parts.
+  const cv::Mat drawing = cv::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/shapes/tari1000/obj18_3.png", cv::IMREAD_GRAYSCALE);
+  REQUIRE(!drawing.empty());
+  const ps::SilhouetteType type = ps::silhouetteFromDrawing("obj18", drawing, 190);
+  const ps::SilhouetteSceneOptions look = photographedLook("brick");
+  cv::Point2d drawn;
+  const cv::Mat teach = ps::renderSilhouetteAlone(type, 585, look, 15, &drawn, 30);
+  const auto learned =
+      learnInImage(teach, {}, cellOptions(), noModels(), 1, "obj18", boxAround(drawn, 190));
+  INFO((learned.ok() ? std::string() : learned.error().message));
+  REQUIRE(learned.ok());
+  CHECK(cv::norm(learned->model.trained_centroid - drawn) < 1);
+  const bool said = std::any_of(learned->notes.begin(), learned->notes.end(), [](const auto& n) {
+    return n.find("ignored") != std::string::npos;
+  });
+  CHECK(said);
+}
+
 TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
           "[vision_app][learn][front]") {
   // A belt with one dark stain and no part: the stain's rim is nowhere a

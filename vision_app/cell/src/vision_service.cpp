@@ -379,10 +379,17 @@ constexpr double kSpeckShare = 0.15;
 // threshold took (a glossy belt at 85 on 150 gave stains of 15 % of the
 // part's area, a fifth as deep as it). A second part stands off as deep.
 constexpr double kStainDepthShare = 0.4;
+// ... or under this share when the threshold speckled it (kMinPinholes or
+// more): a paving's darker bricks, at 30 grey levels of contrast, stand
+// off the surface round them by 0.4 to 0.48 of a small part's depth, each
+// with 10 to 36 holes and pinholes; a second part, solid, stands off
+// about as deep as the part.
+constexpr double kSpeckledDepthShare = 0.6;
 // The ring around a region its surface level is read on (pixels out, past
-// the edge's blur).
+// the edge's blur, and wide enough that a brick's joints are not the most
+// of it).
 constexpr int kRingInner = 2;
-constexpr int kRingOuter = 6;
+constexpr int kRingOuter = 20;
 // An evenly lit part has next to none of its outline beside a shadow or
 // uneven light (vision::unevenEdgeShare): under this share, on a plain or a
 // textured belt, for the t-shaped part of the tests; a soft shadow 8 px
@@ -421,7 +428,22 @@ double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask
   cv::dilate(own, far, disc(kRingOuter));
   const cv::Mat ring = far & ~near & (mask(box) == 0);
   if (cv::countNonZero(core) == 0 || cv::countNonZero(ring) == 0) return 0;
-  return std::abs(cv::mean(grey(box), core)[0] - cv::mean(grey(box), ring)[0]);
+  // The surface's median level there: a region of the surface itself (a
+  // brick of a paving, darker than the light joints round it) is ringed
+  // by its lighter marks, and read against their mean stood off it as a
+  // part does (three bricks inside LEARN AT beside a small part, at 30
+  // grey levels of contrast).
+  std::vector<uint8_t> levels;
+  levels.reserve(static_cast<size_t>(cv::countNonZero(ring)));
+  for (int y = 0; y < ring.rows; ++y) {
+    const uint8_t* in = ring.ptr<uint8_t>(y);
+    const uint8_t* g = grey(box).ptr<uint8_t>(y);
+    for (int x = 0; x < ring.cols; ++x)
+      if (in[x]) levels.push_back(g[x]);
+  }
+  const auto mid = levels.begin() + static_cast<std::ptrdiff_t>(levels.size() / 2);
+  std::nth_element(levels.begin(), mid, levels.end());
+  return std::abs(cv::mean(grey(box), core)[0] - static_cast<double>(*mid));
 }
 
 LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
@@ -458,8 +480,10 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
   const double part_depth = depthOf(regions[out.part], grey, mask);
   for (const size_t i : inside) {
     if (i == out.part) continue;
+    const double depth = depthOf(regions[i], grey, mask);
+    const bool speckled = regions[i].holes + regions[i].pinholes >= kMinPinholes;
     const bool speck = regions[i].area < kSpeckShare * regions[out.part].area ||
-                       depthOf(regions[i], grey, mask) < kStainDepthShare * part_depth;
+                       depth < (speckled ? kSpeckledDepthShare : kStainDepthShare) * part_depth;
     (speck ? out.specks : out.others).push_back(i);
   }
   return out;
