@@ -43,10 +43,11 @@ constexpr double kMinStepShare = 0.3;
 // less than this share of the background, below the surface's typical level
 // is a light mark on the surface, and does not vote (edgeVotes). Ten percent
 // below the surface, a step's dark side is something on it: the soft outer
-// edge of a shadow at 0.65 of the background on a belt at 0.78 (contrast
-// 0.57: a third of it is 0.19) still votes; without it the threshold left a
-// thin layer of such shadows on their parts, too thin to be cut, and 3 of
-// 60 parts beside a shadow were placed 1.6-1.9 px off.
+// edge of a shadow at 0.65 of the background on a belt at 0.78, 0.13 below
+// it (short of kMinStepShare of the contrast, 0.17 of 0.57), still votes;
+// without it the threshold left a thin layer of such shadows on their
+// parts, too thin to be cut, and 3 of 60 parts beside a shadow were placed
+// 1.6-1.9 px off.
 constexpr double kMarkDepth = 0.1;
 // Far from any edge, the threshold lies this share of the contrast below
 // the middle of part and background.
