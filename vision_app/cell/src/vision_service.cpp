@@ -433,17 +433,18 @@ double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask
   // by its lighter marks, and read against their mean stood off it as a
   // part does (three bricks inside LEARN AT beside a small part, at 30
   // grey levels of contrast).
+  const cv::Mat surface = grey(box);
   std::vector<uint8_t> levels;
   levels.reserve(static_cast<size_t>(cv::countNonZero(ring)));
   for (int y = 0; y < ring.rows; ++y) {
     const uint8_t* in = ring.ptr<uint8_t>(y);
-    const uint8_t* g = grey(box).ptr<uint8_t>(y);
+    const uint8_t* g = surface.ptr<uint8_t>(y);
     for (int x = 0; x < ring.cols; ++x)
       if (in[x]) levels.push_back(g[x]);
   }
   const auto mid = levels.begin() + static_cast<std::ptrdiff_t>(levels.size() / 2);
   std::nth_element(levels.begin(), mid, levels.end());
-  return std::abs(cv::mean(grey(box), core)[0] - static_cast<double>(*mid));
+  return std::abs(cv::mean(surface, core)[0] - static_cast<double>(*mid));
 }
 
 LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
