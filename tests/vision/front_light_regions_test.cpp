@@ -274,7 +274,7 @@ TEST_CASE("a shaded part on a blotched belt is placed where it lies", "[vision][
 }
 
 TEST_CASE("a part's lit side, the blur of its tips and its glints are not cut off as a shadow",
-          "[vision][regions][front]") {
+          "[vision][regions][front][accuracy]") {
   // No shadow in these scenes, so cutting shadows must change nothing. Cut
   // off as shadow layers, the lit side of a part shaded within a few levels
   // of its belt (30 levels of contrast), the blurred tips of its arms and a
@@ -392,7 +392,7 @@ TEST_CASE("beside a cast shadow, a part's lit side and the blur of its tips stay
 }
 
 TEST_CASE("a sharp part on a blotched belt is read over its blur, not over the belt",
-          "[vision][regions][front]") {
+          "[vision][regions][front][accuracy]") {
   // The band read from grey levels was widened while its outermost pixels
   // seemed covered; on a blotched belt, which no plane follows, they seemed
   // so a pixel or more past an edge blurred by 0.7 px, and every pixel taken
@@ -465,7 +465,7 @@ TEST_CASE("a part out of focus beside its shadow keeps its edge", "[vision][regi
 }
 
 TEST_CASE("a part beside its shadow is read on its grey levels wherever the shadow falls",
-          "[vision][regions][front]") {
+          "[vision][regions][front][accuracy]") {
   // A plane through the ring of surface about a part tilts towards its
   // shadow; read as the light, it fell to nothing at a corner of the box of
   // many parts (a shadow along most of one side of a small box), which were

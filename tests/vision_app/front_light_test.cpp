@@ -395,7 +395,7 @@ TEST_CASE("a part taught beside its shadow is found and placed beside shadows fa
 }
 
 TEST_CASE("the turn of a separated part under a front light is read on its edges",
-          "[vision_app][locate][front]") {
+          "[vision_app][locate][front][accuracy]") {
   // Glints, a lit side within a few levels of the belt, a grained belt:
   // the moments' phase and the distance map's descent weigh the rim's
   // uneven coverage and turned such parts by a tenth of a degree or more.
@@ -604,7 +604,7 @@ TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
 }
 
 TEST_CASE("touching parts whose corners the light blurs are found from what their blob leaves",
-          "[vision_app][locate][front]") {
+          "[vision_app][locate][front][accuracy]") {
   // Public silhouettes (Tari-1000) the blob search was not written on,
   // touching and overlapping by pairs, on a textured belt and on wood. There
   // a noisy outline's corners open tens of degrees away from the model's, and
@@ -715,7 +715,7 @@ cv::Point2d trueCentroid(const ps::SilhouetteType& type, int side, double angle_
 }  // namespace
 
 TEST_CASE("views of a part lying elsewhere take one teach image's offset out of its origin",
-          "[vision_app][learn][views][front]") {
+          "[vision_app][learn][views][front][accuracy]") {
   // Drawings no benchmark teaches, on wood and under glints: one teach
   // image's grain or glint puts the model's origin (the centroid it read) a
   // tenth of a pixel off, and every part found afterwards with it.
