@@ -2,6 +2,8 @@
 // finds them where a global threshold cannot.
 #include <catch2/catch.hpp>
 
+#include <vector>
+
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/vision/segmentation/binarize.hpp"
@@ -112,6 +114,32 @@ TEST_CASE("binarize never writes into the image it is given", "[vision][binarize
       o.polarity = polarity;
       (void)binarize(img, o);
       CHECK(cv::countNonZero(img != before) == 0);
+    }
+  }
+}
+
+TEST_CASE("the 3x3 mean binarize compares a noisy frame by is cv::blur's to the last bit",
+          "[vision][binarize]") {
+  // Widths that leave a tail past the sixteen-pixel steps, heights down to
+  // one row (both neighbours replicated), levels over the whole range and
+  // near its top (sums up to 2295), noise that rounds either way.
+  cv::RNG rng(11);
+  for (const cv::Size size :
+       {cv::Size(16, 1), cv::Size(17, 2), cv::Size(61, 9), cv::Size(1920, 3), cv::Size(333, 40)}) {
+    for (const int kind : {0, 1, 2}) {
+      cv::Mat grey(size, CV_8UC1);
+      if (kind == 0) rng.fill(grey, cv::RNG::UNIFORM, 0, 256);
+      if (kind == 1) rng.fill(grey, cv::RNG::UNIFORM, 246, 256);
+      if (kind == 2) rng.fill(grey, cv::RNG::NORMAL, 128, 40);
+      cv::Mat expected;
+      cv::blur(grey, expected, cv::Size(3, 3), cv::Point(-1, -1), cv::BORDER_REPLICATE);
+      std::vector<uint16_t> sums(static_cast<size_t>(size.width) + 2);
+      cv::Mat mean(size, CV_8UC1);
+      for (int y = 0; y < size.height; ++y) {
+        meanRow3x3(grey, y, sums.data(), mean.ptr<uint8_t>(y));
+      }
+      INFO(size << " kind " << kind);
+      CHECK(cv::countNonZero(mean != expected) == 0);
     }
   }
 }

@@ -1,6 +1,8 @@
 // Binarization of a grey image into part (255) and background (0) pixels.
 #pragma once
 
+#include <cstdint>
+
 #include <opencv2/core.hpp>
 
 namespace picksight::vision {
@@ -21,6 +23,12 @@ struct BinarizeOptions {
 
 // Returns a CV_8UC1 mask, 255 on parts. `grey` is CV_8UC1.
 cv::Mat binarize(const cv::Mat& grey, const BinarizeOptions& options);
+
+// Row `y` of the 3x3 mean of `grey` (CV_8UC1) into `out` (grey.cols
+// levels), cv::blur's with BORDER_REPLICATE to the last bit; `sums` holds
+// grey.cols + 2 values. binarize compares a noisy frame's mean so, row by
+// row, instead of blurring the whole frame first.
+void meanRow3x3(const cv::Mat& grey, int y, uint16_t* sums, uint8_t* out);
 
 // The adaptive window (pixels) binarize uses on an image of `size`: the
 // option, or its default (a sixth of the smaller side).
