@@ -78,6 +78,40 @@ if [ -n "$phantom" ]; then
   status=1
 fi
 
+# Per binary, the entry's own arguments must run the cases it stands for:
+# every case the binary lists (never a hidden one: any test spec, even one
+# that only leaves cases out, makes Catch 2 select hidden cases too), less
+# the [accuracy] ones where the build leaves them out
+# (PICKSIGHT_TEST_SKIP_ACCURACY).
+if [ "$mode" = per-binary ]; then
+  (cd "$build" && ctest --show-only=json-v1) >"$work/ctest.json"
+  /usr/bin/python3 - "$work/ctest.json" "$tests_dir" >"$work/commands" <<'PY'
+import json, os, sys
+tests_dir = os.path.realpath(sys.argv[2])
+for test in json.load(open(sys.argv[1]))["tests"]:
+    command = test.get("command") or []
+    if command and os.path.dirname(os.path.realpath(command[0])) == tests_dir:
+        print("\x1f".join(command))
+PY
+  # One line an entry, its command's words apart by the unit separator.
+  while IFS=$'\x1f' read -r -a command; do
+    binary="${command[0]}"
+    name="$(basename "$binary")"
+    "$binary" --list-test-names-only | sort >"$work/want" || true
+    if [ "${#command[@]}" -gt 1 ]; then
+      "$binary" "[accuracy]" --list-test-names-only | sort >"$work/left_out" || true
+      comm -23 "$work/want" "$work/left_out" >"$work/want.kept"
+      mv "$work/want.kept" "$work/want"
+    fi
+    "$binary" "${command[@]:1}" --list-test-names-only | sort >"$work/runs" || true
+    if ! cmp -s "$work/want" "$work/runs"; then
+      echo "FAIL: CTest's $name (${command[*]:1}) runs other cases than it stands for:" >&2
+      diff "$work/want" "$work/runs" | sed 's/^/  /' >&2 || true
+      status=1
+    fi
+  done <"$work/commands"
+fi
+
 cases=$(wc -l <"$work/cases")
 expected=$(wc -l <"$work/expected")
 entries=$(wc -l <"$work/entries")
