@@ -205,8 +205,8 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   if (cv::countNonZero(core) < kMinCorePixels) return {};
   // The layers lie within kCoreDepth + 1 of the core, and what follows
   // reads them and kStepReadPx round them: all of it is done on the
-  // rectangle that holds those (a side or two of the part, a third of the
-  // box on the benchmark's shadows), each result the same as over the box.
+  // rectangle that holds those (a shadow lies along a side or two of the
+  // part), each result the same as over the box.
   // Views of the box's images read their neighbours past the rectangle as
   // the whole image would; `rest` and the dilations of the layers, made
   // here, need none (the layers are a margin inside the rectangle).
