@@ -9,6 +9,8 @@ PACKAGES=(
   build-essential cmake pkg-config git clang clang-format
   # CMake's Ninja generator: quickstart's and CI's build trees (docs/CI.md)
   ninja-build
+  # LLVM's linker: quickstart's test trees and CI link with it (docs/CI.md)
+  lld
   # libFuzzer and the sanitizer runtimes for clang (fuzz run in CI)
   libclang-rt-14-dev
   # core libraries
