@@ -1,7 +1,9 @@
 // Parts under the light of a front-lit cell: per condition (textured belt,
 // cast shadows, glints, low contrast, colour, other surfaces, JPEG frames)
-// each type is taught the way a user teaches it (LEARN on an image of the part
-// alone, and LEARN ... AT a box around it when LEARN refuses), then LOCATE ALL
+// each type is taught the way a user teaches it (LEARN on a frame of the cell's
+// camera with the part alone in it, anywhere in the frame and lit as the
+// scenes are there, and LEARN ... AT a box around it when LEARN refuses; with
+// --list-errors, where each teach frame placed the reference point), then LOCATE ALL
 // runs on 1920x1080 scenes of 20 parts with mirrored and scaled distractors,
 // separated and in touching pairs, through the cell's own locate function.
 // Prints per condition what LEARN answered, recall, precision, confusions,
@@ -17,6 +19,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -326,8 +329,18 @@ int main(int argc, char** argv) {
     std::vector<bool> chiral(types.size(), true);
     std::vector<cv::Point2d> reference(types.size());
     Row taught;
+    // Where a part lies in its teach frame: anywhere a user might lay it,
+    // its whole outline a margin inside the frame (view 0: LEARN, then
+    // LEARNVIEW's).
+    const auto teachSpot = [&](size_t i, int view) {
+      std::mt19937_64 rng(0x7465616368ULL + 131 * i + static_cast<uint64_t>(view));
+      const double margin = 0.75 * specs[i].size_px + 20;
+      std::uniform_real_distribution<double> x(margin, look.width - 1 - margin);
+      std::uniform_real_distribution<double> y(margin, look.height - 1 - margin);
+      const double at_x = x(rng);
+      return cv::Point2d(at_x, y(rng));
+    };
     for (size_t i = 0; i < types.size(); ++i) {
-      const int side = static_cast<int>(specs[i].size_px * 1.5) + 300;
       cv::Point2d drawn;
       ps::SilhouetteSceneOptions teach_look = look;
       if (teach_on_plain) {
@@ -338,11 +351,18 @@ int main(int argc, char** argv) {
         teach_look.front = plain;
       }
       const cv::Mat image =
-          delivered(ps::renderSilhouetteAlone(types[i], side, teach_look, 7 + i, &drawn,
-                                              picksight::bench::kTrainAngleDeg),
+          delivered(ps::renderSilhouetteInFrame(types[i], teach_look, 7 + i, teachSpot(i, 0),
+                                                &drawn, picksight::bench::kTrainAngleDeg),
                     jpeg_quality);
       if (!save_frames.empty()) {
         cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + ".png", image);
+        // What the vision pass takes for parts there, before any model.
+        const auto seen =
+            pc::locateInFrame(frameOf(image), options, std::make_shared<pst::ModelList>(), -1);
+        if (!seen.scene.mask.empty()) {
+          cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + "-mask.png",
+                      seen.scene.mask);
+        }
       }
       const picksight::Frame frame = frameOf(image);
       const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
@@ -378,8 +398,11 @@ int main(int argc, char** argv) {
       sharp_look.noise_sigma = 0;
       sharp_look.uneven_light = false;
       cv::Point2d sharp_drawn;
-      const cv::Mat sharp = ps::renderSilhouetteAlone(
-          types[i], side, sharp_look, 7 + i, &sharp_drawn, picksight::bench::kTrainAngleDeg);
+      sharp_look.width = look.width;
+      sharp_look.height = look.height;
+      const cv::Mat sharp =
+          ps::renderSilhouetteInFrame(types[i], sharp_look, 7 + i, teachSpot(i, 0), &sharp_drawn,
+                                      picksight::bench::kTrainAngleDeg);
       pv::BinarizeOptions b;
       b.adaptive_window = kWindow;
       const auto seen = pv::findRegions(pv::binarize(sharp, b), {}, sharp);
@@ -393,6 +416,14 @@ int main(int argc, char** argv) {
       reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
                       offset.x * std::sin(back) + offset.y * std::cos(back)};
       chiral[i] = !learned->model.body.mirror_symmetric;
+      if (list_errors) {
+        // The teach image's reading of the reference point, on the part.
+        const cv::Point2d d = learned->model.trained_centroid - drawn;
+        const cv::Point2d on(d.x * std::cos(back) - d.y * std::sin(back),
+                             d.x * std::sin(back) + d.y * std::cos(back));
+        std::printf("  %s %s: taught %+.3f %+.3f px off on the part\n", condition.c_str(),
+                    specs[i].name.c_str(), on.x - reference[i].x, on.y - reference[i].y);
+      }
       // More views (LEARNVIEW): the part alone again, turned and lying on
       // another stretch of the surface, each read with the model so far.
       for (int v = 1; v < teach_views; ++v) {
@@ -400,8 +431,8 @@ int main(int argc, char** argv) {
         trial->push_back(learned->model);
         cv::Point2d unused;
         const cv::Mat view = delivered(
-            ps::renderSilhouetteAlone(types[i], side, teach_look, 1000 * v + 7 + i, &unused,
-                                      picksight::bench::kTrainAngleDeg + 47.0 * v),
+            ps::renderSilhouetteInFrame(types[i], teach_look, 1000 * v + 7 + i, teachSpot(i, v),
+                                        &unused, picksight::bench::kTrainAngleDeg + 47.0 * v),
             jpeg_quality);
         auto seen =
             pc::viewInFrame(frameOf(view), options, trial, learned->model.type, std::nullopt);

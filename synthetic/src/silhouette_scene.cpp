@@ -400,4 +400,18 @@ cv::Mat renderSilhouetteAlone(const SilhouetteType& type, int side,
   return addNoise(shade(canvas, look, seed), look.noise_sigma, seed);
 }
 
+cv::Mat renderSilhouetteInFrame(const SilhouetteType& type, const SilhouetteSceneOptions& look,
+                                uint64_t seed, cv::Point2d where, cv::Point2d* centre,
+                                double angle_deg) {
+  const Posed p = pose(type.mask, angle_deg, false, 1.0);
+  cv::Mat canvas = cv::Mat::zeros(look.height * kS, look.width * kS, CV_8UC1);
+  // The drawn centroid at `where` (imageCentre's inverse), to the nearest
+  // supersampled pixel.
+  const cv::Point at(static_cast<int>(std::lround((where.x + 0.5) * kS - 0.5 - p.centroid.x)),
+                     static_cast<int>(std::lround((where.y + 0.5) * kS - 0.5 - p.centroid.y)));
+  stamp(p, at, canvas);
+  if (centre) *centre = imageCentre(p, at);
+  return addNoise(shade(canvas, look, seed), look.noise_sigma, seed);
+}
+
 }  // namespace picksight::synthetic

@@ -2,6 +2,7 @@
 #include "picksight/synthetic/scene.hpp"
 
 #include "picksight/synthetic/front_light.hpp"
+#include "picksight/synthetic/silhouette_scene.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -567,4 +568,38 @@ TEST_CASE("a photographed surface keeps the photograph's pattern at the conditio
   // A drawn belt of the same strength is another pattern altogether.
   const cv::Mat belt = ps::detail::surfaceTexture(size, ps::Surface::kBelt, light.texture, 5);
   CHECK(std::abs(correlation(belt, t)) < 0.2);
+}
+
+TEST_CASE("a teach frame is a whole frame of the scenes' light, the part where it was asked",
+          "[synthetic]") {
+  const ps::SilhouetteType type = ps::silhouetteFromPartType("l_shape", 120);
+  REQUIRE(!type.mask.empty());
+  ps::SilhouetteSceneOptions look;
+  look.width = 640;
+  look.height = 400;
+  look.noise_sigma = 0;
+  look.seed = 21;
+  REQUIRE(ps::frontLightCondition("low-contrast", &look.front, &look.part_level,
+                                  &look.background_level));
+  look.parts = 0;
+  const cv::Mat empty = ps::SilhouetteScene({type}, {true}, look).render(0);
+  const cv::Point2d where(150.3, 290.6);
+  cv::Point2d centre;
+  const cv::Mat frame = ps::renderSilhouetteInFrame(type, look, look.seed, where, &centre, 30);
+  REQUIRE(frame.size() == cv::Size(look.width, look.height));
+  // The drawn centroid where it was asked, to the drawing's quarter pixel.
+  CHECK(std::abs(centre.x - where.x) <= 0.125 + 1e-9);
+  CHECK(std::abs(centre.y - where.y) <= 0.125 + 1e-9);
+  // Away from the part, the very levels of a scene of the same seed: the
+  // light falls off across the whole frame, not across the part's image.
+  cv::Mat away(frame.size(), CV_8UC1, cv::Scalar(255));
+  cv::circle(away, cv::Point(150, 290), 100, cv::Scalar(0), cv::FILLED);
+  cv::Mat diff;
+  cv::absdiff(frame, empty, diff);
+  double worst = 0;
+  cv::minMaxLoc(diff, nullptr, &worst, nullptr, nullptr, away);
+  CHECK(worst == 0);
+  // And the part is there: its middle darker than the surface beside it.
+  CHECK(cv::mean(frame(cv::Rect(145, 285, 10, 10)))[0] <
+        cv::mean(empty(cv::Rect(145, 285, 10, 10)))[0] - 10);
 }

@@ -110,4 +110,14 @@ cv::Mat renderSilhouetteAlone(const SilhouetteType& type, int side,
                               const SilhouetteSceneOptions& look, uint64_t seed,
                               cv::Point2d* centre, double angle_deg = 0);
 
+// A training image as the cell's camera takes it: a whole frame of
+// look.width x look.height, lit as the scenes are across the frame, with
+// one part of `type` turned by `angle_deg` whose drawn centroid lies at
+// `where` (to a quarter pixel; `centre` receives it). renderSilhouetteAlone
+// lights its small image with a whole frame's fall-off and vignette: across
+// the part, several times the light's change of any scene.
+cv::Mat renderSilhouetteInFrame(const SilhouetteType& type, const SilhouetteSceneOptions& look,
+                                uint64_t seed, cv::Point2d where, cv::Point2d* centre,
+                                double angle_deg = 0);
+
 }  // namespace picksight::synthetic
