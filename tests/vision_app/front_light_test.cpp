@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -785,18 +786,91 @@ TEST_CASE("views of a part lying elsewhere take one teach image's offset out of 
     INFO(condition << ": origin RMS " << rms1 << " -> " << rms8 << " px, a part found " << place1
                    << " -> " << place8 << " px");
     // Every condition gains. Under glints part of the offset is the same in
-    // every view (the lamp's side) and stays: there the gain is small and
-    // differs between builds (0.78 and 0.95 of the origin error with and
-    // without the sanitizers), elsewhere it is a third and more (textured
-    // 0.51-0.62, wood 0.61, metal 0.64; parts found 0.43-0.79).
+    // every view (the lamp's side) and stays: there the gain is small (0.91
+    // of the origin error); elsewhere it is a quarter and more (textured
+    // 0.59, wood 0.69, metal 0.71). Since the teach image's origin is where
+    // its edges put the centroid (vision::referencePoint) there is less
+    // left to take out: parts found gain 0.72 (textured), 0.67 (wood), 0.84
+    // (glossy) and 0.94 (metal) where the grey centroid left 0.43-0.79.
     CHECK(rms8 < rms1);
     CHECK(place8 < place1);
     if (std::string(condition) != "glossy") {
-      CHECK(rms8 < 0.75 * rms1);
-      CHECK(place8 < 0.85 * place1);
+      CHECK(rms8 < 0.8 * rms1);
       CHECK(place8 <= 0.05);
     }
   }
+}
+
+namespace {
+// The largest region of `image` (dark on light, read with a window wide
+// enough for any part here) whose box holds `at`.
+pv::Region regionAt(const cv::Mat& image, cv::Point2d at) {
+  pv::BinarizeOptions b;
+  b.adaptive_window = 400;
+  const auto regions = pv::findRegions(pv::binarize(image, b), {}, image);
+  const pv::Region* found = nullptr;
+  for (const auto& r : regions) {
+    if (cv::Rect2d(r.bbox).contains(at) && (!found || r.area > found->area)) found = &r;
+  }
+  REQUIRE(found != nullptr);
+  return *found;
+}
+}  // namespace
+
+TEST_CASE("under uneven light a part's origin is where its edges put its centroid",
+          "[vision_app][learn][front][accuracy]") {
+  // Drawings no benchmark teaches, each taught on a whole frame of the cell
+  // lying somewhere in it (the light falls off towards the corners): the
+  // grey levels of one teach image's rim, read against a blotched or glinting
+  // surface, put its centroid a tenth of a pixel off, and the model's origin
+  // with it; the edges much less.
+  const std::vector<std::pair<std::string, double>> files = {
+      {"shapes/tari1000/obj12_5.png", 220}, {"shapes/tari1000/obj19_5.png", 210},
+      {"shapes/tari1000/obj23_5.png", 230}, {"shapes/tari1000/obj28_5.png", 200},
+      {"shapes/tari1000/obj36_5.png", 220}, {"shapes/tari1000/obj44_5.png", 210}};
+  const std::vector<cv::Point2d> spots = {{330, 210}, {950, 230}, {400, 500},
+                                          {880, 510}, {640, 360}, {250, 520}};
+  double all_origin2 = 0;
+  double all_grey2 = 0;
+  for (const char* condition : {"textured", "glossy", "wood", "metal"}) {
+    ps::SilhouetteSceneOptions look = lookOf(condition);
+    look.width = 1280;
+    look.height = 720;
+    ps::SilhouetteSceneOptions sharp;
+    sharp.width = look.width;
+    sharp.height = look.height;
+    sharp.noise_sigma = 0;
+    sharp.uneven_light = false;
+    double origin2 = 0;  // squared errors of the models' origins
+    double grey2 = 0;    // and of the centroids of the parts' grey levels
+    for (size_t i = 0; i < files.size(); ++i) {
+      const ps::SilhouetteType type = drawing(files[i].first, files[i].second);
+      cv::Point2d drawn;
+      const cv::Mat frame =
+          ps::renderSilhouetteInFrame(type, look, 50 + i, spots[i], &drawn, 30 + 40.0 * i);
+      auto learned = learnInImage(frame, {}, cellOptions(), noModels(), 1, "part",
+                                  boxAround(drawn, files[i].second));
+      REQUIRE(learned.ok());
+      const cv::Point2d truth =
+          regionAt(ps::renderSilhouetteInFrame(type, sharp, 1, spots[i], &drawn, 30 + 40.0 * i),
+                   drawn)
+              .centroid;
+      const cv::Point2d origin = learned->model.trained_centroid - truth;
+      const cv::Point2d grey = regionAt(frame, drawn).centroid - truth;
+      origin2 += origin.dot(origin);
+      grey2 += grey.dot(grey);
+    }
+    const double origin_rms = std::sqrt(origin2 / static_cast<double>(files.size()));
+    const double grey_rms = std::sqrt(grey2 / static_cast<double>(files.size()));
+    INFO(condition << ": origin RMS " << origin_rms << " px, grey centroid RMS " << grey_rms);
+    // Measured: textured 0.017 against 0.032, glossy 0.035 / 0.066, wood
+    // 0.043 / 0.057, brushed metal 0.030 / 0.035.
+    CHECK(origin_rms < grey_rms);
+    CHECK(origin_rms <= 0.05);
+    all_origin2 += origin2;
+    all_grey2 += grey2;
+  }
+  CHECK(std::sqrt(all_origin2) < 0.75 * std::sqrt(all_grey2));
 }
 
 TEST_CASE("views move the origin to the median of their readings and survive the model file",

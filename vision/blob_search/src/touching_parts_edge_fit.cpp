@@ -271,6 +271,53 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
   return fit;
 }
 
+std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region& region,
+                                           const ImagePose& pose, double search_px) {
+  const Coverage cov(region);
+  const double flip = pose.mirrored ? -1.0 : 1.0;
+  const double c = std::cos(pose.angle_deg * kRadPerDeg);
+  const double s = std::sin(pose.angle_deg * kRadPerDeg);
+  double area = 0;
+  cv::Point2d first(0, 0);
+  for (const auto& loop : model.loops) {
+    const bool left_interior = loopOrientation(loop) > 0;
+    // Every kFitStepPx along each primitive, to its ends (the polygon must
+    // close round corners too): where the edge crosses, or the boundary
+    // itself where it does not cleanly (about the pose's centre).
+    std::vector<cv::Point2d> points;
+    for (const auto& p : loop.primitives) {
+      const double length = p.length();
+      const int count = std::max(1, static_cast<int>(std::ceil(length / kFitStepPx)));
+      for (int i = 0; i < count; ++i) {
+        const double t = static_cast<double>(i) / count;
+        const cv::Point2d m = p.pointAt(t);
+        const cv::Point2d a = awayNormal(p, t, left_interior, loop.hole);
+        const cv::Point2d r = rotate({m.x, flip * m.y}, c, s);
+        const cv::Point2d n = rotate({a.x, flip * a.y}, c, s);
+        const auto crossing = edgeCrossing(cov, pose.centre + r, n, search_px, 0.0, 0.25, true);
+        points.push_back(r + n * crossing.value_or(0.0));
+      }
+    }
+    // The polygon's area and first moments (the shoelace sums, twice the
+    // area and six times the moments), counted positive for the outer loop
+    // and negative for holes whichever way round they run.
+    double la = 0;
+    cv::Point2d lf(0, 0);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const cv::Point2d& a = points[i];
+      const cv::Point2d& b = points[(i + 1) % points.size()];
+      const double cross = a.x * b.y - b.x * a.y;
+      la += cross;
+      lf += (a + b) * cross;
+    }
+    const double sign = (la < 0 ? -1.0 : 1.0) * (loop.hole ? -1.0 : 1.0);
+    area += sign * la;
+    first += sign * lf;
+  }
+  if (!(area > 0)) return std::nullopt;
+  return pose.centre + first / (3.0 * area);
+}
+
 void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin) {
   const Coverage cov(region);
   for (auto& loop : loops) {

@@ -818,11 +818,12 @@ bool readLocally(int reach, const RowRuns& interior, Dilations& dilations, BandP
 // `zone` (over `box`, or empty) is where a cast shadow lies beside the part
 // (see shadows.hpp): there each band pixel is read against the shadow's
 // level beside it (outsideLevels, past the lens's blur `blur_px`), not the
-// surface's.
+// surface's. `uneven` tells whether the band was read against levels beside
+// it (a shadow's, or readLocally's) rather than planes (Region::uneven_light).
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
                  const cv::Mat& set, const cv::Mat& zone, double blur_px, const cv::Rect& box,
                  cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin,
-                 RowRuns* covered) {
+                 RowRuns* covered, bool* uneven) {
   std::vector<float> raw_row(static_cast<size_t>(box.width));
   BandPixels pixels{grey_box, own, set, raw_row.data(), {}, {}};
   if (!zone.empty() && cv::countNonZero(zone) > 0) {
@@ -876,10 +877,9 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
   if (kept_reach == 0) return false;
   // The band of the width kept summed once: by readLocally where it reads
   // the band again against local levels, else here.
-  if (!readLocally(kept_reach, kept_interior, dilations, &pixels, &kept) &&
-      !sumBand(pixels, &kept)) {
-    return false;
-  }
+  const bool local = readLocally(kept_reach, kept_interior, dilations, &pixels, &kept);
+  if (!local && !sumBand(pixels, &kept)) return false;
+  *uneven = local || !pixels.local.empty();
 
   // The coverage of the band width kept: 1 in the interior, read in the band,
   // 0 elsewhere; the interior and the band make up the covered runs, so
@@ -1022,7 +1022,8 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
 
   if (!grey.empty() &&
       greyMoments(grey(box), own, own_runs, set, zone.empty() ? cv::Mat() : zone(box), blur_px, box,
-                  &r.moments, &r.centroid, &r.coverage, &r.coverage_origin, &r.covered)) {
+                  &r.moments, &r.centroid, &r.coverage, &r.coverage_origin, &r.covered,
+                  &r.uneven_light)) {
     r.area = r.moments.m00;
   } else {
     // Binary moments only where the grey levels cannot be trusted.

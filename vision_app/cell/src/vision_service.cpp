@@ -753,8 +753,18 @@ Result<ViewOutcome> viewInFrame(const Frame& frame, const VisionOptions& options
                   " touches another part: a view is read on a part lying apart");
   }
   const SensorMapping& mapping = located.scene.mapping;
-  const cv::Point2d centroid =
-      mapping.toSensor(located.scene.regions[static_cast<size_t>(part.region)].centroid);
+  // The point the origin stands for, read as LEARN read it: the model (as
+  // this frame sees it) placed where the part was found.
+  const vision::Region& region = located.scene.regions[static_cast<size_t>(part.region)];
+  cv::Point2d seen = region.centroid;
+  const double turn = part.angle_deg * kRadPerDeg;  // sensor axes; into the frame's
+  const double frame_deg =
+      std::atan2(std::sin(turn) * mapping.scale_y, std::cos(turn) * mapping.scale_x) / kRadPerDeg;
+  for (const auto& m : *located.scene.models) {
+    if (m.type != type) continue;
+    seen = vision::referencePoint(m, region, {mapping.toFrame({part.x, part.y}), frame_deg});
+  }
+  const cv::Point2d centroid = mapping.toSensor(seen);
   // Into the model's frame: back by the part's turn, then about the teach
   // image's centroid rather than the current origin.
   const double back = -part.angle_deg * kRadPerDeg;
@@ -885,10 +895,13 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     train.regions = o.regions;
     auto trained = vision::trainModelFromRegion(grey, r, type, name, train);
     if (!trained) return trained.error();
+    // Where the origin lies in the teach image (the grey centroid, or under
+    // uneven light the edges' one: vision::referencePoint).
+    const cv::Point2d origin = trained->trained_centroid;
     LearnOutcome out;
     out.model = !isResized(mapping) ? std::move(*trained)
                                     : vision::scaledModel(*trained, 1.0 / frameScale(mapping));
-    out.model.trained_centroid = mapping.toSensor(r.centroid);
+    out.model.trained_centroid = mapping.toSensor(origin);
     out.model.trained_angle_deg = mapping.directionToSensor(r.angle_deg);
     out.model.min_region_area = options.regions.min_area;
     out.model.min_hole_area = options.regions.min_hole_area;

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -44,6 +45,13 @@ struct EdgeFit {
 EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const ImagePose& start,
                           double search_px = 4.0, int iterations = 6,
                           const std::function<bool(const ImagePose&)>& worth_finishing = {});
+
+// The centroid of the area the region's grey-level edges enclose (image
+// coordinates), read along the normals of the model's boundary placed at
+// `pose`, within `search_px` of it (the boundary itself where no clean
+// crossing is: a contact, a corner); none for a model of no area.
+std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region& region,
+                                           const ImagePose& pose, double search_px = 1.5);
 
 // Moves each primitive of `loops` (model frame: image point minus `origin`)
 // onto the grey-level edges of `region`, the part it was fitted to: lines by

@@ -30,6 +30,11 @@ struct Region {
   int glints = 0;
   cv::Rect bbox;
   bool touches_border = false;
+  // The rim was read against levels beside it rather than a plane through
+  // them: the surface or the part departs from a plane there (blotches,
+  // shading), or a cast shadow lies beside it. Its grey-level centroid is
+  // then only as good as those levels, and its edges more trustworthy.
+  bool uneven_light = false;
   // Moments (grey-weighted with a grey image, else binary). Raw moments
   // (m00..m03) are about an origin near bbox.tl(); central and normalized
   // moments do not depend on the origin.

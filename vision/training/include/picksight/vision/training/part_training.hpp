@@ -40,6 +40,14 @@ Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& region
 // by `shift` (model frame), and prepares it again.
 void moveBoundary(PartModel& model, double turn_deg, cv::Point2d shift);
 
+// Where on region `r` lies the point a model's origin stands for (image
+// pixels), the model's boundary placed at `pose` on the region's edges: the
+// centroid of its grey levels, or where its rim was read against uneven
+// levels (Region::uneven_light) the centroid of the area its edges enclose
+// (outlineCentroid), unless that lies over a pixel from the grey one.
+// Training puts the origin there; each view reads it (addViewReading).
+cv::Point2d referencePoint(const PartModel& model, const Region& r, const ImagePose& pose);
+
 // Adds a view's reading of the part's centroid (the teach image's frame,
 // see PartModel::views) and moves the origin to the median of them all:
 // the boundary is moved the other way, so that a part is found where it
