@@ -80,7 +80,6 @@ void complexMoments(const Region& r, std::vector<double>* strength,
 // would inherit it. The boundary is moved, once, so that the fit to the
 // training edges puts the model's origin on the trained centroid.
 constexpr double kMaxCentringPx = 1.0;
-
 constexpr double kMaxCentringDeg = 1.0;
 
 // Under uneven light (Region::uneven_light) a part's origin is the centroid
