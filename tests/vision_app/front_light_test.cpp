@@ -689,6 +689,14 @@ ps::SilhouetteType drawing(const std::string& file, double size) {
   return ps::silhouetteFromDrawing(file, image, size);
 }
 
+// The regions of `image` (dark on light), read with a window wide enough
+// for any part here.
+std::vector<pv::Region> partRegions(const cv::Mat& image) {
+  pv::BinarizeOptions b;
+  b.adaptive_window = 400;
+  return pv::findRegions(pv::binarize(image, b), {}, image);
+}
+
 // The part of `type`, alone and turned by `angle_deg` in a `side` image, as
 // a sharp, evenly back-lit image of it shows it: where its centroid truly
 // lies, so that a condition's light counts in an error, not in the truth.
@@ -698,9 +706,7 @@ pv::Region sharpPart(const ps::SilhouetteType& type, int side, double angle_deg)
   sharp.uneven_light = false;
   cv::Point2d unused;
   const cv::Mat image = ps::renderSilhouetteAlone(type, side, sharp, 1, &unused, angle_deg);
-  pv::BinarizeOptions b;
-  b.adaptive_window = 400;
-  const auto regions = pv::findRegions(pv::binarize(image, b), {}, image);
+  const auto regions = partRegions(image);
   REQUIRE(!regions.empty());
   size_t largest = 0;
   for (size_t k = 1; k < regions.size(); ++k) {
@@ -802,12 +808,9 @@ TEST_CASE("views of a part lying elsewhere take one teach image's offset out of 
 }
 
 namespace {
-// The largest region of `image` (dark on light, read with a window wide
-// enough for any part here) whose box holds `at`.
+// The largest region of `image` (partRegions) whose box holds `at`.
 pv::Region regionAt(const cv::Mat& image, cv::Point2d at) {
-  pv::BinarizeOptions b;
-  b.adaptive_window = 400;
-  const auto regions = pv::findRegions(pv::binarize(image, b), {}, image);
+  const auto regions = partRegions(image);
   const pv::Region* found = nullptr;
   for (const auto& r : regions) {
     if (cv::Rect2d(r.bbox).contains(at) && (!found || r.area > found->area)) found = &r;
