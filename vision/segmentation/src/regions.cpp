@@ -1062,28 +1062,34 @@ constexpr double kMinSteppedShare = 0.2;
 
 }  // namespace
 
+int stepAcrossOutline(const std::vector<cv::Point>& outline, int i, const cv::Mat& grey,
+                      cv::Point grey_origin, int reach_px) {
+  const int n = static_cast<int>(outline.size());
+  const cv::Point d =
+      outline[static_cast<size_t>((i + 2) % n)] - outline[static_cast<size_t>((i - 2 + n) % n)];
+  const double length = std::hypot(d.x, d.y);
+  if (length == 0) return -1;
+  const cv::Point2d across(-d.y / length * reach_px, d.x / length * reach_px);
+  const cv::Point2d at = outline[static_cast<size_t>(i)];
+  const cv::Point a(static_cast<int>(std::lround(at.x + across.x)),
+                    static_cast<int>(std::lround(at.y + across.y)));
+  const cv::Point b(static_cast<int>(std::lround(at.x - across.x)),
+                    static_cast<int>(std::lround(at.y - across.y)));
+  const cv::Rect box(grey_origin, grey.size());
+  if (!box.contains(a) || !box.contains(b)) return -1;
+  return std::abs(static_cast<int>(grey.at<uint8_t>(a - grey_origin)) -
+                  static_cast<int>(grey.at<uint8_t>(b - grey_origin)));
+}
+
 bool outlineSteps(const Region& r) {
   if (r.grey.empty()) return true;
-  const cv::Rect box(r.grey_origin, r.grey.size());
-  const int n = static_cast<int>(r.outer.size());
   int read = 0;
   int stepped = 0;
-  for (int i = 0; i < n; i += kStepEveryPx) {
-    const cv::Point d =
-        r.outer[static_cast<size_t>((i + 2) % n)] - r.outer[static_cast<size_t>((i - 2 + n) % n)];
-    const double length = std::hypot(d.x, d.y);
-    if (length == 0) continue;
-    const cv::Point2d across(-d.y / length * kStepReachPx, d.x / length * kStepReachPx);
-    const cv::Point2d at = r.outer[static_cast<size_t>(i)];
-    const cv::Point a(static_cast<int>(std::lround(at.x + across.x)),
-                      static_cast<int>(std::lround(at.y + across.y)));
-    const cv::Point b(static_cast<int>(std::lround(at.x - across.x)),
-                      static_cast<int>(std::lround(at.y - across.y)));
-    if (!box.contains(a) || !box.contains(b)) continue;
+  for (int i = 0; i < static_cast<int>(r.outer.size()); i += kStepEveryPx) {
+    const int step = stepAcrossOutline(r.outer, i, r.grey, r.grey_origin, kStepReachPx);
+    if (step < 0) continue;
     ++read;
-    const int step = static_cast<int>(r.grey.at<uint8_t>(a - r.grey_origin)) -
-                     static_cast<int>(r.grey.at<uint8_t>(b - r.grey_origin));
-    stepped += std::abs(step) >= kMinStep ? 1 : 0;
+    stepped += step >= kMinStep ? 1 : 0;
   }
   return read == 0 || stepped >= kMinSteppedShare * read;
 }

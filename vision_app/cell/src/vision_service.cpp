@@ -503,42 +503,117 @@ LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
 constexpr int kNeckPx = 5;
 constexpr double kMaxAppendageShare = 0.2;
 constexpr double kMinSolidShare = 0.5;
+// A stretch of the surface can also lie against the part along a wider
+// neck: a blotch of the belt beside a limb, taught in a dim spot at 30 grey
+// levels (800 px on a 13400 px part, 6 to 10 px across, one pinhole: the
+// model's origin came out 4.5 px off and its copies went unfound when
+// touching). Such a stretch tells itself by its outline: away from the
+// part, nowhere a step, where the part's own limbs step along 86 to 100 %
+// of theirs (the front-light benchmark's teach frames, every condition).
+// Necks up to kWideNeckPx are tried, a piece being dropped when under
+// kMaxSurfaceSteppedShare of its free outline steps.
+constexpr int kWideNeckPx = 15;
+constexpr double kMaxSurfaceSteppedShare = 0.5;
+// Steps are read as vision::outlineSteps reads them, kStepReachPx either
+// side of the outline, at least kMinReads times along the free outline. A
+// step is half the part's own (the median across its whole outline) or
+// kMinStep grey levels, whichever is more: a blotch darker than the
+// noise's reach still falls off over many pixels (a dip of two thirds of
+// the contrast, blurred by 6 px, stepped 0 to 22 levels where the part's
+// edge stepped 15 across the same reach).
+constexpr int kStepReachPx = 3;
+constexpr int kMinStep = 8;
+constexpr int kMinReads = 8;
 
-// Takes such appendages off region `r` in `mask` (frame pixels, in place);
-// the pixels taken off.
-int cutSpeckledAppendages(const vision::Region& r, cv::Mat& mask) {
-  if (r.holes == 0) return 0;
-  const int margin = kNeckPx;
+// The pieces of `own` (a region's pixels, CV_8U) beyond its body: what
+// survives an opening by a disc `neck_px` across, its largest piece, and
+// the pixels of `own` beside that.
+struct Appendages {
+  cv::Mat opened;  // own opened by the neck
+  cv::Mat kept;    // the body, with own's pixels beside it
+  cv::Mat pieces;  // CV_32S labels of own & ~kept, 1..count
+  int count = 0;
+};
+
+std::optional<Appendages> appendagesOf(const cv::Mat& own, int neck_px) {
+  Appendages a;
+  const cv::Mat neck = cv::getStructuringElement(cv::MORPH_ELLIPSE, {neck_px, neck_px});
+  cv::morphologyEx(own, a.opened, cv::MORPH_OPEN, neck);
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(a.opened, labels, stats, centroids, 8);
+  if (n < 2) return std::nullopt;
+  int body = 1;
+  for (int k = 2; k < n; ++k) {
+    if (stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(body, cv::CC_STAT_AREA)) body = k;
+  }
+  cv::dilate(labels == body, a.kept, neck);
+  a.kept &= own;
+  a.count = cv::connectedComponents(own & ~a.kept, a.pieces, 8) - 1;
+  return a;
+}
+
+// The part's own step across its edge: the median over `outline` (most of
+// which is the part's edge, whatever hangs on it).
+int medianStep(const std::vector<cv::Point>& outline, const cv::Mat& grey) {
+  std::vector<int> steps;
+  for (int i = 0; i < static_cast<int>(outline.size()); i += 2) {
+    const int step = vision::stepAcrossOutline(outline, i, grey, {0, 0}, kStepReachPx);
+    if (step >= 0) steps.push_back(step);
+  }
+  if (steps.empty()) return 0;
+  const auto mid = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), mid, steps.end());
+  return *mid;
+}
+
+// The share of `piece`'s outline away from `kept` (more than a pixel off
+// it) that is a step of `min_step` or more in `grey` (same box); -1 when
+// read too few times.
+double freeSteppedShare(const cv::Mat& piece, const cv::Mat& kept, const cv::Mat& grey,
+                        int min_step) {
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(piece.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  cv::Mat near;
+  cv::dilate(kept, near, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  int read = 0;
+  int stepped = 0;
+  for (const auto& c : contours) {
+    for (int i = 0; i < static_cast<int>(c.size()); i += 2) {
+      if (near.at<uint8_t>(c[static_cast<size_t>(i)]) != 0) continue;
+      const int step = vision::stepAcrossOutline(c, i, grey, {0, 0}, kStepReachPx);
+      if (step < 0) continue;
+      ++read;
+      stepped += step >= min_step ? 1 : 0;
+    }
+  }
+  return read < kMinReads ? -1.0 : static_cast<double>(stepped) / read;
+}
+
+// What cutAppendages took off (pixels): speckle on a narrow neck, and
+// stretches of the surface without an edge on a wider one.
+struct AppendageCut {
+  int speckled_px = 0;
+  int surface_px = 0;
+};
+
+// Takes such appendages off region `r` in `mask` (frame pixels, in place;
+// `grey` the frame it was binarized from).
+AppendageCut cutAppendages(const vision::Region& r, cv::Mat& mask, const cv::Mat& grey) {
+  const int margin = kWideNeckPx;
   const cv::Rect box = (r.bbox + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
                        cv::Rect({0, 0}, mask.size());
   cv::Mat filled = cv::Mat::zeros(box.size(), CV_8U);
   cv::drawContours(filled, std::vector<std::vector<cv::Point>>{r.outer}, 0, cv::Scalar(255),
                    cv::FILLED, cv::LINE_8, cv::noArray(), INT_MAX, -box.tl());
   const cv::Mat own = filled & (mask(box) != 0);
-  // The part's body: what survives an opening by the neck's width, its
-  // largest piece, and the pixels of the region beside it.
-  const cv::Mat neck = cv::getStructuringElement(cv::MORPH_ELLIPSE, {kNeckPx, kNeckPx});
-  cv::Mat opened;
-  cv::morphologyEx(own, opened, cv::MORPH_OPEN, neck);
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(opened, labels, stats, centroids, 8);
-  if (n < 2) return 0;
-  int body = 1;
-  for (int k = 2; k < n; ++k) {
-    if (stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(body, cv::CC_STAT_AREA)) body = k;
-  }
-  cv::Mat kept;
-  cv::dilate(labels == body, kept, neck);
-  kept &= own;
-  // What hangs on beyond it, piece by piece: dropped when holed and small.
-  const cv::Mat rest = own & ~kept;
   const double own_area = cv::countNonZero(own);
-  cv::Mat pieces;
-  const int m = cv::connectedComponents(rest, pieces, 8);
   cv::Mat dropped = cv::Mat::zeros(box.size(), CV_8U);
+  // A speckled appendage on a narrow neck: what hangs on beyond the body,
+  // piece by piece, dropped when holed and small.
   std::vector<int> crumbs;  // pieces too small to be a pin: the speckle's crumbs
-  for (int k = 1; k < m; ++k) {
-    const cv::Mat piece = pieces == k;
+  const auto narrow = r.holes > 0 ? appendagesOf(own, kNeckPx) : std::nullopt;
+  for (int k = 1; narrow && k <= narrow->count; ++k) {
+    const cv::Mat piece = narrow->pieces == k;
     const int area = cv::countNonZero(piece);
     if (area > kMaxAppendageShare * own_area) continue;
     if (area < kNeckPx * kNeckPx) crumbs.push_back(k);
@@ -555,12 +630,33 @@ int cutSpeckledAppendages(const vision::Region& r, cv::Mat& mask) {
     // Mostly thinner than the neck too (a mesh of specks), or riddled with
     // pinholes (a blotch the threshold speckled); a lobe of the part's own
     // (a ring on a thin stem) is solid round a hole or two.
-    const bool solid = cv::countNonZero(piece & opened) >= kMinSolidShare * area;
+    const bool solid = cv::countNonZero(piece & narrow->opened) >= kMinSolidShare * area;
     if (holes > 0 && (!solid || pinholes >= kMinPinholes)) dropped.setTo(255, piece);
   }
-  if (cv::countNonZero(dropped) == 0) return 0;
-  for (const int k : crumbs) dropped.setTo(255, pieces == k);
-  const int cut = cv::countNonZero(dropped);
+  AppendageCut out;
+  if (cv::countNonZero(dropped) > 0) {
+    for (const int k : crumbs) dropped.setTo(255, narrow->pieces == k);
+    out.speckled_px = cv::countNonZero(dropped);
+  }
+  // Then a stretch of the surface on a wider neck, its outline no step.
+  const cv::Mat surface = grey(box);
+  std::vector<cv::Point> outline(r.outer.size());
+  std::transform(r.outer.begin(), r.outer.end(), outline.begin(),
+                 [&](const cv::Point& p) { return p - box.tl(); });
+  const int min_step = std::max(kMinStep, medianStep(outline, surface) / 2);
+  for (int neck = kNeckPx + 2; neck <= kWideNeckPx; neck += 2) {
+    const cv::Mat left = own & ~dropped;
+    const auto wide = appendagesOf(left, neck);
+    for (int k = 1; wide && k <= wide->count; ++k) {
+      const cv::Mat piece = wide->pieces == k;
+      const int area = cv::countNonZero(piece);
+      if (area > kMaxAppendageShare * own_area || area < kNeckPx * kNeckPx) continue;
+      const double share = freeSteppedShare(piece, wide->kept, surface, min_step);
+      if (share >= 0 && share < kMaxSurfaceSteppedShare) dropped.setTo(255, piece);
+    }
+  }
+  out.surface_px = cv::countNonZero(dropped) - out.speckled_px;
+  if (out.speckled_px + out.surface_px == 0) return out;
   mask(box).setTo(0, dropped);
   // Pinholes the appendage closed against the part at its neck: the
   // surface between specks, not a hole of the part.
@@ -579,7 +675,7 @@ int cutSpeckledAppendages(const vision::Region& r, cv::Mat& mask) {
       cv::drawContours(mask(box), contours, static_cast<int>(i), cv::Scalar(255), cv::FILLED);
     }
   }
-  return cut;
+  return out;
 }
 
 // What LEARN left out, for its reply (sensor pixels).
@@ -829,15 +925,16 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
                        "no part inside LEARN AT " + sensorRectText(*at));
     }
     LearnRegions seen = sortForLearn(regions, inside, grey, mask);
-    int appendage_px = 0;
+    AppendageCut appendages;
     if (seen.others.empty() && !inside.empty()) {
       cv::Mat cut = mask.clone();
-      appendage_px = cutSpeckledAppendages(regions[seen.part], cut);
-      auto cut_regions = appendage_px > 0 ? vision::findRegions(cut, o.regions, grey)
-                                          : std::vector<vision::Region>{};
+      appendages = cutAppendages(regions[seen.part], cut, grey);
+      const bool any = appendages.speckled_px + appendages.surface_px > 0;
+      auto cut_regions =
+          any ? vision::findRegions(cut, o.regions, grey) : std::vector<vision::Region>{};
       auto cut_inside = regionsInside(cut_regions, rect);
       if (cut_inside.empty()) {
-        appendage_px = 0;  // nothing cut, or nothing left: the region as it was
+        appendages = {};  // nothing cut, or nothing left: the region as it was
       } else {
         mask = cut;
         regions = std::move(cut_regions);
@@ -910,11 +1007,17 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     out.warnings = learnWarnings(r, grey, mask, mapping, options);
     if (auto alike = lookAlikeWarning(r, *frame_models, type)) out.warnings.push_back(*alike);
     if (!seen.specks.empty()) out.notes.push_back(specksNote(regions, seen.specks, mapping));
-    if (appendage_px > 0) {
-      out.notes.push_back("left out " +
-                          std::to_string(std::lround(mapping.areaToSensor(appendage_px))) +
-                          " px of speckled surface joined to the part by a neck under " +
-                          std::to_string(kNeckPx) + " px (its pinholes are not the part's)");
+    if (appendages.speckled_px > 0) {
+      out.notes.push_back(
+          "left out " + std::to_string(std::lround(mapping.areaToSensor(appendages.speckled_px))) +
+          " px of speckled surface joined to the part by a neck under " + std::to_string(kNeckPx) +
+          " px (its pinholes are not the part's)");
+    }
+    if (appendages.surface_px > 0) {
+      out.notes.push_back(
+          "left out " + std::to_string(std::lround(mapping.areaToSensor(appendages.surface_px))) +
+          " px of surface joined to the part by a neck under " + std::to_string(kWideNeckPx) +
+          " px, its outline no edge (a stretch of the surface as dark as the part)");
     }
     return out;
   }

@@ -106,6 +106,14 @@ double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& r
 // grey image, where nothing says otherwise.
 bool outlineSteps(const Region& r);
 
+// How far `grey` steps across `outline` at its `i`th point: the difference
+// of the levels `reach_px` either side of it, square to the outline there
+// (its direction read 2 points either way); -1 where it has none or a side
+// falls outside `grey`. `grey`'s top-left pixel is `grey_origin` in the
+// outline's coordinates.
+int stepAcrossOutline(const std::vector<cv::Point>& outline, int i, const cv::Mat& grey,
+                      cv::Point grey_origin, int reach_px);
+
 // Orientation of a region from its moments and outer boundary (see Region).
 double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
                       const std::vector<cv::Point>& outer);
