@@ -1010,6 +1010,36 @@ TEST_CASE("LEARN leaves out a speckled stretch of the surface hung on the part b
     }
   }
 
+  // Where the speckle ran along the part's edge a pixel off it, the slit
+  // between them stays closed once the speckle beyond the neck is cut: the
+  // surface, not a hole of the part. A plain bar, the speckle hung below it
+  // by a 3 px neck, its top row 2 px under the bar's edge and joined to it
+  // at both ends.
+  {
+    cv::Mat bar(kSide, kSide, CV_8U, cv::Scalar(look.background_level));
+    const cv::Scalar dark(part_level);
+    const cv::Rect body(200, 220, 200, 110);
+    cv::rectangle(bar, body, dark, cv::FILLED);
+    const int edge = body.y + body.height;  // first row under the bar
+    cv::rectangle(bar, cv::Rect(290, edge + 1, 14, 1), dark, cv::FILLED);  // the row
+    cv::rectangle(bar, cv::Rect(290, edge, 1, 1), dark, cv::FILLED);       // its ends
+    cv::rectangle(bar, cv::Rect(303, edge, 1, 1), dark, cv::FILLED);
+    hangSpeckledStretch(bar, {{296, edge + 1}}, 3, part_level);
+    cv::Mat noise(bar.size(), CV_8S);
+    cv::randn(noise, 0, 2);
+    bar += noise;  // saturating, as a sensor's noise
+    cv::GaussianBlur(bar, bar, cv::Size(), 0.7);
+    const auto slit =
+        learnInImage(bar, {}, cellOptions(), noModels(), 1, "bar", cv::Rect(170, 190, 260, 230));
+    INFO((slit.ok() ? std::string() : slit.error().message));
+    REQUIRE(slit.ok());
+    const bool cut = std::any_of(slit->notes.begin(), slit->notes.end(), [](const auto& n) {
+      return n.find("speckled surface") != std::string::npos;
+    });
+    CHECK(cut);
+    CHECK(slit->model.body.holes == 0);
+  }
+
   // A ring on a thin stem is the part's own, its hole too: kept.
   cv::Mat ringed = ps::renderSilhouetteAlone(type, kSide, look, 11, &drawn, 30);
   const auto outline = sharpOutline(type, kSide, 30);

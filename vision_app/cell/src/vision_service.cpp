@@ -527,7 +527,7 @@ constexpr int kMinReads = 8;
 
 // The pieces of `own` (a region's pixels, CV_8U) beyond its body: what
 // survives an opening by a disc `neck_px` across, its largest piece, and
-// the pixels of `own` beside that.
+// the pixels of `own` within kNeckPx / 2 of that.
 struct Appendages {
   cv::Mat opened;  // own opened by the neck
   cv::Mat kept;    // the body, with own's pixels beside it
@@ -546,7 +546,11 @@ std::optional<Appendages> appendagesOf(const cv::Mat& own, int neck_px) {
   for (int k = 2; k < n; ++k) {
     if (stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(body, cv::CC_STAT_AREA)) body = k;
   }
-  cv::dilate(labels == body, a.kept, neck);
+  // Grown back by the narrow neck only: grown by a wide one, the body took
+  // back the stretch of surface lying against it that far (the blotch's
+  // remnant held a model's origin 0.3 px off).
+  cv::dilate(labels == body, a.kept,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, {kNeckPx, kNeckPx}));
   a.kept &= own;
   a.count = cv::connectedComponents(own & ~a.kept, a.pieces, 8) - 1;
   return a;
