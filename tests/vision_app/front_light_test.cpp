@@ -1109,9 +1109,10 @@ TEST_CASE("LEARN leaves out a stretch of the surface lying against a limb, its o
     REQUIRE(learned.ok());
     // The part's own area (the grey rim adds some tens of pixels on every
     // teach image), and its origin where its centroid is but for what is
-    // left of the blotch at the neck (0.05 to 0.34 px here; taken in, 6 px).
+    // left of the blotch at the neck: 0.15 to 0.19 px here (the body grown
+    // back by the wide neck kept more of it: up to 0.34; taken in, 6 px).
     CHECK(learned->model.body.area < truth.area + 150);
-    CHECK(cv::norm(learned->model.trained_centroid - truth.centroid) < 0.5);
+    CHECK(cv::norm(learned->model.trained_centroid - truth.centroid) < 0.3);
     const bool said = std::any_of(learned->notes.begin(), learned->notes.end(), [](const auto& n) {
       return n.find("its outline no edge") != std::string::npos;
     });
