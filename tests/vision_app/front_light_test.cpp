@@ -1013,8 +1013,8 @@ TEST_CASE("LEARN leaves out a speckled stretch of the surface hung on the part b
   // Where the speckle ran along the part's edge a pixel off it, the slit
   // between them stays closed once the speckle beyond the neck is cut: the
   // surface, not a hole of the part. A plain bar, the speckle hung below it
-  // by a 3 px neck, its top row 2 px under the bar's edge and joined to it
-  // at both ends.
+  // by a 3 px neck, its top row a pixel below the bar and joined to it at
+  // both ends.
   {
     cv::Mat bar(kSide, kSide, CV_8U, cv::Scalar(look.background_level));
     const cv::Scalar dark(part_level);
