@@ -1109,10 +1109,12 @@ TEST_CASE("LEARN leaves out a stretch of the surface lying against a limb, its o
     REQUIRE(learned.ok());
     // The part's own area (the grey rim adds some tens of pixels on every
     // teach image), and its origin where its centroid is but for what is
-    // left of the blotch at the neck: 0.15 to 0.19 px here (the body grown
-    // back by the wide neck kept more of it: up to 0.34; taken in, 6 px).
-    CHECK(learned->model.body.area < truth.area + 150);
-    CHECK(cv::norm(learned->model.trained_centroid - truth.centroid) < 0.3);
+    // left of the blotch at the neck or taken with it off the limb: 0.15
+    // to 0.19 px here built by gcc, up to 0.48 by clang (whose binarization
+    // of the same image differs by a few pixels: one limb lost 110 px with
+    // the blotch); taken in, 6 px.
+    CHECK(std::abs(learned->model.body.area - truth.area) < 150);
+    CHECK(cv::norm(learned->model.trained_centroid - truth.centroid) < 0.6);
     const bool said = std::any_of(learned->notes.begin(), learned->notes.end(), [](const auto& n) {
       return n.find("its outline no edge") != std::string::npos;
     });
