@@ -1047,16 +1047,14 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
 
 // A region whose outline is nowhere a step is a patch of the surface's own
 // light that the threshold took in (a vignetted corner, a blotch of a
-// textured belt, under front light), not parts: read kStepReachPx either
-// side of its outline, a part's levels differ by tens of grey levels (13
-// to 36 on the front-light benchmark's 30-level contrast, touching and
+// textured belt, under front light), not parts: read kOutlineStepReachPx
+// either side of its outline, a part's levels differ by tens of grey levels
+// (13 to 36 on the front-light benchmark's 30-level contrast, touching and
 // separated), such a patch's by 2 to 4. One such patch cost a low-contrast
 // frame 17 ms in the blob search, its 24 edge fits, none placed. A region
-// steps when at least kMinSteppedShare of its outline steps by kMinStep:
-// a part in it takes up more of its outline than that, while noise of 3
-// grey levels steps so across 8 % of a flat patch's.
-constexpr int kMinStep = 8;
-constexpr int kStepReachPx = 3;
+// steps when at least kMinSteppedShare of its outline steps by
+// kOutlineMinStep: a part in it takes up more of its outline than that,
+// while noise of 3 grey levels steps so across 8 % of a flat patch's.
 constexpr int kStepEveryPx = 4;
 constexpr double kMinSteppedShare = 0.2;
 
@@ -1086,10 +1084,10 @@ bool outlineSteps(const Region& r) {
   int read = 0;
   int stepped = 0;
   for (int i = 0; i < static_cast<int>(r.outer.size()); i += kStepEveryPx) {
-    const int step = stepAcrossOutline(r.outer, i, r.grey, r.grey_origin, kStepReachPx);
+    const int step = stepAcrossOutline(r.outer, i, r.grey, r.grey_origin, kOutlineStepReachPx);
     if (step < 0) continue;
     ++read;
-    stepped += step >= kMinStep ? 1 : 0;
+    stepped += step >= kOutlineMinStep ? 1 : 0;
   }
   return read == 0 || stepped >= kMinSteppedShare * read;
 }

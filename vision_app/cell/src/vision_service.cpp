@@ -508,21 +508,20 @@ constexpr double kMinSolidShare = 0.5;
 // levels (800 px on a 13400 px part, 6 to 10 px across, one pinhole: the
 // model's origin came out 4.5 px off and its copies went unfound when
 // touching). Such a stretch tells itself by its outline: away from the
-// part, nowhere a step, where the part's own limbs step along 86 to 100 %
-// of theirs (the front-light benchmark's teach frames, every condition).
-// Necks up to kWideNeckPx are tried, a piece being dropped when under
-// kMaxSurfaceSteppedShare of its free outline steps.
+// part, nowhere a step, where the part's own limbs step along theirs (on
+// the front-light benchmark's teach frames, read by 8 grey levels, limbs
+// along 86 to 100 %, the blotch 29 to 32 %). Necks up to kWideNeckPx are
+// tried, a piece being dropped when under kMaxSurfaceSteppedShare of its
+// free outline steps.
 constexpr int kWideNeckPx = 15;
 constexpr double kMaxSurfaceSteppedShare = 0.5;
-// Steps are read as vision::outlineSteps reads them, kStepReachPx either
-// side of the outline, at least kMinReads times along the free outline. A
-// step is half the part's own (the median across its whole outline) or
-// kMinStep grey levels, whichever is more: a blotch darker than the
-// noise's reach still falls off over many pixels (a dip of two thirds of
-// the contrast, blurred by 6 px, stepped 0 to 22 levels where the part's
-// edge stepped 15 across the same reach).
-constexpr int kStepReachPx = 3;
-constexpr int kMinStep = 8;
+// Steps are read as vision::outlineSteps reads them
+// (vision::kOutlineStepReachPx either side), at least kMinReads times
+// along the free outline. A step is half the part's own (the median across
+// its whole outline) or vision::kOutlineMinStep grey levels, whichever is
+// more: a blotch darker than the noise's reach still falls off over many
+// pixels (a dip of two thirds of the contrast, blurred by 6 px, stepped 0
+// to 22 levels where the part's edge stepped 15 across the same reach).
 constexpr int kMinReads = 8;
 
 // The pieces of `own` (a region's pixels, CV_8U) beyond its body: what
@@ -561,7 +560,8 @@ std::optional<Appendages> appendagesOf(const cv::Mat& own, int neck_px) {
 int medianStep(const std::vector<cv::Point>& outline, const cv::Mat& grey) {
   std::vector<int> steps;
   for (int i = 0; i < static_cast<int>(outline.size()); i += 2) {
-    const int step = vision::stepAcrossOutline(outline, i, grey, {0, 0}, kStepReachPx);
+    const int step =
+        vision::stepAcrossOutline(outline, i, grey, {0, 0}, vision::kOutlineStepReachPx);
     if (step >= 0) steps.push_back(step);
   }
   if (steps.empty()) return 0;
@@ -584,7 +584,7 @@ double freeSteppedShare(const cv::Mat& piece, const cv::Mat& kept, const cv::Mat
   for (const auto& c : contours) {
     for (int i = 0; i < static_cast<int>(c.size()); i += 2) {
       if (near.at<uint8_t>(c[static_cast<size_t>(i)]) != 0) continue;
-      const int step = vision::stepAcrossOutline(c, i, grey, {0, 0}, kStepReachPx);
+      const int step = vision::stepAcrossOutline(c, i, grey, {0, 0}, vision::kOutlineStepReachPx);
       if (step < 0) continue;
       ++read;
       stepped += step >= min_step ? 1 : 0;
@@ -647,7 +647,7 @@ AppendageCut cutAppendages(const vision::Region& r, cv::Mat& mask, const cv::Mat
   std::vector<cv::Point> outline(r.outer.size());
   std::transform(r.outer.begin(), r.outer.end(), outline.begin(),
                  [&](const cv::Point& p) { return p - box.tl(); });
-  const int min_step = std::max(kMinStep, medianStep(outline, surface) / 2);
+  const int min_step = std::max(vision::kOutlineMinStep, medianStep(outline, surface) / 2);
   for (int neck = kNeckPx + 2; neck <= kWideNeckPx; neck += 2) {
     const cv::Mat left = own & ~dropped;
     const auto wide = appendagesOf(left, neck);

@@ -106,6 +106,13 @@ double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& r
 // grey image, where nothing says otherwise.
 bool outlineSteps(const Region& r);
 
+// A step across a region's outline, as outlineSteps reads it: the levels
+// kOutlineStepReachPx either side of it differ by kOutlineMinStep or more
+// (a part's edge at 30 grey levels of contrast steps by 13 to 36, a patch
+// of the surface's light by 2 to 4).
+constexpr int kOutlineStepReachPx = 3;
+constexpr int kOutlineMinStep = 8;
+
 // How far `grey` steps across `outline` at its `i`th point: the difference
 // of the levels `reach_px` either side of it, square to the outline there
 // (its direction read 2 points either way); -1 where it has none or a side
