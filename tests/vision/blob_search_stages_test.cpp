@@ -673,3 +673,29 @@ TEST_CASE("blob search: a part touching an untaught shape at a point is found ab
   CHECK(c.model == &disc_model);
   CHECK(std::hypot(c.pose.centre.x - disc_at.x, c.pose.centre.y - disc_at.y) < 0.5);
 }
+
+TEST_CASE("an outline's edge is bridged across the samples that found no crossing",
+          "[vision][edge_fit]") {
+  using picksight::vision::touching::bridgedOffsets;
+  const auto none = std::nullopt;
+  // A straight run between the crossings either side of a gap.
+  const auto inner = bridgedOffsets({1.0, none, none, 4.0});
+  REQUIRE(inner.size() == 4);
+  CHECK(inner[1] == Approx(2.0));
+  CHECK(inner[2] == Approx(3.0));
+  // Round the loop's start: the gap at 0 lies between samples 4 and 1, the
+  // one at 5 between 4 and 1 the other way; crossings themselves kept.
+  const auto round = bridgedOffsets({none, 2.0, none, none, 5.0, none});
+  REQUIRE(round.size() == 6);
+  CHECK(round[0] == Approx(3.0));  // 2 steps from 5.0, 1 from 2.0
+  CHECK(round[1] == Approx(2.0));
+  CHECK(round[2] == Approx(3.0));
+  CHECK(round[3] == Approx(4.0));
+  CHECK(round[4] == Approx(5.0));
+  CHECK(round[5] == Approx(4.0));
+  // One crossing in the loop: the boundary moved by it all round; none:
+  // the boundary as it is.
+  const auto one = bridgedOffsets({none, -0.5, none});
+  CHECK(one == std::vector<double>{-0.5, -0.5, -0.5});
+  CHECK(bridgedOffsets({none, none}) == std::vector<double>{0.0, 0.0});
+}

@@ -271,6 +271,42 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
   return fit;
 }
 
+namespace touching {
+std::vector<double> bridgedOffsets(const std::vector<std::optional<double>>& crossings) {
+  const size_t n = crossings.size();
+  std::vector<double> out(n, 0.0);
+  // The last crossing read before each sample, going round the loop once
+  // first so that a gap over the loop's start knows its near end too.
+  std::optional<size_t> last;
+  for (size_t k = 0; k < 2 * n; ++k) {
+    if (crossings[k % n]) last = k % n;
+  }
+  if (!last) return out;  // none read: the boundary as it is
+  std::vector<size_t> before(n);
+  for (size_t k = 0; k < n; ++k) {
+    if (crossings[k]) last = k;
+    before[k] = *last;
+  }
+  std::optional<size_t> next;
+  for (size_t k = 2 * n; k-- > 0;) {
+    if (crossings[k % n]) next = k % n;
+    if (k < n) {
+      const size_t a = before[k];
+      const size_t b = *next;
+      if (crossings[k]) {
+        out[k] = *crossings[k];
+        continue;
+      }
+      // Steps round the loop from a to k and from k to b.
+      const double da = static_cast<double>((k + n - a) % n);
+      const double db = static_cast<double>((b + n - k) % n);
+      out[k] = (*crossings[a] * db + *crossings[b] * da) / (da + db);
+    }
+  }
+  return out;
+}
+}  // namespace touching
+
 std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region& region,
                                            const ImagePose& pose, double search_px) {
   const Coverage cov(region);
@@ -282,9 +318,12 @@ std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region&
   for (const auto& loop : model.loops) {
     const bool left_interior = loopOrientation(loop) > 0;
     // Every kFitStepPx along each primitive, to its ends (the polygon must
-    // close round corners too): where the edge crosses, or the boundary
-    // itself where it does not cleanly (about the pose's centre).
+    // close round corners too): where the edge crosses, and where it does
+    // not cleanly, the boundary moved by the crossings either side (about
+    // the pose's centre).
     std::vector<cv::Point2d> points;
+    std::vector<cv::Point2d> normals;
+    std::vector<std::optional<double>> crossings;
     for (const auto& p : loop.primitives) {
       const double length = p.length();
       const int count = std::max(1, static_cast<int>(std::ceil(length / kFitStepPx)));
@@ -292,12 +331,15 @@ std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region&
         const double t = static_cast<double>(i) / count;
         const cv::Point2d m = p.pointAt(t);
         const cv::Point2d a = awayNormal(p, t, left_interior, loop.hole);
-        const cv::Point2d r = rotate({m.x, flip * m.y}, c, s);
-        const cv::Point2d n = rotate({a.x, flip * a.y}, c, s);
-        const auto crossing = edgeCrossing(cov, pose.centre + r, n, search_px, 0.0, 0.25, true);
-        points.push_back(r + n * crossing.value_or(0.0));
+        points.push_back(rotate({m.x, flip * m.y}, c, s));
+        normals.push_back(rotate({a.x, flip * a.y}, c, s));
+        crossings.push_back(
+            edgeCrossing(cov, pose.centre + points.back(), normals.back(), search_px, 0.0, 0.25,
+                         true));
       }
     }
+    const std::vector<double> along = bridgedOffsets(crossings);
+    for (size_t i = 0; i < points.size(); ++i) points[i] += normals[i] * along[i];
     // The polygon's area and first moments (the shoelace sums, twice the
     // area and six times the moments), counted positive for the outer loop
     // and negative for holes whichever way round they run.

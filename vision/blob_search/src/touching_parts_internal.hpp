@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -29,6 +30,16 @@ inline cv::Point2d rotate(cv::Point2d p, double c, double s) {
 // Twice the signed area of a loop: > 0 when its interior lies on the side of
 // the left normal (-t.y, t.x) of the walking direction t.
 double loopOrientation(const BoundaryLoop& loop);
+
+// Offsets along a closed loop's normals, one a sample: each sample's edge
+// crossing where it has one, and where it has none, the crossings of the
+// nearest samples either side that have, weighed by how near each lies
+// round the loop (a straight run between them). All 0 when no sample has
+// one. A gap in the crossings (a corner, a notch deeper than the search, a
+// stretch of noise at low contrast) is read as the edge it lies on, not as
+// the model's boundary, which deviates from a rough outline by up to the
+// conformity.
+std::vector<double> bridgedOffsets(const std::vector<std::optional<double>>& crossings);
 
 // A corner as an unordered pair of edges leaving a point, so that it reads
 // the same on a mirrored model: the bisector of the two edges, the opening

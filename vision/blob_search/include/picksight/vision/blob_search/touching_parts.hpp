@@ -48,8 +48,14 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
 
 // The centroid of the area the region's grey-level edges enclose (image
 // coordinates), read along the normals of the model's boundary placed at
-// `pose`, within `search_px` of it (the boundary itself where no clean
-// crossing is: a contact, a corner); none for a model of no area.
+// `pose`, within `search_px` of it; where no clean crossing is (a contact,
+// a corner, a notch deeper than the search, noise at low contrast), the
+// boundary moved by the crossings either side, interpolated along it. The
+// boundary itself there left the teach image's tenths of a pixel of a
+// furred outline out, the same on every view of it: at 30 grey levels
+// 3.5 % of the samples had no crossing, and the parts were placed 0.071 px
+// off (0.14 px one type, every view alike), 0.055 with the crossings
+// either side. None for a model of no area.
 std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region& region,
                                            const ImagePose& pose, double search_px = 1.5);
 
