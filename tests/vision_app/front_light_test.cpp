@@ -876,55 +876,6 @@ TEST_CASE("under uneven light a part's origin is where its edges put its centroi
   CHECK(std::sqrt(all_origin2) < 0.75 * std::sqrt(all_grey2));
 }
 
-TEST_CASE("at 30 grey levels a part's origin is read across the gaps in its edges",
-          "[vision_app][learn][front][accuracy]") {
-  // At 30 levels of contrast on a blotched belt, the edge of a furred
-  // outline gives no clean crossing at a few percent of the places its
-  // centroid is read (noise, the fur's notches): those are read from the
-  // crossings either side, not from the model's boundary, which cuts the
-  // fur's wiggles short. Drawings no benchmark teaches, taught on whole
-  // frames away from the vignetted corners (where the contrast falls to a
-  // few levels: teach where the light is best), five frames each.
-  const std::vector<std::pair<std::string, double>> files = {
-      {"shapes/tari1000/obj12_5.png", 220}, {"shapes/tari1000/obj19_5.png", 210},
-      {"shapes/tari1000/obj23_5.png", 230}, {"shapes/tari1000/obj28_5.png", 200},
-      {"shapes/tari1000/obj36_5.png", 220}, {"shapes/tari1000/obj44_5.png", 210}};
-  const std::vector<cv::Point2d> spots = {{420, 260}, {860, 280}, {500, 450},
-                                          {780, 440}, {640, 360}, {560, 300}};
-  ps::SilhouetteSceneOptions look = lookOf("low-contrast");
-  look.width = 1280;
-  look.height = 720;
-  ps::SilhouetteSceneOptions sharp;
-  sharp.width = look.width;
-  sharp.height = look.height;
-  sharp.noise_sigma = 0;
-  sharp.uneven_light = false;
-  double origin2 = 0;
-  int taught = 0;
-  for (const uint64_t seed : {50, 150, 250, 350, 450}) {
-    for (size_t i = 0; i < files.size(); ++i) {
-      const ps::SilhouetteType type = drawing(files[i].first, files[i].second);
-      const double turn = 30 + 40.0 * static_cast<double>(i) + static_cast<double>(seed);
-      cv::Point2d drawn;
-      const cv::Mat frame =
-          ps::renderSilhouetteInFrame(type, look, seed + i, spots[i], &drawn, turn);
-      auto learned = learnInImage(frame, {}, cellOptions(), noModels(), 1, "part",
-                                  boxAround(drawn, files[i].second));
-      REQUIRE(learned.ok());
-      const cv::Point2d truth =
-          regionAt(ps::renderSilhouetteInFrame(type, sharp, 1, spots[i], &drawn, turn), drawn)
-              .centroid;
-      const cv::Point2d origin = learned->model.trained_centroid - truth;
-      origin2 += origin.dot(origin);
-      ++taught;
-    }
-  }
-  const double rms = std::sqrt(origin2 / taught);
-  INFO("origin RMS " << rms << " px");
-  // Measured (gcc): 0.062 px; 0.084 with the model's boundary in the gaps.
-  CHECK(rms <= 0.072);
-}
-
 TEST_CASE("views move the origin to the median of their readings and survive the model file",
           "[vision_app][learn][views]") {
   cv::Point2d drawn;

@@ -333,9 +333,8 @@ std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region&
         const cv::Point2d a = awayNormal(p, t, left_interior, loop.hole);
         points.push_back(rotate({m.x, flip * m.y}, c, s));
         normals.push_back(rotate({a.x, flip * a.y}, c, s));
-        crossings.push_back(
-            edgeCrossing(cov, pose.centre + points.back(), normals.back(), search_px, 0.0, 0.25,
-                         true));
+        crossings.push_back(edgeCrossing(cov, pose.centre + points.back(), normals.back(),
+                                         search_px, 0.0, 0.25, true));
       }
     }
     const std::vector<double> along = bridgedOffsets(crossings);
