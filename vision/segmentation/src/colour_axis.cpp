@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace picksight::vision {
 namespace {
@@ -37,8 +38,7 @@ cv::Vec3d medianColour(std::vector<cv::Vec3b>& pixels) {
 
 cv::Mat projectOnColourAxes(const cv::Mat& bgr, const std::vector<ColourAxis>& axes) {
   CV_Assert(bgr.type() == CV_8UC3);
-  cv::Mat out;
-  // Each projection costs a pass over the frame's three channels (3-4 ms at
+  // Each projection costs a pass over the frame's three channels (2-4 ms at
   // 1920x1080), and a cell teaches many types of one colour on one surface:
   // fifteen such axes cost 50 ms a frame. Axes whose two ends lie within
   // kSameAxis of an axis already projected give the same levels to within
@@ -51,25 +51,39 @@ cv::Mat projectOnColourAxes(const cv::Mat& bgr, const std::vector<ColourAxis>& a
     });
     if (!seen) distinct.push_back(&axis);
   }
+  // level = part + (background - part) * t, t = (p - part) . d / |d|^2: a
+  // linear map of the three channels, done by cv::transform.
+  std::vector<cv::Matx14d> maps;
   for (const ColourAxis* each : distinct) {
     const ColourAxis& axis = *each;
     const cv::Vec3d d = axis.background - axis.part;
     const double d2 = d.dot(d);
     if (d2 <= 0) continue;
-    // level = part + (background - part) * t, t = (p - part) . d / |d|^2: a
-    // linear map of the three channels, done by cv::transform at full speed.
     const double gain = (kColourBackgroundLevel - kColourPartLevel) / d2;
-    const cv::Matx14d m(gain * d[0], gain * d[1], gain * d[2],
-                        kColourPartLevel - gain * axis.part.dot(d));
-    cv::Mat one;
-    cv::transform(bgr, one, m);
-    if (out.empty()) {
-      out = one;
-    } else {
-      cv::min(out, one, out);
-    }
+    maps.emplace_back(gain * d[0], gain * d[1], gain * d[2],
+                      kColourPartLevel - gain * axis.part.dot(d));
   }
-  if (out.empty()) cv::cvtColor(bgr, out, cv::COLOR_BGR2GRAY);
+  cv::Mat out;
+  if (maps.empty()) {
+    cv::cvtColor(bgr, out, cv::COLOR_BGR2GRAY);
+    return out;
+  }
+  // cv::transform runs on one core: bands of rows on every core instead,
+  // each pixel mapped as before (a 1920x1080 frame's projection took 2.3 ms
+  // on one core, 1.2 ms in bands on two, the same levels; LOCATE on the
+  // front-light benchmark's colour frames, 14 types taught, median 16.2 ->
+  // 11.6 ms separated, 26.3 -> 22.1 touching).
+  out.create(bgr.size(), CV_8UC1);
+  cv::parallel_for_(cv::Range(0, bgr.rows), [&](const cv::Range& rows) {
+    const cv::Mat in = bgr.rowRange(rows.start, rows.end);
+    cv::Mat band = out.rowRange(rows.start, rows.end);
+    cv::transform(in, band, maps.front());
+    cv::Mat one;
+    for (size_t k = 1; k < maps.size(); ++k) {
+      cv::transform(in, one, maps[k]);
+      cv::min(band, one, band);
+    }
+  });
   return out;
 }
 
