@@ -55,7 +55,7 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
 // cuts a furred outline's wiggles short by up to the conformity and left
 // that out of every reading alike. On the front-light benchmark at 30 grey
 // levels 3.5 % of the samples found no crossing; taught with the boundary
-// there, parts separated were placed 0.071 px off (one type 0.14 px, with
+// there, parts separated were placed 0.068 px off (one type 0.14 px, with
 // 7 teach views still 0.11), with the crossings either side 0.055 (4
 // scenes; touching 0.071 -> 0.062, on wood 0.054 / 0.048 -> 0.048 / 0.042).
 // None for a model of no area.
