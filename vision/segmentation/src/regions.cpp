@@ -11,6 +11,7 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fill_contour.hpp"
 #include "picksight/common/angles.hpp"
 #include "picksight/vision/segmentation/row_runs.hpp"
 #include "picksight/vision/segmentation/shadows.hpp"
@@ -989,8 +990,7 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   if (!filled.empty()) {
     set = set.clone();
     for (const int h : filled) {
-      cv::drawContours(set, contours, h, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
-                       -box.tl());
+      fillContour(set, contours[static_cast<size_t>(h)], cv::Scalar(255), -box.tl());
     }
   }
   // The region's pixels over the box: the set pixels 8-connected to its

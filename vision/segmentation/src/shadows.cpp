@@ -10,6 +10,8 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fill_contour.hpp"
+
 namespace picksight::vision {
 namespace {
 // Pixels lighter than the part by this share of the contrast are the edge's
@@ -410,8 +412,7 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
                        frame;
   const cv::Mat g = grey(box);
   cv::Mat own = cv::Mat::zeros(box.size(), CV_8UC1);
-  cv::drawContours(own, contours, i, cv::Scalar(255), cv::FILLED, cv::LINE_8, cv::noArray(), 0,
-                   -box.tl());
+  fillContour(own, contours[static_cast<size_t>(i)], cv::Scalar(255), -box.tl());
   cv::bitwise_and(own, mask(box), own);
 
   Levels l;
