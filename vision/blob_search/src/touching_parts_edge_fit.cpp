@@ -57,6 +57,9 @@ constexpr double kPreciseEdgePx = 1.0;
 constexpr double kCornerClearancePx = 2.0;
 // See refinePoseOnEdges: the turn's ridge, relative to the shift's terms.
 constexpr double kTurnRidge = 1e-6;
+// How far either side of a primitive its teach image's edge is looked for
+// (measureEdgeOffsets): the conformity it was fitted within, and the blur.
+constexpr double kOffsetSearchPx = 1.5;
 
 using picksight::normalizeDeg;
 
@@ -184,7 +187,8 @@ std::vector<EdgeSample> edgeSamples(const PartModel& model, double step) {
     const bool left_interior = loopOrientation(loop) > 0;
     for (const auto& p : loop.primitives) {
       alongPrimitive(p, loop.primitives.size() == 1, loop.weight, step, [&](double t, double w) {
-        out.push_back({p.pointAt(t), awayNormal(p, t, left_interior, loop.hole), w});
+        out.push_back(
+            {p.pointAt(t), awayNormal(p, t, left_interior, loop.hole), w, p.edgeOffsetAt(t)});
       });
     }
   }
@@ -228,17 +232,19 @@ EdgeFit refinePoseOnEdges(const PartModel& model, const Region& region, const Im
       const EdgeSample& e = samples[i];
       const cv::Point2d r = rotate({e.point.x, flip * e.point.y}, c, s);
       const cv::Point2d n = rotate({e.normal.x, flip * e.normal.y}, c, s);
+      // Where the teach image's edge lay: off the primitive by e.offset.
+      const double expected = offset + e.offset;
       const auto crossing =
-          edgeCrossing(cov, fit.pose.centre + r, n, window, offset, kFitStepPx, dense);
-      if (!crossing || std::abs(*crossing - offset) > gate) continue;
-      const double residual = *crossing - offset;
+          edgeCrossing(cov, fit.pose.centre + r, n, window, expected, kFitStepPx, dense);
+      if (!crossing || std::abs(*crossing - expected) > gate) continue;
+      const double residual = *crossing - expected;
       found += e.weight;
       if (std::abs(residual) <= kPreciseEdgePx) precise += e.weight;
       sum2 += residual * residual;
       ++used;
       const cv::Vec4d j(n.x, n.y, n.x * -r.y + n.y * r.x, 1.0);
       a += e.weight * (j * j.t());
-      b += e.weight * *crossing * j;
+      b += e.weight * (*crossing - e.offset) * j;
     }
     if (used < 8) return fit;
     // Measured before the last update: it moves the pose by hundredths of a
@@ -426,6 +432,33 @@ void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Poi
         if (side(p.centre) * side(snapped.centre) < 0) continue;
       }
       p = snapped;
+    }
+  }
+}
+
+void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region,
+                        cv::Point2d origin) {
+  const Coverage cov(region);
+  for (auto& loop : loops) {
+    const bool left_interior = loopOrientation(loop) > 0;
+    // Read round the loop in order, so that a stretch without a crossing
+    // is bridged from the crossings either side (bridgedOffsets).
+    std::vector<std::optional<double>> crossings;
+    for (const auto& p : loop.primitives) {
+      const int count = edgeOffsetCount(p.length());
+      for (int k = 0; k < count; ++k) {
+        const double t = (k + 0.5) / count;
+        const cv::Point2d n = awayNormal(p, t, left_interior, loop.hole);
+        crossings.push_back(
+            edgeCrossing(cov, p.pointAt(t) + origin, n, kOffsetSearchPx, 0.0, 0.25, true));
+      }
+    }
+    const std::vector<double> along = bridgedOffsets(crossings);
+    size_t next = 0;
+    for (auto& p : loop.primitives) {
+      const int count = edgeOffsetCount(p.length());
+      p.edge_offsets_mpx.resize(static_cast<size_t>(count));
+      for (auto& o : p.edge_offsets_mpx) o = edgeOffsetMpx(along[next++]);
     }
   }
 }

@@ -69,6 +69,7 @@ struct EdgeSample {
   cv::Point2d point;
   cv::Point2d normal;
   double weight = 0;
+  double offset = 0;  // the teach image's edge beyond it (Primitive::edge_offsets_mpx)
 };
 
 // The model's edge samples every `step` pixels, away from primitive ends.

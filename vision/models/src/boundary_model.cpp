@@ -233,6 +233,24 @@ double Primitive::length() const {
   return std::abs(sweep_deg) * kRadPerDeg * radius;
 }
 
+int edgeOffsetCount(double length) { return std::max(1, static_cast<int>(std::floor(length))); }
+
+int16_t edgeOffsetMpx(double px) {
+  return static_cast<int16_t>(
+      std::lround(1000.0 * std::clamp(px, -kMaxEdgeOffsetPx, kMaxEdgeOffsetPx)));
+}
+
+double Primitive::edgeOffsetAt(double t) const {
+  const auto& o = edge_offsets_mpx;
+  if (o.empty()) return 0;
+  const double at =
+      std::clamp(t * static_cast<double>(o.size()) - 0.5, 0.0, static_cast<double>(o.size() - 1));
+  const auto k = static_cast<size_t>(at);
+  const size_t next = std::min(k + 1, o.size() - 1);
+  const double w = at - static_cast<double>(k);
+  return 0.001 * ((1 - w) * o[k] + w * o[next]);
+}
+
 cv::Point2d Primitive::pointAt(double t) const {
   if (kind == PrimitiveKind::kLine) return start + (end - start) * t;
   const double a = angleOf(start - centre) * kRadPerDeg + t * sweep_deg * kRadPerDeg;

@@ -227,6 +227,18 @@ std::string modelProblem(const PartModel& m) {
            std::abs(p.sweep_deg) > 360 || !finite(p.centre.x) || !finite(p.centre.y))) {
         return "an arc has a bad centre, radius or sweep";
       }
+      // About one a pixel of its length: a length a hair under a whole
+      // number of pixels when taught may be a hair over after the turns
+      // and shifts that centre the model and views make.
+      const auto& o = p.edge_offsets_mpx;
+      const int count = edgeOffsetCount(p.length());
+      if (!o.empty() && std::abs(static_cast<int>(o.size()) - count) > 1)
+        return "a primitive of " + formatFixed(p.length(), 1) + " px holds " +
+               std::to_string(count) + " edge offsets (one a pixel), not " +
+               std::to_string(o.size());
+      const int16_t bound = edgeOffsetMpx(kMaxEdgeOffsetPx);
+      if (std::any_of(o.begin(), o.end(), [&](int16_t v) { return v < -bound || v > bound; }))
+        return "edge offsets must lie within " + formatFixed(kMaxEdgeOffsetPx, 1) + " px";
     }
   }
   return {};

@@ -399,6 +399,19 @@ Result<PartModel> trainModelFromRegion(const cv::Mat& grey, const Region& r, int
   setOrientation(m, r);
   setSymmetries(m, r);
   setHuTolerance(m, grey, r, options);
+  // Where the teach image's edges lie beyond the lines and arcs: a part a
+  // fifth of whose outline another hides is then fitted to what shows as
+  // the whole was. Front-light benchmark, overlapping pairs of 14 unseen
+  // types, 4 scenes, position RMS px without and with them: clean 0.0525 /
+  // 0.0151, textured 0.051 / 0.020, 30 grey levels 0.075 / 0.060; touching
+  // 0.0138 / 0.0119; separated alike. Separated parts, 15 % of each
+  // outline left out of the fit without them: 0.010 -> 0.040 px. Not for
+  // a part with rotational symmetry: it is found at any of its turns, and
+  // the offsets read on one sector would be laid on another's edges.
+  if (m.symmetry_order == 1) {
+    measureEdgeOffsets(m.loops, r, r.centroid);
+    prepareModel(m);
+  }
   // The origin where the part's edges put its centroid, under uneven
   // light (referencePoint); the boundary moved the other way, so that the
   // fit on the teach image's edges lands on it.
@@ -418,10 +431,19 @@ PartModel scaledModel(const PartModel& model, double scale) {
   m.min_hole_area *= area;
   for (auto& loop : m.loops) {
     for (auto& p : loop.primitives) {
+      const Primitive taught = p;
       p.start *= scale;
       p.end *= scale;
       p.centre *= scale;
       p.radius *= scale;
+      // The offsets again at the scaled length's points, scaled.
+      if (taught.edge_offsets_mpx.empty()) continue;
+      const int count = edgeOffsetCount(p.length());
+      p.edge_offsets_mpx.resize(static_cast<size_t>(count));
+      for (int k = 0; k < count; ++k) {
+        p.edge_offsets_mpx[static_cast<size_t>(k)] =
+            edgeOffsetMpx(scale * taught.edgeOffsetAt((k + 0.5) / count));
+      }
     }
   }
   const auto scaled = [scale](Range r) { return Range{r.min * scale, r.max * scale}; };

@@ -94,6 +94,13 @@ void writeLoops(YAML::Emitter& out, const std::vector<vision::BoundaryLoop>& loo
         out << YAML::Key << "sweep_deg" << YAML::Value << p.sweep_deg;
       }
       out << YAML::Key << "weight" << YAML::Value << p.weight;
+      // Optional on reading: files written before them, and models with
+      // rotational symmetry, have none.
+      if (!p.edge_offsets_mpx.empty()) {
+        out << YAML::Key << "edge_offsets_mpx" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (const int16_t v : p.edge_offsets_mpx) out << static_cast<int>(v);
+        out << YAML::EndSeq;
+      }
       out << YAML::EndMap;
     }
     out << YAML::EndSeq << YAML::EndMap;
@@ -284,7 +291,21 @@ std::vector<vision::BoundaryLoop> readLoops(const YAML::Node& boundary) {
         prim.sweep_deg = as<double>(p, "sweep_deg");
       }
       prim.weight = as<double>(p, "weight");
-      loop.primitives.push_back(prim);
+      if (p["edge_offsets_mpx"]) {
+        const YAML::Node offsets = p["edge_offsets_mpx"];
+        if (!offsets.IsSequence())
+          throw FieldError{"'edge_offsets_mpx' must be a list of whole thousandths of a pixel"};
+        prim.edge_offsets_mpx.reserve(offsets.size());
+        for (const auto& v : offsets) {
+          try {
+            prim.edge_offsets_mpx.push_back(v.as<int16_t>());
+          } catch (const YAML::Exception&) {
+            throw FieldError{
+                "each of 'edge_offsets_mpx' must be a whole number of thousandths of a pixel"};
+          }
+        }
+      }
+      loop.primitives.push_back(std::move(prim));
     }
     loops_out.push_back(std::move(loop));
   }

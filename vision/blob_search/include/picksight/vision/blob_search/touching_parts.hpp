@@ -71,6 +71,11 @@ std::optional<cv::Point2d> outlineCentroid(const PartModel& model, const Region&
 // are located from their edges.
 void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin);
 
+// Sets each primitive's edge offsets (Primitive::edge_offsets_mpx) to where the
+// grey-level edges of `region` cross its normals (model frame as in
+// snapToEdges), bridged where none crosses cleanly.
+void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin);
+
 // The parts of the given models inside region `index` of `regions`, a blob
 // that matched no model as a whole. Best score first; Match::touching set
 // unless one part explains the blob whole.

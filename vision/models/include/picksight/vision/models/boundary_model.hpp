@@ -4,6 +4,7 @@
 // pose against an image's edges is boundary_verification.hpp's.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -22,12 +23,33 @@ struct Primitive {
   double radius = 0;
   double sweep_deg = 0;
   double weight = 1;  // share of this edge in the verified fraction
+  // Where the teach image's edge lay beyond the primitive (thousandths of
+  // a pixel along its normal, away from the body), at
+  // edgeOffsetCount(length()) points evenly spread along it (the k-th at
+  // t = (k + 0.5) / count); empty: on it. Lines and arcs follow a part's
+  // outline only within the conformity; a part's edges are fitted to them
+  // plus these, so that where a stretch of a part is hidden (another part
+  // lies on it) the rest does not pull the fit by the primitives' own
+  // departures from the outline. Whole thousandths: the file holds them
+  // exactly, and the edges' noise is tens of them.
+  std::vector<int16_t> edge_offsets_mpx;
 
   double length() const;
+  // The teach image's edge offset at `t` (linear between the points; 0
+  // without offsets).
+  double edgeOffsetAt(double t) const;
   cv::Point2d pointAt(double t) const;  // t in [0, 1] from start to end
   cv::Point2d startDirection() const;   // unit tangent, in the walking direction
   cv::Point2d endDirection() const;
 };
+
+// The number of edge offsets a primitive of `length` px holds: one a pixel.
+int edgeOffsetCount(double length);
+// Edge offsets are within this of their primitive (px): the conformity
+// the primitives were fitted within, and the blur, are less.
+constexpr double kMaxEdgeOffsetPx = 3.0;
+// An edge offset in px, as stored (Primitive::edge_offsets_mpx).
+int16_t edgeOffsetMpx(double px);
 
 struct BoundaryLoop {
   bool hole = false;
