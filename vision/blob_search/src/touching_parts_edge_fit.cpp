@@ -281,33 +281,25 @@ namespace touching {
 std::vector<double> bridgedOffsets(const std::vector<std::optional<double>>& crossings) {
   const size_t n = crossings.size();
   std::vector<double> out(n, 0.0);
-  // The last crossing read before each sample, going round the loop once
-  // first so that a gap over the loop's start knows its near end too.
-  std::optional<size_t> last;
-  for (size_t k = 0; k < 2 * n; ++k) {
-    if (crossings[k % n]) last = k % n;
-  }
-  if (!last) return out;  // none read: the boundary as it is
-  std::vector<size_t> before(n);
-  for (size_t k = 0; k < n; ++k) {
-    if (crossings[k]) last = k;
-    before[k] = *last;
-  }
-  std::optional<size_t> next;
-  for (size_t k = 2 * n; k-- > 0;) {
-    if (crossings[k % n]) next = k % n;
-    if (k < n) {
-      const size_t a = before[k];
-      const size_t b = *next;
-      if (crossings[k]) {
-        out[k] = *crossings[k];
-        continue;
-      }
-      // Steps round the loop from a to k and from k to b.
-      const double da = static_cast<double>((k + n - a) % n);
-      const double db = static_cast<double>((b + n - k) % n);
+  size_t first = 0;
+  while (first < n && !crossings[first]) ++first;
+  if (first == n) return out;  // none read: the boundary as it is
+  // Once round the loop from the first crossing: each crossing kept, and
+  // the gap before it (from the crossing before, over the loop's start
+  // too; a lone crossing is its own) a straight run between the two.
+  size_t a = first;
+  for (size_t step = 1; step <= n; ++step) {
+    const size_t b = (first + step) % n;
+    if (!crossings[b]) continue;
+    const size_t gap = (b + n - a - 1) % n + 1;  // steps from a to b
+    for (size_t s = 1; s < gap; ++s) {
+      const size_t k = (a + s) % n;
+      const double da = static_cast<double>(s);
+      const double db = static_cast<double>(gap - s);
       out[k] = (*crossings[a] * db + *crossings[b] * da) / (da + db);
     }
+    out[b] = *crossings[b];
+    a = b;
   }
   return out;
 }
