@@ -838,6 +838,63 @@ TEST_CASE("a part another lies on is placed by what shows of its edges as a whol
   CHECK(scatter < 0.02);
 }
 
+TEST_CASE("a part with rotational symmetry is placed at its centre of symmetry",
+          "[vision_app][locate][front][accuracy]") {
+  // Found at any of its turns, such a part is fitted to the mean of its
+  // teach image's edges over them, about its centre of symmetry: it is
+  // then placed by its symmetry, not by where one teach image under a
+  // front light read its centroid. Four shapes of 2 to 12 turns, taught
+  // alone, separated and overlapping by pairs on a textured belt and
+  // glossy: RMS against the drawn centre 0.016 px; fitted to the lines and
+  // arcs alone, 0.031 (0.023 textured, 0.037 glossy).
+  std::vector<ps::SilhouetteType> types;
+  for (const auto& [name, size] : std::vector<std::pair<std::string, double>>{
+           {"rectangle", 220}, {"hex_nut", 200}, {"gear", 220}, {"triangle", 230}}) {
+    types.push_back(ps::silhouetteFromPartType(name, size));
+  }
+  double sum2 = 0;
+  int found = 0;
+  int truths = 0;
+  for (const char* condition : {"textured", "glossy"}) {
+    const ps::SilhouetteSceneOptions look = lookOf(condition);
+    auto models = std::make_shared<ModelList>();
+    for (const auto& type : types) {
+      cv::Point2d at;
+      const cv::Mat teach = ps::renderSilhouetteAlone(type, 645, look, 7, &at, 30);
+      auto learned =
+          learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
+                       type.name, boxAround(at, 260));
+      INFO(condition << " " << type.name << ": "
+                     << (learned.ok() ? std::string() : learned.error().message));
+      REQUIRE(learned.ok());
+      REQUIRE(learned->model.symmetry_order >= 2);
+      models->push_back(learned->model);
+    }
+    for (const auto arrangement : {ps::Arrangement::kSeparated, ps::Arrangement::kOverlapping}) {
+      for (uint64_t seed = 1; seed <= 12; ++seed) {
+        const ps::SilhouetteScene scene = fourByPairs(types, look, arrangement, seed);
+        const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+        const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
+        for (const auto& t : scene.truth()) {
+          ++truths;
+          for (const auto& p : outcome.parts) {
+            if (p.type != static_cast<int>(t.type) + 1 ||
+                std::hypot(p.x - t.centre.x, p.y - t.centre.y) > 2)
+              continue;
+            sum2 +=
+                (p.x - t.centre.x) * (p.x - t.centre.x) + (p.y - t.centre.y) * (p.y - t.centre.y);
+            ++found;
+          }
+        }
+      }
+    }
+  }
+  const double rms = std::sqrt(sum2 / std::max(found, 1));
+  CAPTURE(truths, found, rms);
+  CHECK(found >= 0.98 * truths);
+  CHECK(rms < 0.022);
+}
+
 namespace {
 // A public silhouette of this repository's test data, `size` px across.
 ps::SilhouetteType drawing(const std::string& file, double size) {

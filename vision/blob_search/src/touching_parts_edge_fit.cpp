@@ -428,9 +428,16 @@ void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Poi
   }
 }
 
-void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region,
-                        cv::Point2d origin) {
+void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin,
+                        int turns) {
   const Coverage cov(region);
+  // The model turned by each of the part's symmetric turns about the
+  // origin (its centre of symmetry).
+  std::vector<std::pair<double, double>> cs;
+  for (int j = 0; j < std::max(turns, 1); ++j) {
+    const double a = 2 * M_PI * j / std::max(turns, 1);
+    cs.emplace_back(std::cos(a), std::sin(a));
+  }
   for (auto& loop : loops) {
     const bool left_interior = loopOrientation(loop) > 0;
     // Read round the loop in order, so that a stretch without a crossing
@@ -440,9 +447,18 @@ void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region,
       const int count = edgeOffsetCount(p.length());
       for (int k = 0; k < count; ++k) {
         const double t = (k + 0.5) / count;
+        const cv::Point2d at = p.pointAt(t);
         const cv::Point2d n = awayNormal(p, t, left_interior, loop.hole);
-        crossings.push_back(
-            edgeCrossing(cov, p.pointAt(t) + origin, n, kOffsetSearchPx, 0.0, 0.25, true));
+        double sum = 0;
+        int found = 0;
+        for (const auto& [c, s] : cs) {
+          const auto x = edgeCrossing(cov, origin + rotate(at, c, s), rotate(n, c, s),
+                                      kOffsetSearchPx, 0.0, 0.25, true);
+          if (!x) continue;
+          sum += *x;
+          ++found;
+        }
+        crossings.push_back(found > 0 ? std::optional<double>(sum / found) : std::nullopt);
       }
     }
     const std::vector<double> along = bridgedOffsets(crossings);

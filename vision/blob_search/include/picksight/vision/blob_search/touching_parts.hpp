@@ -74,7 +74,11 @@ void snapToEdges(std::vector<BoundaryLoop>& loops, const Region& region, cv::Poi
 // Sets each primitive's edge offsets (Primitive::edge_offsets_mpx) to where the
 // grey-level edges of `region` cross its normals (model frame as in
 // snapToEdges), bridged where none crosses cleanly.
-void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin);
+// A part with rotational symmetry of order `turns` is found at any of its
+// turns: each offset is then the mean of the crossings read with the model
+// turned by each of them about the origin.
+void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, cv::Point2d origin,
+                        int turns = 1);
 
 // The parts of the given models inside region `index` of `regions`, a blob
 // that matched no model as a whole. Best score first; Match::touching set
