@@ -110,6 +110,42 @@ ps::SilhouetteScene fourByPairs(const std::vector<ps::SilhouetteType>& types,
   look.seed = seed;
   return ps::SilhouetteScene(types, std::vector<bool>(types.size(), true), look);
 }
+
+// Each of `types` taught alone under `look` with LEARN ... AT a box
+// `box_px` across, as types 1, 2, ...
+std::shared_ptr<ModelList> teachEach(const std::vector<ps::SilhouetteType>& types,
+                                     const ps::SilhouetteSceneOptions& look, double box_px) {
+  auto models = std::make_shared<ModelList>();
+  for (const auto& type : types) {
+    cv::Point2d at;
+    const cv::Mat teach = ps::renderSilhouetteAlone(type, 645, look, 7, &at, 30);
+    auto learned =
+        learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
+                     type.name, boxAround(at, box_px));
+    INFO(type.name << ": " << (learned.ok() ? std::string() : learned.error().message));
+    REQUIRE(learned.ok());
+    models->push_back(learned->model);
+  }
+  return models;
+}
+
+// LOCATE ALL on `scene` with `models` (teachEach's types): `found(truth,
+// part)` for each part drawn that is reported as its type within 2 px.
+// Returns the number of parts drawn.
+template <class F>
+int forEachFound(const ps::SilhouetteScene& scene, const std::shared_ptr<ModelList>& models,
+                 F&& found) {
+  const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
+  const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
+  for (const auto& t : scene.truth()) {
+    for (const auto& p : outcome.parts) {
+      if (p.type == static_cast<int>(t.type) + 1 &&
+          std::hypot(p.x - t.centre.x, p.y - t.centre.y) <= 2)
+        found(t, p);
+    }
+  }
+  return static_cast<int>(scene.truth().size());
+}
 }  // namespace
 
 // A worn belt: the textured condition with twice its grain and blotches, so
@@ -789,39 +825,21 @@ TEST_CASE("a part another lies on is placed by what shows of its edges as a whol
     types.push_back(drawn("shapes/tari1000/obj" + std::to_string(k) + "_12.png", size));
   }
   const ps::SilhouetteSceneOptions look = lookOf("clean");
-  auto models = std::make_shared<ModelList>();
-  for (const auto& type : types) {
-    cv::Point2d at;
-    const cv::Mat teach = ps::renderSilhouetteAlone(type, 645, look, 7, &at, 30);
-    auto learned =
-        learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
-                     type.name, boxAround(at, 260));
-    INFO(type.name << ": " << (learned.ok() ? std::string() : learned.error().message));
-    REQUIRE(learned.ok());
-    REQUIRE(learned->model.symmetry_order == 1);
-    models->push_back(learned->model);
-  }
+  const auto models = teachEach(types, look, 260);
+  for (const auto& m : *models) REQUIRE(m.symmetry_order == 1);
   // Per type: the errors on the part of every overlapped part found.
   std::vector<std::vector<cv::Point2d>> errors(types.size());
   int truths = 0;
   int hidden = 0;  // of the parts found, those a tenth or more of whose outline is hidden
   for (uint64_t seed = 1; seed <= 8; ++seed) {
-    const ps::SilhouetteScene scene = fourByPairs(types, look, ps::Arrangement::kOverlapping, seed);
-    const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
-    const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
-    for (const auto& t : scene.truth()) {
-      ++truths;
-      for (const auto& p : outcome.parts) {
-        if (p.type != static_cast<int>(t.type) + 1 ||
-            std::hypot(p.x - t.centre.x, p.y - t.centre.y) > 2)
-          continue;
-        const double a = t.angle_deg * M_PI / 180;
-        const cv::Point2d e(p.x - t.centre.x, p.y - t.centre.y);
-        errors[t.type].emplace_back(e.x * std::cos(a) + e.y * std::sin(a),
-                                    -e.x * std::sin(a) + e.y * std::cos(a));
-        hidden += t.hidden >= 0.1 ? 1 : 0;
-      }
-    }
+    truths += forEachFound(fourByPairs(types, look, ps::Arrangement::kOverlapping, seed), models,
+                           [&](const ps::SilhouettePart& t, const LocatedPart& p) {
+                             const double a = t.angle_deg * M_PI / 180;
+                             const cv::Point2d e(p.x - t.centre.x, p.y - t.centre.y);
+                             errors[t.type].emplace_back(e.x * std::cos(a) + e.y * std::sin(a),
+                                                         -e.x * std::sin(a) + e.y * std::cos(a));
+                             hidden += t.hidden >= 0.1 ? 1 : 0;
+                           });
   }
   double sum2 = 0;
   int found = 0;
@@ -857,35 +875,16 @@ TEST_CASE("a part with rotational symmetry is placed at its centre of symmetry",
   int truths = 0;
   for (const char* condition : {"textured", "glossy"}) {
     const ps::SilhouetteSceneOptions look = lookOf(condition);
-    auto models = std::make_shared<ModelList>();
-    for (const auto& type : types) {
-      cv::Point2d at;
-      const cv::Mat teach = ps::renderSilhouetteAlone(type, 645, look, 7, &at, 30);
-      auto learned =
-          learnInImage(teach, {}, cellOptions(), models, static_cast<int>(models->size()) + 1,
-                       type.name, boxAround(at, 260));
-      INFO(condition << " " << type.name << ": "
-                     << (learned.ok() ? std::string() : learned.error().message));
-      REQUIRE(learned.ok());
-      REQUIRE(learned->model.symmetry_order >= 2);
-      models->push_back(learned->model);
-    }
+    const auto models = teachEach(types, look, 260);
+    for (const auto& m : *models) REQUIRE(m.symmetry_order >= 2);
     for (const auto arrangement : {ps::Arrangement::kSeparated, ps::Arrangement::kOverlapping}) {
       for (uint64_t seed = 1; seed <= 12; ++seed) {
-        const ps::SilhouetteScene scene = fourByPairs(types, look, arrangement, seed);
-        const Frame frame = frameFromImage(scene.render(0), "cam0", 1);
-        const LocateOutcome outcome = locateInFrame(frame, cellOptions(), models, -1);
-        for (const auto& t : scene.truth()) {
-          ++truths;
-          for (const auto& p : outcome.parts) {
-            if (p.type != static_cast<int>(t.type) + 1 ||
-                std::hypot(p.x - t.centre.x, p.y - t.centre.y) > 2)
-              continue;
-            sum2 +=
-                (p.x - t.centre.x) * (p.x - t.centre.x) + (p.y - t.centre.y) * (p.y - t.centre.y);
-            ++found;
-          }
-        }
+        truths += forEachFound(fourByPairs(types, look, arrangement, seed), models,
+                               [&](const ps::SilhouettePart& t, const LocatedPart& p) {
+                                 sum2 +=
+                                     std::pow(p.x - t.centre.x, 2) + std::pow(p.y - t.centre.y, 2);
+                                 ++found;
+                               });
       }
     }
   }
