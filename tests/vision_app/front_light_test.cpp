@@ -97,6 +97,14 @@ ps::SilhouetteScene sixParts(const ps::SilhouetteType& type, ps::SilhouetteScene
   return ps::SilhouetteScene({type}, {true}, look);
 }
 
+// A public silhouette of this repository's test data, `size` px across.
+ps::SilhouetteType drawing(const std::string& file, double size) {
+  const cv::Mat image =
+      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+  REQUIRE(!image.empty());
+  return ps::silhouetteFromDrawing(file, image, size);
+}
+
 // Four parts of `types` under `look` in a 1000 x 800 frame, touching or
 // overlapping by pairs, no distractors.
 ps::SilhouetteScene fourByPairs(const std::vector<ps::SilhouetteType>& types,
@@ -743,17 +751,11 @@ TEST_CASE("touching parts whose corners the light blurs are found from what thei
   // lies 5 to 11 px from its reference point); 96 and 96 now (95 overlapping
   // in the scenes as a clang build renders them). Asked: the issue's recall
   // goal, 0.98, and nothing falsely reported.
-  const auto drawn = [](const char* file, double size) {
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-    REQUIRE(!drawing.empty());
-    return ps::silhouetteFromDrawing(file, drawing, size);
-  };
   const std::vector<std::pair<std::string, ps::SilhouetteType>> shapes = {
-      {"obj8", drawn("shapes/tari1000/obj8_3.png", 230)},
-      {"obj5", drawn("shapes/tari1000/obj5_3.png", 240)},
-      {"obj18", drawn("shapes/tari1000/obj18_3.png", 190)},
-      {"obj1", drawn("shapes/tari1000/obj1_3.png", 220)}};
+      {"obj8", drawing("shapes/tari1000/obj8_3.png", 230)},
+      {"obj5", drawing("shapes/tari1000/obj5_3.png", 240)},
+      {"obj18", drawing("shapes/tari1000/obj18_3.png", 190)},
+      {"obj1", drawing("shapes/tari1000/obj1_3.png", 220)}};
   // Found and reported of the parts drawn, touching and overlapping.
   struct Count {
     int truths = 0;
@@ -813,16 +815,10 @@ TEST_CASE("a part another lies on is placed by what shows of its edges as a whol
   // silhouettes (Tari-1000) of drawings no other test or benchmark uses,
   // each taught alone, then overlapping by pairs; the scatter is read as
   // the benchmark reads it, about each type's mean error on the part.
-  const auto drawn = [](const std::string& file, double size) {
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-    REQUIRE(!drawing.empty());
-    return ps::silhouetteFromDrawing(file, drawing, size);
-  };
   std::vector<ps::SilhouetteType> types;
   for (const auto& [k, size] : std::vector<std::pair<int, double>>{
            {9, 220}, {12, 230}, {14, 210}, {19, 240}, {21, 220}, {24, 230}}) {
-    types.push_back(drawn("shapes/tari1000/obj" + std::to_string(k) + "_12.png", size));
+    types.push_back(drawing("shapes/tari1000/obj" + std::to_string(k) + "_12.png", size));
   }
   const ps::SilhouetteSceneOptions look = lookOf("clean");
   const auto models = teachEach(types, look, 260);
@@ -895,13 +891,6 @@ TEST_CASE("a part with rotational symmetry is placed at its centre of symmetry",
 }
 
 namespace {
-// A public silhouette of this repository's test data, `size` px across.
-ps::SilhouetteType drawing(const std::string& file, double size) {
-  const cv::Mat image =
-      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
-  REQUIRE(!image.empty());
-  return ps::silhouetteFromDrawing(file, image, size);
-}
 
 // The regions of `image` (dark on light), read with a window wide enough
 // for any part here.
