@@ -297,7 +297,12 @@ TEST_CASE("a part's lit side, the blur of its tips and its glints are not cut of
     ps::SilhouetteSceneOptions look;
     REQUIRE(
         ps::frontLightCondition(condition, &look.front, &look.part_level, &look.background_level));
-    looks.push_back({condition, look});
+    // Glossy seed 12: obj25's rim skews the levels beside it as a shadow
+    // along most of an outline does, by under a quarter of the contrast
+    // (kShadowStepShare); read as one, 0.4 % of it was cut, 0.13 px.
+    std::vector<uint64_t> seeds = {7, 11, 16, 17};
+    if (std::string(condition) == "glossy") seeds.push_back(12);
+    looks.push_back({condition, look, seeds});
   }
   {
     // Shaded twice as hard: the lit side comes within a few levels of the
