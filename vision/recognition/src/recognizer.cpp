@@ -64,9 +64,15 @@ struct EdgePose {
 // read its centroid 1.1 to 1.3 px off (the lit side's rim too faint for
 // the band), the fit landed on the part's edges, and a second fit moved it
 // 0.000 to 0.006 px more; it had been placed at the centroid, 1.2 px off,
-// once its noise pinholes no longer sent it to the blob search. A fit that
-// slid onto something else's edges does not settle so, or moves farther.
-constexpr double kMaxSettledShiftPx = 2.0;
+// once its noise pinholes no longer sent it to the blob search. Beside a
+// shadow 2-3 px of which stay joined along a long side (too thin for its
+// layer to be cut), a bottle's centroid moved 2.1-2.8 px and its fit,
+// settled 0.3-0.4 px from the part, was refused at 2 px: the front-light
+// benchmark's 15 standard types beside shadows, separated, 0.32 px RMS,
+// 0.10 with 3 (every other condition, and the unseen types, the same to
+// the last digit). A fit that slid onto something else's edges does not
+// settle so, or moves farther.
+constexpr double kMaxSettledShiftPx = 3.0;
 constexpr double kSettledPx = 0.05;
 constexpr double kSettledDeg = 0.05;
 
