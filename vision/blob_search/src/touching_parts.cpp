@@ -822,39 +822,25 @@ void BlobSearch::fullSearch(std::vector<std::pair<double, size_t>> order) {
     // With parts found, the rest of the blob is most likely one part more:
     // the models closest to its area first. Otherwise those the quick
     // search saw most of.
-    double rest_area = 0;
     if (!taken_.empty()) {
-      rest_area = narrowToRest();
+      const double rest_area = narrowToRest();
       for (auto& entry : order) {
         entry.first = -std::abs(fitting_[entry.second]->body.area - rest_area) / rest_area;
       }
     }
     std::stable_sort(order.begin(), order.end(),
                      [](const auto& a, const auto& b) { return a.first > b.first; });
-    // A part not found yet shows at least 1 - kMaxOverlap of itself beside
-    // the parts found: a model too large for that in the rest is not
-    // screened (a blob a distractor touches is never explained whole, and
-    // every other model is searched in its rest). Not where the frame's
-    // border cuts the blob: a part there may show less.
-    std::vector<std::pair<double, size_t>> round;
-    for (const auto& entry : order) {
-      const PartModel& m = *fitting_[entry.second];
-      if (taken_.empty() || region_.touches_border ||
-          m.body.area * (1 - m.body.area_tolerance) * (1 - kMaxOverlap) <= rest_area) {
-        round.push_back(entry);
-      }
-    }
     // The round's screens read the anchors narrowed above and the edges
     // only: as many at once as there are threads, then refined in order
     // until the blob is explained (at most a thread's worth screened in
     // vain; one by one on one thread).
     const size_t batch = static_cast<size_t>(std::max(1, cv::getNumThreads()));
     std::vector<std::vector<Candidate>> screened;
-    for (size_t start = 0; start < round.size(); start += batch) {
-      const size_t n = std::min(batch, round.size() - start);
+    for (size_t start = 0; start < order.size(); start += batch) {
+      const size_t n = std::min(batch, order.size() - start);
       screened.assign(n, {});
       forEachModel(
-          n, [&](size_t k) { screened[k] = screen(*fitting_[round[start + k].second], false); });
+          n, [&](size_t k) { screened[k] = screen(*fitting_[order[start + k].second], false); });
       for (size_t k = 0; k < n; ++k) {
         refine(screened[k]);
         if (!changed_) continue;
