@@ -891,7 +891,6 @@ TEST_CASE("a part with rotational symmetry is placed at its centre of symmetry",
 }
 
 namespace {
-
 // The regions of `image` (dark on light), read with a window wide enough
 // for any part here.
 std::vector<pv::Region> partRegions(const cv::Mat& image) {

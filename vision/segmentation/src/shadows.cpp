@@ -167,14 +167,16 @@ Level medianLevel(const Histogram& h, int count) {
 // one: the upper quartile lies more than kShadowedSkew times as far above
 // the median as the 90th percentile above it (a symmetric texture's 1.1, a
 // part's lit surface under the benchmark's light fall-off 1.2-1.5; the
-// triangle's 3-5), and more than `min_step`. The surface is then the
+// triangle's 3-5), and more than kShadowStepShare of the contrast to
+// `part` and kTextureSpreads of `noise` (the noise along the outline,
+// noiseAlong). The surface is then the
 // upper quartile, its spread that of the upper tail (for a normal spread,
 // 0.607 of it between the 75th and 90th percentiles).
 constexpr double kShadowedSkew = 2.5;
 constexpr double kMinSkewSpan = 2.0;  // grey levels: quantisation, not skew
 // The step from a shadow's levels up to the surface's is at least this
 // share of the contrast (and three of the noise's spreads along the
-// outline; mayHaveShadow). A belt's blotches and a glossy part's rim skew
+// outline). A belt's blotches and a glossy part's rim skew
 // the levels beside a part by less. Six shapes that cast no shadow, 30
 // noise seeds, two turns: with no bound, 10 of 1440 images (four
 // front-light conditions) were cut 0.4-0.8 % and moved up to 0.13 px, which
@@ -183,8 +185,10 @@ constexpr double kMinSkewSpan = 2.0;  // grey levels: quantisation, not skew
 // triangle's step is 38 % of its contrast). With no bound the front-light
 // benchmark lost one overlapping part of 125 at 30 grey levels.
 constexpr double kShadowStepShare = 0.25;
-Level litSurfaceLevel(const Histogram& h, int count, double min_step) {
+Level litSurfaceLevel(const Histogram& h, int count, double part, double noise) {
   const Level whole = medianLevel(h, count);
+  const double min_step =
+      std::max(kShadowStepShare * (whole.level - part), kTextureSpreads * noise);
   const double upper = quantileOf(h, count, 0.75);
   const double top = quantileOf(h, count, 0.9);
   if (upper - whole.level >
@@ -399,9 +403,7 @@ bool mayHaveShadow(const cv::Mat& mask, const cv::Mat& grey, const std::vector<c
   Histogram out_levels{};
   for (const float v : out) ++out_levels[static_cast<size_t>(std::clamp(v, 0.0f, 255.0f))];
   const double part = medianOf(in);
-  const double contrast_below = quantileOf(out_levels, static_cast<int>(out.size()), 0.5) - part;
-  *lit = litSurfaceLevel(out_levels, static_cast<int>(out.size()),
-                         std::max(kShadowStepShare * contrast_below, out_noise * kTextureSpreads));
+  *lit = litSurfaceLevel(out_levels, static_cast<int>(out.size()), part, out_noise);
   const double surface = lit->level;
   const double contrast = surface - part;
   if (contrast < kMinContrast) return false;
@@ -528,7 +530,7 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
   // level read there, its spread that of the ring's levels above it.
   if (lit.shadowed && lit.level > surface.level) {
     const double spread = spreadAbove(ring_levels, lit.level);
-    if (spread >= 0) surface = {lit.level, spread, true};
+    if (spread >= 0) surface = {lit.level, spread};
   }
   l.surface = surface.level;
   l.surface_spread = surface.spread;
