@@ -52,8 +52,9 @@ using Ms = std::chrono::duration<double, std::milli>;
 constexpr double kMatchRadiusPx = 12;
 // --list-errors names the parts placed further than this from their truth.
 constexpr double kListOffPx = 0.2;
-// The binarization window for parts up to 350 px (the vision app's --window).
-constexpr int kWindow = 400;
+// The binarization window of the sharp, evenly lit image the truth is read
+// on: wider than any part's length, so the window never cuts it.
+constexpr int kTruthWindow = 400;
 
 // Silhouettes none of the other benchmarks or tests trained on (Tari-1000
 // classes outside silhouetteTypeSpecs, and their third drawing).
@@ -235,6 +236,7 @@ int main(int argc, char** argv) {
   bool stages = false;
   std::string save_frames;
   bool keep_shadows = false;
+  int window = 0;
   bool teach_on_plain = false;
   int teach_views = 1;
   double blur_sigma = ps::SilhouetteSceneOptions{}.blur_sigma;
@@ -273,6 +275,11 @@ int main(int argc, char** argv) {
                  "the lens's blur (Gaussian sigma, px) of scenes and teach images: a camera out "
                  "of focus")
       ->check(CLI::Range(0.0, 5.0))
+      ->capture_default_str();
+  app.add_option("--window", window,
+                 "the adaptive threshold's window, as the vision app's --window (0: the app's "
+                 "own, from the image and the taught parts)")
+      ->check(CLI::Range(0, 4000))
       ->capture_default_str();
   app.add_flag("--keep-shadows", keep_shadows,
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
@@ -314,9 +321,10 @@ int main(int argc, char** argv) {
       }
     }
     look.blur_sigma = blur_sigma;
-    // The vision app's defaults, with the window a user sets for these parts.
+    // The vision app's defaults (the window it picks from the image and the
+    // models, unless --window sets one as a user's --window would).
     pc::VisionOptions options;
-    options.binarize.adaptive_window = kWindow;
+    options.binarize.adaptive_window = window;
     options.regions.cut_shadows = !keep_shadows;
     if (look.part_level > look.background_level) {
       options.binarize.polarity = pv::Polarity::kLightOnDark;
@@ -404,7 +412,7 @@ int main(int argc, char** argv) {
           ps::renderSilhouetteInFrame(types[i], sharp_look, 7 + i, teachSpot(i, 0), &sharp_drawn,
                                       picksight::bench::kTrainAngleDeg);
       pv::BinarizeOptions b;
-      b.adaptive_window = kWindow;
+      b.adaptive_window = kTruthWindow;
       const auto seen = pv::findRegions(pv::binarize(sharp, b), {}, sharp);
       size_t largest = 0;
       for (size_t k = 1; k < seen.size(); ++k) {

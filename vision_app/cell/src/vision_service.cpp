@@ -919,10 +919,24 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
   VisionOptions o = frameOptions(options, mapping, grey.size(), *frame_models);
   o.regions.keep_border_regions = true;
   if (colour) o.binarize.polarity = vision::Polarity::kDarkOnLight;
+  // The first pass reads the part with the frame's own window; a second
+  // with one wide enough for it (below). When the part had no hole in the
+  // first, the second has nothing to mend, and where it loses the part
+  // (the wider window joined a wood grain's darker streaks to a tulip on a
+  // long stem: four parts inside LEARN AT, 71 in the frame) the first
+  // pass's reading is taken again rather than refused.
+  const int own_window = o.binarize.adaptive_window;
+  bool first_whole = false;
+  const auto readAgainNarrow = [&](int pass) {
+    if (pass != 1 || !first_whole) return false;
+    o.binarize.adaptive_window = own_window;
+    return true;
+  };
   for (int pass = 0;; ++pass) {
     cv::Mat mask = vision::binarize(grey, o.binarize);
     auto regions = vision::findRegions(mask, o.regions, grey);
     auto inside = regionsInside(regions, rect);
+    if (inside.empty() && readAgainNarrow(pass)) continue;
     if (inside.empty()) {
       if (!at) return makeError(vision::PartModelErrc::kNoPart, "no part in the frame");
       return makeError(VisionServiceErrc::kNoPartInRectangle,
@@ -946,6 +960,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
         seen = sortForLearn(regions, inside, grey, mask);
       }
     }
+    if (!seen.others.empty() && readAgainNarrow(pass)) continue;
     if (!seen.others.empty()) {
       const std::string count = std::to_string(seen.others.size() + 1) + " parts";
       if (!at) {
@@ -988,6 +1003,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     const int needed = vision::windowForPart(farthestBoundary(r));
     if (pass == 0 && o.binarize.method == vision::ThresholdMethod::kAdaptive &&
         vision::adaptiveWindow(grey.size(), o.binarize) < needed) {
+      first_whole = r.holes == 0;
       o.binarize.adaptive_window = needed;
       continue;
     }
