@@ -119,32 +119,54 @@ constexpr int kBoxMargin = kMaxBand + 2;
 // kGlintNoise deviations of the surface beside the part: in a large hole on
 // a blotched belt, with only 30 levels of contrast, the very brightest pixel
 // of thousands lies beyond half the contrast by noise alone, and its 99th
-// percentile close to it.
+// percentile close to it. And beyond the surface's own brightest beside the
+// part (its 99th percentile) by kGlintPastSurfaceShare of the contrast: a
+// paving's joints are far lighter than its bricks, and a part's hole over a
+// joint read 19 levels beyond the bricks' median (24 of contrast, noise
+// 4.4) but 2 beyond the brightest of the surface beside the part; filled as
+// a glint, it let the part's model (a slot, its hole at one end) verify
+// turned end for end in a blob with a part touching it. A lamp's glint
+// saturates, far past any surface the part lies on.
 constexpr double kGlintPercentile = 0.99;
 constexpr double kGlintNoise = 4;
 constexpr double kGlintShare = 0.5;
+constexpr double kGlintPastSurfaceShare = 0.25;
 
 // The levels just outside (the background) and just inside (the part) a
-// region's outer boundary: the medians of sideSamples, and the deviation of
-// the outside ones (from their median absolute deviation). False when either
-// side has no reading.
+// region's outer boundary: the medians of sideSamples, the deviation of the
+// outside ones (from their median absolute deviation), and their level
+// farthest from the part's (kGlintPercentile of them: the lightest beside a
+// dark part). False when either side has no reading.
+struct SideLevels {
+  double background = 0;
+  double part = 0;
+  double background_spread = 0;
+  double background_extreme = 0;
+};
+
 bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
-                double* background, double* part, double* background_spread) {
+                SideLevels* levels) {
   std::vector<float> out;
   std::vector<float> in;
   sideSamples(grey, mask, outer, &out, &in);
   if (out.empty() || in.empty()) return false;
-  *background = medianOf(out);
-  *part = medianOf(in);
-  for (float& v : out) v = std::abs(v - static_cast<float>(*background));
-  *background_spread = 1.4826 * medianOf(out);
+  SideLevels& l = *levels;
+  l.background = medianOf(out);
+  l.part = medianOf(in);
+  const double share = l.part < l.background ? kGlintPercentile : 1 - kGlintPercentile;
+  const auto rank = static_cast<std::ptrdiff_t>(std::floor(share * (out.size() - 1)));
+  std::nth_element(out.begin(), out.begin() + rank, out.end());
+  l.background_extreme = out[static_cast<size_t>(rank)];
+  for (float& v : out) v = std::abs(v - static_cast<float>(l.background));
+  l.background_spread = 1.4826 * medianOf(out);
   return true;
 }
 
 // Whether the hole traced by `hole` is a glint (kGlintShare), given the
 // levels beside its region.
 bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& hole,
-             double background, double part, double background_spread) {
+             const SideLevels& side) {
+  const double background = side.background;
   const cv::Rect box = cv::boundingRect(hole);
   cv::Mat inside = cv::Mat::zeros(box.size(), CV_8UC1);
   cv::drawContours(inside, std::vector<std::vector<cv::Point>>{hole}, 0, cv::Scalar(255),
@@ -164,14 +186,16 @@ bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Poi
   }
   if (levels.empty()) return false;
   // The darker side when parts are light (contrast > 0), else the lighter.
-  const double contrast = part - background;
+  const double contrast = side.part - background;
   const auto rank = static_cast<std::ptrdiff_t>(
       std::floor((contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile) * (levels.size() - 1)));
   std::nth_element(levels.begin(), levels.begin() + rank, levels.end());
   const double level = levels[static_cast<size_t>(rank)];
   const double beyond = std::abs(level - background);
   return (level - background) * contrast < 0 && beyond > kGlintShare * std::abs(contrast) &&
-         beyond > kGlintNoise * background_spread;
+         beyond > kGlintNoise * side.background_spread &&
+         (side.background_extreme - level) * (contrast < 0 ? 1 : -1) <
+             -kGlintPastSurfaceShare * std::abs(contrast);
 }
 
 // A least-squares plane z = a + b x + c y through grey levels, and the
@@ -942,12 +966,10 @@ std::vector<int> glintHoles(const cv::Mat& mask, const cv::Mat& grey,
                             const std::vector<cv::Vec4i>& hierarchy, int i) {
   std::vector<int> glints;
   if (grey.empty() || hierarchy[i][2] < 0) return glints;
-  double background = 0;
-  double part = 0;
-  double spread = 0;
-  if (!sideLevels(grey, mask, contours[i], &background, &part, &spread)) return glints;
+  SideLevels side;
+  if (!sideLevels(grey, mask, contours[i], &side)) return glints;
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
-    if (isGlint(grey, mask, contours[h], background, part, spread)) glints.push_back(h);
+    if (isGlint(grey, mask, contours[h], side)) glints.push_back(h);
   }
   return glints;
 }
