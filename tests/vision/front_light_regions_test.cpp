@@ -44,14 +44,21 @@ ps::SilhouetteType drawn(const char* file, double size) {
   return ps::silhouetteFromDrawing(file, drawing, size);
 }
 
-// The largest region of `image` (dark parts on light) as the front-light
-// benchmark binarizes it: the belt's own blotches may make regions too.
-pv::Region largestPart(const cv::Mat& image, pv::RegionOptions r = {}) {
+// The regions of `image` (dark parts on light) of a part's size, as the
+// front-light benchmark binarizes it: the belt's own blotches, a paving's
+// darker bricks, may make regions too.
+std::vector<pv::Region> partSizedRegions(const cv::Mat& image, pv::RegionOptions r = {}) {
   pv::BinarizeOptions b;
   b.adaptive_window = 400;
   r.min_area = 2000;
-  const auto regions = pv::findRegions(pv::binarize(image, b), r, image);
+  auto regions = pv::findRegions(pv::binarize(image, b), r, image);
   REQUIRE(!regions.empty());
+  return regions;
+}
+
+// The largest of them.
+pv::Region largestPart(const cv::Mat& image, pv::RegionOptions r = {}) {
+  const auto regions = partSizedRegions(image, r);
   return *std::max_element(
       regions.begin(), regions.end(),
       [](const pv::Region& u, const pv::Region& v) { return u.area < v.area; });
@@ -748,14 +755,9 @@ TEST_CASE("a hole over a paving's light joint is a hole, not a glint", "[vision]
       const cv::Point2d at(300 + 220.0 * seed, 250 + 90.0 * seed);
       cv::Point2d centre;
       const cv::Mat image = ps::renderSilhouetteInFrame(slot, look, seed, at, &centre, turn);
-      pv::BinarizeOptions b;
-      b.adaptive_window = 400;
-      pv::RegionOptions o;
-      o.min_area = 2000;
-      const auto regions = pv::findRegions(pv::binarize(image, b), o, image);
       // The part's region: the one whose centroid lies nearest where it
       // was drawn (darker bricks make regions of their own).
-      REQUIRE(!regions.empty());
+      const auto regions = partSizedRegions(image);
       const pv::Region& r = *std::min_element(
           regions.begin(), regions.end(), [&](const pv::Region& u, const pv::Region& v) {
             return cv::norm(u.centroid - centre) < cv::norm(v.centroid - centre);

@@ -153,10 +153,8 @@ bool sideLevels(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::
   SideLevels& l = *levels;
   l.background = medianOf(out);
   l.part = medianOf(in);
-  const double share = l.part < l.background ? kGlintPercentile : 1 - kGlintPercentile;
-  const auto rank = static_cast<std::ptrdiff_t>(std::floor(share * (out.size() - 1)));
-  std::nth_element(out.begin(), out.begin() + rank, out.end());
-  l.background_extreme = out[static_cast<size_t>(rank)];
+  l.background_extreme =
+      percentileOf(out, l.part < l.background ? kGlintPercentile : 1 - kGlintPercentile);
   for (float& v : out) v = std::abs(v - static_cast<float>(l.background));
   l.background_spread = 1.4826 * medianOf(out);
   return true;
@@ -187,15 +185,14 @@ bool isGlint(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Poi
   if (levels.empty()) return false;
   // The darker side when parts are light (contrast > 0), else the lighter.
   const double contrast = side.part - background;
-  const auto rank = static_cast<std::ptrdiff_t>(
-      std::floor((contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile) * (levels.size() - 1)));
-  std::nth_element(levels.begin(), levels.begin() + rank, levels.end());
-  const double level = levels[static_cast<size_t>(rank)];
+  const double level = percentileOf(levels, contrast < 0 ? kGlintPercentile : 1 - kGlintPercentile);
   const double beyond = std::abs(level - background);
+  // How far past the surface's lightest beside a dark part (its darkest
+  // beside a light one) the hole's level lies.
+  const double past = (level - side.background_extreme) * (contrast < 0 ? 1 : -1);
   return (level - background) * contrast < 0 && beyond > kGlintShare * std::abs(contrast) &&
          beyond > kGlintNoise * side.background_spread &&
-         (side.background_extreme - level) * (contrast < 0 ? 1 : -1) <
-             -kGlintPastSurfaceShare * std::abs(contrast);
+         past > kGlintPastSurfaceShare * std::abs(contrast);
 }
 
 // A least-squares plane z = a + b x + c y through grey levels, and the

@@ -757,6 +757,14 @@ double medianOf(std::vector<float>& values) {
   return *mid;
 }
 
+double percentileOf(std::vector<float>& values, double share) {
+  if (values.empty()) return 0;
+  const auto at = values.begin() + static_cast<std::ptrdiff_t>(
+                                       std::floor(share * static_cast<double>(values.size() - 1)));
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
 void sideSamples(const cv::Mat& grey, const cv::Mat& mask, const std::vector<cv::Point>& outer,
                  std::vector<float>* out, std::vector<float>* in) {
   // Every this many boundary points is read, this far out and in.

@@ -56,6 +56,10 @@ cv::Mat outsideLevels(const cv::Mat& grey, const cv::Mat& own, const cv::Mat& fr
 // The median of `values` (reordered); 0 when empty.
 double medianOf(std::vector<float>& values);
 
+// The value `share` (0..1) of the way up `values` sorted, the lower of two
+// when it falls between (reordered); 0 when empty.
+double percentileOf(std::vector<float>& values, double share);
+
 // The levels 3 px out (`out`) and in (`in`) of every 4th point of a
 // region's outer boundary, along its normal, each where the mask says it
 // is: what lies beside the part and just inside its edge.
