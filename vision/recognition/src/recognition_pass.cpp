@@ -54,10 +54,17 @@ std::optional<ScreenedOut> screen(const Match& match, const Region& region,
 
 RegionOptions regionOptionsFor(const RegionOptions& cell, const std::vector<PartModel>& models) {
   RegionOptions o = cell;
+  double smallest_part = 0;
   for (const auto& m : models) {
     o.min_hole_area = std::min(o.min_hole_area, m.min_hole_area);
     if (m.min_region_area > 0) o.min_area = std::min(o.min_area, m.min_region_area);
+    // The smallest a part of the model may be (the blob search's own bound).
+    const double part = m.body.area * (1 - m.body.area_tolerance);
+    if (smallest_part == 0 || part < smallest_part) smallest_part = part;
   }
+  // A region at the frame's edge may hold a whole part (see
+  // RegionOptions::border_min_area) when it is as large as one.
+  if (!models.empty()) o.border_min_area = std::max(smallest_part, 1.0);
   return o;
 }
 

@@ -101,6 +101,10 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
                                    const std::vector<const PartModel*>& models,
                                    double max_tolerance) {
   const Region& r = regions[i];
+  // Cut by the frame's edge, the region is no part whole: it may hold
+  // parts whole, joined to what runs off the frame (the blob search places
+  // only parts that lie inside it).
+  if (r.touches_border) return locateInBlob(regions, i, models);
   RegionCache cache(r, max_tolerance);
   const PartModel* best = nullptr;
   Verdict best_verdict;

@@ -1035,11 +1035,18 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   // The region's pixels are all in its bounding box, so its runs over
   // the wider box count them.
   if (static_cast<double>(own_runs.count()) < options.min_area) return false;
+  const bool border =
+      bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+  // Kept at the edge only for the parts it may hold (border_min_area).
+  if (border && !options.keep_border_regions &&
+      static_cast<double>(own_runs.count()) < options.border_min_area) {
+    return false;
+  }
 
   Region& r = *region;
   r.bbox = bbox;
-  r.touches_border =
-      bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+  r.touches_border = border;
+  r.image_size = mask.size();
   r.outer = std::move(contours[i]);
   for (int h = hierarchy[i][2]; h >= 0; h = hierarchy[h][0]) {
     if (options.min_hole_area > 0 && cv::contourArea(contours[h]) < options.min_hole_area) continue;
@@ -1082,11 +1089,10 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
 // (13 to 36 on the front-light benchmark's 30-level contrast, touching and
 // separated), such a patch's by 2 to 4. One such patch cost a low-contrast
 // frame 17 ms in the blob search, its 24 edge fits, none placed. A region
-// steps when at least kMinSteppedShare of its outline steps by
+// steps when at least kMinOutlineSteppedShare of its outline steps by
 // kOutlineMinStep: a part in it takes up more of its outline than that,
 // while noise of 3 grey levels steps so across 8 % of a flat patch's.
 constexpr int kStepEveryPx = 4;
-constexpr double kMinSteppedShare = 0.2;
 
 }  // namespace
 
@@ -1109,7 +1115,7 @@ int stepAcrossOutline(const std::vector<cv::Point>& outline, int i, const cv::Ma
                   static_cast<int>(grey.at<uint8_t>(b - grey_origin)));
 }
 
-bool outlineSteps(const Region& r) {
+bool outlineSteps(const Region& r, double min_share) {
   if (r.grey.empty()) return true;
   int read = 0;
   int stepped = 0;
@@ -1119,7 +1125,7 @@ bool outlineSteps(const Region& r) {
     ++read;
     stepped += step >= kOutlineMinStep ? 1 : 0;
   }
-  return read == 0 || stepped >= kMinSteppedShare * read;
+  return read == 0 || stepped >= min_share * read;
 }
 
 double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& region) {
@@ -1179,7 +1185,10 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
     if (bbox.area() < options.min_area) continue;  // fewer pixels than that, surely
     const bool border =
         bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
-    if (border && !options.keep_border_regions) continue;
+    if (border && !options.keep_border_regions &&
+        !(options.border_min_area > 0 && bbox.area() >= options.border_min_area)) {
+      continue;
+    }
     outers.push_back(i);
   }
   // Regions are measured independently, on all cores (the labelling this

@@ -18,7 +18,9 @@ namespace picksight::vision {
 
 // The region settings that let every model of `models` see what it was
 // trained to see: the smallest minimum hole and region areas among the
-// cell's (`cell`) and the models' own (frame pixels, all of them).
+// cell's (`cell`) and the models' own (frame pixels, all of them); and the
+// regions at the frame's edge as large as a part of a model kept, for the
+// parts they may hold whole (recognize searches them as blobs).
 RegionOptions regionOptionsFor(const RegionOptions& cell, const std::vector<PartModel>& models);
 
 // The smallest region worth a look when every type is known: a share of the

@@ -30,6 +30,7 @@ struct Region {
   int glints = 0;
   cv::Rect bbox;
   bool touches_border = false;
+  cv::Size image_size;  // of the image the region was found in
   // The rim was read against levels beside it rather than a plane through
   // them: the surface or the part departs from a plane there (blotches,
   // shading), or a cast shadow lies beside it. Its grey-level centroid is
@@ -71,6 +72,12 @@ struct RegionOptions {
   // (the hole count must match exactly).
   double min_hole_area = 0;
   bool keep_border_regions = false;  // a part cut by the image edge cannot be located
+  // Regions touching the image edge of at least this many pixels (> 0) are
+  // kept all the same, for the parts they may hold whole: a part joined to
+  // something that runs off the frame (a tray's wall, a streak of wood, a
+  // shadow) is a blob of parts, like parts that touch. LOCATE sets it to
+  // the smallest part its models may be; a smaller region holds none.
+  double border_min_area = 0;
   // With a grey image, cast shadows joined to dark parts are cut off them
   // (see shadows.hpp), and each edge beside a shadow is read against the
   // shadow's level.
@@ -99,12 +106,13 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
 // as such a share; an evenly lit part on its surface has next to none.
 double unevenEdgeShare(const cv::Mat& grey, const cv::Mat& mask, const Region& region);
 
-// Whether a region's outline is a step in grey level somewhere (at least a
-// fifth of it steps by 8 levels or more, read 3 px either side): a patch of
-// the surface's own light that the threshold took in (a vignetted corner,
-// a blotch of a textured belt) steps nowhere. True without the region's
-// grey image, where nothing says otherwise.
-bool outlineSteps(const Region& r);
+// Whether a region's outline is a step in grey level somewhere (at least
+// `min_share` of it, by default a fifth, steps by 8 levels or more, read
+// 3 px either side): a patch of the surface's own light that the threshold
+// took in (a vignetted corner, a blotch of a textured belt) steps nowhere.
+// True without the region's grey image, where nothing says otherwise.
+constexpr double kMinOutlineSteppedShare = 0.2;
+bool outlineSteps(const Region& r, double min_share = kMinOutlineSteppedShare);
 
 // A step across a region's outline, as outlineSteps reads it: the levels
 // kOutlineStepReachPx either side of it differ by kOutlineMinStep or more
