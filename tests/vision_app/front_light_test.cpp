@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -1548,7 +1549,7 @@ cv::Mat againstWall(const cv::Mat& image, const cv::Mat& dark, cv::Point part, i
 }
 }  // namespace
 
-TEST_CASE("a part against a tray's wall at the frame's edge is found, and one the edge cuts is not",
+TEST_CASE("a part against a tray's wall at the frame's edge is found but not one the edge cuts",
           "[vision_app][locate][front]") {
   // A tray's wall along the left of the frame, as dark as the parts, and a
   // part lying against it: one region runs from the part off the frame.
@@ -1594,53 +1595,98 @@ TEST_CASE("a part against a tray's wall at the frame's edge is found, and one th
     }
   }
   CHECK(checked == 8);
-  // A part the frame's edge cuts (a sixth of it off the frame), against
-  // nothing: not reported, whichever way it lies.
+  // A part the frame's edge cuts, against nothing, by 3, 8 or 40 px: not
+  // reported, whichever way it lies. (Cut by a few pixels, its region
+  // passes the model's area and shape tests, and most of its outline
+  // verifies: a part partly hidden, for the search of parts that touch.)
   for (const int turn : {0, 90, 180, 270}) {
-    CAPTURE(turn);
+    // How far the part reaches below its centroid, lying this way.
     cv::Point2d centre;
-    const cv::Mat cut =
-        ps::renderSilhouetteInFrame(hand, look, 5, {960.2, 1080 - 45.4}, &centre, turn);
-    const LocateOutcome outcome =
-        locateInFrame(frameFromImage(cut, "cam0", 1), defaults, models, -1);
-    CHECK(outcome.parts.empty());
+    cv::Mat whole = ps::renderSilhouetteInFrame(hand, look, 5, {960.2, 540.4}, &centre, turn);
+    cv::threshold(whole, whole, 0.5 * (look.part_level + look.background_level), 255,
+                  cv::THRESH_BINARY_INV);
+    const cv::Rect reach = cv::boundingRect(whole(cv::Rect(800, 380, 320, 320)));
+    const double below = 380 + reach.br().y - centre.y;
+    for (const int cut_px : {3, 8, 40}) {
+      CAPTURE(turn, cut_px);
+      const cv::Mat cut = ps::renderSilhouetteInFrame(
+          hand, look, 5, {960.2, 1080 - below + cut_px + 0.4}, &centre, turn);
+      const LocateOutcome outcome =
+          locateInFrame(frameFromImage(cut, "cam0", 1), defaults, models, -1);
+      CHECK(outcome.parts.empty());
+    }
   }
 }
 
-TEST_CASE("a vignetted corner the threshold speckles at 30 levels of contrast holds no part",
+TEST_CASE("the front-light benchmark's speckled corner at 30 levels holds no part",
           "[vision_app][locate][front]") {
-  // At 30 grey levels the light's fall-off into a corner of the frame
-  // takes the surface under the threshold there, speckled (hundreds of
-  // holes): a region cut by the frame's edge as large as a part, which
-  // may hold parts (a part against a tray's wall, above). Its outline
-  // barely steps in grey level: it is not searched. Searched, an X-shaped
-  // part was placed in it (seed 10). Public silhouettes (Tari-1000), one
-  // part of each type in mid-frame, LOCATE ALL with the vision app's
-  // defaults.
-  const std::vector<ps::SilhouetteType> types = {drawing("shapes/tari1000/obj6_3.png", 210),
-                                                 drawing("shapes/tari1000/obj2_1.png", 220),
-                                                 drawing("shapes/tari1000/obj13_1.png", 220)};
-  const ps::SilhouetteSceneOptions look = lookOf("low-contrast");
-  const auto models = teachEach(types, look, 300);
-  const VisionOptions defaults;
-  int corners = 0;
-  for (size_t k = 0; k < types.size(); ++k) {
-    for (const uint64_t seed : {8, 9, 10, 11}) {
-      CAPTURE(k, seed);
-      cv::Point2d centre;
-      const cv::Mat image =
-          ps::renderSilhouetteInFrame(types[k], look, seed, {958.3, 541.6}, &centre, 40.0 * seed);
-      const LocateOutcome outcome =
-          locateInFrame(frameFromImage(image, "cam0", 1), defaults, models, -1);
-      for (const auto& r : outcome.scene.regions) {
-        corners += r.touches_border && r.holes > 100 ? 1 : 0;
-      }
-      const auto& parts = outcome.parts;
-      REQUIRE(parts.size() == 1);
-      CHECK(parts[0].type == static_cast<int>(k) + 1);
-      CHECK(std::hypot(parts[0].x - centre.x, parts[0].y - centre.y) < 0.5);
-    }
+  // picksight-bench-front-light --conditions low-contrast --arrangements
+  // touching, scene 1, as the benchmark makes it: 14 public silhouettes
+  // (Tari-1000, their third drawings) taught as the benchmark teaches them
+  // (LEARN on the part alone under the same light, else LEARN AT), 20
+  // parts touching by pairs, distractors among them. The top right corner, dark
+  // with the vignette, is a speckled region the frame's edge cuts (73116
+  // px, 424 holes) whose outline steps along 23 % of its length: searched
+  // for parts, it gave a part of obj6 where none lies (and cost 128 ms).
+  const std::vector<std::pair<std::string, double>> specs = {
+      {"obj1_3", 220},  {"obj3_3", 200},  {"obj5_3", 240},  {"obj6_3", 210},  {"obj8_3", 230},
+      {"obj11_3", 200}, {"obj13_3", 220}, {"obj15_3", 250}, {"obj18_3", 190}, {"obj22_3", 230},
+      {"obj25_3", 210}, {"obj27_3", 240}, {"obj35_3", 200}, {"obj45_3", 220}};
+  std::vector<ps::SilhouetteType> types;
+  for (const auto& [file, size] : specs) {
+    types.push_back(drawing("shapes/tari1000/" + file + ".png", size));
   }
-  // The frames have such corners (else this shows nothing).
-  CHECK(corners >= 4);
+  const ps::SilhouetteSceneOptions look = lookOf("low-contrast");
+  const VisionOptions defaults;
+  auto models = std::make_shared<ModelList>();
+  std::vector<bool> chiral;
+  for (size_t i = 0; i < types.size(); ++i) {
+    // The benchmark's spot for the part in its teach frame.
+    std::mt19937_64 rng(0x7465616368ULL + 131 * i);
+    const double margin = 0.75 * specs[i].second + 20;
+    std::uniform_real_distribution<double> x(margin, look.width - 1 - margin);
+    std::uniform_real_distribution<double> y(margin, look.height - 1 - margin);
+    const double at_x = x(rng);
+    const cv::Point2d spot(at_x, y(rng));
+    cv::Point2d drawn;
+    const cv::Mat teach = ps::renderSilhouetteInFrame(types[i], look, 7 + i, spot, &drawn, 30);
+    const int type = static_cast<int>(i) + 1;
+    auto learned = learnInImage(teach, {}, defaults, models, type, specs[i].first, std::nullopt);
+    if (!learned.ok()) {
+      learned = learnInImage(teach, {}, defaults, models, type, specs[i].first,
+                             boxAround(drawn, specs[i].second));
+    }
+    INFO(specs[i].first << ": " << (learned.ok() ? std::string() : learned.error().message));
+    REQUIRE(learned.ok());
+    chiral.push_back(!learned->model.body.mirror_symmetric);
+    models->push_back(learned->model);
+  }
+  ps::SilhouetteSceneOptions o = look;
+  o.arrangement = ps::Arrangement::kTouching;
+  o.seed = 5000 * (static_cast<uint64_t>(ps::Arrangement::kTouching) + 1) + 1;
+  const ps::SilhouetteScene scene(types, chiral, o);
+  const LocateOutcome outcome =
+      locateInFrame(frameFromImage(scene.render(0), "cam0", 1), defaults, models, -1);
+  // The corner is there, and searched for nothing.
+  const auto corner = std::find_if(
+      outcome.scene.regions.begin(), outcome.scene.regions.end(), [](const pv::Region& r) {
+        return r.touches_border && r.holes > 100 && r.bbox.x > 1000 && r.bbox.y == 0;
+      });
+  CHECK(corner != outcome.scene.regions.end());
+  int found = 0;
+  for (const auto& p : outcome.parts) {
+    CAPTURE(p.type, p.x, p.y);
+    const bool drawn = std::any_of(scene.truth().begin(), scene.truth().end(), [&](const auto& t) {
+      return t.kind == ps::PartKind::kTrue && static_cast<int>(t.type) + 1 == p.type &&
+             std::hypot(t.centre.x - p.x, t.centre.y - p.y) < 2;
+    });
+    CHECK(drawn);
+    found += drawn ? 1 : 0;
+  }
+  // And every part drawn whole of a taught type (the others are
+  // distractors: mirror images, other sizes).
+  const auto drawn_true =
+      std::count_if(scene.truth().begin(), scene.truth().end(),
+                    [](const auto& t) { return t.kind == ps::PartKind::kTrue; });
+  CHECK(found == drawn_true);
 }
