@@ -694,10 +694,18 @@ TEST_CASE("LEARN AT takes a small part on paving bricks, not the darker bricks b
   INFO((learned.ok() ? std::string() : learned.error().message));
   REQUIRE(learned.ok());
   CHECK(cv::norm(learned->model.trained_centroid - drawn) < 1);
-  const bool said = std::any_of(learned->notes.begin(), learned->notes.end(), [](const auto& n) {
-    return n.find("ignored") != std::string::npos;
-  });
-  CHECK(said);
+  // The darker bricks are regions beside the part in LEARN's first reading
+  // (else this tests nothing), where they must not count as parts; its
+  // second, at the part's own level, leaves them surface.
+  pv::BinarizeOptions first;
+  first.adaptive_window = cellOptions().binarize.adaptive_window;
+  const cv::Rect box = boxAround(drawn, 190);
+  int bricks = 0;
+  for (const auto& r : pv::findRegions(pv::binarize(teach, first), {}, teach)) {
+    const bool inside = (r.bbox & box).area() >= 0.5 * r.bbox.area();
+    if (inside && !r.bbox.contains(drawn) && r.area > 0.15 * learned->model.body.area) ++bricks;
+  }
+  CHECK(bricks >= 1);
 }
 
 TEST_CASE("LEARN refuses a patch of the surface's own light, and says so",
@@ -803,6 +811,53 @@ TEST_CASE("touching parts whose corners the light blurs are found from what thei
     CHECK(count.found >= 0.98 * count.truths);
     CHECK(count.reported == count.found);
   }
+}
+
+TEST_CASE("parts taught alone on gravel keep their own outline and are found touching",
+          "[vision_app][learn][locate][front]") {
+  // A part alone in a whole frame of photographed gravel: the frame is
+  // surface but for a hundredth of it, and its levels are no two
+  // populations. Otsu split the stones' own shades, the contrast came out
+  // a third of the part's, every stone's edge set the threshold near it,
+  // and the part's outline took in the crevices beside it (bumps of up to
+  // 8 px, the whole outline half a pixel out). Such models screened
+  // touching parts at 0.64 where their own outline gives 0.91, and on the
+  // front-light benchmark 7 of 18 touching parts on gravel were found.
+  // LEARN reads the frame again at the part's own level against the
+  // surface's.
+  ps::SilhouetteSceneOptions look = photographedLook("gravel");
+  const std::vector<std::pair<std::string, ps::SilhouetteType>> shapes = {
+      {"obj8", drawing("shapes/tari1000/obj8_3.png", 230)},
+      {"obj5", drawing("shapes/tari1000/obj5_3.png", 240)},
+      {"obj18", drawing("shapes/tari1000/obj18_3.png", 190)},
+      {"obj1", drawing("shapes/tari1000/obj1_3.png", 220)}};
+  const VisionOptions defaults;
+  auto models = std::make_shared<ModelList>();
+  std::vector<ps::SilhouetteType> types;
+  for (const auto& [name, type] : shapes) {
+    cv::Point2d drawn;
+    const cv::Mat teach = ps::renderSilhouetteInFrame(type, look, 7, {900.3, 520.6}, &drawn, 30);
+    auto learned = learnInImage(teach, {}, defaults, models, static_cast<int>(models->size()) + 1,
+                                name, std::nullopt);
+    INFO(name << ": " << (learned.ok() ? std::string() : learned.error().message));
+    REQUIRE(learned.ok());
+    models->push_back(learned->model);
+    types.push_back(type);
+  }
+  int truths = 0;
+  int found = 0;
+  int reported = 0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    const ps::SilhouetteScene scene = fourByPairs(types, look, ps::Arrangement::kTouching, seed);
+    const LocateOutcome outcome =
+        locateInFrame(frameFromImage(scene.render(0), "cam0", 1), defaults, models, -1);
+    truths += static_cast<int>(scene.truth().size());
+    found += foundTrue(scene.truth(), outcome.parts);
+    for (const auto& p : outcome.parts) reported += p.type >= 0 ? 1 : 0;
+  }
+  INFO(found << " of " << truths << " found, " << reported << " reported");
+  CHECK(found >= 0.98 * truths);
+  CHECK(reported == found);
 }
 
 TEST_CASE("a part another lies on is placed by what shows of its edges as a whole one is",
@@ -1297,6 +1352,7 @@ TEST_CASE("LEARN leaves out a stretch of the surface lying against a limb, its o
   };
   const cv::Rect box = boxAround(trueCentroid(type, kSide, kAngle), 240);
   int joined = 0;
+  int cut_notes = 0;
   for (const uint64_t seed : {31, 32, 33, 34}) {
     INFO("seed " << seed);
     const cv::Mat image = withBlotch(seed, 0.65);
@@ -1321,9 +1377,14 @@ TEST_CASE("LEARN leaves out a stretch of the surface lying against a limb, its o
     const bool said = std::any_of(learned->notes.begin(), learned->notes.end(), [](const auto& n) {
       return n.find("its outline no edge") != std::string::npos;
     });
-    CHECK(said == joins);
+    // Said only where the blotch joined the part. LEARN's second reading,
+    // at the part's own level, may leave the blotch surface (seed 34):
+    // then nothing was cut, and nothing is said.
+    CHECK((joins || !said));
+    cut_notes += said ? 1 : 0;
   }
   CHECK(joined >= 2);
+  CHECK(cut_notes >= 2);
 
   // A lobe of the part's own on a neck as wide: solid, and its outline a
   // step all round, kept (and nothing said).
@@ -1562,7 +1623,6 @@ TEST_CASE("a part against a tray's wall at the frame's edge is found but not one
   const ps::SilhouetteSceneOptions look = lookOf("textured");
   const auto models = teachEach({hand, umbrella}, look, 300);
   const VisionOptions defaults;
-  int checked = 0;
   for (const int turn : {0, 75, 160, 250}) {
     for (const uint64_t seed : {3, 4}) {
       CAPTURE(turn, seed);
@@ -1591,10 +1651,8 @@ TEST_CASE("a part against a tray's wall at the frame's edge is found but not one
       REQUIRE(outcome.parts.size() == 1);
       CHECK(outcome.parts[0].type == (seed == 3 ? 1 : 2));
       CHECK(std::hypot(outcome.parts[0].x - centre.x, outcome.parts[0].y - centre.y) < 0.5);
-      ++checked;
     }
   }
-  CHECK(checked == 8);
   // A part the frame's edge cuts, against nothing, by 3, 8 or 40 px: not
   // reported, whichever way it lies. (Cut by a few pixels, its region
   // passes the model's area and shape tests, and most of its outline

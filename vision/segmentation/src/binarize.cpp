@@ -393,9 +393,26 @@ struct RatioSplit {
   double surface = 1;
 };
 
+// The split where the parts' level is known (BinarizeOptions::part_level)
+// and the frame's is not two populations: the surface is the frame's median
+// ratio (most of such a frame is surface), the parts lie at `part_level` of
+// it, and the split is halfway.
+RatioSplit splitAtPartLevel(const cv::Mat& ratio8, double part_level) {
+  std::vector<uint8_t> levels(ratio8.begin<uint8_t>(), ratio8.end<uint8_t>());
+  const auto mid = levels.begin() + static_cast<std::ptrdiff_t>(levels.size() / 2);
+  std::nth_element(levels.begin(), mid, levels.end());
+  const double surface = *mid / 200.0;
+  RatioSplit split;
+  split.k_ratio = std::clamp(0.5 * (1 + part_level) * surface, kMinRatio, kMaxSeparatedRatio);
+  split.contrast = (1 - part_level) * surface;
+  split.surface = surface;
+  return split;
+}
+
 // The split of the ratio image (200 = the background's level) of `small_f`
-// to `background_f`, both at low resolution.
-RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
+// to `background_f`, both at low resolution (`part_level`: see
+// BinarizeOptions).
+RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f, double part_level) {
   cv::Mat ratio;
   cv::divide(small_f, cv::max(background_f, 1.0f), ratio, 200.0);
   cv::Mat ratio8;
@@ -416,6 +433,11 @@ RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
     cv::meanStdDev(ratio8, mean_dark, sd_dark, ~upper);
     const double spread = std::sqrt(0.5 * (sd_bright[0] * sd_bright[0] + sd_dark[0] * sd_dark[0]));
     const bool separated = mean_bright[0] - mean_dark[0] > kMinSeparation * std::max(spread, 1.0);
+    // Not two populations: a frame of surface with a part or two on a
+    // grainy surface (gravel: Otsu split the stones' own shades, the
+    // contrast came out a third of the part's, and every stone's edge
+    // voted: the part's outline took in the crevices beside it).
+    if (!separated && part_level > 0 && part_level < 1) return splitAtPartLevel(ratio8, part_level);
     split.k_ratio = std::clamp(0.5 * (mean_bright[0] + mean_dark[0]) / 200.0, kMinRatio,
                                separated ? kMaxSeparatedRatio : kMaxRatio);
     // An even surface (its spread a small share of the contrast: a back
@@ -430,7 +452,7 @@ RatioSplit splitRatio(const cv::Mat& small_f, const cv::Mat& background_f) {
   return split;
 }
 
-cv::Mat adaptive(const cv::Mat& grey, int window) {
+cv::Mat adaptive(const cv::Mat& grey, int window, double part_level) {
   const int reduce = std::min({kReduce, std::max(1, grey.cols / 16), std::max(1, grey.rows / 16)});
   cv::Mat small;
   if (grey.cols % reduce == 0 && grey.rows % reduce == 0) {
@@ -450,7 +472,7 @@ cv::Mat adaptive(const cv::Mat& grey, int window) {
   cv::Mat background_f;
   small.convertTo(small_f, CV_32F);
   background.convertTo(background_f, CV_32F);
-  const RatioSplit split = splitRatio(small_f, background_f);
+  const RatioSplit split = splitRatio(small_f, background_f, part_level);
   const double k_ratio = split.k_ratio;
   const double contrast = split.contrast;
 
@@ -587,7 +609,7 @@ cv::Mat binarize(const cv::Mat& grey, const BinarizeOptions& options) {
       cv::threshold(input, mask, 0, 255, cv::THRESH_BINARY_INV | cv::THRESH_OTSU);
       break;
     case ThresholdMethod::kAdaptive:
-      mask = adaptive(input, adaptiveWindow(input.size(), options));
+      mask = adaptive(input, adaptiveWindow(input.size(), options), options.part_level);
       break;
   }
   return mask;

@@ -47,6 +47,12 @@ double orientationDeg(const cv::Moments& m, cv::Point2d centroid,
 }
 
 namespace {
+
+// The frame's edge cuts whatever lies in a box that reaches it.
+bool touchesBorder(const cv::Rect& bbox, cv::Size image) {
+  return bbox.x == 0 || bbox.y == 0 || bbox.br().x == image.width || bbox.br().y == image.height;
+}
+
 // Below this relative contrast between part and background, coverage read
 // from grey levels is mostly noise; the binary moments are kept.
 constexpr double kMinContrast = 0.08;
@@ -1035,8 +1041,7 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   // The region's pixels are all in its bounding box, so its runs over
   // the wider box count them.
   if (static_cast<double>(own_runs.count()) < options.min_area) return false;
-  const bool border =
-      bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+  const bool border = touchesBorder(bbox, mask.size());
   // Kept at the edge only for the parts it may hold (border_min_area).
   if (border && !options.keep_border_regions &&
       static_cast<double>(own_runs.count()) < options.border_min_area) {
@@ -1183,8 +1188,7 @@ std::vector<Region> findRegions(const cv::Mat& mask, const RegionOptions& option
     if (hierarchy[i][3] >= 0) continue;  // a hole
     const cv::Rect bbox = boxes[static_cast<size_t>(i)];
     if (bbox.area() < options.min_area) continue;  // fewer pixels than that, surely
-    const bool border =
-        bbox.x == 0 || bbox.y == 0 || bbox.br().x == mask.cols || bbox.br().y == mask.rows;
+    const bool border = touchesBorder(bbox, mask.size());
     if (border && !options.keep_border_regions &&
         !(options.border_min_area > 0 && bbox.area() >= options.border_min_area)) {
       continue;

@@ -9,6 +9,7 @@
 #include <climits>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "picksight/cell/scaled_model_cache.hpp"
 #include "picksight/cell/vision_settings.hpp"
@@ -409,10 +410,14 @@ struct LearnRegions {
   std::vector<size_t> others;
 };
 
-// How far region `r`'s level stands off the surface around it: the mean of
-// its pixels (an edge's blur left out) against that of a ring a few pixels
-// out, over pixels of no region of `mask`. 0 where either is not seen.
-double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask) {
+// Region `r`'s level and its surface's: the mean of its pixels (an edge's
+// blur left out) and the median of a ring a few pixels out, over pixels of
+// no region of `mask`. None where either is not seen.
+struct Levels {
+  double region = 0;
+  double surface = 0;
+};
+std::optional<Levels> levelsOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask) {
   const cv::Rect box =
       (r.bbox + cv::Size(2 * kRingOuter, 2 * kRingOuter) - cv::Point(kRingOuter, kRingOuter)) &
       cv::Rect({0, 0}, grey.size());
@@ -427,7 +432,7 @@ double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask
   cv::dilate(own, near, disc(kRingInner));
   cv::dilate(own, far, disc(kRingOuter));
   const cv::Mat ring = far & ~near & (mask(box) == 0);
-  if (cv::countNonZero(core) == 0 || cv::countNonZero(ring) == 0) return 0;
+  if (cv::countNonZero(core) == 0 || cv::countNonZero(ring) == 0) return std::nullopt;
   // The surface's median level there: a region of the surface itself (a
   // brick of a paving, darker than the light joints round it) is ringed
   // by its lighter marks, and read against their mean stood off it as a
@@ -444,7 +449,28 @@ double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask
   }
   const auto mid = levels.begin() + static_cast<std::ptrdiff_t>(levels.size() / 2);
   std::nth_element(levels.begin(), mid, levels.end());
-  return std::abs(cv::mean(surface, core)[0] - static_cast<double>(*mid));
+  return Levels{cv::mean(surface, core)[0], static_cast<double>(*mid)};
+}
+
+// How far region `r`'s level stands off the surface around it (levelsOf);
+// 0 where either is not seen.
+double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask) {
+  const auto levels = levelsOf(r, grey, mask);
+  return levels ? std::abs(levels->region - levels->surface) : 0.0;
+}
+
+// The part's level as a share of its surface's, as binarize reads it
+// (vision::BinarizeOptions::part_level: light parts' levels inverted);
+// 0 where not seen, or where the part is not the darker.
+double partLevelOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask,
+                   vision::Polarity polarity) {
+  const auto levels = levelsOf(r, grey, mask);
+  if (!levels) return 0;
+  const bool light = polarity == vision::Polarity::kLightOnDark;
+  const double part = light ? 255 - levels->region : levels->region;
+  const double surface = light ? 255 - levels->surface : levels->surface;
+  if (surface <= 0 || part >= surface) return 0;
+  return part / surface;
 }
 
 LearnRegions sortForLearn(const std::vector<vision::Region>& regions,
@@ -932,10 +958,27 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     o.binarize.adaptive_window = own_window;
     return true;
   };
+  // Then once more at the part's own level against its surface's
+  // (vision::BinarizeOptions::part_level). A frame that is surface but for
+  // the part is no two populations of levels: on gravel the first reading
+  // split the stones' own shades, took a third of the part's contrast for
+  // it, and the part's outline took in the crevices beside it (bumps of up
+  // to 8 px, the outline half a pixel out), where LOCATE, reading a frame
+  // of many parts, finds the parts' own contrast. Where that reading loses
+  // the part, the one before is taken again.
+  bool level_read = false;
+  bool level_pass = false;
+  const auto readAgainWithoutLevel = [&]() {
+    if (!level_pass) return false;
+    o.binarize.part_level = 0;
+    level_pass = false;
+    return true;
+  };
   for (int pass = 0;; ++pass) {
     cv::Mat mask = vision::binarize(grey, o.binarize);
     auto regions = vision::findRegions(mask, o.regions, grey);
     auto inside = regionsInside(regions, rect);
+    if (inside.empty() && readAgainWithoutLevel()) continue;
     if (inside.empty() && readAgainNarrow(pass)) continue;
     if (inside.empty()) {
       if (!at) return makeError(vision::PartModelErrc::kNoPart, "no part in the frame");
@@ -960,6 +1003,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
         seen = sortForLearn(regions, inside, grey, mask);
       }
     }
+    if (!seen.others.empty() && readAgainWithoutLevel()) continue;
     if (!seen.others.empty() && readAgainNarrow(pass)) continue;
     if (!seen.others.empty()) {
       const std::string count = std::to_string(seen.others.size() + 1) + " parts";
@@ -980,6 +1024,7 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
     // corner), not a part: such a model would match nothing a robot should
     // pick. (A green part on a grey belt of its brightness, read in grey,
     // left one such patch in the frame.)
+    if (!vision::outlineSteps(r) && readAgainWithoutLevel()) continue;
     if (!vision::outlineSteps(r)) {
       const std::string what = "the largest region (" +
                                formatFixed(mapping.areaToSensor(r.area), 0) +
@@ -1006,6 +1051,15 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
       first_whole = r.holes == 0;
       o.binarize.adaptive_window = needed;
       continue;
+    }
+    if (o.binarize.method == vision::ThresholdMethod::kAdaptive && !level_read) {
+      level_read = true;
+      const double level = partLevelOf(r, grey, mask, o.binarize.polarity);
+      if (level > 0) {
+        level_pass = true;
+        o.binarize.part_level = level;
+        continue;
+      }
     }
     vision::TrainOptions train;
     train.binarize = o.binarize;
