@@ -19,9 +19,10 @@ struct BinarizeOptions {
   // middle is taken for background and the part breaks apart. 0 = a sixth of
   // the smaller image side.
   int adaptive_window = 0;
-  // kAdaptive: the part's grey level as a share of its surface's beside it
-  // (in this polarity: a dark part's level over the surface's; 0 = not
-  // known), where LEARN has read it. Where the frame's levels do not fall
+  // kAdaptive: the grey level of the part's faintest stretch as a share of
+  // its surface's beside it (in this polarity: a dark part's lightest
+  // pixels' level over the surface's; 0 = not known), where LEARN has read
+  // it. Where the frame's levels do not fall
   // into two populations (a part alone on gravel or a textured belt: the
   // frame is surface but for a hundredth of it, and Otsu splits the
   // surface's own grain), part and surface are split by it instead.
