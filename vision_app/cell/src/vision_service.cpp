@@ -480,9 +480,9 @@ double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask
   return levels ? std::abs(levels->region - levels->surface) : 0.0;
 }
 
-// The part's level as a share of its surface's, as binarize reads it
-// (vision::BinarizeOptions::part_level: light parts' levels inverted);
-// 0 where not seen, or where the part is not the darker.
+// The level of the part's faintest stretch as a share of its surface's, as
+// binarize reads it (vision::BinarizeOptions::part_level: light parts'
+// levels inverted); 0 where not seen, or where the part is not the darker.
 double partLevelOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask,
                    vision::Polarity polarity) {
   const auto levels = levelsOf(r, grey, mask);

@@ -22,10 +22,10 @@ struct BinarizeOptions {
   // kAdaptive: the grey level of the part's faintest stretch as a share of
   // its surface's beside it (in this polarity: a dark part's lightest
   // pixels' level over the surface's; 0 = not known), where LEARN has read
-  // it. Where the frame's levels do not fall
-  // into two populations (a part alone on gravel or a textured belt: the
-  // frame is surface but for a hundredth of it, and Otsu splits the
-  // surface's own grain), part and surface are split by it instead.
+  // it. Where the frame's levels do not fall into two populations (a part
+  // alone on gravel or a textured belt: the frame is surface but for a
+  // hundredth of it, and Otsu splits the surface's own grain), part and
+  // surface are split by it instead.
   double part_level = 0;
 };
 
