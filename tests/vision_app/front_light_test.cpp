@@ -821,8 +821,9 @@ TEST_CASE("parts taught alone on gravel keep their own outline and are found tou
   // a third of the part's, every stone's edge set the threshold near it,
   // and the part's outline took in the crevices beside it (bumps of up to
   // 8 px, the whole outline half a pixel out). Such models screened
-  // touching parts at 0.64 where their own outline gives 0.91, and on the
-  // front-light benchmark 7 of 18 touching parts on gravel were found.
+  // touching parts at 0.64 where models taught on card gave 0.91, and in
+  // a scene of the front-light benchmark's gravel 7 of 18 touching parts
+  // were found.
   // LEARN reads the frame again at the part's own level against the
   // surface's.
   ps::SilhouetteSceneOptions look = photographedLook("gravel");
