@@ -689,8 +689,8 @@ TEST_CASE("LEARN AT takes a small part on paving bricks, not the darker bricks b
   const ps::SilhouetteSceneOptions look = photographedLook("brick");
   cv::Point2d drawn;
   const cv::Mat teach = ps::renderSilhouetteAlone(type, 585, look, 15, &drawn, 30);
-  const auto learned =
-      learnInImage(teach, {}, cellOptions(), noModels(), 1, "obj18", boxAround(drawn, 190));
+  const cv::Rect box = boxAround(drawn, 190);
+  const auto learned = learnInImage(teach, {}, cellOptions(), noModels(), 1, "obj18", box);
   INFO((learned.ok() ? std::string() : learned.error().message));
   REQUIRE(learned.ok());
   CHECK(cv::norm(learned->model.trained_centroid - drawn) < 1);
@@ -699,7 +699,6 @@ TEST_CASE("LEARN AT takes a small part on paving bricks, not the darker bricks b
   // second, at the part's own level, leaves them surface.
   pv::BinarizeOptions first;
   first.adaptive_window = cellOptions().binarize.adaptive_window;
-  const cv::Rect box = boxAround(drawn, 190);
   int bricks = 0;
   for (const auto& r : pv::findRegions(pv::binarize(teach, first), {}, teach)) {
     const bool inside = (r.bbox & box).area() >= 0.5 * r.bbox.area();

@@ -416,12 +416,15 @@ struct LearnRegions {
 struct Levels {
   double region = 0;
   double surface = 0;
-  // The region's own pixels' (of `mask`, its edge's blur left out) 5th and
-  // 95th percentiles: its faintest stretch, in either polarity.
+  // With `spread` only: the 5th and 95th percentiles of the region's own
+  // pixels (of `mask`, its edge's blur left out), its faintest stretch in
+  // either polarity (LEARN asks it of the part alone; sortForLearn reads
+  // the depth of every speck, up to thousands on gravel).
   double region_low = 0;
   double region_high = 0;
 };
-std::optional<Levels> levelsOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask) {
+std::optional<Levels> levelsOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask,
+                               bool spread = false) {
   const cv::Rect box =
       (r.bbox + cv::Size(2 * kRingOuter, 2 * kRingOuter) - cv::Point(kRingOuter, kRingOuter)) &
       cv::Rect({0, 0}, grey.size());
@@ -437,37 +440,36 @@ std::optional<Levels> levelsOf(const vision::Region& r, const cv::Mat& grey, con
   cv::dilate(own, far, disc(kRingOuter));
   const cv::Mat ring = far & ~near & (mask(box) == 0);
   if (cv::countNonZero(core) == 0 || cv::countNonZero(ring) == 0) return std::nullopt;
+  const cv::Mat surface = grey(box);
+  // The grey levels of `surface` where `where` is set; the k-th of them,
+  // and the one a `share` of the way up.
+  std::vector<uint8_t> levels;
+  const auto gather = [&](const cv::Mat& where) {
+    levels.clear();
+    for (int y = 0; y < where.rows; ++y) {
+      const uint8_t* in = where.ptr<uint8_t>(y);
+      const uint8_t* g = surface.ptr<uint8_t>(y);
+      for (int x = 0; x < where.cols; ++x)
+        if (in[x]) levels.push_back(g[x]);
+    }
+  };
+  const auto nth = [&](size_t k) {
+    std::nth_element(levels.begin(), levels.begin() + static_cast<std::ptrdiff_t>(k), levels.end());
+    return static_cast<double>(levels[k]);
+  };
+  const auto at = [&](double share) {
+    return nth(static_cast<size_t>(share * static_cast<double>(levels.size() - 1)));
+  };
   // The surface's median level there: a region of the surface itself (a
   // brick of a paving, darker than the light joints round it) is ringed
   // by its lighter marks, and read against their mean stood off it as a
   // part does (three bricks inside LEARN AT beside a small part, at 30
   // grey levels of contrast).
-  const cv::Mat surface = grey(box);
-  std::vector<uint8_t> levels;
-  levels.reserve(static_cast<size_t>(cv::countNonZero(ring)));
-  for (int y = 0; y < ring.rows; ++y) {
-    const uint8_t* in = ring.ptr<uint8_t>(y);
-    const uint8_t* g = surface.ptr<uint8_t>(y);
-    for (int x = 0; x < ring.cols; ++x)
-      if (in[x]) levels.push_back(g[x]);
-  }
-  const auto mid = levels.begin() + static_cast<std::ptrdiff_t>(levels.size() / 2);
-  std::nth_element(levels.begin(), mid, levels.end());
-  Levels out{cv::mean(surface, core)[0], static_cast<double>(*mid)};
-  levels.clear();
-  const cv::Mat own_pixels = core & (mask(box) != 0);
-  for (int y = 0; y < own_pixels.rows; ++y) {
-    const uint8_t* in = own_pixels.ptr<uint8_t>(y);
-    const uint8_t* g = surface.ptr<uint8_t>(y);
-    for (int x = 0; x < own_pixels.cols; ++x)
-      if (in[x]) levels.push_back(g[x]);
-  }
+  gather(ring);
+  Levels out{cv::mean(surface, core)[0], nth(levels.size() / 2)};
+  if (!spread) return out;
+  gather(core & (mask(box) != 0));
   if (levels.empty()) return std::nullopt;
-  const auto at = [&](double share) {
-    const auto k = levels.begin() + static_cast<std::ptrdiff_t>(share * (levels.size() - 1));
-    std::nth_element(levels.begin(), k, levels.end());
-    return static_cast<double>(*k);
-  };
   out.region_low = at(0.05);
   out.region_high = at(0.95);
   return out;
@@ -485,7 +487,7 @@ double depthOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask
 // levels inverted); 0 where not seen, or where the part is not the darker.
 double partLevelOf(const vision::Region& r, const cv::Mat& grey, const cv::Mat& mask,
                    vision::Polarity polarity) {
-  const auto levels = levelsOf(r, grey, mask);
+  const auto levels = levelsOf(r, grey, mask, true);
   if (!levels) return 0;
   // Its faintest stretch's level (a part shaded lighter at one end): split
   // at its mean, that end fell to the surface, and the part's outline with
