@@ -1762,3 +1762,51 @@ TEST_CASE("the front-light benchmark's speckled corner at 30 levels holds no par
                     [](const auto& t) { return t.kind == ps::PartKind::kTrue; });
   CHECK(found == drawn_true);
 }
+
+TEST_CASE("LEARN names a shadow only where one lies beside the part, an uneven surface otherwise",
+          "[vision_app][learn][front]") {
+  // At 30 grey levels of contrast a blotched belt, paving bricks and gravel
+  // lie a quarter of the contrast off the surface's level along a tenth or
+  // a fifth of a part's outline, as a cast shadow does: LEARN called each of
+  // them "a shadow or uneven light" and told the user to light the cell
+  // along the camera's axis, which changes nothing there. A shadow is named
+  // only where the region pass cut one off the part, from whichever side
+  // the lamp casts it.
+  const std::vector<std::pair<std::string, double>> files = {
+      {"shapes/tari1000/obj3_11.png", 220},
+      {"shapes/tari1000/obj16_11.png", 230},
+      {"shapes/tari1000/obj27_11.png", 210},
+      {"shapes/kimia99/trainimage6_11.png", 230}};
+  const auto warningsOf = [&](const ps::SilhouetteSceneOptions& look, size_t i) {
+    const ps::SilhouetteType type = drawing(files[i].first, files[i].second);
+    cv::Point2d drawn;
+    const cv::Mat teach =
+        ps::renderSilhouetteInFrame(type, look, 20 + i, {300.0 + 330 * i, 540.5}, &drawn, 30);
+    const auto learned = learnInImage(teach, {}, VisionOptions{}, noModels(), 1, "part",
+                                      boxAround(drawn, files[i].second));
+    REQUIRE(learned.ok());
+    for (const auto& w : learned->warnings) UNSCOPED_INFO(files[i].first << ": " << w);
+    return learned->warnings;
+  };
+  int uneven = 0;
+  for (const std::string condition : {"low-contrast", "brick", "gravel"}) {
+    const ps::SilhouetteSceneOptions look =
+        condition == "low-contrast" ? lookOf(condition) : photographedLook(condition);
+    for (size_t i = 0; i < files.size(); ++i) {
+      CAPTURE(condition, files[i].first);
+      const auto warnings = warningsOf(look, i);
+      CHECK_FALSE(mentions(warnings, "shadow beside"));
+      uneven += mentions(warnings, "an uneven surface") ? 1 : 0;
+    }
+  }
+  // Most of them see the surface's unevenness, and say so.
+  CHECK(uneven >= 6);
+  for (const double lamp : {45.0, 220.0}) {
+    ps::SilhouetteSceneOptions look = lookOf("shadow");
+    look.front.shadow_angle_deg = lamp;
+    for (size_t i = 0; i < files.size(); ++i) {
+      CAPTURE(lamp, files[i].first);
+      CHECK(mentions(warningsOf(look, i), "a shadow beside the part"));
+    }
+  }
+}

@@ -870,10 +870,10 @@ bool readLocally(int reach, const RowRuns& interior, Dilations& dilations, BandP
 // pixels are still measurably covered: by more than the levels they are
 // read against could make up (kTailNoiseShare).
 //
-// `zone` (over `box`, or empty) is where a cast shadow lies beside the part
-// (see shadows.hpp): there each band pixel is read against the shadow's
-// level beside it (outsideLevels, past the lens's blur `blur_px`), not the
-// surface's. `uneven` tells whether the band was read against levels beside
+// `zone` (over `box`; empty where none lies in it) is where a cast shadow
+// lies beside the part (see shadows.hpp): there each band pixel is read
+// against the shadow's level beside it (outsideLevels, past the lens's blur
+// `blur_px`), not the surface's. `uneven` tells whether the band was read against levels beside
 // it (a shadow's, or readLocally's) rather than planes (Region::uneven_light).
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
                  const cv::Mat& set, const cv::Mat& zone, double blur_px, const cv::Rect& box,
@@ -881,9 +881,7 @@ bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own
                  RowRuns* covered, bool* uneven) {
   std::vector<float> raw_row(static_cast<size_t>(box.width));
   BandPixels pixels{grey_box, own, set, raw_row.data(), {}, {}};
-  if (!zone.empty() && cv::countNonZero(zone) > 0) {
-    pixels.local = outsideLevels(grey_box, own, set == 0, zone, blur_px);
-  }
+  if (!zone.empty()) pixels.local = outsideLevels(grey_box, own, set == 0, zone, blur_px);
   Dilations dilations(own_runs);
   BandReading kept;
   int kept_reach = 0;
@@ -1078,9 +1076,12 @@ bool measureRegion(const cv::Mat& mask, const cv::Mat& grey, const cv::Mat& zone
   r.glints = static_cast<int>(glints.size());
   r.pinholes = static_cast<int>(filled.size() - glints.size());
 
+  // A shadow cut off a part lies within its box (its zone: the shadow and
+  // a few pixels round it).
+  r.beside_shadow = !zone.empty() && cv::countNonZero(zone(box)) > 0;
   if (!grey.empty() &&
-      greyMoments(grey(box), own, own_runs, set, zone.empty() ? cv::Mat() : zone(box), blur_px, box,
-                  &r.moments, &r.centroid, &r.coverage, &r.coverage_origin, &r.covered,
+      greyMoments(grey(box), own, own_runs, set, r.beside_shadow ? zone(box) : cv::Mat(), blur_px,
+                  box, &r.moments, &r.centroid, &r.coverage, &r.coverage_origin, &r.covered,
                   &r.uneven_light)) {
     r.area = r.moments.m00;
   } else {

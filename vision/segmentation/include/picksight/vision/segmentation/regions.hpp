@@ -36,6 +36,10 @@ struct Region {
   // shading), or a cast shadow lies beside it. Its grey-level centroid is
   // then only as good as those levels, and its edges more trustworthy.
   bool uneven_light = false;
+  // A cast shadow joined to a part was cut off it within the region's box
+  // (shadows.hpp): its edge there was read against the shadow's level. Of
+  // a part alone (LEARN's), its own shadow.
+  bool beside_shadow = false;
   // Moments (grey-weighted with a grey image, else binary). Raw moments
   // (m00..m03) are about an origin near bbox.tl(); central and normalized
   // moments do not depend on the origin.
