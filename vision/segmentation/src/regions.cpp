@@ -873,8 +873,9 @@ bool readLocally(int reach, const RowRuns& interior, Dilations& dilations, BandP
 // `zone` (over `box`; empty where none lies in it) is where a cast shadow
 // lies beside the part (see shadows.hpp): there each band pixel is read
 // against the shadow's level beside it (outsideLevels, past the lens's blur
-// `blur_px`), not the surface's. `uneven` tells whether the band was read against levels beside
-// it (a shadow's, or readLocally's) rather than planes (Region::uneven_light).
+// `blur_px`), not the surface's. `uneven` tells whether the band was read
+// against levels beside it (a shadow's, or readLocally's) rather than
+// planes (Region::uneven_light).
 bool greyMoments(const cv::Mat& grey_box, const cv::Mat& own, const RowRuns& own_runs,
                  const cv::Mat& set, const cv::Mat& zone, double blur_px, const cv::Rect& box,
                  cv::Moments* moments, cv::Point2d* centroid, cv::Mat* weights, cv::Point* origin,
