@@ -727,3 +727,51 @@ TEST_CASE("an outline's centroid is read across a stretch with no crossing from 
   // ends of the stretch outwards); 0.32 with the boundary across the tab.
   CHECK(cv::norm(*centroid - *truth) < 0.17);
 }
+
+TEST_CASE("blob search: a mesh running off the frame holds no part whole, and is not searched",
+          "[vision][blob_search][front]") {
+  // Where the threshold speckles a dark stretch of the surface at a low
+  // contrast (gravel's crevices, a vignetted corner), it makes a mesh of
+  // strands a few pixels wide that runs off the frame and steps along its
+  // outline as a part's edge does. No part lies whole in it: what an
+  // erosion of the seam's width leaves of it is crumbs, smaller than any
+  // model leaves of its part. Searched, such blobs cost the front-light
+  // benchmark's gravel scenes their slowest LOCATEs.
+  std::vector<pt::DrawnPart> mesh;
+  const ps::Shape strand_down = pt::centred(ps::Shape{{pt::rectLoop(3, 204)}});
+  const ps::Shape strand_across = pt::centred(ps::Shape{{pt::rectLoop(262, 3)}});
+  for (int k = 0; k <= 18; ++k) mesh.push_back({strand_down, 200.0 + 14 * k, 100, 0});
+  for (int k = 0; k <= 13; ++k) mesh.push_back({strand_across, 331, 10.0 + 14 * k, 0});
+  RegionOptions keep;
+  keep.keep_border_regions = true;
+  const auto regionsOf = [&](const std::vector<pt::DrawnPart>& parts) {
+    const cv::Mat grey = pt::drawParts(640, 480, parts, 9);
+    return findRegions(binarize(grey, {}), keep, grey);
+  };
+  const auto models_list = all();
+  {
+    const auto regions = regionsOf(mesh);
+    REQUIRE(regions.size() == 1);
+    REQUIRE(regions[0].touches_border);
+    // As large as the L and the bar both, and as long and wide.
+    REQUIRE(regions[0].area > models().l.body.area + models().b.body.area);
+    const BlobSearch search(regions, 0, models_list, nullptr);
+    CHECK(search.fitting().empty());
+  }
+  {
+    // The L joined to the mesh's lower edge: the blob holds it whole, and it
+    // is searched for and found.
+    std::vector<pt::DrawnPart> with_l = mesh;
+    with_l.push_back({lShape(), 330.3, 226.6, 0});
+    const auto regions = regionsOf(with_l);
+    REQUIRE(regions.size() == 1);
+    const BlobSearch search(regions, 0, models_list, nullptr);
+    CHECK(std::find(search.fitting().begin(), search.fitting().end(), &models().l) !=
+          search.fitting().end());
+    const auto found = locateInBlob(regions, 0, models_list);
+    for (const auto& m : found) UNSCOPED_INFO(m.model->name << " at " << m.centroid);
+    CHECK(std::any_of(found.begin(), found.end(), [](const Match& m) {
+      return m.model == &models().l && std::hypot(m.centroid.x - 330.3, m.centroid.y - 226.6) < 1.0;
+    }));
+  }
+}
