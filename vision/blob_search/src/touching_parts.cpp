@@ -154,9 +154,8 @@ constexpr int kFrameClearancePx = 1;
 constexpr double kMinBorderSteppedShare = 0.35;
 
 // A part lies whole in its blob: what an erosion by kSeamPx leaves of the
-// blob holds, in one piece, what it leaves of the part (less its area
-// tolerance). A blob the frame's edge cuts is measured so before it is
-// searched: where the threshold speckles a dark stretch of the surface at
+// blob holds, in one piece, what it leaves of the part (leastCore). A blob the frame's edge cuts is
+// measured so before it is searched: where the threshold speckles a dark stretch of the surface at
 // a low contrast (gravel's crevices, a vignetted corner), the mesh it makes
 // runs off the frame and may step along half its outline, as a part's edge
 // does, and its ragged outline and its holes give hundreds of corners to
@@ -170,14 +169,26 @@ constexpr double kMinBorderSteppedShare = 0.35;
 // solid in places still holds pieces a part's size, and is searched (one
 // at 30 levels: 11-33 ms of a LOCATE).
 
-// A part's area less a seam of kSeamPx along its boundary (what the rest's
-// erosion leaves of it).
-double erodedArea(const PartModel& m) {
+double boundaryLength(const PartModel& m) {
   double length = 0;
   for (const auto& loop : m.loops) {
     for (const auto& p : loop.primitives) length += p.length();
   }
-  return std::max(1.0, m.body.area - kSeamPx * length);
+  return length;
+}
+
+// A part's area less a seam of kSeamPx along its boundary (what the rest's
+// erosion leaves of it).
+double erodedArea(const PartModel& m) {
+  return std::max(1.0, m.body.area - kSeamPx * boundaryLength(m));
+}
+
+// The least the blob's erosion leaves of a part lying in it: its area less
+// its tolerance, less the seam where the square erosion reaches furthest
+// (across a diagonal edge, kSeamPx times the square root of 2), so that a
+// slender part lying diagonally is not taken for crumbs.
+double leastCore(const PartModel& m) {
+  return m.body.area * (1 - m.body.area_tolerance) - kSeamPx * std::sqrt(2.0) * boundaryLength(m);
 }
 
 // A part lies inside its blob (parts that touch or overlap make one blob
@@ -530,7 +541,7 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
   const Extent blob_extent =
       extentOf(std::vector<cv::Point2f>(region_.outer.begin(), region_.outer.end()));
   // Of a blob the frame's edge cuts, the largest piece its erosion leaves
-  // (kSeamPx; see erodedArea).
+  // (kSeamPx; see leastCore).
   double core = region_.area;
   if (region_.touches_border) {
     cv::Mat blob;
@@ -549,7 +560,7 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
     // A part in the blob is no larger than the blob.
     if (m->loops.empty() || m->body.area * (1 - m->body.area_tolerance) > region_.area) continue;
     if (!fitsIn(searchOf(*m)->extent, blob_extent)) continue;
-    if (erodedArea(*m) * (1 - m->body.area_tolerance) > core) continue;
+    if (leastCore(*m) > core) continue;
     fitting_.push_back(m);
     tolerance_ = std::max(tolerance_, m->edge_tolerance);
     conformity_ = std::min(conformity_, m->conformity);
