@@ -162,10 +162,9 @@ constexpr double kMinBorderSteppedShare = 0.35;
 // search from, for nothing; its strands are a few pixels wide, and the
 // erosion leaves crumbs of them. Front-light benchmark, photographed gravel
 // at 30 grey levels, 3 scenes x 3 frames, the slowest LOCATE (p99) before
-// and after, two runs: separated 31.3 / 31.3 -> 20.4 / 21.4 ms, touching
-// 84.8 / 84.6 -> 65.4 / 68.6, overlapping 44.4 / 44.6 -> 32.7 / 35.5; the
-// medians, and every part found and its pose, the same on all eight
-// lights and bricks. A vignetted corner that the threshold took in as
+// and after: separated 31.8 -> 20.2 ms, touching 86.5 -> 65.0, overlapping
+// 44.8 -> 32.9; the medians, and every part found and its pose, the same
+// on all eight lights, bricks and gravel. A vignetted corner that the threshold took in as
 // solid in places still holds pieces a part's size, and is searched (one
 // at 30 levels: 11-33 ms of a LOCATE).
 
