@@ -542,7 +542,7 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
   // Of a blob the frame's edge cuts, the largest piece its erosion leaves
   // (kSeamPx; see leastCore).
   double core = region_.area;
-  if (region_.touches_border) {
+  if (region_.touches_border && !region_.coverage.empty()) {
     cv::Mat blob;
     cv::compare(region_.coverage, 0.5, blob, cv::CMP_GE);
     cv::erode(
