@@ -153,21 +153,6 @@ constexpr int kFrameClearancePx = 1;
 // up more of their outline than the frame's edge leaves a part in these.
 constexpr double kMinBorderSteppedShare = 0.35;
 
-// A part lies whole in its blob: what an erosion by kSeamPx leaves of the
-// blob holds, in one piece, what it leaves of the part (leastCore). A blob the frame's edge cuts is
-// measured so before it is searched: where the threshold speckles a dark stretch of the surface at
-// a low contrast (gravel's crevices, a vignetted corner), the mesh it makes
-// runs off the frame and may step along half its outline, as a part's edge
-// does, and its ragged outline and its holes give hundreds of corners to
-// search from, for nothing; its strands are a few pixels wide, and the
-// erosion leaves crumbs of them. Front-light benchmark, photographed gravel
-// at 30 grey levels, 3 scenes x 3 frames, the slowest LOCATE (p99) before
-// and after: separated 31.8 -> 20.2 ms, touching 86.5 -> 65.0, overlapping
-// 44.8 -> 32.9; the medians, and every part found and its pose, the same
-// on all eight lights, bricks and gravel. A vignetted corner that the threshold took in as
-// solid in places still holds pieces a part's size, and is searched (one
-// at 30 levels: 11-33 ms of a LOCATE).
-
 double boundaryLength(const PartModel& m) {
   double length = 0;
   for (const auto& loop : m.loops) {
@@ -182,10 +167,24 @@ double erodedArea(const PartModel& m) {
   return std::max(1.0, m.body.area - kSeamPx * boundaryLength(m));
 }
 
-// The least the blob's erosion leaves of a part lying in it: its area less
+// A part lies whole in its blob: what an erosion by kSeamPx leaves of the
+// blob holds, in one piece, at least this much of the part: its area less
 // its tolerance, less the seam where the square erosion reaches furthest
-// (across a diagonal edge, kSeamPx times the square root of 2), so that a
-// slender part lying diagonally is not taken for crumbs.
+// (across a diagonal edge, kSeamPx times the square root of 2, so that a
+// slender part lying diagonally is not taken for crumbs). A blob the
+// frame's edge cuts is measured so before it is searched: where the
+// threshold speckles a dark stretch of the surface at a low contrast
+// (gravel's crevices, a vignetted corner), the mesh it makes runs off the
+// frame and may step along half its outline, as a part's edge does, and
+// its ragged outline and its holes give hundreds of corners to search
+// from, for nothing; its strands are a few pixels wide, and the erosion
+// leaves crumbs of them. Front-light benchmark, photographed gravel at 30
+// grey levels, 3 scenes x 3 frames, the slowest LOCATE (p99) before and
+// after: separated 31.8 -> 20.2 ms, touching 86.5 -> 65.0, overlapping
+// 44.8 -> 32.9; the medians, and every part found and its pose, the same
+// on all eight lights, bricks and gravel. A vignetted corner that the
+// threshold took in as solid in places still holds pieces a part's size,
+// and is searched (one at 30 levels: 11-33 ms of a LOCATE).
 double leastCore(const PartModel& m) {
   return m.body.area * (1 - m.body.area_tolerance) - kSeamPx * std::sqrt(2.0) * boundaryLength(m);
 }
@@ -543,13 +542,13 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
   // (kSeamPx; see leastCore).
   double core = region_.area;
   if (region_.touches_border && !region_.coverage.empty()) {
-    cv::Mat blob;
-    cv::compare(region_.coverage, 0.5, blob, cv::CMP_GE);
+    cv::compare(region_.coverage, 0.5, blob_, cv::CMP_GE);
+    cv::Mat eroded;
     cv::erode(
-        blob, blob,
+        blob_, eroded,
         cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kSeamPx + 1, 2 * kSeamPx + 1)));
     cv::Mat labels, stats, centres;
-    const int pieces = cv::connectedComponentsWithStats(blob, labels, stats, centres, 8);
+    const int pieces = cv::connectedComponentsWithStats(eroded, labels, stats, centres, 8);
     core = 0;
     for (int k = 1; k < pieces; ++k) {
       core = std::max(core, static_cast<double>(stats.at<int>(k, cv::CC_STAT_AREA)));
@@ -586,7 +585,8 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
   double smallest = region_.area;
   for (const PartModel* m : fitting_) smallest = std::min(smallest, m->body.area);
   blob_box_ = cv::Rect(region_.coverage_origin, region_.coverage.size());
-  cv::compare(region_.coverage, 0.5, blob_, cv::CMP_GE);
+  // The blob's pixels: made above already for a blob the frame cuts.
+  if (blob_.empty()) cv::compare(region_.coverage, 0.5, blob_, cv::CMP_GE);
   coverage_.emplace(region_);
   blob_pixels_ = cv::countNonZero(blob_);
   const int parts = std::max(1, static_cast<int>(region_.area / std::max(smallest, 1.0)));

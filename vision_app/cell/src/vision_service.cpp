@@ -798,18 +798,21 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const cv::Mat& g
                        "under a direct light)");
   }
   const double uneven = vision::unevenEdgeShare(grey, mask, r);
-  if (uneven > kShadowShare && r.beside_shadow) {
-    warnings.push_back(
-        "a shadow beside the part along " + std::to_string(std::lround(100 * uneven)) +
-        " % of the outline (cut off the part, which may still be placed half a pixel off: light "
-        "the cell along the camera's axis, a ring light or a dome)");
-  } else if (uneven > kShadowShare) {
-    warnings.push_back(
-        "an uneven surface beside the part along " + std::to_string(std::lround(100 * uneven)) +
-        " % of the outline (a quarter of the contrast off the surface's or the part's level "
-        "there: blotches, grain or stones of the surface, the part's shading, a faint shadow; "
-        "the part may be placed a tenth of a pixel off: teach it on a plainer stretch, or add "
-        "views of it lying elsewhere with LEARNVIEW)");
+  if (uneven > kShadowShare) {
+    const std::string along =
+        " along " + std::to_string(std::lround(100 * uneven)) + " % of the outline";
+    if (r.beside_shadow) {
+      warnings.push_back("a shadow beside the part" + along +
+                         " (cut off the part, which may still be placed half a pixel off: light "
+                         "the cell along the camera's axis, a ring light or a dome)");
+    } else {
+      warnings.push_back(
+          "an uneven surface beside the part" + along +
+          " (a quarter of the contrast off the surface's or the part's level there: blotches, "
+          "grain or stones of the surface, the part's shading, a faint shadow; the part may be "
+          "placed a tenth of a pixel off: teach it on a plainer stretch, or add views of it "
+          "lying elsewhere with LEARNVIEW)");
+    }
   }
   const double small_hole = kSmallHoleShare * r.area;
   int small = 0;
