@@ -1,9 +1,12 @@
-// Sensor mapping conversions, written once for every vision result.
+// Sensor mapping conversions, written once for every vision result; JPEG
+// files told from the rest.
 #include "picksight/common/frame.hpp"
 
 #include "picksight/common/angles.hpp"
 
+#include <array>
 #include <cmath>
+#include <fstream>
 
 #include "picksight/common/clock.hpp"
 
@@ -69,6 +72,16 @@ Frame frameFromImage(const cv::Mat& image, const std::string& camera, uint64_t s
   frame.info.height = static_cast<uint32_t>(image.rows);
   frame.info.triggered = true;
   return frame;
+}
+
+bool isJpegFile(const std::string& path) {
+  // Every JPEG stream starts with a start-of-image marker followed by
+  // another marker (JFIF, Exif, a table).
+  std::array<char, 3> head{};
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(head.data(), head.size())) return false;
+  return static_cast<unsigned char>(head[0]) == 0xFF &&
+         static_cast<unsigned char>(head[1]) == 0xD8 && static_cast<unsigned char>(head[2]) == 0xFF;
 }
 
 }  // namespace picksight

@@ -1,6 +1,11 @@
 // Pins the sensor mapping conversions (the convention of
 // proto/picksight.proto) and frames made from still images.
+#include <stdlib.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
 
 #include <catch2/catch.hpp>
 
@@ -100,4 +105,22 @@ TEST_CASE("frameFromImage makes a full sensor frame that shares the pixels", "[c
   CHECK(frame.info.host_timestamp_ns > 0);
   CHECK(frame.mapping.toSensor({5, 6}) == cv::Point2d(5, 6));
   CHECK(frame.truth.empty());
+  CHECK_FALSE(frame.info.compressed);
+}
+
+TEST_CASE("isJpegFile reads a file's first bytes, not its name", "[common]") {
+  char pattern[] = "/tmp/picksight-jpeg-XXXXXX";
+  REQUIRE(::mkdtemp(pattern) != nullptr);
+  const std::string dir = pattern;
+  const auto write = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir + "/" + name, std::ios::binary) << bytes;
+    return dir + "/" + name;
+  };
+  // A JPEG begins with its start-of-image marker and another marker.
+  CHECK(picksight::isJpegFile(write("a.png", std::string("\xFF\xD8\xFF\xE0rest", 8))));
+  CHECK_FALSE(picksight::isJpegFile(write("b.jpg", "\x89PNG\r\n")));
+  CHECK_FALSE(picksight::isJpegFile(write("c.jpg", std::string("\xFF\xD8", 2))));  // cut short
+  CHECK_FALSE(picksight::isJpegFile(write("d.jpg", std::string("\xFF\x00\xFF", 3))));
+  CHECK_FALSE(picksight::isJpegFile(dir + "/missing.jpg"));
+  std::filesystem::remove_all(dir);
 }

@@ -100,7 +100,9 @@ LineClient VisionProcess::connect() const {
 
 PhotographCell::PhotographCell(const std::string& scene_file)
     : server({"--source",
-              "cam0=file:" + std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + scene_file,
+              "cam0=file:" + (scene_file.rfind('/', 0) == 0
+                                  ? scene_file
+                                  : std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + scene_file),
               "--mode", "trigger"}),
       vision(server),
       robot(vision.connect()) {}

@@ -47,6 +47,7 @@ struct VisionProcess {
 // A cell whose camera is one photograph of tests/data/scenes (a file
 // camera in trigger mode), and a robot's connection to its vision app.
 struct PhotographCell {
+  // `scene_file`: a file of tests/data/scenes, or an absolute path.
   explicit PhotographCell(const std::string& scene_file);
   // The reply to `line`; REQUIREs one within 20 s.
   std::string ask(const std::string& line);

@@ -188,6 +188,7 @@ TEST_CASE("A frame survives encoding and decoding and outlives its sender's imag
   sent.info.device_timestamp_ns = 11;
   sent.info.host_timestamp_ns = 22;
   sent.info.triggered = true;
+  sent.info.compressed = true;
   sent.truth.push_back({"ring", 1, 2, 30, 180, 400});
   const cv::Mat expected = sent.image.clone();
   picksight::transport::sendFrame(pub, sent);
@@ -201,6 +202,7 @@ TEST_CASE("A frame survives encoding and decoding and outlives its sender's imag
   CHECK(got->info.device_timestamp_ns == 11);
   CHECK(got->info.host_timestamp_ns == 22);
   CHECK(got->info.triggered);
+  CHECK(got->info.compressed);
   CHECK(got->info.received_ns > 0);
   CHECK(got->info.width == 30);
   CHECK(got->info.height == 20);

@@ -13,7 +13,10 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "cell_fixture.hpp"
+#include "temp_dir.hpp"
 
 using namespace picksight;
 using namespace picksight::e2e;
@@ -161,6 +164,61 @@ TEST_CASE("photographs: every whole sweet from one taught in colour", "[e2e][pho
           {1, 294, 320},
           {1, 134, 327}},
          5});
+}
+
+TEST_CASE("photographs: a part taught on its colour from a JPEG frame is warned of",
+          "[e2e][photographs][colour]") {
+  // The sweets photograph as an IP camera, a phone or an MJPEG webcam sends
+  // it (JPEG at quality 90: colour at half resolution, quantised in blocks),
+  // through a file camera: the green sweet is taught on its colour, and
+  // LEARN says the frame came compressed and what that costs. The same
+  // photograph lossless, and a part taught on its grey levels through JPEG,
+  // are not warned of. The file camera tells a JPEG by its first bytes: the
+  // copies are named .png.
+  const test::TempDir dir;
+  const auto asJpeg = [&](const std::string& scene) {
+    const cv::Mat photo =
+        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + scene, cv::IMREAD_COLOR);
+    REQUIRE(!photo.empty());
+    std::vector<uint8_t> bytes;
+    REQUIRE(cv::imencode(".jpg", photo, bytes, {cv::IMWRITE_JPEG_QUALITY, 90}));
+    return dir.write(scene, std::string(bytes.begin(), bytes.end()));
+  };
+  const std::string warned = "this frame came compressed";
+  // A colour camera: the video server sends bgr8.
+  const auto inColour = [](const PhotographCell& cell) {
+    const CommandResult set =
+        run({binPath("picksight-cam"), "--control", cell.server.control, "format", "cam0", "bgr8"});
+    INFO(set.out);
+    REQUIRE(set.exit_code == 0);
+  };
+  {
+    PhotographCell cell(asJpeg("smarties.png"));
+    inColour(cell);
+    const std::string reply = cell.ask("LEARN 1 sweet AT 236 85 64 64");
+    INFO(reply);
+    CHECK(reply.rfind("OK 1 sweet ", 0) == 0);
+    CHECK(reply.find(warned) != std::string::npos);
+    CHECK(reply.find("half resolution") != std::string::npos);
+  }
+  {
+    PhotographCell cell("smarties.png");
+    inColour(cell);
+    const std::string reply = cell.ask("LEARN 1 sweet AT 236 85 64 64");
+    INFO(reply);
+    CHECK(reply.rfind("OK 1 sweet ", 0) == 0);
+    CHECK(reply.find(warned) == std::string::npos);
+  }
+  {
+    // pic3.png: an outline painted on white, dark enough to be taught on
+    // its grey levels.
+    PhotographCell cell(asJpeg("pic3.png"));
+    inColour(cell);
+    const std::string reply = cell.ask("LEARN 1 square AT 230 160 135 135");
+    INFO(reply);
+    CHECK(reply.rfind("OK 1 square ", 0) == 0);
+    CHECK(reply.find(warned) == std::string::npos);
+  }
 }
 
 TEST_CASE("photographs: six bars on a light table seen at a slant, the two nearest by WHY's remedy",

@@ -39,6 +39,7 @@ proto::FrameHeader headerOf(const Frame& f, const cv::Mat& img) {
   h.set_scale_x(f.mapping.scale_x);
   h.set_scale_y(f.mapping.scale_y);
   h.set_triggered(f.info.triggered);
+  h.set_compressed(f.info.compressed);
   for (const auto& t : f.truth) {
     auto* p = h.add_truth();
     p->set_type(t.type);
@@ -118,6 +119,7 @@ std::optional<Frame> decodeFrame(const proto::FrameHeader& h, zmq::message_t pix
   frame.info.width = h.width();
   frame.info.height = h.height();
   frame.info.triggered = h.triggered();
+  frame.info.compressed = h.compressed();
   frame.truth.reserve(static_cast<size_t>(h.truth_size()));
   for (const auto& t : h.truth()) {
     frame.truth.push_back(

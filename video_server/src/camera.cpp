@@ -512,6 +512,7 @@ void Camera::publish(std::unique_lock<std::mutex>& lock, uint64_t sequence, bool
   frame.info.width = static_cast<uint32_t>(frame.image.cols);
   frame.info.height = static_cast<uint32_t>(frame.image.rows);
   frame.info.triggered = triggered;
+  frame.info.compressed = grab.grabbed->compressed || grab.grabbed->layout == PixelLayout::kMJPEG;
   frame.truth = std::move(grab.grabbed->truth);
   // Statistics first, then the hand-over: a subscriber must never hold a
   // frame that `stats` does not count yet.

@@ -96,12 +96,28 @@ TEST_CASE("dir: 16-bit images are Mono16, colour images BGR8", "[video_server][d
   auto deep = source->grab(1s);
   REQUIRE(deep);
   CHECK(deep->layout == PixelLayout::kMono16);
+  CHECK_FALSE(deep->compressed);
   CHECK(levelOf(*source) == 22);  // the colour one, grey: 0.114*10 + 0.587*20 + 0.299*30
   auto again = source->grab(1s);
   REQUIRE(again);
   auto grey = toOutputFormat(again->image, again->layout, OutputFormat::kMono8);
   REQUIRE(grey);
   CHECK(grey->at<uint8_t>(0, 0) == 200);
+}
+
+TEST_CASE("dir: a JPEG's frame is marked compressed, a PNG's is not", "[video_server][dir]") {
+  TempDir dir;
+  const cv::Mat bgr(8, 8, CV_8UC3, cv::Scalar(10, 20, 30));
+  REQUIRE(cv::imwrite((dir.path() / "0.jpg").string(), bgr));
+  REQUIRE(cv::imwrite((dir.path() / "1.png").string(), bgr));
+  auto source = dirSource(dir.path());
+  REQUIRE(source->open());
+  auto jpeg = source->grab(1s);
+  REQUIRE(jpeg);
+  CHECK(jpeg->compressed);
+  auto png = source->grab(1s);
+  REQUIRE(png);
+  CHECK_FALSE(png->compressed);
 }
 
 TEST_CASE("dir: empty, missing or unreadable directories are unavailable", "[video_server][dir]") {

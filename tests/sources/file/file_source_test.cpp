@@ -104,6 +104,32 @@ TEST_CASE("FileSource serves colour as BGR and 16-bit images as 8-bit", "[video_
   }
 }
 
+TEST_CASE("FileSource marks a JPEG's frames compressed, by its content, not its name",
+          "[video_server]") {
+  TempDir dir;
+  const cv::Mat bgr(48, 64, CV_8UC3, cv::Scalar(40, 160, 70));
+  std::vector<uint8_t> jpeg;
+  REQUIRE(cv::imencode(".jpg", bgr, jpeg));
+  const std::string named_png = dir.file("photo.png");
+  std::ofstream(named_png, std::ios::binary)
+      .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
+  auto source = fileSource(named_png);
+  REQUIRE(source->open());
+  auto frame = source->grab(1000ms);
+  REQUIRE(frame);
+  CHECK(frame->compressed);
+  // A lossless image, even named .jpg, is not.
+  const std::string lossless = dir.file("photo.jpg.png");
+  REQUIRE(cv::imwrite(lossless, bgr));
+  const std::string named_jpg = dir.file("lossless.jpg");
+  REQUIRE(std::rename(lossless.c_str(), named_jpg.c_str()) == 0);
+  auto plain = fileSource(named_jpg);
+  REQUIRE(plain->open());
+  auto kept = plain->grab(1000ms);
+  REQUIRE(kept);
+  CHECK_FALSE(kept->compressed);
+}
+
 TEST_CASE("FileSource picks up a new image renamed over the path", "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");

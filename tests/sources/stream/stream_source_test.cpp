@@ -236,6 +236,7 @@ TEST_CASE("stream: a video file plays every frame in order and loops", "[video_s
     if (!frame) FAIL(frame.error().message);
     INFO("frame " << k);
     CHECK(std::abs(meanOf(*frame, cv::Rect(0, 0, 64, 48))[0] - (20 + 40 * (k % 5))) <= 4);
+    CHECK(frame->compressed);  // what a stream carries went through a lossy codec
   }
   source.close();
   fs::remove_all(dir);

@@ -73,6 +73,12 @@ class CollectingSink : public FrameSink {
   void publish(picksight::Frame frame) override {
     std::lock_guard<std::mutex> lock(mutex_);
     frames_.push_back(frame.info.sequence);
+    compressed_ = compressed_ || frame.info.compressed;
+  }
+  // Whether any frame published was marked compressed.
+  bool anyCompressed() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return compressed_;
   }
   size_t count() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -82,6 +88,7 @@ class CollectingSink : public FrameSink {
  private:
   mutable std::mutex mutex_;
   std::vector<uint64_t> frames_;
+  bool compressed_ = false;
 };
 
 template <typename Pred>
@@ -279,6 +286,23 @@ TEST_CASE("v4l2 camera reconnects after the device comes back", "[video_server][
   CHECK(eventually([&] { return sink.count() >= before + 3; }));
   camera.stop();
   CHECK(sim->state().open_fds == 0);
+}
+
+TEST_CASE("v4l2 camera marks an MJPEG webcam's frames compressed, a YUYV one's not",
+          "[video_server][v4l2]") {
+  for (const std::string format : {"mjpeg", "yuyv"}) {
+    INFO(format);
+    Rig rig("?format=" + format);
+    CollectingSink sink;
+    CameraConfig config;
+    config.name = "webcam";
+    config.uri = "v4l2:/dev/video0?format=" + format;
+    Camera camera(config, std::move(rig.source), sink);
+    camera.start();
+    REQUIRE(eventually([&] { return sink.count() >= 2; }));
+    camera.stop();
+    CHECK(sink.anyCompressed() == (format == "mjpeg"));
+  }
 }
 
 TEST_CASE("v4l2 controls are typed features named from their labels", "[video_server][v4l2]") {

@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "eight_bit_image.hpp"
+#include "picksight/common/frame.hpp"
 #include "picksight/common/log.hpp"
 
 namespace picksight::video {
@@ -128,7 +129,9 @@ Result<SourceFrame> DirSource::grab(std::chrono::milliseconds /*timeout*/) {
       continue;
     }
     warned_.erase(name);  // rewritten into a good image: warn again if it breaks again
-    return toFrame(std::move(image));
+    SourceFrame frame = toFrame(std::move(image));
+    frame.compressed = isJpegFile(file);
+    return frame;
   }
   return makeError(SourceErrc::kUnavailable, "dir:" + path_ + ": no readable image among " +
                                                  std::to_string(names_.size()) + " files");

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "eight_bit_image.hpp"
+#include "picksight/common/frame.hpp"
 
 namespace picksight::video {
 
@@ -46,6 +47,7 @@ Result<void> FileSource::refresh() {
   if (loaded.empty()) return failing("not a readable image");
   failing_since_.reset();
   image_ = toEightBit(loaded);
+  jpeg_ = isJpegFile(path_);
   inode_ = st.st_ino;
   size_ = st.st_size;
   mtime_ = st.st_mtim;
@@ -70,6 +72,7 @@ Result<SourceFrame> FileSource::grab(std::chrono::milliseconds /*timeout*/) {
   SourceFrame frame;
   frame.image = image_;  // shared, read-only: the pipeline copies or converts it
   frame.layout = image_.channels() == 3 ? PixelLayout::kBGR8 : PixelLayout::kMono8;
+  frame.compressed = jpeg_;
   return frame;
 }
 

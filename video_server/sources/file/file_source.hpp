@@ -39,7 +39,8 @@ class FileSource : public Source {
   std::chrono::milliseconds grace_;
   // When a grab first found the file unreadable; unset while it reads.
   std::optional<std::chrono::steady_clock::time_point> failing_since_;
-  cv::Mat image_;  // last good image, CV_8UC1 or CV_8UC3
+  cv::Mat image_;      // last good image, CV_8UC1 or CV_8UC3
+  bool jpeg_ = false;  // image_ came from a JPEG (SourceFrame::compressed)
   // What the file was when image_ was read: a rename over it changes the
   // inode, an in-place rewrite the size or mtime.
   ino_t inode_ = 0;

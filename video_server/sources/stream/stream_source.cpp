@@ -200,6 +200,9 @@ Result<SourceFrame> StreamSource::grab(std::chrono::milliseconds timeout) {
     has_frame_ = false;
     frame_taken_.notify_all();
     frame.layout = frame.image.channels() == 1 ? PixelLayout::kMono8 : PixelLayout::kBGR8;
+    // What a stream carries (MJPEG, H.264, H.265, a video file's codec) is
+    // compressed with loss, colour at half resolution.
+    frame.compressed = true;
     if (!is_file_) {
       // Its wait here, then its way from the sender to decoded.
       const uint64_t now = monotonicNs();

@@ -349,12 +349,13 @@ int learnOffline(const OfflineRequest& r, const cv::Mat& image, const std::strin
   }
   // As LEARN does it: the whole image binarized the way LOCATE will see it.
   const SensorMapping full;
-  const auto learned =
+  auto learned =
       learnInImage(image, full, r.options.vision, library.snapshot(), r.type, name, r.at);
   if (!learned) {
     out << errorReply(learned.error()) << "\n";
     return 1;
   }
+  warnOfCompressedColour(isJpegFile(path), &*learned);
   std::string change =
       "picksight-vision learn --type " + std::to_string(r.type) + " --name " + name;
   if (r.at) {

@@ -70,6 +70,10 @@ struct FrameInfo {
   uint32_t width = 0;
   uint32_t height = 0;
   bool triggered = false;  // produced for a software trigger
+  // Its pixels went through lossy compression (a stream, MJPEG, a JPEG
+  // file): colour at half resolution, so LEARN warns where a part is told
+  // from its surface by colour alone.
+  bool compressed = false;
 };
 
 struct Frame {
@@ -84,5 +88,9 @@ struct Frame {
 // resize, triggered, stamped now. Shares the image's pixels: the caller must
 // not write into them afterwards (clone first if it will).
 Frame frameFromImage(const cv::Mat& image, const std::string& camera, uint64_t sequence);
+
+// Whether the file holds a JPEG (its first bytes, whatever its name says): an
+// image read from it went through lossy compression (FrameInfo::compressed).
+bool isJpegFile(const std::string& path);
 
 }  // namespace picksight

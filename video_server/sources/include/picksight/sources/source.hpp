@@ -138,6 +138,11 @@ struct SourceFrame {
   // measured decode and buffering delay plus the configured latency). 0: the
   // frame counts as taken when grabbed.
   std::chrono::nanoseconds age{0};
+  // The pixels went through lossy compression on their way here (a network
+  // stream, a JPEG file; an MJPEG webcam's frames are known by `layout`):
+  // colour at half resolution and quantised, which costs a part told from its
+  // surface by colour alone tenths of a pixel (FrameInfo::compressed).
+  bool compressed = false;
 };
 
 struct SourceInfo {

@@ -231,6 +231,14 @@ Result<LearnOutcome> learnInImage(const cv::Mat& image, const SensorMapping& map
                                   const std::string& name, const std::optional<cv::Rect>& at,
                                   ScaledModelCache* cache = nullptr);
 
+// LEARN's warning where its part was taught on its colour (PartModel::colour)
+// from a frame that went through lossy compression (FrameInfo::compressed: a
+// stream, an MJPEG webcam, a JPEG file): such frames carry colour at half
+// resolution and quantise it in blocks, and a part told from its surface by
+// colour is then placed tenths of a pixel off. Added to `learned`'s
+// warnings; nothing otherwise.
+void warnOfCompressedColour(bool compressed, LearnOutcome* learned);
+
 // LOCATE on one frame, as the robot server, the offline tool and the
 // benchmarks run it: the parts of `type` (-1: all types) recognized with
 // `models` (every region when there are none), with the scene kept for
