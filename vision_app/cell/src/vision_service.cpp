@@ -1144,8 +1144,10 @@ void warnOfCompressedColour(bool compressed, LearnOutcome* learned) {
   // Front-light benchmark, a green part on a grey belt of its brightness,
   // 14 types, separated, position RMS: 0.032 px from lossless frames, 0.047
   // through JPEG at quality 95, 0.074 at 90, 0.23 at 75 (one type's teach
-  // image 0.5 px off); grey parts at 30 levels of contrast lose 0.01-0.02
-  // px at 75.
+  // image 0.5 px off). Parts taught on their grey levels are not warned of:
+  // their edges lie in the brightness, which JPEG keeps at full resolution
+  // (at 30 grey levels of contrast 0.051 px lossless, 0.056 to 0.070
+  // through JPEG at 75 to 95).
   learned->warnings.push_back(
       "the part is told from its surface by its colour, and this frame came compressed (a "
       "stream, MJPEG or JPEG), which keeps colour at half resolution: expect it placed a tenth "
