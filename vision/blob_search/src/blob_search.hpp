@@ -126,8 +126,10 @@ class BlobSearch {
   // into fitting()) what the quick search saw of it.
   void fullSearch(std::vector<std::pair<double, size_t>> order);
   // Each model turned about its point (proposeAbout), all at once, then the
-  // poses refined best first.
-  void searchAbout(const std::vector<std::pair<const PartModel*, cv::Point2d>>& sized);
+  // poses refined best first. `from_core`: each point is where the part's
+  // deepest core lies (proposeAbout).
+  void searchAbout(const std::vector<std::pair<const PartModel*, cv::Point2d>>& sized,
+                   bool from_core = false);
   // The distance map of the blob's outline, exact up to `reach`.
   EdgeDistance edgeMap(double reach) const;
 

@@ -71,9 +71,8 @@ constexpr double kCoarseScanStepPx = 6.0;
 constexpr double kCoarseSlack = 0.25;
 // Rotation scan about an arc's centre: the largest step at the model's rim.
 constexpr double kScanStepPx = 1.5;
-// proposeAbout's reference points: a grid this far apart (pixels), this
-// far either way of the middle it is given.
-constexpr double kAboutStepPx = 4.0;
+// proposeAbout's reference points: a grid kAboutStepPx apart, this far
+// either way of the middle it is given.
 constexpr double kAboutReachPx = 12.0;
 // Its first look: reference points this far apart (read kAboutWidePx more
 // loosely).
@@ -454,11 +453,21 @@ struct AboutPose {
 }  // namespace
 
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
-                  const EdgeDistance& edges, const EdgeDistance& wide,
-                  std::vector<Candidate>* out) {
+                  const EdgeDistance& edges, const EdgeDistance& wide, std::vector<Candidate>* out,
+                  bool from_core) {
   const double threshold = model.verify_percent / 100.0 - kCoarseSlack;
   const double radius = std::max(model.radius, 1.0);
   const double loose = kLooseScreenFactor * model.edge_tolerance;
+  // Where the reference point lies from `centre` at a turn (cos, sin): at
+  // it, or, from the part's deepest core, less the core's middle turned.
+  const cv::Point2d core = from_core ? search.core_middle : cv::Point2d();
+  const auto fromCentre = [&](double c, double s) {
+    return cv::Point2d(-(c * core.x - s * core.y), -(s * core.x + c * core.y));
+  };
+  const auto fromCentreAt = [&](double turn_deg) {
+    const double a = turn_deg * kRadPerDeg;
+    return fromCentre(std::cos(a), std::sin(a));
+  };
   // The turns of a scan `step_px` apart at the model's rim, their cosines
   // and sines computed once.
   const auto turnsOf = [&](double step_px, double* step_deg) {
@@ -478,14 +487,18 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
   static const std::vector<cv::Point2d> coarse_grid = aboutGrid(kAboutCoarsePx);
   double coarse_deg = 0;
   const std::vector<cv::Point2d> coarse_turns = turnsOf(2 * kCoarseScanStepPx, &coarse_deg);
+  std::vector<cv::Point2d> coarse_shifts(coarse_turns.size());
+  for (size_t k = 0; k < coarse_turns.size(); ++k) {
+    coarse_shifts[k] = fromCentre(coarse_turns[k].x, coarse_turns[k].y);
+  }
   const double wide_tolerance = loose + kAboutWidePx;
   // The first look's best pose (the first of poses that score alike: the
   // nearest to `centre`); a pose is scored in full only when it may be it.
   AboutPose first{threshold, centre, 0};
   bool seen = false;
   for (const cv::Point2d& offset : coarse_grid) {
-    const cv::Point2d at = centre + offset;
     for (size_t k = 0; k < coarse_turns.size(); ++k) {
+      const cv::Point2d at = centre + offset + coarse_shifts[k];
       const cv::Point2d& cs = coarse_turns[k];
       if (!verifiesAtLeast(search.glance, search.glance_weight, at, cs.x, cs.y, 1.0, wide,
                            wide_tolerance, threshold - kGlanceSlack) ||
@@ -506,15 +519,19 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
   // the first look's loose tolerance.
   static const std::vector<cv::Point2d> fine_grid = aboutGrid(kAboutStepPx, kAboutCoarsePx / 2);
   const double fine_step = coarse_deg / 2;
+  // The first look's reference point as `centre` would have put it at each
+  // turn (the same at every turn but from the core).
+  const cv::Point2d first_centre = first.at - fromCentreAt(first.turn_deg);
   double best = -1;
   double best_turn = 0;
   cv::Point2d best_at = centre;
   double best_off = 0;
   for (const cv::Point2d& offset : fine_grid) {
-    const cv::Point2d at = first.at + offset;
-    const double off = cv::norm(at - centre);
     for (int k = -2; k <= 2; ++k) {
       const double turn = first.turn_deg + k * fine_step;
+      const cv::Point2d shift = from_core ? fromCentreAt(turn) : cv::Point2d();
+      const cv::Point2d at = from_core ? first_centre + offset + shift : first.at + offset;
+      const double off = cv::norm(at - (centre + shift));
       const double a = turn * kRadPerDeg;
       if (!verifiesAtLeast(search.glance, search.glance_weight, at, std::cos(a), std::sin(a), 1.0,
                            edges, loose, threshold - kGlanceSlack)) {
@@ -538,11 +555,13 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
   }
   if (best < 0) return;
   const double fine = kScanStepPx / radius / kRadPerDeg;
+  const cv::Point2d best_centre = best_at - fromCentreAt(best_turn);
   Candidate chosen{&model, ImagePose{best_at, 0, false}, -1, 0};
   for (double a = best_turn - fine_step; a <= best_turn + fine_step; a += fine) {
-    const double score = verifyScore(search.sparse, best_at, a, edges, model.edge_tolerance, false);
+    const cv::Point2d at = from_core ? best_centre + fromCentreAt(a) : best_at;
+    const double score = verifyScore(search.sparse, at, a, edges, model.edge_tolerance, false);
     if (score > chosen.score)
-      chosen = Candidate{&model, ImagePose{best_at, normalizeDeg(a), false}, score, 0};
+      chosen = Candidate{&model, ImagePose{at, normalizeDeg(a), false}, score, 0};
   }
   if (chosen.score >= threshold) out->push_back(chosen);
 }
@@ -588,6 +607,19 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   boundary.reserve(model.samples.size());
   for (const auto& sample : model.samples) boundary.emplace_back(sample.point);
   b->extent = extentOf(boundary);
+  // The part drawn whole, its box 2 px clear of the image's edge, and its
+  // deepest core read as a blob's is.
+  const auto outline = placedOutline(model, {{0, 0}, 0, false});
+  const cv::Rect at = outline.empty() ? cv::Rect() : cv::boundingRect(outline.front());
+  if (!at.empty()) {
+    const cv::Point2d shift(2 - at.x, 2 - at.y);
+    cv::Mat drawn = cv::Mat::zeros(at.height + 4, at.width + 4, CV_8UC1);
+    cv::fillPoly(drawn, placedOutline(model, {shift, 0, false}), cv::Scalar(255));
+    if (const auto core = deepestCore(drawn, cv::Rect(2, 2, at.width, at.height))) {
+      b->core_middle = core->middle - shift;
+      b->core_depth_px = core->depth_px;
+    }
+  }
   return b;
 }
 

@@ -125,6 +125,10 @@ constexpr double kLooseScreenFactor = 2.0;
 // proposeAbout's first look reads its map this much more loosely than the
 // loose screening tolerance, so a map it reads reaches that much further.
 constexpr double kAboutWidePx = 4.0;
+// proposeAbout's reference points at last lie on a grid this far apart
+// (pixels): a part whose reference point lies within it of a point searched
+// about is found there.
+constexpr double kAboutStepPx = 4.0;
 
 }  // namespace touching
 
@@ -146,6 +150,12 @@ struct BlobSearchModel {
   double glance_weight = 0;                 // the glance samples' total
   double sparse_weight = 0;                 // the sparse samples' total
   Extent extent;                            // of the boundary samples (fitsIn)
+  // The middle of the part's deepest core (touching::deepestCore of the
+  // part drawn whole), model frame: where a blob's deepest core lies from
+  // the part's reference point when the part holds it; and its depth
+  // (pixels from the outline).
+  cv::Point2d core_middle;
+  double core_depth_px = 0;
 };
 
 namespace touching {
@@ -177,8 +187,28 @@ void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
 // reads `edges` about the first look's best; appended to `out` when it
 // screens as well as propose() asks. For a part whose corners and arcs the
 // blob's outline does not show as the model's.
+// `from_core`: `centre` is where the part's deepest core lies, and its
+// reference point is looked for about centre less the model's core_middle
+// turned with the part, at every turn.
 void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Point2d centre,
-                  const EdgeDistance& edges, const EdgeDistance& wide, std::vector<Candidate>* out);
+                  const EdgeDistance& edges, const EdgeDistance& wide, std::vector<Candidate>* out,
+                  bool from_core = false);
+
+// The model's loops placed at a pose, as polygons in image coordinates:
+// filled together, the holes stay empty.
+std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose);
+
+// The deepest core of `piece` (a mask over an image, 255 on the piece, `box`
+// its bounding box): of its pixels deeper inside than half the deepest,
+// those 8-connected to the deepest. Read at a reduced scale, as the rest's
+// pieces are parted at their necks (`step_px`: a reduced pixel's side).
+// None for an empty piece.
+struct DeepestCore {
+  cv::Point2d middle;  // image coordinates
+  double depth_px;     // the deepest pixel's distance from the outline
+  double step_px;
+};
+std::optional<DeepestCore> deepestCore(const cv::Mat& piece, const cv::Rect& box);
 
 }  // namespace touching
 }  // namespace picksight::vision
