@@ -1163,7 +1163,7 @@ void BlobSearch::searchRestMiddle() {
   // core's middle puts it at every turn. Front-light benchmark, overlapping,
   // 14 unseen types, 14 scenes: parts found at 30 grey levels 0.961 ->
   // 0.976, glossy 0.990 -> 0.995, clean 0.985 -> 0.990; 5 scenes wood 0.987
-  // -> 1.000, gravel 0.821 -> 0.833; the 15 standard types (8 scenes) and
+  // -> 1.000, gravel 0.821 -> 0.846; the 15 standard types (8 scenes) and
   // touching parts the same; nothing falsely reported.
   const size_t largest = pieces.front().second;
   const cv::Rect largest_box = cv::boundingRect(outlines[largest]);
