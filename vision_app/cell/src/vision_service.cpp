@@ -1148,12 +1148,14 @@ void warnOfCompressedColour(bool compressed, LearnOutcome* learned) {
   // their edges lie in the brightness, which JPEG keeps at full resolution
   // (at 30 grey levels of contrast 0.051 px lossless, 0.056 to 0.070
   // through JPEG at 75 to 95).
+  // The remedy named is not a webcam's YUYV: it keeps colour at half the
+  // width too (without JPEG's blocks).
   learned->warnings.push_back(
       "the part is told from its surface by its colour, and this frame came compressed (a "
       "stream, MJPEG or JPEG), which keeps colour at half resolution: expect it placed a tenth "
       "to a few tenths of a pixel off (JPEG quality 75: 0.2 px; raw frames: 0.03); for "
-      "sub-pixel work use raw frames (GigE or USB3 Vision, a webcam in YUYV) or a surface of "
-      "another brightness");
+      "sub-pixel work use raw frames (a GigE or USB3 Vision camera) or a surface of another "
+      "brightness");
 }
 
 Result<std::vector<vision::BlobFeatures>> VisionService::blobs() {
