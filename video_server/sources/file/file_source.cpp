@@ -47,6 +47,8 @@ Result<void> FileSource::refresh() {
   if (loaded.empty()) return failing("not a readable image");
   failing_since_.reset();
   image_ = toEightBit(loaded);
+  // Its first bytes read again: a file renamed over the path in between
+  // has another inode than `st`'s, and is read whole at the next grab.
   jpeg_ = isJpegFile(path_);
   inode_ = st.st_ino;
   size_ = st.st_size;
