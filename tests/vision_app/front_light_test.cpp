@@ -330,9 +330,17 @@ TEST_CASE("a green part on a grey belt is taught from a colour image file withou
     CHECK(status == 0);
     return out.str();
   };
-  CHECK_THAT(run("learn", "part.png"), Catch::StartsWith("OK 1 tee "));
+  const std::string taught = run("learn", "part.png");
+  CHECK_THAT(taught, Catch::StartsWith("OK 1 tee "));
+  CHECK_THAT(taught, !Catch::Contains("came compressed"));
   const std::string located = run("locate", "scene.png");
   CHECK_THAT(located, Catch::StartsWith("OK " + std::to_string(scene.truth().size()) + " "));
+  // The same image as a JPEG (a phone's, an IP camera's): taught in colour
+  // still, with the warning that its colour came at half resolution.
+  REQUIRE(cv::imwrite((dir / "part.jpg").string(), alone, {cv::IMWRITE_JPEG_QUALITY, 90}));
+  const std::string from_jpeg = run("learn", "part.jpg");
+  CHECK_THAT(from_jpeg, Catch::StartsWith("OK 1 tee "));
+  CHECK_THAT(from_jpeg, Catch::Contains("came compressed"));
   std::filesystem::remove_all(dir);
 }
 
