@@ -328,11 +328,7 @@ std::vector<std::vector<cv::Point>> touching::placedOutline(const PartModel& m,
   return polys;
 }
 
-namespace {
-
-// `m` drawn at `pose` (255 on it) over `*box`, its outline's box widened by
-// `margin` pixels all round (image coordinates).
-cv::Mat drawnPart(const PartModel& m, const ImagePose& pose, int margin, cv::Rect* box) {
+cv::Mat touching::drawnPart(const PartModel& m, const ImagePose& pose, int margin, cv::Rect* box) {
   const auto outline = placedOutline(m, pose);
   cv::Rect around;
   for (const auto& poly : outline) around |= cv::boundingRect(poly);
@@ -342,6 +338,8 @@ cv::Mat drawnPart(const PartModel& m, const ImagePose& pose, int margin, cv::Rec
   cv::fillPoly(drawn, outline, cv::Scalar(255), cv::LINE_8, 0, -box->tl());
   return drawn;
 }
+
+namespace {
 
 // Pixels two placed candidates share.
 int sharedPixels(const Placed& a, const Placed& b) {
@@ -1091,19 +1089,12 @@ std::optional<DeepestCore> deepestCore(const cv::Mat& piece, const cv::Rect& box
   cv::Mat core;
   cv::compare(reduced.depth, kCoreDepthShare * deepest, core, cv::CMP_GT);
   cv::Mat labels;
-  cv::connectedComponents(core, labels, 8, CV_32S);
+  cv::Mat stats;
+  cv::Mat middles;
+  cv::connectedComponentsWithStats(core, labels, stats, middles, 8, CV_32S);
   const int own = labels.at<int>(at);
-  cv::Point2d sum;
-  double count = 0;
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* row = labels.ptr<int>(y);
-    for (int x = 0; x < labels.cols; ++x) {
-      if (row[x] != own) continue;
-      sum += cv::Point2d(x, y);
-      count += 1;
-    }
-  }
-  return DeepestCore{reduced.toImage(sum / count, box), deepest * reduced.scale,
+  const cv::Point2d middle(middles.at<double>(own, 0), middles.at<double>(own, 1));
+  return DeepestCore{reduced.toImage(middle, box), deepest * reduced.scale,
                      static_cast<double>(reduced.scale)};
 }
 

@@ -607,16 +607,13 @@ std::shared_ptr<const BlobSearchModel> makeBlobSearchModel(const PartModel& mode
   boundary.reserve(model.samples.size());
   for (const auto& sample : model.samples) boundary.emplace_back(sample.point);
   b->extent = extentOf(boundary);
-  // The part drawn whole, its box 2 px clear of the image's edge, and its
-  // deepest core read as a blob's is.
-  const auto outline = placedOutline(model, {{0, 0}, 0, false});
-  const cv::Rect at = outline.empty() ? cv::Rect() : cv::boundingRect(outline.front());
-  if (!at.empty()) {
-    const cv::Point2d shift(2 - at.x, 2 - at.y);
-    cv::Mat drawn = cv::Mat::zeros(at.height + 4, at.width + 4, CV_8UC1);
-    cv::fillPoly(drawn, placedOutline(model, {shift, 0, false}), cv::Scalar(255));
-    if (const auto core = deepestCore(drawn, cv::Rect(2, 2, at.width, at.height))) {
-      b->core_middle = core->middle - shift;
+  // The part drawn whole at its own origin, and its deepest core read as a
+  // blob's is.
+  if (!model.loops.empty()) {
+    cv::Rect box;
+    const cv::Mat drawn = drawnPart(model, {{0, 0}, 0, false}, 0, &box);
+    if (const auto core = deepestCore(drawn, cv::Rect({0, 0}, drawn.size()))) {
+      b->core_middle = core->middle + cv::Point2d(box.tl());
       b->core_depth_px = core->depth_px;
     }
   }

@@ -198,6 +198,10 @@ void proposeAbout(const PartModel& model, const BlobSearchModel& search, cv::Poi
 // filled together, the holes stay empty.
 std::vector<std::vector<cv::Point>> placedOutline(const PartModel& m, const ImagePose& pose);
 
+// `m` drawn at `pose` (255 on it) over `*box`, its outline's box widened by
+// `margin` pixels all round (image coordinates).
+cv::Mat drawnPart(const PartModel& m, const ImagePose& pose, int margin, cv::Rect* box);
+
 // The deepest core of `piece` (a mask over an image, 255 on the piece, `box`
 // its bounding box): of its pixels deeper inside than half the deepest,
 // those 8-connected to the deepest. Read at a reduced scale, as the rest's
