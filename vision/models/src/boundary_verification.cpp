@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "picksight/common/angles.hpp"
@@ -97,6 +99,24 @@ void EdgeDistance::keepBounds() {
 }
 
 namespace {
+// A sample's weight when it lies within the tolerance of an edge, else 0,
+// without a branch: whether a placed sample meets an edge is a coin toss
+// to the processor, and its mispredictions cost more than the rest of the
+// test (the hypothesis search asks it millions of times a frame). Adding 0
+// leaves a sum as it was: every score and answer is the branch's. Front-light
+// benchmark, touching / overlapping, 3 scenes, LOCATE median: clean 10.7 /
+// 11.3 -> 9.8 / 10.5 ms, textured 13.7 / 14.5 -> 13.1 / 13.8 ms.
+// (Masked as an integer: the compiler turns a product with the comparison
+// back into a branch.)
+inline double onEdge(double weight, float distance, double tolerance) {
+  uint64_t bits;
+  std::memcpy(&bits, &weight, sizeof bits);
+  bits &= -static_cast<uint64_t>(distance <= tolerance);
+  double kept;
+  std::memcpy(&kept, &bits, sizeof kept);
+  return kept;
+}
+
 // Calls f(weight, distance to the nearest edge) for every placed sample.
 template <typename F>
 void forPlaced(const std::vector<BoundarySample>& samples, cv::Point2d centre, double angle_deg,
@@ -118,7 +138,7 @@ double verifyScore(const std::vector<BoundarySample>& samples, cv::Point2d centr
   double total = 0;
   forPlaced(samples, centre, angle_deg, edges, mirrored, [&](double w, double d) {
     total += w;
-    if (d <= tolerance) on += w;
+    on += onEdge(w, d, tolerance);
   });
   return total > 0 ? on / total : 0;
 }
@@ -132,10 +152,9 @@ bool verifiesAtLeast(const std::vector<BoundarySample>& samples, double total, c
   for (const auto& sample : samples) {
     const double x = sample.point.x;
     const double y = flip * sample.point.y;
-    if (edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}) <= tolerance) {
-      on += sample.weight;
-      if (on >= goal) return true;
-    }
+    on += onEdge(sample.weight, edges.at({centre.x + c * x - s * y, centre.y + s * x + c * y}),
+                 tolerance);
+    if (on >= goal) return true;
     left -= sample.weight;
     if (on + left < goal) return false;
   }
