@@ -135,7 +135,8 @@ TEST_CASE("blob search: screening proposes the part's pose, best first, no two a
   const PartModel& l = models().l;
   for (const bool quick : {true, false}) {
     INFO("quick " << quick);
-    const auto screened = search.screen(l, quick);
+    const auto screened =
+        search.screen(l, quick ? touching::Anchors::kQuick : touching::Anchors::kAll);
     REQUIRE(!screened.empty());
     CHECK(screened.size() <= 8);
     for (size_t i = 1; i < screened.size(); ++i) {
@@ -154,7 +155,7 @@ TEST_CASE("blob search: the edge fit puts a screened pose on the part, placed in
   const auto models_list = all();
   BlobSearch search(scene.regions, 0, models_list, nullptr);
   const PartModel& l = models().l;
-  search.refine(search.screen(l, false));
+  search.refine(search.screen(l, touching::Anchors::kAll));
   const Candidate* fitted = closest(search.refined(), l, scene.l_pose);
   REQUIRE(fitted);
   CHECK(near(fitted->pose, scene.l_pose, l, 0.3, 0.5));
@@ -173,7 +174,7 @@ TEST_CASE("blob search: the parts are chosen and explain the blob whole", "[visi
   const auto models_list = all();
   BlobSearch search(scene.regions, 0, models_list, nullptr);
   // The L alone leaves the bar's pixels unexplained.
-  search.refine(search.screen(models().l, false));
+  search.refine(search.screen(models().l, touching::Anchors::kAll));
   search.choose();
   REQUIRE(search.taken().size() == 1);
   CHECK_FALSE(search.explainsWhole());
@@ -188,7 +189,7 @@ TEST_CASE("blob search: the parts are chosen and explain the blob whole", "[visi
     CHECK(std::hypot(c.at.x - scene.bar_pose.centre.x, c.at.y - scene.bar_pose.centre.y) < 70);
   }
   // With the bar, the two parts are the blob.
-  search.refine(search.screen(models().b, false));
+  search.refine(search.screen(models().b, touching::Anchors::kAll));
   search.choose();
   const auto matches = search.matches();
   REQUIRE(matches.size() == 2);
@@ -221,7 +222,7 @@ TEST_CASE("blob search: a part drawn as the mirror image of its model is not rep
     const Scene scene = touchingPair(false);
     REQUIRE(scene.regions.size() == 1);
     BlobSearch search(scene.regions, 0, models_list, nullptr);
-    search.refine(search.screen(l, false));
+    search.refine(search.screen(l, touching::Anchors::kAll));
     const Candidate* fitted = closest(search.refined(), l, scene.l_pose);
     REQUIRE(fitted);
     CHECK_FALSE(search.showsMirror(*fitted));

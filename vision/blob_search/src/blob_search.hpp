@@ -72,8 +72,11 @@ class BlobSearch {
   const std::vector<ArcAnchor>& arcs() const { return *arcs_; }
 
   // The best screened poses of one model (its own hand: see alignedMirror),
-  // best first, no two alike. `quick`: from its most telling anchors only.
-  std::vector<Candidate> screen(const PartModel& model, bool quick) const;
+  // best first, no two alike, from its `anchors`. `whole`, when given: set
+  // to whether every pose the screening found was kept (none beyond the
+  // kMaxRefinedPerModel best).
+  std::vector<Candidate> screen(const PartModel& model, Anchors anchors,
+                                bool* whole = nullptr) const;
   // Refines screened poses, best first, and places those that fit.
   void refine(const std::vector<Candidate>& screened);
   // Places a refined candidate (kept by the caller for the search's
@@ -161,6 +164,9 @@ class BlobSearch {
   std::deque<Candidate> refined_;
   std::vector<Placed> placed_;
   size_t refinements_ = 0;
+  // Per model (as fitting_): whether its quick screening kept every pose it
+  // found, so that the full search need not start from its quick anchors.
+  std::vector<bool> quick_whole_;
   // Whether a choice made now could differ from the last one.
   bool changed_ = false;
   std::map<const Candidate*, std::optional<Candidate>> aligned_mirrors_;

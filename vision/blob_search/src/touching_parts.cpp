@@ -603,18 +603,23 @@ int BlobSearch::coveredIn(const cv::Mat& drawn, const cv::Rect& box) const {
   return cv::countNonZero(covered);
 }
 
-std::vector<Candidate> BlobSearch::screen(const PartModel& model, bool quick) const {
+std::vector<Candidate> BlobSearch::screen(const PartModel& model, Anchors anchors,
+                                          bool* whole) const {
   std::vector<Candidate> proposed;
-  propose(model, *searchOf(model), quick, *corners_, *arcs_, *edges_, &proposed);
+  propose(model, *searchOf(model), anchors, *corners_, *arcs_, *edges_, &proposed);
   std::stable_sort(proposed.begin(), proposed.end(),
                    [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
   std::vector<Candidate> screened;
   for (const auto& p : proposed) {
-    if (static_cast<int>(screened.size()) >= kMaxRefinedPerModel) break;
+    if (static_cast<int>(screened.size()) >= kMaxRefinedPerModel) {
+      if (whole) *whole = false;
+      return screened;
+    }
     const auto near = [&](const Candidate& q) { return samePose(model, p.pose, q.pose, 2.0, 3.0); };
     if (std::any_of(screened.begin(), screened.end(), near)) continue;
     screened.push_back(p);
   }
+  if (whole) *whole = true;
   return screened;
 }
 
@@ -923,8 +928,18 @@ void BlobSearch::fullSearch(std::vector<std::pair<double, size_t>> order) {
     for (size_t start = 0; start < order.size(); start += batch) {
       const size_t n = std::min(batch, order.size() - start);
       screened.assign(n, {});
-      forEachModel(
-          n, [&](size_t k) { screened[k] = screen(*fitting_[order[start + k].second], false); });
+      // A model whose quick screening kept every pose it found is screened
+      // from its other anchors only: its quick ones lead to those poses
+      // again (the anchors narrowed to the rest are among those it read),
+      // all refined already. Front-light benchmark, textured belt, touching,
+      // 3 scenes: 8 % fewer pairs of anchors screened, LOCATE median 2 %
+      // less; every part found and placed the same on 7 lights and the 15
+      // standard types.
+      forEachModel(n, [&](size_t k) {
+        const size_t model = order[start + k].second;
+        screened[k] =
+            screen(*fitting_[model], quick_whole_[model] ? Anchors::kBeyondQuick : Anchors::kAll);
+      });
       for (size_t k = 0; k < n; ++k) {
         refine(screened[k]);
         if (!changed_) continue;
@@ -1229,7 +1244,13 @@ std::vector<Match> BlobSearch::run() {
   // The screens read the blob's anchors and edges only: all at once, then
   // refined in model order.
   std::vector<std::vector<Candidate>> quick(fitting_.size());
-  forEachModel(fitting_.size(), [&](size_t k) { quick[k] = screen(*fitting_[k], true); });
+  std::vector<char> whole(fitting_.size(), 0);
+  forEachModel(fitting_.size(), [&](size_t k) {
+    bool w = false;
+    quick[k] = screen(*fitting_[k], Anchors::kQuick, &w);
+    whole[k] = w;
+  });
+  quick_whole_.assign(whole.begin(), whole.end());
   std::vector<std::pair<double, size_t>> order;
   for (size_t k = 0; k < fitting_.size(); ++k) {
     order.emplace_back(quick[k].empty() ? -1.0 : quick[k].front().score, k);

@@ -209,12 +209,12 @@ namespace {
 // screens as well as a part verifies settles the anchors it explains.
 class Proposer {
  public:
-  Proposer(const PartModel& model, const BlobSearchModel& search, bool quick,
+  Proposer(const PartModel& model, const BlobSearchModel& search, Anchors anchors,
            const BlobCorners& blob_corners, const std::vector<ArcAnchor>& image_arcs,
            const EdgeDistance& edges, std::vector<Candidate>* out)
       : model_(model),
         search_(search),
-        quick_(quick),
+        anchors_(anchors),
         image_corners_(blob_corners.corners),
         by_opening_(blob_corners.by_opening),
         image_arcs_(image_arcs),
@@ -288,9 +288,11 @@ class Proposer {
     });
   }
 
-  // Whether anchor `mi` is searched (a quick search: only its quick ones).
+  // Whether anchor `mi` is searched (see Anchors).
   bool visits(size_t mi, const std::vector<size_t>& quick_ones) const {
-    return !quick_ || std::find(quick_ones.begin(), quick_ones.end(), mi) != quick_ones.end();
+    if (anchors_ == Anchors::kAll) return true;
+    const bool quick = std::find(quick_ones.begin(), quick_ones.end(), mi) != quick_ones.end();
+    return quick == (anchors_ == Anchors::kQuick);
   }
 
   // The image corners model corner `mc` may be (a few in ten: about its
@@ -348,7 +350,8 @@ class Proposer {
     if (glances(cosine, sine, needed)) return angle;
     // Just short of it, the bisector may be a few degrees off (a corner
     // between short or curved edges): see kGlanceNearMiss.
-    if (!quick_ || !glances(cosine, sine, needed - kGlanceNearMiss)) return std::nullopt;
+    if (anchors_ != Anchors::kQuick || !glances(cosine, sine, needed - kGlanceNearMiss))
+      return std::nullopt;
     for (const double k : {-1.0, 1.0}) {
       const double a = (angle + k * kGlanceTurnDeg) * kRadPerDeg;
       if (glances(std::cos(a), std::sin(a), threshold_)) return angle + k * kGlanceTurnDeg;
@@ -420,7 +423,7 @@ class Proposer {
 
   const PartModel& model_;
   const BlobSearchModel& search_;
-  bool quick_;
+  Anchors anchors_;
   const std::vector<CornerAnchor>& image_corners_;
   const std::vector<size_t>& by_opening_;
   const std::vector<ArcAnchor>& image_arcs_;
@@ -435,10 +438,10 @@ class Proposer {
 }  // namespace
 
 // Screens the poses proposed for one model (its own hand) in a blob.
-void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
+void propose(const PartModel& model, const BlobSearchModel& search, Anchors anchors,
              const BlobCorners& blob_corners, const std::vector<ArcAnchor>& image_arcs,
              const EdgeDistance& edges, std::vector<Candidate>* out) {
-  Proposer proposer(model, search, quick, blob_corners, image_arcs, edges, out);
+  Proposer proposer(model, search, anchors, blob_corners, image_arcs, edges, out);
   proposer.fromCorners();
   proposer.fromArcs();
 }

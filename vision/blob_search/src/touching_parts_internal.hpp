@@ -172,11 +172,17 @@ struct BlobCorners {
   std::vector<size_t> by_opening;
 };
 
+// Which of a model's corners and arcs a screening starts from: its quick
+// ones (its sharpest corners and longest arcs, the first look at a corner
+// forgiving a few degrees), all of them, or all but the quick ones (those
+// a quick screening that kept every pose it found has searched already).
+enum class Anchors { kQuick, kAll, kBeyondQuick };
+
 // Screens the poses proposed for one model (its own hand; the mirror image
 // is asked of each part about to be taken, in touching_parts.cpp) in a
-// blob: appends those that verify well enough on `edges` to `out`. `quick`:
-// from the model's quick corners and arcs only.
-void propose(const PartModel& model, const BlobSearchModel& search, bool quick,
+// blob from the model's `anchors`: appends those that verify well enough on
+// `edges` to `out`.
+void propose(const PartModel& model, const BlobSearchModel& search, Anchors anchors,
              const BlobCorners& image_corners, const std::vector<ArcAnchor>& image_arcs,
              const EdgeDistance& edges, std::vector<Candidate>* out);
 
