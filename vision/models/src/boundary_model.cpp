@@ -56,9 +56,12 @@ void douglasPeucker(const std::vector<cv::Point2d>& pts, size_t a, size_t b, dou
   } else {
     // The farthest point from the chord: the largest cross product, divided
     // by the chord's length once (this runs over every boundary pixel of
-    // every blob).
+    // every blob). The index wraps by a comparison, not a division per
+    // point (a division cost more than the rest of the loop).
+    size_t wrapped = (a + 1) % n;
     for (size_t i = a + 1; i < b; ++i) {
-      const cv::Point2d v = pts[i % n] - from;
+      const cv::Point2d v = pts[wrapped] - from;
+      if (++wrapped == n) wrapped = 0;
       const double e = std::abs(d.x * v.y - d.y * v.x);
       if (e > worst) {
         worst = e;
@@ -96,8 +99,9 @@ class ContourSums {
     const size_t n = pts.size();
     sums_.resize(2 * n + 1);
     for (size_t i = 0; i < 2 * n; ++i) {
-      const double u = pts[i % n].x - origin_.x;
-      const double v = pts[i % n].y - origin_.y;
+      const cv::Point2d& p = pts[i < n ? i : i - n];
+      const double u = p.x - origin_.x;
+      const double v = p.y - origin_.y;
       const Sums term{1, u, v, u * u, v * v, u * v, u * u * u, v * v * v, u * u * v, u * v * v};
       for (size_t k = 0; k < term.size(); ++k) sums_[i + 1][k] = sums_[i][k] + term[k];
     }
@@ -138,10 +142,22 @@ class ContourSums {
 };
 
 // Whether every point first..last lies within `limit` of the circle.
+// A point whose squared distance from the centre lies well inside the band
+// (by a relative margin far above hypot's rounding) is within without its
+// square root; only those near the band's edges are measured as before, so
+// the answer is the one the root gives. The index wraps by a comparison.
 bool withinOfCircle(const std::vector<cv::Point2d>& pts, size_t first, size_t last, const Circle& c,
                     double limit) {
+  const size_t n = pts.size();
+  const double inner = std::max(0.0, c.radius - limit);
+  const double surely_above = inner * inner * (1 + 1e-9);
+  const double surely_below = (c.radius + limit) * (c.radius + limit) * (1 - 1e-9);
+  size_t wrapped = first % n;
   for (size_t i = first; i <= last; ++i) {
-    const cv::Point2d d = pts[i % pts.size()] - c.centre;
+    const cv::Point2d d = pts[wrapped] - c.centre;
+    if (++wrapped == n) wrapped = 0;
+    const double d2 = d.x * d.x + d.y * d.y;
+    if (d2 > surely_above && d2 < surely_below) continue;
     if (std::abs(std::hypot(d.x, d.y) - c.radius) > limit) return false;
   }
   return true;
