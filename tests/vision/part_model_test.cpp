@@ -256,6 +256,41 @@ TEST_CASE("the bounded edge map has the exact distances within its reach", "[vis
   CHECK(within > box.area() / 4);
 }
 
+TEST_CASE("the edge map's test of a tolerance answers as its distances do", "[vision][model]") {
+  // A map with a reach holds whole squared distances and tests a tolerance
+  // against them; it must answer at(p) <= tolerance exactly, also where the
+  // tolerance is a distance the map holds (2, the root of 5, of 13) or just
+  // either side of one, and outside the map. Likewise on an exact map.
+  cv::RNG rng(23);
+  std::vector<std::vector<cv::Point>> contours(2);
+  for (auto& c : contours) {
+    for (int i = 0; i < 30; ++i) c.emplace_back(rng.uniform(-4, 54), rng.uniform(-4, 34));
+  }
+  const cv::Rect box(0, 0, 50, 30);
+  const EdgeDistance bounded(contours, box, 6.5);
+  const EdgeDistance exact(contours, box);
+  const double root5 = std::sqrt(5.0);
+  const double root13 = static_cast<double>(std::sqrt(13.0f));
+  for (const double tolerance :
+       {0.0, 0.5, 1.0, 2.0, std::nextafter(2.0, 0.0), std::nextafter(2.0, 3.0), root5,
+        std::nextafter(root5, 0.0), root13, std::nextafter(root13, 0.0), 3.0, 6.0, 6.5, 7.0}) {
+    for (const EdgeDistance* map : {&bounded, &exact}) {
+      const EdgeDistance::Within within = map->withinOf(tolerance);
+      int agreed = 0;
+      for (int i = 0; i < 3000; ++i) {
+        // Pixel centres and points between them, some outside the box.
+        const cv::Point2d p = i % 2 == 0
+                                  ? cv::Point2d(rng.uniform(-3, 53), rng.uniform(-3, 33))
+                                  : cv::Point2d(rng.uniform(-3.0, 53.0), rng.uniform(-3.0, 33.0));
+        INFO("tolerance " << tolerance << " at " << p << ": distance " << map->at(p));
+        CHECK(map->isWithin(p, within) == (map->at(p) <= tolerance));
+        agreed += map->at(p) <= tolerance ? 1 : 0;
+      }
+      if (tolerance >= 2.0) CHECK(agreed > 100);  // the test saw points within
+    }
+  }
+}
+
 TEST_CASE("verification fails when the model is off the part", "[vision][model]") {
   const Trained l = train("l_shape", 1);
   const ps::SceneRenderer s(scene(400, 400, 1, 78, {"l_shape"}));

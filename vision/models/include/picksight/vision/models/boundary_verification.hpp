@@ -3,6 +3,8 @@
 // model's boundary samples that land within a tolerance of an edge.
 #pragma once
 
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -16,36 +18,68 @@ namespace picksight::vision {
 class EdgeDistance {
  public:
   EdgeDistance() = default;
-  // `max_distance` > 0: distances are exact up to it and a large value
-  // beyond, for callers that only ask "within a tolerance?" or clip there;
-  // much cheaper than the exact transform of the whole region of interest.
+  // `max_distance` > 0: distances are exact up to it (at most kMaxReach)
+  // and a large value beyond, for callers that only ask "within a
+  // tolerance?" or clip there; much cheaper than the exact transform of
+  // the whole region of interest.
   EdgeDistance(const std::vector<std::vector<cv::Point>>& contours, cv::Rect roi,
                double max_distance = 0);
   // Pixels; a large value outside the region of interest. Inline: the
   // hypothesis search asks it millions of times a frame.
   float at(cv::Point2d p) const {
-    // Outside the map (in doubles first: a pose from degenerate geometry can
-    // put a point at infinity or NaN, which no integer holds). Inside, the
-    // rounded point is a pixel of the map.
-    if (!(p.x > low_.x && p.y > low_.y && p.x < high_.x && p.y < high_.y)) return 1e9f;
-    const int x = cvRound(p.x) - origin_.x;
-    const int y = cvRound(p.y) - origin_.y;
-    return reinterpret_cast<const float*>(data_ + static_cast<size_t>(y) * step_)[x];
+    const int offset = offsetOf(p);
+    if (offset < 0) return kFar;
+    if (squared_) {
+      const uint16_t d2 = reinterpret_cast<const uint16_t*>(data_)[offset];
+      return d2 == kFarSquared ? kFar : std::sqrt(static_cast<float>(d2));
+    }
+    return reinterpret_cast<const float*>(data_)[offset];
+  }
+  // Whether at(p) <= tolerance, given within = withinOf(tolerance): on a
+  // map with a reach, one comparison of whole squared distances.
+  struct Within {
+    float tolerance = 0;
+    int squared = -1;  // the largest whole d^2 whose distance is within
+  };
+  Within withinOf(double tolerance) const;
+  bool isWithin(cv::Point2d p, const Within& within) const {
+    const int offset = offsetOf(p);
+    if (offset < 0) return kFar <= within.tolerance;
+    if (squared_) return reinterpret_cast<const uint16_t*>(data_)[offset] <= within.squared;
+    return reinterpret_cast<const float*>(data_)[offset] <= within.tolerance;
   }
   bool empty() const { return distance_.empty(); }
 
+  // The largest reach a map holds (its squared distances in 16 bits).
+  static constexpr double kMaxReach = 255;
+
  private:
+  static constexpr float kFar = 1e9f;
+  static constexpr uint16_t kFarSquared = 0xFFFF;
+  // The map's element p rounds to, or -1 outside the map (in doubles
+  // first: a pose from degenerate geometry can put a point at infinity or
+  // NaN, which no integer holds). Inside, the rounded point is a pixel of
+  // the map.
+  int offsetOf(cv::Point2d p) const {
+    if (!(p.x > low_.x && p.y > low_.y && p.x < high_.x && p.y < high_.y)) return -1;
+    return (cvRound(p.y) - origin_.y) * row_elements_ + (cvRound(p.x) - origin_.x);
+  }
   // The bounds and rows at() reads, kept beside the map.
   void keepBounds();
 
-  cv::Mat distance_;  // CV_32F
+  // With a reach, each pixel's squared distance to the nearest boundary
+  // pixel (a whole number; kFarSquared beyond the reach): half the memory
+  // of floats, and "within a tolerance?" a comparison of integers. Without
+  // one, the exact transform's distances (CV_32F).
+  bool squared_ = false;
+  cv::Mat distance_;
   cv::Point origin_;
   // Pixel centres are at origin_ + (i, j): a point rounds into the map when
   // strictly between low_ and high_.
   cv::Point2d low_;
   cv::Point2d high_;
   const uchar* data_ = nullptr;
-  size_t step_ = 0;
+  int row_elements_ = 0;
 };
 
 // The fraction (0..1) of the samples' weight that lies within `tolerance`
