@@ -813,7 +813,7 @@ std::vector<std::string> learnWarnings(const vision::Region& r, const cv::Mat& g
           " (a quarter of the contrast off the surface's or the part's level there: blotches, "
           "grain or stones of the surface, the part's shading, a faint shadow; the part may be "
           "placed a tenth of a pixel off: teach it on a plainer stretch, or add views of it "
-          "lying elsewhere with LEARNVIEW)");
+          "lying elsewhere with LEARNVIEW, eight at 30 grey levels of contrast)");
     }
   }
   const double small_hole = kSmallHoleShare * r.area;
