@@ -225,15 +225,29 @@ TEST_CASE("recognized parts: position, and rotation from the trained pose", "[vi
                                << " deg");
 }
 
+namespace {
+// `loops` contours of `points` boundary pixels each, scattered over `box`
+// and `margin` pixels past each of its sides (some near its edges, some
+// outside it).
+std::vector<std::vector<cv::Point>> scatteredContours(uint64_t seed, int loops, int points,
+                                                      const cv::Rect& box, int margin) {
+  cv::RNG rng(seed);
+  std::vector<std::vector<cv::Point>> contours(static_cast<size_t>(loops));
+  for (auto& c : contours) {
+    for (int i = 0; i < points; ++i) {
+      c.emplace_back(rng.uniform(box.x - margin, box.br().x + margin),
+                     rng.uniform(box.y - margin, box.br().y + margin));
+    }
+  }
+  return contours;
+}
+}  // namespace
+
 TEST_CASE("the bounded edge map has the exact distances within its reach", "[vision][model]") {
   // Boundary pixels anywhere, some near the box's edges and some outside it,
   // against the distance to the nearest of them, pixel by pixel.
-  cv::RNG rng(11);
-  std::vector<std::vector<cv::Point>> contours(3);
-  for (auto& c : contours) {
-    for (int i = 0; i < 40; ++i) c.emplace_back(rng.uniform(-6, 66), rng.uniform(-6, 46));
-  }
   const cv::Rect box(0, 0, 60, 40);
+  const auto contours = scatteredContours(11, 3, 40, box, 6);
   const double reach = 4.3;
   const EdgeDistance bounded(contours, box, reach);
   int within = 0;
@@ -261,12 +275,9 @@ TEST_CASE("the edge map's test of a tolerance answers as its distances do", "[vi
   // against them; it must answer at(p) <= tolerance exactly, also where the
   // tolerance is a distance the map holds (2, the root of 5, of 13) or just
   // either side of one, and outside the map. Likewise on an exact map.
-  cv::RNG rng(23);
-  std::vector<std::vector<cv::Point>> contours(2);
-  for (auto& c : contours) {
-    for (int i = 0; i < 30; ++i) c.emplace_back(rng.uniform(-4, 54), rng.uniform(-4, 34));
-  }
   const cv::Rect box(0, 0, 50, 30);
+  const auto contours = scatteredContours(23, 2, 30, box, 4);
+  cv::RNG rng(29);
   const EdgeDistance bounded(contours, box, 6.5);
   const EdgeDistance exact(contours, box);
   const double root5 = std::sqrt(5.0);

@@ -166,7 +166,8 @@ class BlobSearch {
   size_t refinements_ = 0;
   // Per model (as fitting_): whether its quick screening kept every pose it
   // found, so that the full search need not start from its quick anchors.
-  std::vector<bool> quick_whole_;
+  // (chars: the quick screenings write them from several threads at once.)
+  std::vector<char> quick_whole_;
   // Whether a choice made now could differ from the last one.
   bool changed_ = false;
   std::map<const Candidate*, std::optional<Candidate>> aligned_mirrors_;

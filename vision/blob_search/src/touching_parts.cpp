@@ -1244,13 +1244,12 @@ std::vector<Match> BlobSearch::run() {
   // The screens read the blob's anchors and edges only: all at once, then
   // refined in model order.
   std::vector<std::vector<Candidate>> quick(fitting_.size());
-  std::vector<char> whole(fitting_.size(), 0);
+  quick_whole_.assign(fitting_.size(), 0);
   forEachModel(fitting_.size(), [&](size_t k) {
-    bool w = false;
-    quick[k] = screen(*fitting_[k], Anchors::kQuick, &w);
-    whole[k] = w;
+    bool whole = false;
+    quick[k] = screen(*fitting_[k], Anchors::kQuick, &whole);
+    quick_whole_[k] = whole;
   });
-  quick_whole_.assign(whole.begin(), whole.end());
   std::vector<std::pair<double, size_t>> order;
   for (size_t k = 0; k < fitting_.size(); ++k) {
     order.emplace_back(quick[k].empty() ? -1.0 : quick[k].front().score, k);

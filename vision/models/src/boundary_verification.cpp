@@ -136,10 +136,9 @@ namespace {
 // without a branch: whether a placed sample meets an edge is a coin toss
 // to the processor, and the mispredicted branch's landing was the hottest
 // spot of the test (the hypothesis search asks it millions of times a
-// frame). Adding 0
-// leaves a sum as it was: every score and answer is the branch's. A LOCATE
-// of touching and overlapping parts on a textured belt, the two ways timed
-// in turn in one process: 3 % less time.
+// frame). Adding 0 leaves a sum as it was: every score and answer is the
+// branch's. A LOCATE of touching and overlapping parts on a textured belt,
+// the two ways timed in turn in one process: 3 % less time.
 // (Masked as an integer: the compiler turns a product with the comparison
 // back into a branch.)
 inline double onEdge(double weight, bool within) {
