@@ -882,6 +882,159 @@ TEST_CASE("parts taught alone on gravel keep their own outline and are found tou
   CHECK(rms < 0.3);
 }
 
+namespace {
+// A part of Tari-1000 (its 3rd drawing, `size_px` across) alone on
+// photographed gravel, where the front-light benchmark teaches the k-th of
+// its types (a spot and a seed drawn from k).
+cv::Mat onGravelAsTaught(const std::string& name, int size_px, uint64_t k,
+                         ps::SilhouetteType* type) {
+  const ps::SilhouetteSceneOptions look = photographedLook("gravel");
+  *type = drawing("shapes/tari1000/" + name + "_3.png", size_px);
+  std::mt19937_64 rng(0x7465616368ULL + 131 * k);
+  const double margin = 0.75 * size_px + 20;
+  std::uniform_real_distribution<double> x(margin, look.width - 1 - margin);
+  std::uniform_real_distribution<double> y(margin, look.height - 1 - margin);
+  const double at_x = x(rng);
+  const cv::Point2d spot(at_x, y(rng));
+  cv::Point2d drawn;
+  return ps::renderSilhouetteInFrame(*type, look, 7 + k, spot, &drawn, 30);
+}
+}  // namespace
+
+TEST_CASE("stones a part's teach outline took in do not keep it from being found touching",
+          "[vision_app][learn][locate][front]") {
+  // On photographed gravel a dark stone against the part joins it in the
+  // teach image's mask: a bump of a few pixels on the outline, a stretch
+  // too short for its primitive's median contrast to see. In a scene the
+  // bumps lie on the background, 3 to 5 % of the boundary, and the blob
+  // search took the part, touching another, for a look-alike crossing the
+  // background (front-light benchmark, gravel, touching: 0.826 of the
+  // parts found). The teach image's contrast along the outline weighs them
+  // at the least a stretch may weigh. Two of the benchmark's types, taught
+  // as it teaches them (the two it missed most), and two it does not have.
+  struct Shape {
+    std::string name;
+    int size_px;
+    uint64_t k;
+  };
+  const std::vector<Shape> shapes = {
+      {"obj13", 220, 6}, {"obj3", 200, 1}, {"obj9", 230, 20}, {"obj20", 210, 21}};
+  const VisionOptions defaults;
+  auto models = std::make_shared<ModelList>();
+  std::vector<ps::SilhouetteType> types;
+  int weak_points = 0;
+  int points = 0;
+  for (const auto& [name, size_px, k] : shapes) {
+    ps::SilhouetteType type;
+    const cv::Mat teach = onGravelAsTaught(name, size_px, k, &type);
+    auto learned = learnInImage(teach, {}, defaults, models, static_cast<int>(models->size()) + 1,
+                                name, std::nullopt);
+    INFO(name << ": " << (learned.ok() ? std::string() : learned.error().message));
+    REQUIRE(learned.ok());
+    for (const auto& loop : learned->model.loops) {
+      for (const auto& p : loop.primitives) {
+        points += pv::edgeOffsetCount(p.length());
+        for (const uint8_t w : p.edge_weights_pct) weak_points += w < 100 ? 1 : 0;
+      }
+    }
+    models->push_back(learned->model);
+    types.push_back(type);
+  }
+  // Stretches, not whole sides.
+  CAPTURE(weak_points, points);
+  CHECK(weak_points > 0);
+  CHECK(weak_points < 0.2 * points);
+  const ps::SilhouetteSceneOptions look = photographedLook("gravel");
+  int truths = 0;
+  int found = 0;
+  int reported = 0;
+  for (const auto arrangement : {ps::Arrangement::kTouching, ps::Arrangement::kOverlapping}) {
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+      const ps::SilhouetteScene scene = fourByPairs(types, look, arrangement, seed);
+      const LocateOutcome outcome =
+          locateInFrame(frameFromImage(scene.render(0), "cam0", 1), defaults, models, -1);
+      truths += static_cast<int>(scene.truth().size());
+      found += foundTrue(scene.truth(), outcome.parts);
+      for (const auto& p : outcome.parts) reported += p.type >= 0 ? 1 : 0;
+    }
+  }
+  INFO(found << " of " << truths << " found, " << reported << " reported");
+  // 47 of 48 here, 31 with every stretch at its primitive's weight.
+  CHECK(found >= truths - 1);
+  CHECK(reported == found);
+}
+
+TEST_CASE("a model's edge weights survive its file and a resize, and damaged ones are refused",
+          "[vision_app][learn][front]") {
+  ps::SilhouetteType type;
+  const cv::Mat teach = onGravelAsTaught("obj13", 220, 6, &type);
+  const auto learned = learnInImage(teach, {}, cellOptions(), noModels(), 1, "obj13", std::nullopt);
+  REQUIRE(learned.ok());
+  const pv::PartModel& m = learned->model;
+  int weighed = 0;
+  int in_part = 0;  // primitives part of whose points are a stretch
+  for (const auto& loop : m.loops) {
+    for (const auto& p : loop.primitives) {
+      if (p.edge_weights_pct.empty()) continue;
+      ++weighed;
+      CHECK(static_cast<int>(p.edge_weights_pct.size()) == pv::edgeOffsetCount(p.length()));
+      // A stretch at the least weight, the rest of the primitive at its own.
+      for (const int w : p.edge_weights_pct) {
+        if (w < 100) CHECK(p.weight * 0.01 * w == Approx(0.1).margin(0.006));
+      }
+      in_part += *std::max_element(p.edge_weights_pct.begin(), p.edge_weights_pct.end()) == 100;
+    }
+  }
+  REQUIRE(weighed > 0);
+  CHECK(in_part > 0);
+  const std::string yaml = modelToYaml(m);
+  const auto back = modelFromYaml(yaml);
+  REQUIRE(back.ok());
+  REQUIRE(back->samples.size() == m.samples.size());
+  for (size_t i = 0; i < m.samples.size(); ++i)
+    CHECK(back->samples[i].weight == Approx(m.samples[i].weight).epsilon(1e-9));
+  // A camera resized to half: the same stretches, at half as many points.
+  const pv::PartModel half = pv::scaledModel(m, 0.5);
+  CHECK(pv::validateModel(half).ok());
+  for (size_t l = 0; l < m.loops.size(); ++l) {
+    for (size_t k = 0; k < m.loops[l].primitives.size(); ++k) {
+      const pv::Primitive& p = m.loops[l].primitives[k];
+      const pv::Primitive& q = half.loops[l].primitives[k];
+      CHECK(q.edge_weights_pct.empty() == p.edge_weights_pct.empty());
+      for (const double t : {0.1, 0.3, 0.5, 0.7, 0.9}) {
+        // The weight of a taught point within two (a resized point spans
+        // two taught ones) of the same place along the primitive.
+        const double dt = 1.0 / std::max(1.0, p.length());
+        bool near = false;
+        for (int d = -2; d <= 2; ++d) near = near || q.weightAt(t) == p.weightAt(t + d * dt);
+        CHECK(near);
+      }
+    }
+  }
+  // Damaged: refused, naming what is wrong, never read as full weight.
+  const auto at = yaml.find("edge_weights_pct: [");
+  REQUIRE(at != std::string::npos);
+  for (const auto& [list, why] :
+       std::vector<std::pair<std::string, std::string>>{{"[100, 10]", "edge weights (one a pixel)"},
+                                                        {"7", "'edge_weights_pct' must be a list"},
+                                                        {"[1.5, 2]", "whole percent"},
+                                                        {"[-1]", "whole percent"}}) {
+    std::string d = yaml;
+    d.replace(at, d.find(']', at) + 1 - at, "edge_weights_pct: " + list);
+    const auto refused = modelFromYaml(d);
+    INFO(list);
+    REQUIRE_FALSE(refused.ok());
+    CHECK(refused.error().message.find(why) != std::string::npos);
+  }
+  // One weight over 100, the count right.
+  std::string over = yaml;
+  const auto first = at + std::string("edge_weights_pct: [").size();
+  over.replace(first, over.find_first_of(",]", first) - first, "101");
+  const auto refused = modelFromYaml(over);
+  REQUIRE_FALSE(refused.ok());
+  CHECK(refused.error().message.find("whole percent, 0 to 100") != std::string::npos);
+}
+
 TEST_CASE("a part another lies on is placed by what shows of its edges as a whole one is",
           "[vision_app][locate][front][accuracy]") {
   // Lines and arcs follow a drawn outline only within the conformity; fitted

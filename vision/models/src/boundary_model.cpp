@@ -267,6 +267,14 @@ double Primitive::edgeOffsetAt(double t) const {
   return 0.001 * ((1 - w) * o[k] + w * o[next]);
 }
 
+double Primitive::weightAt(double t) const {
+  const auto& w = edge_weights_pct;
+  if (w.empty()) return weight;
+  const auto k = std::min(w.size() - 1, static_cast<size_t>(std::max(0.0, t * w.size())));
+  // Whole percents of the weight, as stored.
+  return weight * 0.01 * w[k];
+}
+
 cv::Point2d Primitive::pointAt(double t) const {
   if (kind == PrimitiveKind::kLine) return start + (end - start) * t;
   const double a = angleOf(start - centre) * kRadPerDeg + t * sweep_deg * kRadPerDeg;
@@ -427,8 +435,10 @@ std::vector<BoundarySample> sampleBoundary(const std::vector<BoundaryLoop>& loop
     for (const auto& p : loop.primitives) {
       const double length = p.length();
       const int count = std::max(1, static_cast<int>(std::ceil(length / step)));
-      const double w = loop.weight * p.weight * length / count;
-      for (int i = 0; i < count; ++i) samples.push_back({p.pointAt((i + 0.5) / count), w});
+      for (int i = 0; i < count; ++i) {
+        const double t = (i + 0.5) / count;
+        samples.push_back({p.pointAt(t), loop.weight * p.weightAt(t) * length / count});
+      }
     }
   }
   return samples;

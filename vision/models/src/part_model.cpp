@@ -239,6 +239,13 @@ std::string modelProblem(const PartModel& m) {
       const int16_t bound = edgeOffsetMpx(kMaxEdgeOffsetPx);
       if (std::any_of(o.begin(), o.end(), [&](int16_t v) { return v < -bound || v > bound; }))
         return "edge offsets must lie within " + formatFixed(kMaxEdgeOffsetPx, 1) + " px";
+      const auto& w = p.edge_weights_pct;
+      if (!w.empty() && std::abs(static_cast<int>(w.size()) - count) > 1)
+        return "a primitive of " + formatFixed(p.length(), 1) + " px holds " +
+               std::to_string(count) + " edge weights (one a pixel), not " +
+               std::to_string(w.size());
+      if (std::any_of(w.begin(), w.end(), [](uint8_t v) { return v > 100; }))
+        return "edge weights are whole percents, 0 to 100";
     }
   }
   return {};

@@ -101,6 +101,11 @@ void writeLoops(YAML::Emitter& out, const std::vector<vision::BoundaryLoop>& loo
         for (const int16_t v : p.edge_offsets_mpx) out << static_cast<int>(v);
         out << YAML::EndSeq;
       }
+      if (!p.edge_weights_pct.empty()) {
+        out << YAML::Key << "edge_weights_pct" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+        for (const uint8_t v : p.edge_weights_pct) out << static_cast<int>(v);
+        out << YAML::EndSeq;
+      }
       out << YAML::EndMap;
     }
     out << YAML::EndSeq << YAML::EndMap;
@@ -303,6 +308,22 @@ std::vector<vision::BoundaryLoop> readLoops(const YAML::Node& boundary) {
             throw FieldError{
                 "each of 'edge_offsets_mpx' must be a whole number of thousandths of a pixel"};
           }
+        }
+      }
+      if (p["edge_weights_pct"]) {
+        const YAML::Node weights = p["edge_weights_pct"];
+        if (!weights.IsSequence())
+          throw FieldError{"'edge_weights_pct' must be a list of whole percents"};
+        prim.edge_weights_pct.reserve(weights.size());
+        for (const auto& v : weights) {
+          int pct = -1;
+          try {
+            pct = v.as<int>();
+          } catch (const YAML::Exception&) {
+          }
+          if (pct < 0 || pct > 100)
+            throw FieldError{"each of 'edge_weights_pct' must be a whole percent, 0 to 100"};
+          prim.edge_weights_pct.push_back(static_cast<uint8_t>(pct));
         }
       }
       loop.primitives.push_back(std::move(prim));
