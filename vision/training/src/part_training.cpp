@@ -140,10 +140,11 @@ constexpr int kMinContrastSamples = 4;
 // by their own contrast instead (about a third of the part's, two thirds
 // of kFullContrastShare), they still put a part 4 to 5 % of whose
 // boundary they are on the background in the blob search's eyes:
-// front-light benchmark, gravel, 14 unseen types, 3 scenes, touching
-// parts found 0.826 without the stretches, 0.913 weighed by their
-// contrast, 0.957 and 0.978 by its square and fourth power, 1.000 at
-// kMinEdgeWeight; overlapping 0.833, 0.917, 0.917, 0.938, 0.958. Lone
+// front-light benchmark, gravel, 14 unseen types, 3 scenes (the edge fit
+// weighing them too), touching parts found 0.826 without the stretches,
+// 0.913 weighed by their contrast, 0.957 and 0.978 by its square and
+// fourth power, 1.000 at kMinEdgeWeight; overlapping 0.833, 0.917, 0.917,
+// 0.938, 0.958. Lone
 // weak points are the noise of the readings; a stretch longer than
 // kMaxWeakRun is the part's own faint side (a shadow cut off beside it, its
 // shading), which its primitives' weights already say: weighed at the
@@ -154,8 +155,10 @@ constexpr int kMinWeakRun = 3;
 constexpr int kMaxWeakRun = 24;
 // Where a stone's outline meets the part's the probes straddle both, and
 // the contrast climbs over a point or so: the stretch is taken this many
-// points wider each way. Gravel, 8 scenes: touching / overlapping found
-// 0.966 / 0.974 without, 0.983 / 0.974 with 1 point, 0.983 / 0.965 with 2.
+// points wider each way. Gravel, 8 scenes, the edge fit weighing the
+// stretches too (it does not, Primitive::edge_weights_pct): touching /
+// overlapping found 0.966 / 0.974 without, 0.983 / 0.974 with 1 point,
+// 0.983 / 0.965 with 2.
 constexpr size_t kWeakMargin = 1;
 
 // `contrastAt(p, t)`: the contrast across primitive p at t, negative where
