@@ -5,6 +5,8 @@ shows the newest frame binarized with the panel's values while they move
 (measured on the image's own pixels), without changing the app; Apply makes
 them the app's, and the next LOCATE finds the six discs, without a restart."""
 
+import time
+
 import numpy as np
 import pytest
 from selenium.webdriver.common.by import By
@@ -83,7 +85,21 @@ def test_vision_panel_previews_and_applies_polarity_without_restart(cell, browse
     located = ok_fields(cell.say("LOCATE ALL"))
     assert located[0] == "1", located
     assert cell.say("VISION").startswith("OK polarity=dark ")
-    hint = wait_until(lambda: hint_shown(browser, "live-polarity-hint"), what="the Live panel's hint")
+    # A result published before the web server's subscription to the app's
+    # results, or the page's event stream, has joined is lost to them (a
+    # live cell publishes another at its next LOCATE): under a loaded
+    # machine the first one was, and the hint never came. LOCATE again
+    # while waiting.
+    asked = [time.monotonic()]
+
+    def hint_after_locate():
+        shown = hint_shown(browser, "live-polarity-hint")
+        if not shown and time.monotonic() - asked[0] > 2:
+            assert ok_fields(cell.say("LOCATE ALL"))[0] == "1"
+            asked[0] = time.monotonic()
+        return shown
+
+    hint = wait_until(hint_after_locate, what="the Live panel's hint")
     assert "covers most of the image" in hint and "Try polarity light" in hint, hint
 
     select_tab(browser, "vision")
