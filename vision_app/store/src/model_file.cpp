@@ -320,6 +320,7 @@ std::vector<vision::BoundaryLoop> readLoops(const YAML::Node& boundary) {
           try {
             pct = v.as<int>();
           } catch (const YAML::Exception&) {
+            // No whole number: refused below, as one out of range is.
           }
           if (pct < 0 || pct > 100)
             throw FieldError{"each of 'edge_weights_pct' must be a whole percent, 0 to 100"};
