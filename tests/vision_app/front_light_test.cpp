@@ -157,6 +157,33 @@ int forEachFound(const ps::SilhouetteScene& scene, const std::shared_ptr<ModelLi
 }
 }  // namespace
 
+// A model file is refused, naming what is wrong, when the first list under
+// `key` in `yaml` is replaced by each of `lists` (with the words each
+// refusal must hold), and when that list's first value is replaced by
+// `beyond` (the count right, the value out of bounds: `beyond_why`).
+void checkDamagedListsRefused(const std::string& yaml, const std::string& key,
+                              const std::vector<std::pair<std::string, std::string>>& lists,
+                              const std::string& beyond, const std::string& beyond_why) {
+  const std::string opening = key + ": [";
+  const auto at = yaml.find(opening);
+  REQUIRE(at != std::string::npos);
+  for (const auto& [list, why] : lists) {
+    std::string damaged = yaml;
+    damaged.replace(at, damaged.find(']', at) + 1 - at, key + ": " + list);
+    const auto refused = modelFromYaml(damaged);
+    INFO(key << ": " << list);
+    REQUIRE_FALSE(refused.ok());
+    CHECK(refused.error().message.find(why) != std::string::npos);
+  }
+  std::string damaged = yaml;
+  const auto first = at + opening.size();
+  damaged.replace(first, damaged.find_first_of(",]", first) - first, beyond);
+  const auto refused = modelFromYaml(damaged);
+  INFO(key << ": first value " << beyond);
+  REQUIRE_FALSE(refused.ok());
+  CHECK(refused.error().message.find(beyond_why) != std::string::npos);
+}
+
 // A worn belt: the textured condition with twice its grain and blotches, so
 // that its darkest spots binarize as specks and stains beside the parts.
 ps::SilhouetteSceneOptions wornBelt() {
@@ -417,30 +444,13 @@ TEST_CASE("a model's edge offsets survive its file and a resize, and damaged one
     }
   }
   CHECK(moved > 0);
-  // Damaged: refused, naming what is wrong, never read as no offsets.
-  const auto at = yaml.find("edge_offsets_mpx: [");
-  REQUIRE(at != std::string::npos);
-  const auto damaged = [&](const std::string& list) {
-    std::string d = yaml;
-    d.replace(at, d.find(']', at) + 1 - at, "edge_offsets_mpx: " + list);
-    return modelFromYaml(d);
-  };
-  for (const auto& [list, why] :
-       std::vector<std::pair<std::string, std::string>>{{"[1, 2]", "edge offsets (one a pixel)"},
-                                                        {"7", "'edge_offsets_mpx' must be a list"},
-                                                        {"[1.5, 2]", "whole number"}}) {
-    const auto refused = damaged(list);
-    INFO(list);
-    REQUIRE_FALSE(refused.ok());
-    CHECK(refused.error().message.find(why) != std::string::npos);
-  }
-  // One offset beyond the bound, the count right.
-  std::string far = yaml;
-  const auto first = at + std::string("edge_offsets_mpx: [").size();
-  far.replace(first, far.find_first_of(",]", first) - first, "9999");
-  const auto refused = modelFromYaml(far);
-  REQUIRE_FALSE(refused.ok());
-  CHECK(refused.error().message.find("within 3.0 px") != std::string::npos);
+  // Damaged: refused, naming what is wrong, never read as no offsets (one
+  // offset beyond the bound, the count right, too).
+  checkDamagedListsRefused(yaml, "edge_offsets_mpx",
+                           {{"[1, 2]", "edge offsets (one a pixel)"},
+                            {"7", "'edge_offsets_mpx' must be a list"},
+                            {"[1.5, 2]", "whole number"}},
+                           "9999", "within 3.0 px");
 }
 
 TEST_CASE("the sweets photograph: a green sweet taught in colour is found",
@@ -1012,28 +1022,14 @@ TEST_CASE("a model's edge weights survive its file and a resize, and damaged one
       }
     }
   }
-  // Damaged: refused, naming what is wrong, never read as full weight.
-  const auto at = yaml.find("edge_weights_pct: [");
-  REQUIRE(at != std::string::npos);
-  for (const auto& [list, why] :
-       std::vector<std::pair<std::string, std::string>>{{"[100, 10]", "edge weights (one a pixel)"},
-                                                        {"7", "'edge_weights_pct' must be a list"},
-                                                        {"[1.5, 2]", "whole percent"},
-                                                        {"[-1]", "whole percent"}}) {
-    std::string d = yaml;
-    d.replace(at, d.find(']', at) + 1 - at, "edge_weights_pct: " + list);
-    const auto refused = modelFromYaml(d);
-    INFO(list);
-    REQUIRE_FALSE(refused.ok());
-    CHECK(refused.error().message.find(why) != std::string::npos);
-  }
-  // One weight over 100, the count right.
-  std::string over = yaml;
-  const auto first = at + std::string("edge_weights_pct: [").size();
-  over.replace(first, over.find_first_of(",]", first) - first, "101");
-  const auto refused = modelFromYaml(over);
-  REQUIRE_FALSE(refused.ok());
-  CHECK(refused.error().message.find("whole percent, 0 to 100") != std::string::npos);
+  // Damaged: refused, naming what is wrong, never read as full weight (one
+  // weight over 100, the count right, too).
+  checkDamagedListsRefused(yaml, "edge_weights_pct",
+                           {{"[100, 10]", "edge weights (one a pixel)"},
+                            {"7", "'edge_weights_pct' must be a list"},
+                            {"[1.5, 2]", "whole percent"},
+                            {"[-1]", "whole percent"}},
+                           "101", "whole percent, 0 to 100");
 }
 
 TEST_CASE("a part another lies on is placed by what shows of its edges as a whole one is",

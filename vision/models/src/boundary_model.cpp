@@ -267,12 +267,10 @@ double Primitive::edgeOffsetAt(double t) const {
   return 0.001 * ((1 - w) * o[k] + w * o[next]);
 }
 
-double Primitive::weightAt(double t) const {
+int Primitive::weightPctAt(double t) const {
   const auto& w = edge_weights_pct;
-  if (w.empty()) return weight;
-  const auto k = std::min(w.size() - 1, static_cast<size_t>(std::max(0.0, t * w.size())));
-  // Whole percents of the weight, as stored.
-  return weight * 0.01 * w[k];
+  if (w.empty()) return 100;
+  return w[std::min(w.size() - 1, static_cast<size_t>(std::max(0.0, t * w.size())))];
 }
 
 cv::Point2d Primitive::pointAt(double t) const {

@@ -144,13 +144,12 @@ constexpr int kMinContrastSamples = 4;
 // weighing them too), touching parts found 0.826 without the stretches,
 // 0.913 weighed by their contrast, 0.957 and 0.978 by its square and
 // fourth power, 1.000 at kMinEdgeWeight; overlapping 0.833, 0.917, 0.917,
-// 0.938, 0.958. Lone
-// weak points are the noise of the readings; a stretch longer than
-// kMaxWeakRun is the part's own faint side (a shadow cut off beside it, its
-// shading), which its primitives' weights already say: weighed at the
-// least too, the benchmark's parts beside shadows were placed 0.062 ->
-// 0.068 px RMS off (touching), 0.077 -> 0.082 (overlapping); with the
-// bound as before, gravel as above.
+// 0.938, 0.958. Lone weak points are the noise of the readings; a stretch
+// longer than kMaxWeakRun is the part's own faint side (a shadow cut off
+// beside it, its shading), which its primitives' weights already say:
+// weighed at the least too, the benchmark's parts beside shadows were
+// placed 0.062 -> 0.068 px RMS off (touching), 0.077 -> 0.082
+// (overlapping); with the bound as before, gravel as above.
 constexpr int kMinWeakRun = 3;
 constexpr int kMaxWeakRun = 24;
 // Where a stone's outline meets the part's the probes straddle both, and
@@ -534,12 +533,10 @@ PartModel scaledModel(const PartModel& model, double scale) {
       // offsets scaled).
       const int count = edgeOffsetCount(p.length());
       if (!taught.edge_weights_pct.empty()) {
-        const auto& w = taught.edge_weights_pct;
         p.edge_weights_pct.resize(static_cast<size_t>(count));
-        for (size_t k = 0; k < p.edge_weights_pct.size(); ++k) {
-          // The taught point nearest (Primitive::weightAt).
-          const double t = (static_cast<double>(k) + 0.5) / count;
-          p.edge_weights_pct[k] = w[std::min(w.size() - 1, static_cast<size_t>(t * w.size()))];
+        for (int k = 0; k < count; ++k) {
+          p.edge_weights_pct[static_cast<size_t>(k)] =
+              static_cast<uint8_t>(taught.weightPctAt((k + 0.5) / count));
         }
       }
       if (taught.edge_offsets_mpx.empty()) continue;

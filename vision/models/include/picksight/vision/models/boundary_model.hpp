@@ -46,8 +46,11 @@ struct Primitive {
   std::vector<uint8_t> edge_weights_pct;
 
   double length() const;
-  // The primitive's weight at `t` (its share at the nearest point).
-  double weightAt(double t) const;
+  // The primitive's weight at `t`: `weight` times the share held for the
+  // point whose stretch of the primitive holds t (weightPctAt, 100 without
+  // edge weights).
+  double weightAt(double t) const { return weight * 0.01 * weightPctAt(t); }
+  int weightPctAt(double t) const;
   // The teach image's edge offset at `t` (linear between the points; 0
   // without offsets).
   double edgeOffsetAt(double t) const;
