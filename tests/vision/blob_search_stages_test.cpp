@@ -16,6 +16,7 @@
 #include "picksight/common/angles.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/blob_search/touching_parts.hpp"
+#include "picksight/vision/recognition/recognizer.hpp"
 #include "picksight/vision/segmentation/binarize.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
 #include "picksight/vision/training/part_training.hpp"
@@ -84,6 +85,35 @@ Scene touchingPair(bool mirrored_l) {
       pt::drawParts(640, 480,
                     {{lShape(), scene.l_pose.centre.x, scene.l_pose.centre.y, turn, mirrored_l},
                      {bar(), scene.bar_pose.centre.x, scene.bar_pose.centre.y, turn}},
+                    11);
+  scene.regions = findRegions(binarize(scene.grey, {}), {}, scene.grey);
+  return scene;
+}
+
+// A block wider than the L's arms (none of it fits in the L, nor the L's
+// arm in it: the bar, as wide as the long arm, screens as one there).
+ps::Shape block() { return pt::centred(ps::Shape{{pt::rectLoop(50, 40)}}); }
+
+// The block beyond the end of the L's long arm, its side against the arm's
+// end along 10 px (a contact, no overlap); its pose in `bar_pose`.
+Scene blockAtArm(bool mirrored_l) {
+  const ps::ShapeMoments lm = ps::shapeMoments(lDrawing());
+  const double turn = 25;
+  const double c = std::cos(turn * M_PI / 180);
+  const double s = std::sin(turn * M_PI / 180);
+  const double flip = mirrored_l ? -1.0 : 1.0;
+  // The block's centre in the L's frame: half its width past the arm's
+  // end (x = 100), its top 10 above the arm's lower side (y = 30).
+  const cv::Point2d offset(100 + 25 - lm.cx, flip * (30 - 10 + 20 - lm.cy));
+  Scene scene;
+  scene.l_pose = {{240, 200}, turn, mirrored_l};
+  scene.bar_pose = {
+      scene.l_pose.centre + cv::Point2d(c * offset.x - s * offset.y, s * offset.x + c * offset.y),
+      turn, false};
+  scene.grey =
+      pt::drawParts(640, 480,
+                    {{lShape(), scene.l_pose.centre.x, scene.l_pose.centre.y, turn, mirrored_l},
+                     {block(), scene.bar_pose.centre.x, scene.bar_pose.centre.y, turn}},
                     11);
   scene.regions = findRegions(binarize(scene.grey, {}), {}, scene.grey);
   return scene;
@@ -241,6 +271,96 @@ TEST_CASE("blob search: a part drawn as the mirror image of its model is not rep
                                          m.centroid.y - scene.bar_pose.centre.y) < 0.5);
   }
   CHECK(bar_found);
+}
+
+TEST_CASE("blob search: what the parts leave is not searched when it is a whole untaught copy",
+          "[vision][blob_search]") {
+  // A block against the end of the L drawn mirrored: once the block is
+  // taken, what is left is the L's mirror image whole, which the region
+  // tests call a copy (no part): the search ends there.
+  const Scene scene = blockAtArm(true);
+  REQUIRE(scene.regions.size() == 1);
+  static const PartModel block_model = trainAlone(block(), 5, "block");
+  const auto testFor = [](const std::vector<const PartModel*>& list) {
+    double tolerance = 0;
+    for (const PartModel* m : list) tolerance = std::max(tolerance, m->edge_tolerance);
+    return WholeCopyTest(
+        [list, tolerance](const Region& r) { return isWholeCopy(r, list, tolerance); });
+  };
+  // A part taken alone: the best of its model's screened poses, refined.
+  const auto takeAt = [&](BlobSearch& search, const PartModel& model, const ImagePose& truth) {
+    auto screened = search.screen(model, touching::Anchors::kAll);
+    REQUIRE(!screened.empty());
+    screened.resize(1);
+    search.refine(screened);
+    search.choose();
+    REQUIRE(search.taken().size() == 1);
+    const Candidate& taken = *search.placed()[search.taken().front()].candidate;
+    REQUIRE(std::hypot(taken.pose.centre.x - truth.centre.x, taken.pose.centre.y - truth.centre.y) <
+            0.5);
+  };
+  const auto takeBlock = [&](BlobSearch& search) { takeAt(search, block_model, scene.bar_pose); };
+  const auto isAt = [&](const Match& m, const PartModel& model, const ImagePose& pose) {
+    return m.model == &model &&
+           std::hypot(m.centroid.x - pose.centre.x, m.centroid.y - pose.centre.y) < 0.5;
+  };
+  const std::vector<const PartModel*> taught{&models().l, &block_model};
+  const WholeCopyTest copy_test = testFor(taught);
+  {
+    BlobSearch search(scene.regions, 0, taught, nullptr, &copy_test);
+    CHECK_FALSE(search.restIsWholeCopy());  // nothing taken yet: the blob is no copy
+    takeBlock(search);
+    CHECK(search.restIsWholeCopy());
+    CHECK(search.restIsWholeCopy());  // the same parts taken: the same answer
+    // Without the test, nothing is taken for a copy.
+    BlobSearch plain(scene.regions, 0, taught, nullptr);
+    takeBlock(plain);
+    CHECK_FALSE(plain.restIsWholeCopy());
+  }
+  const auto found = locateInBlob(scene.regions, 0, taught, nullptr, &copy_test);
+  REQUIRE(found.size() == 1);
+  CHECK(isAt(found.front(), block_model, scene.bar_pose));
+  // The mirror image taught as a type of its own (a left and a right
+  // bracket): what the block leaves is that type's part, not a copy, and it
+  // is found.
+  PartModel mirror_l;
+  {
+    const cv::Mat image = pt::drawParts(400, 300, {{lShape(), 200, 150, 0, true}}, 5);
+    auto trained = trainModel(image, 4, "ell-mirrored");
+    REQUIRE(trained.ok());
+    mirror_l = trained.value();
+  }
+  const std::vector<const PartModel*> both_hands{&models().l, &block_model, &mirror_l};
+  const WholeCopyTest hands_test = testFor(both_hands);
+  BlobSearch search(scene.regions, 0, both_hands, nullptr, &hands_test);
+  takeBlock(search);
+  CHECK_FALSE(search.restIsWholeCopy());
+  const auto both = locateInBlob(scene.regions, 0, both_hands, nullptr, &hands_test);
+  CHECK(both.size() == 2);
+  CHECK(std::any_of(both.begin(), both.end(),
+                    [&](const Match& m) { return isAt(m, mirror_l, scene.l_pose); }));
+  CHECK(std::any_of(both.begin(), both.end(),
+                    [&](const Match& m) { return isAt(m, block_model, scene.bar_pose); }));
+}
+
+TEST_CASE("blob search: a rest is a copy when mirrored or larger, never when smaller",
+          "[vision][blob_search]") {
+  // A rest smaller than a part may be that part less what its neighbours'
+  // drawn outlines took off it (a part 90 px long between two others read
+  // at 0.93 of its model's scale): it is searched. The mirror image and a
+  // larger copy cannot be a part of the type.
+  const PartModel& l = models().l;
+  const auto alone = [](const ps::Shape& shape, bool mirrored) {
+    const cv::Mat image = pt::drawParts(400, 300, {{shape, 200, 150, 30, mirrored}}, 5);
+    auto regions = findRegions(binarize(image, {}), {}, image);
+    REQUIRE(regions.size() == 1);
+    return regions.front();
+  };
+  const std::vector<const PartModel*> taught{&l};
+  CHECK(isWholeCopy(alone(lShape(), true), taught, l.edge_tolerance));
+  CHECK(isWholeCopy(alone(pt::scaled(lShape(), 1.25), false), taught, l.edge_tolerance));
+  CHECK_FALSE(isWholeCopy(alone(pt::scaled(lShape(), 0.8), false), taught, l.edge_tolerance));
+  CHECK_FALSE(isWholeCopy(alone(lShape(), false), taught, l.edge_tolerance));
 }
 
 TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blob_search]") {

@@ -14,6 +14,9 @@
 //   explainsWhole()     whether the parts taken are the whole blob
 //   narrowToRest()      the anchors the full search starts from: those near
 //                       what the parts taken leave unexplained
+//   restIsWholeCopy()   whether what the parts taken leave is one whole
+//                       untaught copy of a type (its mirror image, another
+//                       size): nothing more to search for
 //   searchRestMiddle()  each model the size of what is left unexplained,
 //                       put on its middle and turned (proposeAbout): a part
 //                       whose corners its outline does not show as the
@@ -21,9 +24,9 @@
 //                       pieces and those its largest parts into at its
 //                       necks, each about its own middle
 //   run()               the stages in order: a quick search of every model,
-//                       then while the blob is not explained whole the full
-//                       search, model by model, and the search of the rest's
-//                       middle
+//                       then while the blob is not explained whole (and
+//                       what is left no whole copy) the full search, model
+//                       by model, and the search of the rest's middle
 #pragma once
 
 #include <deque>
@@ -34,6 +37,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "picksight/vision/blob_search/touching_parts.hpp"
 #include "picksight/vision/models/boundary_verification.hpp"
 #include "picksight/vision/models/match.hpp"
 #include "picksight/vision/models/part_model.hpp"
@@ -57,7 +61,8 @@ class BlobSearch {
   // the blob and, when any does, reads the blob: its edge map (unless given),
   // corners and arcs, and pixels. Keeps references to all arguments.
   BlobSearch(const std::vector<Region>& regions, size_t index,
-             const std::vector<const PartModel*>& models, const EdgeDistance* built_edges);
+             const std::vector<const PartModel*>& models, const EdgeDistance* built_edges,
+             const WholeCopyTest* whole_copy = nullptr);
   BlobSearch(const BlobSearch&) = delete;
   BlobSearch& operator=(const BlobSearch&) = delete;
 
@@ -98,6 +103,13 @@ class BlobSearch {
   // of a candidate about to be taken; the aligned mirror image is fitted
   // once per candidate).
   bool showsMirror(const Candidate& candidate);
+  // Whether what the parts taken leave of the blob is one piece (after an
+  // opening by the seam) that the whole-copy test (see locateInBlob) takes
+  // for an untaught copy of a type: the search then ends. False without
+  // the test, with no part taken, for a blob the frame cuts, and where the
+  // rest's outline is not the blob's (kWholeOutlineShare: a part the parts
+  // taken lie over). Asked again with the same parts taken, the same answer.
+  bool restIsWholeCopy();
   // The models of the size of the largest piece the parts taken leave, each
   // turned about its middle; where nothing is taken then, the two models
   // nearest the size of each other piece, and of each piece the largest
@@ -138,6 +150,9 @@ class BlobSearch {
 
   const Region& region_;
   size_t index_;
+  const WholeCopyTest* whole_copy_ = nullptr;
+  // The parts taken when restIsWholeCopy was last asked, and its answer.
+  std::optional<std::pair<std::vector<size_t>, bool>> copy_tested_;
   std::vector<const PartModel*> fitting_;
   double tolerance_ = 0;     // the largest edge tolerance of the fitting models
   double conformity_ = 1e9;  // their smallest conformity

@@ -132,10 +132,36 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
     return {match};
   }
   if (whole_part) return {};
-  // No model explains the blob whole: parts that touch, or none.
-  return locateInBlob(regions, i, models, cache.builtEdges());
+  // No model explains the blob whole: parts that touch, or none. What the
+  // parts found leave is judged as a lone region would be: one whole copy
+  // of a type that is no part (its mirror image, another size) holds no
+  // part, and is not searched. Every model of a recognize() shares its
+  // hole setting, which the piece is read with as the regions were.
+  const WholeCopyTest whole_copy = [&](const Region& piece) {
+    return isWholeCopy(piece, models, max_tolerance);
+  };
+  return locateInBlob(regions, i, models, cache.builtEdges(), &whole_copy);
 }
 }  // namespace
+
+bool isWholeCopy(const Region& region, const std::vector<const PartModel*>& models,
+                 double max_edge_tolerance) {
+  if (models.empty()) return false;
+  const Region held = withHolesAtLeast(region, models.front()->min_hole_area);
+  RegionCache cache(held, max_edge_tolerance);
+  bool copy = false;
+  for (const PartModel* model : models) {
+    const Verdict v = judgeRegion(cache, *model, true);
+    if (v.test == RegionTest::kPasses) return false;
+    // Smaller than the part, a rest may be that part less what its
+    // neighbours' drawn outlines took off it (a part 90 px long between
+    // two others read at 0.93 of its model's scale, the bound 0.95): only
+    // a larger copy counts.
+    const bool larger = v.test == RegionTest::kScale && v.measured > v.high;
+    copy = copy || larger || v.test == RegionTest::kMirror;
+  }
+  return copy;
+}
 
 std::vector<Match> recognize(const std::vector<Region>& regions,
                              const std::vector<const PartModel*>& models) {

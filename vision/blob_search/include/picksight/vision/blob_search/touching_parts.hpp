@@ -91,8 +91,16 @@ void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, 
 // `models`, past the region's box by more), which the search then reads
 // instead of building its own: the same distances as far as anything here
 // reads them.
+// `whole_copy`, when given: whether a region is one whole copy of a taught
+// type that no model takes for a part (its mirror image, or a copy of
+// another size), as the region tests judge a lone region. What the parts
+// found leave of the blob, when it is one piece that this says is such a
+// copy, is not searched further: no part lies there (it is the blob's
+// untaught object, touching the parts found).
+using WholeCopyTest = std::function<bool(const Region&)>;
 std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
                                 const std::vector<const PartModel*>& models,
-                                const EdgeDistance* edges = nullptr);
+                                const EdgeDistance* edges = nullptr,
+                                const WholeCopyTest* whole_copy = nullptr);
 
 }  // namespace picksight::vision

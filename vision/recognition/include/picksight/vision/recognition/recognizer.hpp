@@ -25,6 +25,17 @@ namespace picksight::vision {
 std::vector<Match> recognize(const std::vector<Region>& regions,
                              const std::vector<const PartModel*>& models);
 
+// Whether a region is one whole copy of a type that no model takes for a
+// part, as recognize() judges a lone region, but only a larger one: some
+// model finds it its mirror image or a copy larger than the part
+// (judgeRegion's kMirror, kScale above the scales the model allows) and
+// none passes it. `models` share one minimum hole area (the region's holes
+// are counted with it). What the parts found in a blob leave is asked this
+// (see locateInBlob): such a copy holds no part to search for, while a
+// smaller one may be a part less what the parts beside it took off.
+bool isWholeCopy(const Region& region, const std::vector<const PartModel*>& models,
+                 double max_edge_tolerance);
+
 // recognize() with each model judging holes with its own minimum hole area
 // (the one it was trained with; byMinHoleArea): one recognize() per setting
 // on the regions as it sees them (withHolesAtLeast). Where several settings
