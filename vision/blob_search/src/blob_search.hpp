@@ -15,8 +15,8 @@
 //   narrowToRest()      the anchors the full search starts from: those near
 //                       what the parts taken leave unexplained
 //   restIsWholeCopy()   whether what the parts taken leave is one whole
-//                       untaught copy of a type (its mirror image, another
-//                       size): nothing more to search for
+//                       untaught copy of a type (its mirror image, a larger
+//                       copy): nothing more to search for
 //   searchRestMiddle()  each model the size of what is left unexplained,
 //                       put on its middle and turned (proposeAbout): a part
 //                       whose corners its outline does not show as the

@@ -1381,7 +1381,7 @@ std::vector<Match> BlobSearch::run() {
   }
   choose();
   // A part found beside one whole untaught copy of a type (its mirror
-  // image, another size): nothing else to look for.
+  // image, a larger copy): nothing else to look for.
   if (!explainsWhole() && restIsWholeCopy()) return matches();
   if (!explainsWhole()) fullSearch(std::move(order));
   if (changed_) choose();

@@ -134,7 +134,7 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
   if (whole_part) return {};
   // No model explains the blob whole: parts that touch, or none. What the
   // parts found leave is judged as a lone region would be: one whole copy
-  // of a type that is no part (its mirror image, another size) holds no
+  // of a type that is no part (its mirror image, a larger copy) holds no
   // part, and is not searched. Every model of a recognize() shares its
   // hole setting, which the piece is read with as the regions were.
   const WholeCopyTest whole_copy = [&](const Region& piece) {

@@ -92,8 +92,8 @@ void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, 
 // instead of building its own: the same distances as far as anything here
 // reads them.
 // `whole_copy`, when given: whether a region is one whole copy of a taught
-// type that no model takes for a part (its mirror image, or a copy of
-// another size), as the region tests judge a lone region. What the parts
+// type that no model takes for a part (its mirror image, or a larger copy;
+// see isWholeCopy), as the region tests judge a lone region. What the parts
 // found leave of the blob, when it is one piece that this says is such a
 // copy, is not searched further: no part lies there (it is the blob's
 // untaught object, touching the parts found).
