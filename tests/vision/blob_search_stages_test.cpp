@@ -343,7 +343,7 @@ TEST_CASE("blob search: what the parts leave is not searched when it is a whole 
                     [&](const Match& m) { return isAt(m, block_model, scene.bar_pose); }));
 }
 
-TEST_CASE("blob search: a rest is a copy when mirrored or larger, never when smaller",
+TEST_CASE("blob search: a rest is a copy when mirrored or larger, never when smaller than a part",
           "[vision][blob_search]") {
   // A rest smaller than a part may be that part less what its neighbours'
   // drawn outlines took off it (a part 90 px long between two others read
@@ -361,6 +361,15 @@ TEST_CASE("blob search: a rest is a copy when mirrored or larger, never when sma
   CHECK(isWholeCopy(alone(pt::scaled(lShape(), 1.25), false), taught, l.edge_tolerance));
   CHECK_FALSE(isWholeCopy(alone(pt::scaled(lShape(), 0.8), false), taught, l.edge_tolerance));
   CHECK_FALSE(isWholeCopy(alone(lShape(), false), taught, l.edge_tolerance));
+  // Two sizes of one shape taught as two types (washers of two sizes): an
+  // L between them is smaller than the large one's part, and may be that
+  // part less what its neighbours took, though the small one finds it a
+  // larger copy of its own; larger than both, it is a copy.
+  static const PartModel small_l = trainAlone(pt::scaled(lShape(), 0.8), 6, "small ell");
+  const std::vector<const PartModel*> sizes{&l, &small_l};
+  CHECK(isWholeCopy(alone(pt::scaled(lShape(), 0.9), false), {&small_l}, l.edge_tolerance));
+  CHECK_FALSE(isWholeCopy(alone(pt::scaled(lShape(), 0.9), false), sizes, l.edge_tolerance));
+  CHECK(isWholeCopy(alone(pt::scaled(lShape(), 1.25), false), sizes, l.edge_tolerance));
 }
 
 TEST_CASE("blob search: a part touches only what shares its blob", "[vision][blob_search]") {

@@ -155,10 +155,11 @@ bool isWholeCopy(const Region& region, const std::vector<const PartModel*>& mode
     if (v.test == RegionTest::kPasses) return false;
     // Smaller than the part, a rest may be that part less what its
     // neighbours' drawn outlines took off it (a part 90 px long between
-    // two others read at 0.93 of its model's scale, the bound 0.95): only
-    // a larger copy counts.
-    const bool larger = v.test == RegionTest::kScale && v.measured > v.high;
-    copy = copy || larger || v.test == RegionTest::kMirror;
+    // two others read at 0.93 of its model's scale, the bound 0.95): then
+    // it is no copy, even where a smaller type of the same shape (a washer
+    // of the next size down) finds it a larger copy of its own.
+    if (v.test == RegionTest::kScale && v.measured < v.low) return false;
+    copy = copy || v.test == RegionTest::kScale || v.test == RegionTest::kMirror;
   }
   return copy;
 }

@@ -28,11 +28,12 @@ std::vector<Match> recognize(const std::vector<Region>& regions,
 // Whether a region is one whole copy of a type that no model takes for a
 // part, as recognize() judges a lone region, but only a larger one: some
 // model finds it its mirror image or a copy larger than the part
-// (judgeRegion's kMirror, kScale above the scales the model allows) and
-// none passes it. `models` share one minimum hole area (the region's holes
-// are counted with it). What the parts found in a blob leave is asked this
-// (see locateInBlob): such a copy holds no part to search for, while a
-// smaller one may be a part less what the parts beside it took off.
+// (judgeRegion's kMirror, kScale above the scales the model allows), none
+// passes it and none finds it smaller than its part. `models` share one
+// minimum hole area (the region's holes are counted with it). What the
+// parts found in a blob leave is asked this (see locateInBlob): such a copy
+// holds no part to search for, while one smaller than some model's part
+// may be that part less what the parts beside it took off.
 bool isWholeCopy(const Region& region, const std::vector<const PartModel*>& models,
                  double max_edge_tolerance);
 
