@@ -68,55 +68,44 @@ struct Scene {
   ImagePose bar_pose;
 };
 
-Scene touchingPair(bool mirrored_l) {
+// The L at `l_centre` turned 25 degrees (mirrored or not) and `other`
+// beside it, turned with it, its centre at `at` in the L's drawing (y
+// flipped with the L); the other's pose in `bar_pose`.
+Scene lAndOther(bool mirrored_l, cv::Point2d l_centre, const ps::Shape& other, cv::Point2d at) {
   const ps::ShapeMoments lm = ps::shapeMoments(lDrawing());
   const double turn = 25;
   const double c = std::cos(turn * M_PI / 180);
   const double s = std::sin(turn * M_PI / 180);
-  // The bar's centre in the L's frame: past the long arm's end, on its axis.
   const double flip = mirrored_l ? -1.0 : 1.0;
-  const cv::Point2d offset(100 - lm.cx + 45 - 2, flip * (15 - lm.cy));
+  const cv::Point2d offset(at.x - lm.cx, flip * (at.y - lm.cy));
   Scene scene;
-  scene.l_pose = {{260, 220}, turn, mirrored_l};
+  scene.l_pose = {l_centre, turn, mirrored_l};
   scene.bar_pose = {
       scene.l_pose.centre + cv::Point2d(c * offset.x - s * offset.y, s * offset.x + c * offset.y),
       turn, false};
   scene.grey =
       pt::drawParts(640, 480,
                     {{lShape(), scene.l_pose.centre.x, scene.l_pose.centre.y, turn, mirrored_l},
-                     {bar(), scene.bar_pose.centre.x, scene.bar_pose.centre.y, turn}},
+                     {other, scene.bar_pose.centre.x, scene.bar_pose.centre.y, turn}},
                     11);
   scene.regions = findRegions(binarize(scene.grey, {}), {}, scene.grey);
   return scene;
+}
+
+// The bar past the L's long arm's end, on its axis, 2 px over it.
+Scene touchingPair(bool mirrored_l) {
+  return lAndOther(mirrored_l, {260, 220}, bar(), {100 + 45 - 2, 15});
 }
 
 // A block wider than the L's arms (none of it fits in the L, nor the L's
 // arm in it: the bar, as wide as the long arm, screens as one there).
 ps::Shape block() { return pt::centred(ps::Shape{{pt::rectLoop(50, 40)}}); }
 
-// The block beyond the end of the L's long arm, its side against the arm's
-// end along 10 px (a contact, no overlap); its pose in `bar_pose`.
+// The block beyond the end of the L's long arm (x = 100), half its width
+// past it, its top 10 above the arm's lower side (y = 30): its side
+// against the arm's end along 10 px (a contact, no overlap).
 Scene blockAtArm(bool mirrored_l) {
-  const ps::ShapeMoments lm = ps::shapeMoments(lDrawing());
-  const double turn = 25;
-  const double c = std::cos(turn * M_PI / 180);
-  const double s = std::sin(turn * M_PI / 180);
-  const double flip = mirrored_l ? -1.0 : 1.0;
-  // The block's centre in the L's frame: half its width past the arm's
-  // end (x = 100), its top 10 above the arm's lower side (y = 30).
-  const cv::Point2d offset(100 + 25 - lm.cx, flip * (30 - 10 + 20 - lm.cy));
-  Scene scene;
-  scene.l_pose = {{240, 200}, turn, mirrored_l};
-  scene.bar_pose = {
-      scene.l_pose.centre + cv::Point2d(c * offset.x - s * offset.y, s * offset.x + c * offset.y),
-      turn, false};
-  scene.grey =
-      pt::drawParts(640, 480,
-                    {{lShape(), scene.l_pose.centre.x, scene.l_pose.centre.y, turn, mirrored_l},
-                     {block(), scene.bar_pose.centre.x, scene.bar_pose.centre.y, turn}},
-                    11);
-  scene.regions = findRegions(binarize(scene.grey, {}), {}, scene.grey);
-  return scene;
+  return lAndOther(mirrored_l, {240, 200}, block(), {100 + 25, 30 - 10 + 20});
 }
 
 std::vector<const PartModel*> all() { return {&models().l, &models().b, &models().big}; }
