@@ -110,6 +110,28 @@ Scene blockAtArm(bool mirrored_l) {
 
 std::vector<const PartModel*> all() { return {&models().l, &models().b, &models().big}; }
 
+// Takes one part alone: the best of its model's screened poses, refined,
+// within half a pixel of `truth`.
+void takeAlone(BlobSearch& search, const PartModel& model, const ImagePose& truth) {
+  auto screened = search.screen(model, touching::Anchors::kAll);
+  REQUIRE(!screened.empty());
+  screened.resize(1);
+  search.refine(screened);
+  search.choose();
+  REQUIRE(search.taken().size() == 1);
+  const Candidate& taken = *search.placed()[search.taken().front()].candidate;
+  REQUIRE(std::hypot(taken.pose.centre.x - truth.centre.x, taken.pose.centre.y - truth.centre.y) <
+          0.5);
+}
+
+// The lone-region reading of `list` (see readLoneRegion), as recognize()
+// hands it to the blob search.
+LoneRegionTest loneReadingOf(const std::vector<const PartModel*>& list) {
+  double tolerance = 0;
+  for (const PartModel* m : list) tolerance = std::max(tolerance, m->edge_tolerance);
+  return [list, tolerance](const Region& r) { return readLoneRegion(r, list, tolerance); };
+}
+
 bool near(const ImagePose& a, const ImagePose& b, const PartModel& m, double px, double deg) {
   return std::hypot(a.centre.x - b.centre.x, a.centre.y - b.centre.y) <= px &&
          angleDiffDeg(a.angle_deg, b.angle_deg, m.symmetryDeg()) <= deg;
@@ -270,31 +292,15 @@ TEST_CASE("blob search: what the parts leave is not searched when it is a whole 
   const Scene scene = blockAtArm(true);
   REQUIRE(scene.regions.size() == 1);
   static const PartModel block_model = trainAlone(block(), 5, "block");
-  const auto testFor = [](const std::vector<const PartModel*>& list) {
-    double tolerance = 0;
-    for (const PartModel* m : list) tolerance = std::max(tolerance, m->edge_tolerance);
-    return WholeCopyTest(
-        [list, tolerance](const Region& r) { return isWholeCopy(r, list, tolerance); });
+  const auto takeBlock = [&](BlobSearch& search) {
+    takeAlone(search, block_model, scene.bar_pose);
   };
-  // A part taken alone: the best of its model's screened poses, refined.
-  const auto takeAt = [&](BlobSearch& search, const PartModel& model, const ImagePose& truth) {
-    auto screened = search.screen(model, touching::Anchors::kAll);
-    REQUIRE(!screened.empty());
-    screened.resize(1);
-    search.refine(screened);
-    search.choose();
-    REQUIRE(search.taken().size() == 1);
-    const Candidate& taken = *search.placed()[search.taken().front()].candidate;
-    REQUIRE(std::hypot(taken.pose.centre.x - truth.centre.x, taken.pose.centre.y - truth.centre.y) <
-            0.5);
-  };
-  const auto takeBlock = [&](BlobSearch& search) { takeAt(search, block_model, scene.bar_pose); };
   const auto isAt = [&](const Match& m, const PartModel& model, const ImagePose& pose) {
     return m.model == &model &&
            std::hypot(m.centroid.x - pose.centre.x, m.centroid.y - pose.centre.y) < 0.5;
   };
   const std::vector<const PartModel*> taught{&models().l, &block_model};
-  const WholeCopyTest copy_test = testFor(taught);
+  const LoneRegionTest copy_test = loneReadingOf(taught);
   {
     BlobSearch search(scene.regions, 0, taught, nullptr, &copy_test);
     CHECK_FALSE(search.restIsWholeCopy());  // nothing taken yet: the blob is no copy
@@ -320,7 +326,7 @@ TEST_CASE("blob search: what the parts leave is not searched when it is a whole 
     mirror_l = trained.value();
   }
   const std::vector<const PartModel*> both_hands{&models().l, &block_model, &mirror_l};
-  const WholeCopyTest hands_test = testFor(both_hands);
+  const LoneRegionTest hands_test = loneReadingOf(both_hands);
   BlobSearch search(scene.regions, 0, both_hands, nullptr, &hands_test);
   takeBlock(search);
   CHECK_FALSE(search.restIsWholeCopy());
@@ -330,6 +336,39 @@ TEST_CASE("blob search: what the parts leave is not searched when it is a whole 
                     [&](const Match& m) { return isAt(m, mirror_l, scene.l_pose); }));
   CHECK(std::any_of(both.begin(), both.end(),
                     [&](const Match& m) { return isAt(m, block_model, scene.bar_pose); }));
+}
+
+TEST_CASE("blob search: what the parts leave is placed from its reading when it is one part",
+          "[vision][blob_search]") {
+  // The L and the block against the end of its long arm: once the block is
+  // taken, what is left is the L whole, which its model passes as a lone
+  // region: it is placed from that reading's pose, with no model screened.
+  const Scene scene = blockAtArm(false);
+  REQUIRE(scene.regions.size() == 1);
+  static const PartModel block_model = trainAlone(block(), 5, "block");
+  const PartModel& l = models().l;
+  const std::vector<const PartModel*> taught{&l, &block_model};
+  const LoneRegionTest reading = loneReadingOf(taught);
+  BlobSearch search(scene.regions, 0, taught, nullptr, &reading);
+  takeAlone(search, block_model, scene.bar_pose);
+  const LoneReading rest = search.readRest();
+  CHECK(rest.kind == LoneReading::Kind::kPart);
+  CHECK(rest.model == &l);
+  const size_t refined = search.refined().size();
+  CHECK(search.settleRest());
+  CHECK(search.refined().size() == refined + 1);  // one edge fit, no screening
+  REQUIRE(search.taken().size() == 2);
+  const auto l_at = std::find_if(search.taken().begin(), search.taken().end(), [&](size_t i) {
+    return search.placed()[i].candidate->model == &l;
+  });
+  REQUIRE(l_at != search.taken().end());
+  CHECK(near(search.placed()[*l_at].candidate->pose, scene.l_pose, l, 0.3, 0.3));
+  // Without the reading the rest is neither: the search goes on.
+  BlobSearch plain(scene.regions, 0, taught, nullptr);
+  takeAlone(plain, block_model, scene.bar_pose);
+  CHECK(plain.readRest().kind == LoneReading::Kind::kNeither);
+  CHECK_FALSE(plain.settleRest());
+  CHECK(plain.taken().size() == 1);
 }
 
 TEST_CASE("blob search: a rest is a copy when mirrored or larger, never when smaller than a part",

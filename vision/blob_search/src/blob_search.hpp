@@ -14,9 +14,12 @@
 //   explainsWhole()     whether the parts taken are the whole blob
 //   narrowToRest()      the anchors the full search starts from: those near
 //                       what the parts taken leave unexplained
-//   restIsWholeCopy()   whether what the parts taken leave is one whole
-//                       untaught copy of a type (its mirror image, a larger
-//                       copy): nothing more to search for
+//   readRest()          what the parts taken leave, read as a lone region:
+//                       one whole untaught copy of a type (its mirror
+//                       image, a larger copy: nothing more to search for),
+//                       one part of a model, or neither
+//   settleRest()        ends the search beside such a copy; places such a
+//                       part from the reading's pose
 //   searchRestMiddle()  each model the size of what is left unexplained,
 //                       put on its middle and turned (proposeAbout): a part
 //                       whose corners its outline does not show as the
@@ -25,8 +28,9 @@
 //                       necks, each about its own middle
 //   run()               the stages in order: a quick search of every model,
 //                       then while the blob is not explained whole (and
-//                       what is left no whole copy) the full search, model
-//                       by model, and the search of the rest's middle
+//                       what is left no whole copy) the rest settled, the
+//                       full search, model by model, and the search of
+//                       the rest's middle
 #pragma once
 
 #include <deque>
@@ -62,7 +66,7 @@ class BlobSearch {
   // corners and arcs, and pixels. Keeps references to all arguments.
   BlobSearch(const std::vector<Region>& regions, size_t index,
              const std::vector<const PartModel*>& models, const EdgeDistance* built_edges,
-             const WholeCopyTest* whole_copy = nullptr);
+             const LoneRegionTest* read_rest = nullptr);
   BlobSearch(const BlobSearch&) = delete;
   BlobSearch& operator=(const BlobSearch&) = delete;
 
@@ -103,13 +107,21 @@ class BlobSearch {
   // of a candidate about to be taken; the aligned mirror image is fitted
   // once per candidate).
   bool showsMirror(const Candidate& candidate);
-  // Whether what the parts taken leave of the blob is one piece (after an
-  // opening by the seam) that the whole-copy test (see locateInBlob) takes
-  // for an untaught copy of a type: the search then ends. False without
-  // the test, with no part taken, for a blob the frame cuts, and where the
-  // rest's outline is not the blob's (kWholeOutlineShare: a part the parts
-  // taken lie over). Asked again with the same parts taken, the same answer.
-  bool restIsWholeCopy();
+  // What the parts taken leave of the blob, where it is one piece (after an
+  // opening by the seam), read by the lone-region test (see locateInBlob):
+  // an untaught copy of a type (the search then ends), one part, or
+  // neither. Neither without the test, with no part taken, for a blob the
+  // frame cuts, and where the rest's outline is not the blob's
+  // (kWholeOutlineShare: a part the parts taken lie over). Asked again with
+  // the same parts taken, the same reading; kPart's pose is about
+  // `rest_centre`.
+  LoneReading readRest();
+  bool restIsWholeCopy() { return readRest().kind == LoneReading::Kind::kCopy; }
+  // True where the search is over: what is left is a whole copy, or reads
+  // as one part which, refined from the reading's pose and taken by
+  // choose(), leaves the blob explained whole. A part a blob search would
+  // otherwise find screening model after model.
+  bool settleRest();
   // The models of the size of the largest piece the parts taken leave, each
   // turned about its middle; where nothing is taken then, the two models
   // nearest the size of each other piece, and of each piece the largest
@@ -150,9 +162,15 @@ class BlobSearch {
 
   const Region& region_;
   size_t index_;
-  const WholeCopyTest* whole_copy_ = nullptr;
-  // The parts taken when restIsWholeCopy was last asked, and its answer.
-  std::optional<std::pair<std::vector<size_t>, bool>> copy_tested_;
+  const LoneRegionTest* read_rest_ = nullptr;
+  // The parts taken when readRest was last asked, its reading, and the
+  // centroid of the piece it read.
+  struct RestRead {
+    std::vector<size_t> taken;
+    LoneReading reading;
+    cv::Point2d centre;
+  };
+  std::optional<RestRead> rest_read_;
   std::vector<const PartModel*> fitting_;
   double tolerance_ = 0;     // the largest edge tolerance of the fitting models
   double conformity_ = 1e9;  // their smallest conformity

@@ -532,8 +532,8 @@ int FaintPart::countIn(const cv::Mat& drawn, cv::Rect box) const {
 
 BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
                        const std::vector<const PartModel*>& models, const EdgeDistance* built_edges,
-                       const WholeCopyTest* whole_copy)
-    : region_(regions[index]), index_(index), whole_copy_(whole_copy) {
+                       const LoneRegionTest* read_rest)
+    : region_(regions[index]), index_(index), read_rest_(read_rest) {
   // Nothing to place parts on in a patch of the surface's light.
   if (!outlineSteps(region_,
                     region_.touches_border ? kMinBorderSteppedShare : kMinOutlineSteppedShare)) {
@@ -947,8 +947,9 @@ void BlobSearch::fullSearch(std::vector<std::pair<double, size_t>> order) {
         if (!changed_) continue;
         choose();
         if (explainsWhole()) return;
-        // Beside a whole untaught copy of a type, nothing more to look for.
-        if (restIsWholeCopy()) return;
+        // Beside a whole untaught copy of a type, nothing more to look for;
+        // where the rest is one part, it is taken from there.
+        if (settleRest()) return;
       }
     }
     if (taken_.size() <= found_before || refinements_ >= budget_) return;
@@ -1294,17 +1295,17 @@ constexpr double kWholeRestShare = 0.95;
 constexpr double kWholeOutlineShare = 0.97;
 constexpr double kOnBlobOutlinePx = 2.5;
 
-bool BlobSearch::restIsWholeCopy() {
-  if (!whole_copy_ || taken_.empty() || region_.touches_border) return false;
-  // Asked again with the same parts taken, the answer is the same.
-  if (copy_tested_ && copy_tested_->first == taken_) return copy_tested_->second;
-  copy_tested_.emplace(taken_, false);
+LoneReading BlobSearch::readRest() {
+  if (!read_rest_ || taken_.empty() || region_.touches_border) return {};
+  // Asked again with the same parts taken, the reading is the same.
+  if (rest_read_ && rest_read_->taken == taken_) return rest_read_->reading;
+  rest_read_ = RestRead{taken_, {}, {}};
   // Read over the box of what is left, with room for the opening (the
   // same there as over the blob's box): where a part lies over another,
   // that is a part's box, not the blob's.
   const cv::Mat unexplained_box = unexplained();
   const cv::Rect held = cv::boundingRect(unexplained_box);
-  if (held.empty()) return false;
+  if (held.empty()) return {};
   const int margin = kSeamPx + 1;
   const cv::Rect box = (held + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin)) &
                        cv::Rect({0, 0}, unexplained_box.size());
@@ -1314,7 +1315,7 @@ bool BlobSearch::restIsWholeCopy() {
   // is an object of its own only where its outline is the blob's.
   cv::Mat rest;
   cv::morphologyEx(left, rest, cv::MORPH_OPEN, seam_);
-  if (outlineShareOn(rest, origin, *edges_, kOnBlobOutlinePx) < kWholeOutlineShare) return false;
+  if (outlineShareOn(rest, origin, *edges_, kOnBlobOutlinePx) < kWholeOutlineShare) return {};
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
   cv::findContours(rest, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE, origin);
@@ -1328,7 +1329,7 @@ bool BlobSearch::restIsWholeCopy() {
       largest = i;
     }
   }
-  if (largest < 0) return false;
+  if (largest < 0) return {};
   // The piece, its holes cleared, over its own box (as a region's coverage).
   Region piece;
   piece.outer = contours[static_cast<size_t>(largest)];
@@ -1347,7 +1348,7 @@ bool BlobSearch::restIsWholeCopy() {
   }
   cv::bitwise_and(own, rest(piece.bbox - origin), own);
   const int pixels = cv::countNonZero(own);
-  if (pixels <= 0 || pixels < kWholeRestShare * cv::countNonZero(rest)) return false;
+  if (pixels <= 0 || pixels < kWholeRestShare * cv::countNonZero(rest)) return {};
   piece.area = pixels;
   piece.moments = cv::moments(own, true);
   piece.centroid = cv::Point2d(piece.bbox.x + piece.moments.m10 / piece.moments.m00,
@@ -1355,8 +1356,23 @@ bool BlobSearch::restIsWholeCopy() {
   own.convertTo(piece.coverage, CV_32F, 1.0 / 255);
   piece.coverage_origin = piece.bbox.tl();
   piece.image_size = region_.image_size;
-  copy_tested_->second = (*whole_copy_)(piece);
-  return copy_tested_->second;
+  rest_read_->reading = (*read_rest_)(piece);
+  rest_read_->centre = piece.centroid;
+  return rest_read_->reading;
+}
+
+bool BlobSearch::settleRest() {
+  const LoneReading rest = readRest();
+  if (rest.kind == LoneReading::Kind::kCopy) return true;
+  if (rest.kind != LoneReading::Kind::kPart) return false;
+  // Only a model the blob search may place (one that fits in the blob).
+  if (std::find(fitting_.begin(), fitting_.end(), rest.model) == fitting_.end()) return false;
+  Candidate at_rest;
+  at_rest.model = rest.model;
+  at_rest.pose = {rest_read_->centre, rest.angle_deg, false};
+  refine({at_rest});
+  if (changed_) choose();
+  return explainsWhole();
 }
 
 std::vector<Match> BlobSearch::run() {
@@ -1381,8 +1397,9 @@ std::vector<Match> BlobSearch::run() {
   }
   choose();
   // A part found beside one whole untaught copy of a type (its mirror
-  // image, a larger copy): nothing else to look for.
-  if (!explainsWhole() && restIsWholeCopy()) return matches();
+  // image, a larger copy): nothing else to look for. Beside one whole part
+  // the quick search missed, that part is placed from its reading.
+  if (!explainsWhole() && settleRest()) return matches();
   if (!explainsWhole()) fullSearch(std::move(order));
   if (changed_) choose();
   // A part the anchors did not lead to: under a front light at 30 grey
@@ -1397,7 +1414,7 @@ std::vector<Match> BlobSearch::run() {
   // textured belt and on wood: touching 154, 155, 157 before, 158, 160, 160
   // with it; overlapping 154, 152, 155 before, 160, 158, 159 with it (157,
   // 155, 156 searched at the middle alone); nothing falsely reported.
-  if (!explainsWhole() && refinements_ < budget_ && !restIsWholeCopy()) {
+  if (!explainsWhole() && refinements_ < budget_ && !settleRest()) {
     searchRestMiddle();
     if (changed_) choose();
   }
@@ -1432,8 +1449,8 @@ std::vector<Match> BlobSearch::matches() const {
 
 std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
                                 const std::vector<const PartModel*>& models,
-                                const EdgeDistance* built_edges, const WholeCopyTest* whole_copy) {
-  touching::BlobSearch search(regions, index, models, built_edges, whole_copy);
+                                const EdgeDistance* built_edges, const LoneRegionTest* read_rest) {
+  touching::BlobSearch search(regions, index, models, built_edges, read_rest);
   return search.run();
 }
 

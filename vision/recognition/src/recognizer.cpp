@@ -137,31 +137,51 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
   // of a type that is no part (its mirror image, a larger copy) holds no
   // part, and is not searched. Every model of a recognize() shares its
   // hole setting, which the piece is read with as the regions were.
-  const WholeCopyTest whole_copy = [&](const Region& piece) {
-    return isWholeCopy(piece, models, max_tolerance);
+  const LoneRegionTest read_rest = [&](const Region& piece) {
+    return readLoneRegion(piece, models, max_tolerance);
   };
-  return locateInBlob(regions, i, models, cache.builtEdges(), &whole_copy);
+  return locateInBlob(regions, i, models, cache.builtEdges(), &read_rest);
 }
 }  // namespace
 
 bool isWholeCopy(const Region& region, const std::vector<const PartModel*>& models,
                  double max_edge_tolerance) {
-  if (models.empty()) return false;
+  return readLoneRegion(region, models, max_edge_tolerance).kind == LoneReading::Kind::kCopy;
+}
+
+LoneReading readLoneRegion(const Region& region, const std::vector<const PartModel*>& models,
+                           double max_edge_tolerance) {
+  LoneReading reading;
+  if (models.empty()) return reading;
   const Region held = withHolesAtLeast(region, models.front()->min_hole_area);
   RegionCache cache(held, max_edge_tolerance);
+  Verdict best;
   bool copy = false;
+  bool smaller = false;
   for (const PartModel* model : models) {
     const Verdict v = judgeRegion(cache, *model, true);
-    if (v.test == RegionTest::kPasses) return false;
+    if (v.test == RegionTest::kPasses) {
+      if (reading.model == nullptr || ranksAbove(v, best)) {
+        reading.model = model;
+        reading.angle_deg = v.angle_deg;
+        best = v;
+      }
+      continue;
+    }
     // Smaller than the part, a rest may be that part less what its
     // neighbours' drawn outlines took off it (a part 90 px long between
     // two others read at 0.93 of its model's scale, the bound 0.95): then
     // it is no copy, even where a smaller type of the same shape (a washer
     // of the next size down) finds it a larger copy of its own.
-    if (v.test == RegionTest::kScale && v.measured < v.low) return false;
+    smaller = smaller || (v.test == RegionTest::kScale && v.measured < v.low);
     copy = copy || v.test == RegionTest::kScale || v.test == RegionTest::kMirror;
   }
-  return copy;
+  if (reading.model != nullptr) {
+    reading.kind = LoneReading::Kind::kPart;
+  } else if (copy && !smaller) {
+    reading.kind = LoneReading::Kind::kCopy;
+  }
+  return reading;
 }
 
 std::vector<Match> recognize(const std::vector<Region>& regions,

@@ -91,16 +91,25 @@ void measureEdgeOffsets(std::vector<BoundaryLoop>& loops, const Region& region, 
 // `models`, past the region's box by more), which the search then reads
 // instead of building its own: the same distances as far as anything here
 // reads them.
-// `whole_copy`, when given: whether a region is one whole copy of a taught
-// type that no model takes for a part (its mirror image, or a larger copy;
-// see isWholeCopy), as the region tests judge a lone region. What the parts
-// found leave of the blob, when it is one piece that this says is such a
-// copy, is not searched further: no part lies there (it is the blob's
-// untaught object, touching the parts found).
-using WholeCopyTest = std::function<bool(const Region&)>;
+// `read_rest`, when given: what a region is, read as the region tests read
+// a lone region (see readLoneRegion). What the parts found leave of the
+// blob, when it is one piece that this reads as one whole copy of a taught
+// type that no model takes for a part (its mirror image, or a larger copy),
+// is not searched further: no part lies there (it is the blob's untaught
+// object, touching the parts found). Where it reads as one part, that part
+// is placed from the reading's pose before any search.
+struct LoneReading {
+  enum class Kind { kNeither, kPart, kCopy };
+  Kind kind = Kind::kNeither;
+  // kPart: the model that passes it (the first in rank among those that
+  // do) and its turn there, about the region's centroid (unrefined).
+  const PartModel* model = nullptr;
+  double angle_deg = 0;
+};
+using LoneRegionTest = std::function<LoneReading(const Region&)>;
 std::vector<Match> locateInBlob(const std::vector<Region>& regions, size_t index,
                                 const std::vector<const PartModel*>& models,
                                 const EdgeDistance* edges = nullptr,
-                                const WholeCopyTest* whole_copy = nullptr);
+                                const LoneRegionTest* read_rest = nullptr);
 
 }  // namespace picksight::vision

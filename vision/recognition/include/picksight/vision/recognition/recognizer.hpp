@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "picksight/vision/blob_search/touching_parts.hpp"
 #include "picksight/vision/models/match.hpp"
 #include "picksight/vision/models/part_model.hpp"
 #include "picksight/vision/segmentation/regions.hpp"
@@ -36,6 +37,12 @@ std::vector<Match> recognize(const std::vector<Region>& regions,
 // may be that part less what the parts beside it took off.
 bool isWholeCopy(const Region& region, const std::vector<const PartModel*>& models,
                  double max_edge_tolerance);
+
+// A region read as recognize() reads a lone region: one part where some
+// model passes it (the best by ranksAbove, with its turn), else one whole
+// copy where isWholeCopy says so, else neither.
+LoneReading readLoneRegion(const Region& region, const std::vector<const PartModel*>& models,
+                           double max_edge_tolerance);
 
 // recognize() with each model judging holes with its own minimum hole area
 // (the one it was trained with; byMinHoleArea): one recognize() per setting
