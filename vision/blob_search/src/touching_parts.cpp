@@ -11,7 +11,6 @@
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -24,6 +23,7 @@
 
 #include "blob_search.hpp"
 #include "picksight/common/angles.hpp"
+#include "picksight/vision/segmentation/row_runs.hpp"
 #include "touching_parts_internal.hpp"
 
 namespace picksight::vision {
@@ -1254,28 +1254,13 @@ double outlineShareOn(const cv::Mat& mask, cv::Point origin, const EdgeDistance&
   const EdgeDistance::Within within = edges.withinOf(reach);
   int all = 0;
   int on = 0;
-  const auto read = [&](int x, int y) {
+  forEachSetPixel(outline, [&](int x, int y) {
     ++all;
     on += edges.isWithin({static_cast<double>(origin.x + x), static_cast<double>(origin.y + y)},
                          within)
               ? 1
               : 0;
-  };
-  for (int y = 0; y < outline.rows; ++y) {
-    const uint8_t* row = outline.ptr<uint8_t>(y);
-    int x = 0;
-#if CV_SIMD128
-    for (; x + 16 <= outline.cols; x += 16) {
-      if (!cv::v_check_any(cv::v_load(row + x) != cv::v_setzero_u8())) continue;
-      for (int i = x; i < x + 16; ++i) {
-        if (row[i] != 0) read(i, y);
-      }
-    }
-#endif
-    for (; x < outline.cols; ++x) {
-      if (row[x] != 0) read(x, y);
-    }
-  }
+  });
   return all > 0 ? static_cast<double>(on) / all : 0.0;
 }
 }  // namespace

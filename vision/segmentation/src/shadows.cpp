@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fill_contour.hpp"
+#include "picksight/vision/segmentation/row_runs.hpp"
 
 namespace picksight::vision {
 namespace {
@@ -662,26 +663,9 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
   cv::Mat level = cv::Mat::zeros(height, width, CV_32F);
   const size_t row_floats = weight.step1();
   // The ring's pixels, in rows as cv::findNonZero lists them (the sums
-  // below are then added in the same order), sixteen pixels a test where
-  // the ring is not: a ring a pixel or two wide leaves most of the box
-  // empty, and findNonZero (a count, then a test a pixel) took a sixth of
-  // this function.
+  // below are then added in the same order).
   std::vector<cv::Point> ring_pixels;
-  for (int y = 0; y < ring.rows; ++y) {
-    const uint8_t* row = ring.ptr<uint8_t>(y);
-    int x = 0;
-#if CV_SIMD128
-    for (; x + 16 <= ring.cols; x += 16) {
-      if (!cv::v_check_any(cv::v_load(row + x) != cv::v_setzero_u8())) continue;
-      for (int i = x; i < x + 16; ++i) {
-        if (row[i] != 0) ring_pixels.emplace_back(i, y);
-      }
-    }
-#endif
-    for (; x < ring.cols; ++x) {
-      if (row[x] != 0) ring_pixels.emplace_back(x, y);
-    }
-  }
+  forEachSetPixel(ring, [&](int x, int y) { ring_pixels.emplace_back(x, y); });
   for (const cv::Point& p : ring_pixels) {
     const int x = p.x;
     const int y = p.y;
