@@ -189,23 +189,31 @@ TEST_CASE("Triggers are answered at once while other clients snap and read a slo
   std::atomic<int> slow_reads{0};
   std::atomic<int> snaps{0};
   std::atomic<int> failures{0};
+  // What the failed calls answered, for the report.
+  std::mutex failed_mutex;
+  std::vector<std::string> failed;
+  const auto fail = [&](const std::string& what, const picksight::Error& error) {
+    ++failures;
+    std::lock_guard<std::mutex> lock(failed_mutex);
+    failed.push_back(what + ": " + error.message);
+  };
   std::thread reader([&] {
     picksight::transport::ControlClient client(context, server.controlEndpoint(), kTimeout);
     while (!done) {
-      if (client.call(getFeature("slow", "SlowRead"))) {
+      if (const auto reply = client.call(getFeature("slow", "SlowRead"))) {
         ++slow_reads;
       } else {
-        ++failures;
+        fail("read", reply.error());
       }
     }
   });
   std::thread snapper([&] {
     picksight::transport::ControlClient client(context, server.controlEndpoint(), kTimeout);
     while (!done) {
-      if (client.call(snap("cam"))) {
+      if (const auto reply = client.call(snap("cam"))) {
         ++snaps;
       } else {
-        ++failures;
+        fail("snap", reply.error());
       }
     }
   });
@@ -233,6 +241,7 @@ TEST_CASE("Triggers are answered at once while other clients snap and read a slo
 
   CHECK(slow_reads >= 2);
   CHECK(snaps >= 2);
+  for (const auto& f : failed) UNSCOPED_INFO(f);
   CHECK(failures == 0);
   REQUIRE_FALSE(round_trips_ms.empty());
   const double worst = *std::max_element(round_trips_ms.begin(), round_trips_ms.end());
