@@ -135,8 +135,9 @@ std::vector<Match> recognizeRegion(const std::vector<Region>& regions, size_t i,
   // No model explains the blob whole: parts that touch, or none. What the
   // parts found leave is judged as a lone region would be: one whole copy
   // of a type that is no part (its mirror image, a larger copy) holds no
-  // part, and is not searched. Every model of a recognize() shares its
-  // hole setting, which the piece is read with as the regions were.
+  // part, and is not searched; one part of a model is placed from the
+  // reading's pose. Every model of a recognize() shares its hole setting,
+  // which the piece is read with as the regions were.
   const LoneRegionTest read_rest = [&](const Region& piece) {
     return readLoneRegion(piece, models, max_tolerance);
   };
