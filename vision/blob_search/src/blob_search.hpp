@@ -113,9 +113,10 @@ class BlobSearch {
   // neither. Neither without the test, with no part taken, for a blob the
   // frame cuts, and where the rest's outline is not the blob's
   // (kWholeOutlineShare: a part the parts taken lie over). Asked again with
-  // the same parts taken, the same reading; kPart's pose is about
-  // `rest_centre`.
+  // the same parts taken, the same reading (kPart's turn is about the
+  // piece's centroid, kept with it).
   LoneReading readRest();
+  // Whether readRest() reads a whole copy.
   bool restIsWholeCopy() { return readRest().kind == LoneReading::Kind::kCopy; }
   // True where the search is over: what is left is a whole copy, or reads
   // as one part which, refined from the reading's pose and taken by
