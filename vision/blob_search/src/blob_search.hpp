@@ -116,8 +116,6 @@ class BlobSearch {
   // the same parts taken, the same reading (kPart's turn is about the
   // piece's centroid, kept with it).
   LoneReading readRest();
-  // Whether readRest() reads a whole copy.
-  bool restIsWholeCopy() { return readRest().kind == LoneReading::Kind::kCopy; }
   // True where the search is over: what is left is a whole copy, or reads
   // as one part which, refined from the reading's pose and taken by
   // choose(), leaves the blob explained whole. A part a blob search would
