@@ -106,7 +106,43 @@ struct Row {
   std::vector<double> binarize_ms;
   std::vector<double> regions_ms;
   std::vector<double> uncut_ms;  // the region pass without cutting shadows
+  // --teachings: each teaching's position RMS, in order.
+  std::vector<double> pos_by_teaching;
 };
+
+double positionRms(const Row& r) { return r.found ? std::sqrt(r.pos2 / r.found) : 0.0; }
+
+// Adds `more` (the same row under another teaching) to `into`. Each
+// teaching's types keep their own offsets (`types` apart in on_part):
+// the scatter is about each model's own mean error, and another teaching
+// is another model.
+void addTeaching(const Row& more, size_t types, size_t teaching, Row* into) {
+  into->learn_ok += more.learn_ok;
+  into->learn_at_ok += more.learn_at_ok;
+  into->untaught += more.untaught;
+  into->views_refused += more.views_refused;
+  if (into->first_refusal.empty()) into->first_refusal = more.first_refusal;
+  into->truths += more.truths;
+  into->found += more.found;
+  into->reported += more.reported;
+  into->correct += more.correct;
+  into->mirror += more.mirror;
+  into->size += more.size;
+  into->other += more.other;
+  into->nothing += more.nothing;
+  into->pos2 += more.pos2;
+  for (const auto& [type, sum] : more.on_part) into->on_part[teaching * types + type] = sum;
+  into->ang2 += more.ang2;
+  into->angles += more.angles;
+  for (auto [to, from] :
+       {std::pair{&into->locate_ms, &more.locate_ms}, std::pair{&into->plain_ms, &more.plain_ms},
+        std::pair{&into->binarize_ms, &more.binarize_ms},
+        std::pair{&into->regions_ms, &more.regions_ms},
+        std::pair{&into->uncut_ms, &more.uncut_ms}}) {
+    to->insert(to->end(), from->begin(), from->end());
+  }
+  into->pos_by_teaching.push_back(positionRms(more));
+}
 
 // The frame a camera delivers: lossless, or through JPEG.
 cv::Mat delivered(const cv::Mat& image, int jpeg_quality) {
@@ -239,6 +275,7 @@ int main(int argc, char** argv) {
   int window = 0;
   bool teach_on_plain = false;
   int teach_views = 1;
+  int teachings = 1;
   double blur_sigma = ps::SilhouetteSceneOptions{}.blur_sigma;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> conditions = {"clean",        "textured", "shadow", "glossy",
@@ -288,6 +325,12 @@ int main(int argc, char** argv) {
                "teach each type on a plain surface, evenly lit (a sheet of card under the cell), "
                "the part's and the surface's levels and colours kept; the scenes keep the "
                "condition's light");
+  app.add_option("--teachings", teachings,
+                 "teach the cell this many times over, each type laid again for each teaching "
+                 "(another spot, another stretch of the surface, another draw of the noise), and "
+                 "run every scene with each teaching's models: one teach image's texture and noise "
+                 "move every part of its type alike, and one teaching shows one draw of that")
+      ->check(CLI::Range(1, 20));
   app.add_option("--teach-views", teach_views,
                  "teach each type from this many images of it (LEARN, then LEARNVIEW on the part "
                  "lying elsewhere, turned), each under the teach light")
@@ -329,218 +372,234 @@ int main(int argc, char** argv) {
     if (look.part_level > look.background_level) {
       options.binarize.polarity = pv::Polarity::kLightOnDark;
     }
-    // Teach every type as a user would: LEARN on an image of the part alone
-    // under the same light (or, --teach-on-plain, on a plain surface); when
-    // LEARN refuses, LEARN ... AT a box around it.
-    auto models = std::make_shared<pst::ModelList>();
-    std::vector<int> type_of_model;
-    std::vector<bool> chiral(types.size(), true);
-    std::vector<cv::Point2d> reference(types.size());
-    Row taught;
-    // Where a part lies in its teach frame: anywhere a user might lay it,
-    // its whole outline a margin inside the frame (view 0: LEARN, then
-    // LEARNVIEW's).
-    const auto teachSpot = [&](size_t i, int view) {
-      std::mt19937_64 rng(0x7465616368ULL + 131 * i + static_cast<uint64_t>(view));
-      const double margin = 0.75 * specs[i].size_px + 20;
-      std::uniform_real_distribution<double> x(margin, look.width - 1 - margin);
-      std::uniform_real_distribution<double> y(margin, look.height - 1 - margin);
-      const double at_x = x(rng);
-      return cv::Point2d(at_x, y(rng));
-    };
-    for (size_t i = 0; i < types.size(); ++i) {
-      cv::Point2d drawn;
-      ps::SilhouetteSceneOptions teach_look = look;
-      if (teach_on_plain) {
-        ps::FrontLight plain;
-        plain.colour = look.front.colour;
-        plain.part_bgr = look.front.part_bgr;
-        plain.background_bgr = look.front.background_bgr;
-        teach_look.front = plain;
-      }
-      const cv::Mat image =
-          delivered(ps::renderSilhouetteInFrame(types[i], teach_look, 7 + i, teachSpot(i, 0),
-                                                &drawn, picksight::bench::kTrainAngleDeg),
-                    jpeg_quality);
-      if (!save_frames.empty()) {
-        cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + ".png", image);
-        // What the vision pass takes for parts there, before any model.
-        const auto seen =
-            pc::locateInFrame(frameOf(image), options, std::make_shared<pst::ModelList>(), -1);
-        if (!seen.scene.mask.empty()) {
-          cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + "-mask.png",
-                      seen.scene.mask);
+    std::vector<Row> taught_rows;  // one per arrangement, over every teaching
+    for (int teaching = 0; teaching < teachings; ++teaching) {
+      // Teaching 0 is the benchmark's own; each further one lays every part
+      // down again: its spots, its surface and its noise from other seeds.
+      const uint64_t again = 100003ULL * static_cast<uint64_t>(teaching);
+      // Teach every type as a user would: LEARN on an image of the part alone
+      // under the same light (or, --teach-on-plain, on a plain surface); when
+      // LEARN refuses, LEARN ... AT a box around it.
+      auto models = std::make_shared<pst::ModelList>();
+      std::vector<int> type_of_model;
+      std::vector<bool> chiral(types.size(), true);
+      std::vector<cv::Point2d> reference(types.size());
+      Row taught;
+      // Where a part lies in its teach frame: anywhere a user might lay it,
+      // its whole outline a margin inside the frame (view 0: LEARN, then
+      // LEARNVIEW's).
+      const auto teachSpot = [&](size_t i, int view) {
+        std::mt19937_64 rng(0x7465616368ULL + 131 * i + static_cast<uint64_t>(view) + again);
+        const double margin = 0.75 * specs[i].size_px + 20;
+        std::uniform_real_distribution<double> x(margin, look.width - 1 - margin);
+        std::uniform_real_distribution<double> y(margin, look.height - 1 - margin);
+        const double at_x = x(rng);
+        return cv::Point2d(at_x, y(rng));
+      };
+      for (size_t i = 0; i < types.size(); ++i) {
+        cv::Point2d drawn;
+        ps::SilhouetteSceneOptions teach_look = look;
+        if (teach_on_plain) {
+          ps::FrontLight plain;
+          plain.colour = look.front.colour;
+          plain.part_bgr = look.front.part_bgr;
+          plain.background_bgr = look.front.background_bgr;
+          teach_look.front = plain;
         }
-      }
-      const picksight::Frame frame = frameOf(image);
-      const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
-      auto learned =
-          pc::learnInImage(grey, frame.mapping, options, models,
-                           static_cast<int>(models->size()) + 1, specs[i].name, std::nullopt);
-      if (learned) {
-        taught.learn_ok += 1;
-      } else {
-        if (taught.first_refusal.empty()) {
-          taught.first_refusal = specs[i].name + ": " + learned.error().message;
-        }
-        // The box a user drags: the part with a margin of a tenth of its size.
-        const double half = 0.6 * specs[i].size_px;
-        const cv::Rect at(static_cast<int>(drawn.x - half), static_cast<int>(drawn.y - half),
-                          static_cast<int>(2 * half), static_cast<int>(2 * half));
-        learned = pc::learnInImage(grey, frame.mapping, options, models,
-                                   static_cast<int>(models->size()) + 1, specs[i].name, at);
-        if (learned) taught.learn_at_ok += 1;
-      }
-      if (!learned) {
-        taught.untaught += 1;
-        if (list_errors) {
-          std::printf("  %s %s: not taught: %s\n", condition.c_str(), specs[i].name.c_str(),
-                      learned.error().message.c_str());
-        }
-        continue;
-      }
-      // Where the model's reference point lies on the drawn part: measured on
-      // a sharp, evenly back-lit image of it, so that the light of the
-      // condition counts in the error, not in the truth.
-      ps::SilhouetteSceneOptions sharp_look;
-      sharp_look.noise_sigma = 0;
-      sharp_look.uneven_light = false;
-      cv::Point2d sharp_drawn;
-      sharp_look.width = look.width;
-      sharp_look.height = look.height;
-      const cv::Mat sharp =
-          ps::renderSilhouetteInFrame(types[i], sharp_look, 7 + i, teachSpot(i, 0), &sharp_drawn,
-                                      picksight::bench::kTrainAngleDeg);
-      pv::BinarizeOptions b;
-      b.adaptive_window = kTruthWindow;
-      const auto seen = pv::findRegions(pv::binarize(sharp, b), {}, sharp);
-      size_t largest = 0;
-      for (size_t k = 1; k < seen.size(); ++k) {
-        if (seen[k].area > seen[largest].area) largest = k;
-      }
-      const cv::Point2d offset =
-          seen.empty() ? cv::Point2d() : seen[largest].centroid - sharp_drawn;
-      const double back = -picksight::bench::kTrainAngleDeg * M_PI / 180.0;
-      reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
-                      offset.x * std::sin(back) + offset.y * std::cos(back)};
-      chiral[i] = !learned->model.body.mirror_symmetric;
-      if (list_errors) {
-        // The teach image's reading of the reference point, on the part.
-        const cv::Point2d d = learned->model.trained_centroid - drawn;
-        const cv::Point2d on(d.x * std::cos(back) - d.y * std::sin(back),
-                             d.x * std::sin(back) + d.y * std::cos(back));
-        std::printf("  %s %s: taught %+.3f %+.3f px off on the part\n", condition.c_str(),
-                    specs[i].name.c_str(), on.x - reference[i].x, on.y - reference[i].y);
-      }
-      // More views (LEARNVIEW): the part alone again, turned and lying on
-      // another stretch of the surface, each read with the model so far.
-      for (int v = 1; v < teach_views; ++v) {
-        auto trial = std::make_shared<pst::ModelList>(*models);
-        trial->push_back(learned->model);
-        cv::Point2d unused;
-        const cv::Mat view = delivered(
-            ps::renderSilhouetteInFrame(types[i], teach_look, 1000 * v + 7 + i, teachSpot(i, v),
-                                        &unused, picksight::bench::kTrainAngleDeg + 47.0 * v),
+        const cv::Mat image = delivered(
+            ps::renderSilhouetteInFrame(types[i], teach_look, 7 + i + again, teachSpot(i, 0),
+                                        &drawn, picksight::bench::kTrainAngleDeg),
             jpeg_quality);
-        auto seen =
-            pc::viewInFrame(frameOf(view), options, trial, learned->model.type, std::nullopt);
-        if (!seen) {
-          taught.views_refused += 1;
+        if (!save_frames.empty()) {
+          cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + ".png", image);
+          // What the vision pass takes for parts there, before any model.
+          const auto seen =
+              pc::locateInFrame(frameOf(image), options, std::make_shared<pst::ModelList>(), -1);
+          if (!seen.scene.mask.empty()) {
+            cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + "-mask.png",
+                        seen.scene.mask);
+          }
+        }
+        const picksight::Frame frame = frameOf(image);
+        const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
+        auto learned =
+            pc::learnInImage(grey, frame.mapping, options, models,
+                             static_cast<int>(models->size()) + 1, specs[i].name, std::nullopt);
+        if (learned) {
+          taught.learn_ok += 1;
+        } else {
+          if (taught.first_refusal.empty()) {
+            taught.first_refusal = specs[i].name + ": " + learned.error().message;
+          }
+          // The box a user drags: the part with a margin of a tenth of its size.
+          const double half = 0.6 * specs[i].size_px;
+          const cv::Rect at(static_cast<int>(drawn.x - half), static_cast<int>(drawn.y - half),
+                            static_cast<int>(2 * half), static_cast<int>(2 * half));
+          learned = pc::learnInImage(grey, frame.mapping, options, models,
+                                     static_cast<int>(models->size()) + 1, specs[i].name, at);
+          if (learned) taught.learn_at_ok += 1;
+        }
+        if (!learned) {
+          taught.untaught += 1;
           if (list_errors) {
-            std::printf("  %s %s: view %d refused: %s\n", condition.c_str(), specs[i].name.c_str(),
-                        v, seen.error().message.c_str());
+            std::printf("  %s %s: not taught: %s\n", condition.c_str(), specs[i].name.c_str(),
+                        learned.error().message.c_str());
           }
           continue;
         }
-        learned->model = std::move(seen->model);
-      }
-      if (list_errors && teach_views > 1) {
-        std::printf("  %s %s: %zu views, origin at %+.3f %+.3f\n", condition.c_str(),
-                    specs[i].name.c_str(), learned->model.views.size() + 1,
-                    learned->model.origin_shift.x, learned->model.origin_shift.y);
-      }
-      auto next = std::make_shared<pst::ModelList>(*models);
-      next->push_back(std::move(learned->model));
-      models = next;
-      type_of_model.resize(static_cast<size_t>(models->back().type) + 1, -1);
-      type_of_model[static_cast<size_t>(models->back().type)] = static_cast<int>(i);
-    }
-    for (const auto& name : arrangements) {
-      const ps::Arrangement arrangement = name == "separated"  ? ps::Arrangement::kSeparated
-                                          : name == "touching" ? ps::Arrangement::kTouching
-                                                               : ps::Arrangement::kOverlapping;
-      Row row = taught;
-      row.condition = condition;
-      row.arrangement = name;
-      size_t turn = 0;
-      for (int n = 0; n < scenes; ++n) {
-        ps::SilhouetteSceneOptions o = look;
-        o.arrangement = arrangement;
-        o.seed = 5000 * (static_cast<uint64_t>(arrangement) + 1) + static_cast<uint64_t>(n);
-        const ps::SilhouetteScene scene(types, chiral, o);
-        for (int r = 0; r < rounds; ++r) {
-          const cv::Mat image = delivered(scene.render(static_cast<uint64_t>(r)), jpeg_quality);
-          if (!save_frames.empty() && r == 0) {
-            cv::imwrite(
-                save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) + ".png",
-                image);
-          }
-          const picksight::Frame frame = frameOf(image);
-          pc::LocateOutcome outcome;
-          double sink = 0;
-          picksight::bench::timeInTurn<2>(turn++,
-                                          {[&] {
-                                             if (models->empty()) return;
-                                             outcome =
-                                                 pc::locateInFrame(frame, options, models, -1);
-                                           },
-                                           [&] {
-                                             cv::Mat grey = image;
-                                             if (image.channels() == 3)
-                                               cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-                                             sink += picksight::bench::competentOpenCvPass(grey);
-                                           }},
-                                          {&row.locate_ms, &row.plain_ms});
-          if (!save_frames.empty() && r == 0 && !outcome.scene.mask.empty()) {
-            // What the vision pass took for parts: to look at beside the frame.
-            cv::imwrite(
-                save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) + "-mask.png",
-                outcome.scene.mask);
-          }
-          if (stages && !models->empty()) {
-            // As locateInFrame prepares them: the vision image (a colour
-            // frame projected on the taught colours) and the frame's options.
-            const cv::Mat grey = pc::visionImage(frame, *models);
-            const pc::VisionOptions o =
-                pc::frameOptions(options, frame.mapping, grey.size(), *models);
-            cv::Mat mask;
-            row.binarize_ms.push_back(
-                picksight::bench::elapsedMs([&] { mask = pv::binarize(grey, o.binarize); }));
-            // The regions LOCATE finds: from the speck area up when the
-            // smallest region follows the models.
-            const pv::RegionOptions located = pc::locateRegionOptions(o, *models);
-            std::vector<pv::Region> regions;
-            row.regions_ms.push_back(picksight::bench::elapsedMs(
-                [&] { regions = pv::findRegions(mask, located, grey); }));
-            pv::RegionOptions uncut = located;
-            uncut.cut_shadows = false;
-            row.uncut_ms.push_back(
-                picksight::bench::elapsedMs([&] { regions = pv::findRegions(mask, uncut, grey); }));
-          }
-          if (list_errors)
-            std::printf("  %s %s scene %d round %d:\n", condition.c_str(), name.c_str(), n, r);
-          score(scene.truth(), outcome, type_of_model, reference, list_errors, specs, row);
-          if (sink == 0) std::printf("!");
+        // Where the model's reference point lies on the drawn part: measured on
+        // a sharp, evenly back-lit image of it, so that the light of the
+        // condition counts in the error, not in the truth.
+        ps::SilhouetteSceneOptions sharp_look;
+        sharp_look.noise_sigma = 0;
+        sharp_look.uneven_light = false;
+        cv::Point2d sharp_drawn;
+        sharp_look.width = look.width;
+        sharp_look.height = look.height;
+        const cv::Mat sharp =
+            ps::renderSilhouetteInFrame(types[i], sharp_look, 7 + i + again, teachSpot(i, 0),
+                                        &sharp_drawn, picksight::bench::kTrainAngleDeg);
+        pv::BinarizeOptions b;
+        b.adaptive_window = kTruthWindow;
+        const auto seen = pv::findRegions(pv::binarize(sharp, b), {}, sharp);
+        size_t largest = 0;
+        for (size_t k = 1; k < seen.size(); ++k) {
+          if (seen[k].area > seen[largest].area) largest = k;
         }
+        const cv::Point2d offset =
+            seen.empty() ? cv::Point2d() : seen[largest].centroid - sharp_drawn;
+        const double back = -picksight::bench::kTrainAngleDeg * M_PI / 180.0;
+        reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
+                        offset.x * std::sin(back) + offset.y * std::cos(back)};
+        chiral[i] = !learned->model.body.mirror_symmetric;
+        if (list_errors) {
+          // The teach image's reading of the reference point, on the part.
+          const cv::Point2d d = learned->model.trained_centroid - drawn;
+          const cv::Point2d on(d.x * std::cos(back) - d.y * std::sin(back),
+                               d.x * std::sin(back) + d.y * std::cos(back));
+          std::printf("  %s %s: taught %+.3f %+.3f px off on the part\n", condition.c_str(),
+                      specs[i].name.c_str(), on.x - reference[i].x, on.y - reference[i].y);
+        }
+        // More views (LEARNVIEW): the part alone again, turned and lying on
+        // another stretch of the surface, each read with the model so far.
+        for (int v = 1; v < teach_views; ++v) {
+          auto trial = std::make_shared<pst::ModelList>(*models);
+          trial->push_back(learned->model);
+          cv::Point2d unused;
+          const cv::Mat view =
+              delivered(ps::renderSilhouetteInFrame(types[i], teach_look, 1000 * v + 7 + i + again,
+                                                    teachSpot(i, v), &unused,
+                                                    picksight::bench::kTrainAngleDeg + 47.0 * v),
+                        jpeg_quality);
+          auto seen =
+              pc::viewInFrame(frameOf(view), options, trial, learned->model.type, std::nullopt);
+          if (!seen) {
+            taught.views_refused += 1;
+            if (list_errors) {
+              std::printf("  %s %s: view %d refused: %s\n", condition.c_str(),
+                          specs[i].name.c_str(), v, seen.error().message.c_str());
+            }
+            continue;
+          }
+          learned->model = std::move(seen->model);
+        }
+        if (list_errors && teach_views > 1) {
+          std::printf("  %s %s: %zu views, origin at %+.3f %+.3f\n", condition.c_str(),
+                      specs[i].name.c_str(), learned->model.views.size() + 1,
+                      learned->model.origin_shift.x, learned->model.origin_shift.y);
+        }
+        auto next = std::make_shared<pst::ModelList>(*models);
+        next->push_back(std::move(learned->model));
+        models = next;
+        type_of_model.resize(static_cast<size_t>(models->back().type) + 1, -1);
+        type_of_model[static_cast<size_t>(models->back().type)] = static_cast<int>(i);
       }
-      rows.push_back(row);
-      std::fprintf(stderr, "%s %s done\n", condition.c_str(), name.c_str());
+      for (size_t a = 0; a < arrangements.size(); ++a) {
+        const std::string& name = arrangements[a];
+        const ps::Arrangement arrangement = name == "separated"  ? ps::Arrangement::kSeparated
+                                            : name == "touching" ? ps::Arrangement::kTouching
+                                                                 : ps::Arrangement::kOverlapping;
+        Row row = taught;
+        row.condition = condition;
+        row.arrangement = name;
+        size_t turn = 0;
+        for (int n = 0; n < scenes; ++n) {
+          ps::SilhouetteSceneOptions o = look;
+          o.arrangement = arrangement;
+          o.seed = 5000 * (static_cast<uint64_t>(arrangement) + 1) + static_cast<uint64_t>(n);
+          const ps::SilhouetteScene scene(types, chiral, o);
+          for (int r = 0; r < rounds; ++r) {
+            const cv::Mat image = delivered(scene.render(static_cast<uint64_t>(r)), jpeg_quality);
+            if (!save_frames.empty() && r == 0) {
+              cv::imwrite(
+                  save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) + ".png",
+                  image);
+            }
+            const picksight::Frame frame = frameOf(image);
+            pc::LocateOutcome outcome;
+            double sink = 0;
+            picksight::bench::timeInTurn<2>(turn++,
+                                            {[&] {
+                                               if (models->empty()) return;
+                                               outcome =
+                                                   pc::locateInFrame(frame, options, models, -1);
+                                             },
+                                             [&] {
+                                               cv::Mat grey = image;
+                                               if (image.channels() == 3)
+                                                 cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+                                               sink += picksight::bench::competentOpenCvPass(grey);
+                                             }},
+                                            {&row.locate_ms, &row.plain_ms});
+            if (!save_frames.empty() && r == 0 && !outcome.scene.mask.empty()) {
+              // What the vision pass took for parts: to look at beside the frame.
+              cv::imwrite(save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) +
+                              "-mask.png",
+                          outcome.scene.mask);
+            }
+            if (stages && !models->empty()) {
+              // As locateInFrame prepares them: the vision image (a colour
+              // frame projected on the taught colours) and the frame's options.
+              const cv::Mat grey = pc::visionImage(frame, *models);
+              const pc::VisionOptions o =
+                  pc::frameOptions(options, frame.mapping, grey.size(), *models);
+              cv::Mat mask;
+              row.binarize_ms.push_back(
+                  picksight::bench::elapsedMs([&] { mask = pv::binarize(grey, o.binarize); }));
+              // The regions LOCATE finds: from the speck area up when the
+              // smallest region follows the models.
+              const pv::RegionOptions located = pc::locateRegionOptions(o, *models);
+              std::vector<pv::Region> regions;
+              row.regions_ms.push_back(picksight::bench::elapsedMs(
+                  [&] { regions = pv::findRegions(mask, located, grey); }));
+              pv::RegionOptions uncut = located;
+              uncut.cut_shadows = false;
+              row.uncut_ms.push_back(picksight::bench::elapsedMs(
+                  [&] { regions = pv::findRegions(mask, uncut, grey); }));
+            }
+            if (list_errors)
+              std::printf("  %s %s scene %d round %d:\n", condition.c_str(), name.c_str(), n, r);
+            score(scene.truth(), outcome, type_of_model, reference, list_errors, specs, row);
+            if (sink == 0) std::printf("!");
+          }
+        }
+        if (teaching == 0) {
+          row.pos_by_teaching.push_back(positionRms(row));
+          taught_rows.push_back(row);
+        } else {
+          addTeaching(row, types.size(), static_cast<size_t>(teaching), &taught_rows[a]);
+        }
+        std::fprintf(stderr, "%s %s done (teaching %d)\n", condition.c_str(), name.c_str(),
+                     teaching + 1);
+      }
     }
+    rows.insert(rows.end(), taught_rows.begin(), taught_rows.end());
   }
 
   std::printf(
-      "\n%zu types (%s), %d scenes x %d frames per row, 1920x1080, 20 parts, %s\n", specs.size(),
+      "\n%zu types (%s), %d scenes x %d frames per row%s, 1920x1080, 20 parts, %s\n", specs.size(),
       standard_types ? "the silhouette benchmark's" : "unseen", scenes, rounds,
+      teachings > 1 ? (" x " + std::to_string(teachings) + " teachings").c_str() : "",
       jpeg_quality > 0 ? ("JPEG quality " + std::to_string(jpeg_quality)).c_str() : "lossless");
   std::printf("%-13s %-10s %5s %5s %5s %7s %9s %6s %5s %5s %8s %8s %8s %8s %8s %8s\n", "condition",
               "arrange", "LEARN", "AT", "none", "recall", "precision", "mirror", "size", "other",
@@ -559,8 +618,7 @@ int main(int argc, char** argv) {
         r.condition.c_str(), r.arrangement.c_str(), r.learn_ok, r.learn_at_ok, r.untaught,
         r.truths ? static_cast<double>(r.found) / r.truths : 0.0,
         r.reported ? static_cast<double>(r.correct) / r.reported : 1.0, r.mirror, r.size, r.other,
-        r.found ? std::sqrt(r.pos2 / r.found) : 0.0, scatter,
-        r.angles ? std::sqrt(r.ang2 / r.angles) : 0.0,
+        positionRms(r), scatter, r.angles ? std::sqrt(r.ang2 / r.angles) : 0.0,
         picksight::bench::nearestRank(r.locate_ms, 50),
         picksight::bench::nearestRank(r.locate_ms, 99),
         picksight::bench::nearestRank(r.plain_ms, 50));
@@ -571,6 +629,17 @@ int main(int argc, char** argv) {
       "<= 0.05 deg; LOCATE median <= 10 ms, p99 <= 20 ms (times here: the vision pass in process, "
       "ms, beside the plain OpenCV pass); scatter: the position RMS less each type's own mean "
       "error on the part (the offset a model is taught with; what is left varies part to part)\n");
+  if (teachings > 1) {
+    // What one teaching shows: the position RMS each gave, and their spread.
+    std::printf("\nposition RMS (px) by teaching, each over the row's scenes\n");
+    for (const auto& r : rows) {
+      std::printf("%-13s %-10s", r.condition.c_str(), r.arrangement.c_str());
+      for (const double p : r.pos_by_teaching) std::printf(" %7.4f", p);
+      const auto [low, high] =
+          std::minmax_element(r.pos_by_teaching.begin(), r.pos_by_teaching.end());
+      std::printf("   min %.4f max %.4f\n", *low, *high);
+    }
+  }
   if (stages) {
     std::printf(
         "\nwhere the time goes (medians, ms): binarize, regions (shadows cut), of which "

@@ -581,6 +581,17 @@ constexpr double kMaxSurfaceSteppedShare = 0.5;
 // pixels (a dip of two thirds of the contrast, blurred by 6 px, stepped 0
 // to 22 levels where the part's edge stepped 15 across the same reach).
 constexpr int kMinReads = 8;
+// A piece whose free outline steps too seldom is still the part's own when
+// it lies as deep as the part: its level, against the levels round it within
+// kNearPiecePx (the body's, and the surface's beyond the piece), reaches
+// kMinOwnDepth of the way from the surface to the part. A limb lying over a
+// darker stretch of the surface steps by little along its edge (a dog's
+// tail over a blotch at 30 grey levels of contrast: 18 to 36 % of its free
+// outline stepped, and LEARN cut it off and placed the model's origin 2 px
+// off) but is as dark as the body (depth 0.9 to 1.1); the blotches the
+// rule is for lie a third of the contrast short of the part (0.6 to 0.7).
+constexpr int kNearPiecePx = 10;
+constexpr double kMinOwnDepth = 0.85;
 
 // The pieces of `own` (a region's pixels, CV_8U) beyond its body: what
 // survives an opening by a disc `neck_px` across, its largest piece, and
@@ -651,6 +662,40 @@ double freeSteppedShare(const cv::Mat& piece, const cv::Mat& kept, const cv::Mat
   return read < kMinReads ? -1.0 : static_cast<double>(stepped) / read;
 }
 
+// How deep `piece` lies (see kMinOwnDepth): its median level's share of
+// the way from the surface's level beside it to the body's, both read
+// within kNearPiecePx of it (`own`: the region's pixels, `grey` the same
+// box); 0 where either has too few pixels or they are level.
+double pieceDepth(const cv::Mat& piece, const cv::Mat& own, const cv::Mat& grey) {
+  cv::Mat near;
+  cv::dilate(
+      piece, near,
+      cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * kNearPiecePx + 1, 2 * kNearPiecePx + 1}));
+  const auto median = [&](const cv::Mat& where, double* level) {
+    std::vector<uint8_t> values;
+    for (int y = 0; y < where.rows; ++y) {
+      const uint8_t* w = where.ptr<uint8_t>(y);
+      const uint8_t* g = grey.ptr<uint8_t>(y);
+      for (int x = 0; x < where.cols; ++x) {
+        if (w[x] != 0) values.push_back(g[x]);
+      }
+    }
+    if (values.size() < static_cast<size_t>(kMinReads)) return false;
+    const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), mid, values.end());
+    *level = *mid;
+    return true;
+  };
+  double level = 0;
+  double body = 0;
+  double surface = 0;
+  if (!median(piece, &level) || !median(near & own & ~piece, &body) ||
+      !median(near & ~own, &surface) || body == surface) {
+    return 0;
+  }
+  return (surface - level) / (surface - body);
+}
+
 // What cutAppendages took off (pixels): speckle on a narrow neck, and
 // stretches of the surface without an edge on a wider one.
 struct AppendageCut {
@@ -714,7 +759,10 @@ AppendageCut cutAppendages(const vision::Region& r, cv::Mat& mask, const cv::Mat
       const int area = cv::countNonZero(piece);
       if (area > kMaxAppendageShare * own_area || area < kNeckPx * kNeckPx) continue;
       const double share = freeSteppedShare(piece, wide->kept, surface, min_step);
-      if (share >= 0 && share < kMaxSurfaceSteppedShare) dropped.setTo(255, piece);
+      if (share >= 0 && share < kMaxSurfaceSteppedShare &&
+          pieceDepth(piece, own, surface) < kMinOwnDepth) {
+        dropped.setTo(255, piece);
+      }
     }
   }
   out.surface_px = cv::countNonZero(dropped) - out.speckled_px;
