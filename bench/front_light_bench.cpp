@@ -411,13 +411,16 @@ int main(int argc, char** argv) {
                                         &drawn, picksight::bench::kTrainAngleDeg),
             jpeg_quality);
         if (!save_frames.empty()) {
-          cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + ".png", image);
+          // Each teaching's own teach images (the first's named as without
+          // --teachings).
+          const std::string teach_name = condition + "-teach-" + specs[i].name +
+                                         (teaching > 0 ? "-" + std::to_string(teaching + 1) : "");
+          cv::imwrite(save_frames + "/" + teach_name + ".png", image);
           // What the vision pass takes for parts there, before any model.
           const auto seen =
               pc::locateInFrame(frameOf(image), options, std::make_shared<pst::ModelList>(), -1);
           if (!seen.scene.mask.empty()) {
-            cv::imwrite(save_frames + "/" + condition + "-teach-" + specs[i].name + "-mask.png",
-                        seen.scene.mask);
+            cv::imwrite(save_frames + "/" + teach_name + "-mask.png", seen.scene.mask);
           }
         }
         const picksight::Frame frame = frameOf(image);
