@@ -106,11 +106,13 @@ struct Row {
   std::vector<double> binarize_ms;
   std::vector<double> regions_ms;
   std::vector<double> uncut_ms;  // the region pass without cutting shadows
-  // --teachings: each teaching's position RMS, in order.
+  // --teachings: each teaching's position RMS and recall, in order.
   std::vector<double> pos_by_teaching;
+  std::vector<double> recall_by_teaching;
 };
 
 double positionRms(const Row& r) { return r.found ? std::sqrt(r.pos2 / r.found) : 0.0; }
+double recallOf(const Row& r) { return r.truths ? static_cast<double>(r.found) / r.truths : 0.0; }
 
 // Adds `more` (the same row under another teaching) to `into`. Each
 // teaching's types keep their own offsets (`types` apart in on_part):
@@ -142,6 +144,7 @@ void addTeaching(const Row& more, size_t types, size_t teaching, Row* into) {
     to->insert(to->end(), from->begin(), from->end());
   }
   into->pos_by_teaching.push_back(positionRms(more));
+  into->recall_by_teaching.push_back(recallOf(more));
 }
 
 // The frame a camera delivers: lossless, or through JPEG.
@@ -588,6 +591,7 @@ int main(int argc, char** argv) {
         }
         if (teaching == 0) {
           row.pos_by_teaching.push_back(positionRms(row));
+          row.recall_by_teaching.push_back(recallOf(row));
           taught_rows.push_back(row);
         } else {
           addTeaching(row, types.size(), static_cast<size_t>(teaching), &taught_rows[a]);
@@ -619,9 +623,8 @@ int main(int argc, char** argv) {
     std::printf(
         "%-13s %-10s %5d %5d %5d %7.3f %9.3f %6d %5d %5d %8.4f %8.4f %8.4f %8.2f %8.2f %8.2f\n",
         r.condition.c_str(), r.arrangement.c_str(), r.learn_ok, r.learn_at_ok, r.untaught,
-        r.truths ? static_cast<double>(r.found) / r.truths : 0.0,
-        r.reported ? static_cast<double>(r.correct) / r.reported : 1.0, r.mirror, r.size, r.other,
-        positionRms(r), scatter, r.angles ? std::sqrt(r.ang2 / r.angles) : 0.0,
+        recallOf(r), r.reported ? static_cast<double>(r.correct) / r.reported : 1.0, r.mirror,
+        r.size, r.other, positionRms(r), scatter, r.angles ? std::sqrt(r.ang2 / r.angles) : 0.0,
         picksight::bench::nearestRank(r.locate_ms, 50),
         picksight::bench::nearestRank(r.locate_ms, 99),
         picksight::bench::nearestRank(r.plain_ms, 50));
@@ -633,14 +636,18 @@ int main(int argc, char** argv) {
       "ms, beside the plain OpenCV pass); scatter: the position RMS less each type's own mean "
       "error on the part (the offset a model is taught with; what is left varies part to part)\n");
   if (teachings > 1) {
-    // What one teaching shows: the position RMS each gave, and their spread.
-    std::printf("\nposition RMS (px) by teaching, each over the row's scenes\n");
+    // What one teaching shows: the position RMS and recall each gave, and
+    // their spread.
+    std::printf("\nby teaching, each over the row's scenes: position RMS (px) / recall\n");
     for (const auto& r : rows) {
       std::printf("%-13s %-10s", r.condition.c_str(), r.arrangement.c_str());
-      for (const double p : r.pos_by_teaching) std::printf(" %7.4f", p);
+      for (size_t t = 0; t < r.pos_by_teaching.size(); ++t) {
+        std::printf(" %7.4f/%.3f", r.pos_by_teaching[t], r.recall_by_teaching[t]);
+      }
       const auto [low, high] =
           std::minmax_element(r.pos_by_teaching.begin(), r.pos_by_teaching.end());
-      std::printf("   min %.4f max %.4f\n", *low, *high);
+      std::printf("   position min %.4f max %.4f, recall min %.3f\n", *low, *high,
+                  *std::min_element(r.recall_by_teaching.begin(), r.recall_by_teaching.end()));
     }
   }
   if (stages) {
