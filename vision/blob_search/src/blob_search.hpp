@@ -188,6 +188,9 @@ class BlobSearch {
   // Distance to the blob's outline and large holes (see onOutline): empty
   // when that is every edge (edges_); made when first asked.
   std::optional<EdgeDistance> outline_;
+  // The wide map the searches about a point read (searchAbout): the same
+  // for each of them, made when first asked (a tenth of each search).
+  std::optional<EdgeDistance> about_map_;
   int blob_pixels_ = 0;
   size_t budget_ = 0;  // edge fits the blob may cost
   cv::Mat seam_;       // what erodes a seam away

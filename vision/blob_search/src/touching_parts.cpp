@@ -1121,7 +1121,8 @@ std::optional<DeepestCore> deepestCore(const cv::Mat& piece, const cv::Rect& box
 void BlobSearch::searchAbout(const std::vector<std::pair<const PartModel*, cv::Point2d>>& sized,
                              bool from_core) {
   if (sized.empty()) return;
-  const EdgeDistance wide = edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx);
+  if (!about_map_) about_map_ = edgeMap(kLooseScreenFactor * tolerance_ + kAboutWidePx);
+  const EdgeDistance& wide = *about_map_;
   std::vector<std::vector<Candidate>> each(sized.size());
   forEachModel(sized.size(), [&](size_t k) {
     const PartModel& m = *sized[k].first;
