@@ -1,7 +1,8 @@
 // Rejections and the WHY line of a LOCATE: every region no offered part
 // came from, explained against the asked type's models (or as a part of
 // another type, or one with no free grasp), with the tolerance change that
-// would accept it where one test alone refuses it.
+// would accept it where one test alone refuses it, and whether it is
+// plainly unlike any part (which WHY counts rather than explains).
 #include "picksight/results/request_record.hpp"
 
 #include <algorithm>
@@ -70,7 +71,18 @@ std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type
   return list;
 }
 
+// WHY's clause for the regions unlike any part, after the near misses.
+std::string unlikeSummary(size_t count) {
+  return std::to_string(count) + (count == 1 ? " region" : " regions") + " unlike any part";
+}
+
 }  // namespace
+
+bool unlikeAnyPart(const RegionRejection& r, const vision::Region& region,
+                   const ModelList& models) {
+  if (r.test != "holes" && r.test != "area" && r.test != "hu" && r.test != "edge") return false;
+  return r.remedy_key.empty() && vision::unlikeEveryModel(region, modelsOf(models, -1));
+}
 
 namespace {
 const char* replyFrameName(store::CoordinateFrame frame) {
@@ -176,6 +188,7 @@ void RequestRecord::explain() const {
         if (m.type == r.nearest_type) r.nearest_name = m.name;
     }
     r.text = rejectionText(r) + remedyText(r);
+    r.unlike_any_part = unlikeAnyPart(r, scene.regions[i], models);
     rejections_.push_back(std::move(r));
   }
   why_ = "OK " + std::to_string(rejections_.size());
@@ -183,15 +196,28 @@ void RequestRecord::explain() const {
     why_ += scene.regions.empty() ? " no region in the frame" : " every region reported";
     return;
   }
+  // The near misses' sentences, then one clause for the rest: on a
+  // textured belt a sentence per blotch pushed the few regions worth a
+  // look out of the line.
+  const size_t unlike = std::count_if(rejections_.begin(), rejections_.end(),
+                                      [](const RegionRejection& r) { return r.unlike_any_part; });
+  const std::string summary = unlike ? unlikeSummary(unlike) : "";
   const std::string more = "; ...";
-  for (size_t i = 0; i < rejections_.size(); ++i) {
-    const std::string item = (i == 0 ? " " : "; ") + rejections_[i].text;
-    if (why_.size() + item.size() + more.size() > kMaxWhyBytes) {
+  // Room kept for the summary's clause after the "; ...".
+  const size_t tail = more.size() + (unlike ? 2 + summary.size() : 0);
+  bool first = true;
+  for (const auto& r : rejections_) {
+    if (r.unlike_any_part) continue;
+    const std::string item = (first ? " " : "; ") + r.text;
+    if (why_.size() + item.size() + tail > kMaxWhyBytes) {
       why_ += more;
+      first = false;
       break;
     }
     why_ += item;
+    first = false;
   }
+  if (unlike) why_ += (first ? " " : "; ") + summary;
 }
 
 std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
