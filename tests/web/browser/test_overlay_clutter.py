@@ -89,7 +89,13 @@ def test_near_misses_are_labelled_and_the_belt_is_not(cell, browser):
     counted = f"{len(unlike)} regions unlike any part"
     summary = browser.driver.find_element(By.ID, "result-summary").text
     assert counted + " left unlabelled" in summary, summary
-    assert result["why"].endswith("; " + counted), result["why"]
+    # WHY: the near misses first, then the belt's regions while the line
+    # has room, then how many it left unsaid.
+    why = result["why"]
+    said = sum(1 for r in rejections if r.get("unlike_any_part") and r.get("text") in why)
+    assert why.endswith(f"; {len(unlike) - said} more regions unlike any part"), why
+    assert why.index(near[-1]["text"]) < min(why.index(r["text"]) for r in rejections
+                                             if r.get("unlike_any_part") and r.get("text") in why), why
     # The list: the near misses first, then one line for the rest, closed.
     items = browser.js("""
         return Array.from(document.querySelectorAll('#result-rejections > li')).map(li => ({

@@ -71,9 +71,11 @@ std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type
   return list;
 }
 
-// WHY's clause for the regions unlike any part, after the near misses.
-std::string unlikeSummary(size_t count) {
-  return std::to_string(count) + (count == 1 ? " region" : " regions") + " unlike any part";
+// WHY's clause counting the regions unlike any part it left unsaid
+// (`more`: after some that it said).
+std::string unlikeSummary(size_t count, bool more) {
+  return std::to_string(count) + (more ? " more" : "") + (count == 1 ? " region" : " regions") +
+         " unlike any part";
 }
 
 }  // namespace
@@ -196,28 +198,44 @@ void RequestRecord::explain() const {
     why_ += scene.regions.empty() ? " no region in the frame" : " every region reported";
     return;
   }
-  // The near misses' sentences, then one clause for the rest: on a
-  // textured belt a sentence per blotch pushed the few regions worth a
-  // look out of the line.
+  // The near misses' sentences first, then those of the regions unlike any
+  // part, each while the line has room, in region order: on a textured belt
+  // a sentence per blotch pushed the few regions worth a look out of the
+  // line. What did not fit is counted at the end: "; ..." where near misses
+  // were left out, and the regions unlike any part left unsaid.
   const size_t unlike = std::count_if(rejections_.begin(), rejections_.end(),
                                       [](const RegionRejection& r) { return r.unlike_any_part; });
-  const std::string summary = unlike ? unlikeSummary(unlike) : "";
   const std::string more = "; ...";
-  // Room kept for the summary's clause after the "; ...".
-  const size_t tail = more.size() + (unlike ? 2 + summary.size() : 0);
+  // Room kept for the count's clause ("; <k> more regions unlike any part").
+  const size_t tail = unlike ? 2 + unlikeSummary(unlike, true).size() : 0;
   bool first = true;
-  for (const auto& r : rejections_) {
-    if (r.unlike_any_part) continue;
-    const std::string item = (first ? " " : "; ") + r.text;
-    if (why_.size() + item.size() + tail > kMaxWhyBytes) {
-      why_ += more;
+  size_t said_unlike = 0;
+  bool near_cut = false;
+  for (const bool unlike_pass : {false, true}) {
+    for (const auto& r : rejections_) {
+      if (r.unlike_any_part != unlike_pass) continue;
+      const std::string item = (first ? " " : "; ") + r.text;
+      // Room after it for what may follow: "; ..." and the count after a
+      // near miss, the count after a region unlike any part but the last.
+      const size_t keep =
+          !unlike_pass ? more.size() + tail : (said_unlike + 1 == unlike ? 0 : tail);
+      if (why_.size() + item.size() + keep > kMaxWhyBytes) {
+        if (!unlike_pass) {
+          why_ += more;
+          first = false;
+          near_cut = true;
+        }
+        break;
+      }
+      why_ += item;
       first = false;
-      break;
+      if (unlike_pass) ++said_unlike;
     }
-    why_ += item;
-    first = false;
+    if (near_cut) break;
   }
-  if (unlike) why_ += (first ? " " : "; ") + summary;
+  if (said_unlike < unlike) {
+    why_ += (first ? " " : "; ") + unlikeSummary(unlike - said_unlike, said_unlike > 0);
+  }
 }
 
 std::shared_ptr<RequestRecord> locateRecord(Result<CellLocate>&& located, int type,
