@@ -67,6 +67,8 @@ TEST_CASE("REPLAY answers as the LOCATE did with the same models, and as today's
   const std::string missed = cell.ask("LOCATE 1");
   REQUIRE(missed == "OK 0");
   const std::string why = cell.ask("WHY");
+  // The bar, far from the plate taught in area and holes, unlike any part:
+  // the one region, said whole.
   REQUIRE_THAT(why, Catch::StartsWith("OK 1 region 0 "));
   cell.written(3);
   // Newest first; the miss and the WHY kept as failures.

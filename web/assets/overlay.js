@@ -1,9 +1,12 @@
 // The results overlay of the Live view: the latest VisionResult of the
 // selected app drawn over the frame (outlines, labels, pose axes, grasp,
 // fingers, rejected regions with the remedy WHY names), and its summary in
-// the Live panel. Labels are placed so that none covers another, and a
-// label under the mouse is highlighted with its region. Sets
-// picksight.lastOverlay to what it drew, in CSS pixels of the image.
+// the Live panel. Regions unlike any part (belt texture, shadows: the
+// rejection's unlike_any_part) are outlined faintly without a label unless
+// "all reasons" is ticked, so the near misses' labels stand out. Labels are
+// placed so that none covers another, and a label under the mouse is
+// highlighted with its region. Sets picksight.lastOverlay to what it drew,
+// in CSS pixels of the image.
 "use strict";
 
 (function () {
@@ -11,6 +14,16 @@
   const $ = ps.$;
   const num = (v) => Number(v || 0);  // proto JSON omits zeros, and writes 64-bit ints as strings
   const pt = (p) => [num(p && p.x), num(p && p.y)];
+  const unlike = (rej) => !!rej.unlike_any_part;
+
+  // The rejections near misses first, each group in region order (as the
+  // result lists them): their labels take the first spots.
+  function nearMissesFirst(rejections) {
+    return (rejections || []).filter((r) => !unlike(r)).concat((rejections || []).filter(unlike));
+  }
+
+  // "31 regions unlike any part".
+  function unlikeCount(n) { return n + (n === 1 ? " region" : " regions") + " unlike any part"; }
 
   function polygonPath(m, polygons) {
     let d = "";
@@ -72,11 +85,22 @@
     });
   }
 
-  function drawRejection(g, m, result, rej, size, drawn, labels) {
+  function drawRejection(g, m, result, rej, size, drawn, labels, allReasons) {
     const region = (result.regions || []).find((r) => num(r.index) === num(rej.region));
     if (!region) return;
-    const group = ps.svg(g, "g", { class: "rejection", "data-region": num(rej.region) });
+    const cls = unlike(rej) ? "rejection unlike" : "rejection";
+    const group = ps.svg(g, "g", { class: cls, "data-region": num(rej.region) });
     ps.svg(group, "path", { class: "rejected", d: polygonPath(m, [region.outline]) });
+    const c = pt(region.centroid);
+    const seen = { region: num(rej.region), test: rej.test || "", text: rej.text || "",
+                   remedy: rej.remedy_key ? rej.remedy_key + " " + rej.remedy_value : "",
+                   unlike: unlike(rej), labelled: !unlike(rej) || allReasons,
+                   sensor_x: c[0], sensor_y: c[1] };
+    drawn.rejections.push(seen);
+    if (!seen.labelled) {
+      drawn.unlabelled += 1;
+      return;
+    }
     const f = ps.sensorToFrame(m, num(region.box_x) + num(region.box_width), num(region.box_y));
     // The reason on one line; the remedy, when WHY names one, on a second
     // that applies it when clicked.
@@ -90,10 +114,6 @@
       remedy.addEventListener("click", () => applyRemedy(result, rej));
     }
     labels.push({ el: text, x: f[0], y: f[1], gap: size * 0.006 });
-    const c = pt(region.centroid);
-    drawn.rejections.push({ region: num(rej.region), test: rej.test || "", text: rej.text || "",
-                            remedy: rej.remedy_key ? rej.remedy_key + " " + rej.remedy_value : "",
-                            sensor_x: c[0], sensor_y: c[1] });
   }
 
   // The labels placed one after another (parts first, then the reasons),
@@ -142,7 +162,8 @@
     svgRoot.textContent = "";
     ps.sizeLayers();
     const result = ps.app ? ps.latest[ps.app] : null;
-    const drawn = { app: ps.app, request_id: null, parts: [], rejections: [], regions: 0, labels: 0 };
+    const drawn = { app: ps.app, request_id: null, parts: [], rejections: [], regions: 0, labels: 0,
+                    unlabelled: 0 };
     ps.lastOverlay = drawn;
     svgRoot.dataset.parts = "0";
     if (!result || !$("live-overlay").checked) return;
@@ -159,7 +180,10 @@
     }
     const partLabels = [];
     const reasons = [];
-    for (const rej of result.rejections || []) drawRejection(g, m, result, rej, size, drawn, reasons);
+    const allReasons = $("live-all-reasons").checked;
+    for (const rej of nearMissesFirst(result.rejections)) {
+      drawRejection(g, m, result, rej, size, drawn, reasons, allReasons);
+    }
     (result.parts || []).forEach((part, i) => drawPart(g, m, result, part, i, size, drawn, partLabels));
     // Parts' labels first: they are placed nearest their parts.
     placeLabels(partLabels.concat(reasons), m);
@@ -168,6 +192,8 @@
     svgRoot.dataset.requestId = drawn.request_id;
   }
   ps.drawOverlay = draw;
+
+  let unlikeOpen = false;  // the Live list's line of regions unlike any part
 
   function summarize() {
     const result = ps.app ? ps.latest[ps.app] : null;
@@ -183,7 +209,7 @@
       "#" + (result.request_id || 0) + " " + (result.request_line || result.request || "") + " -> " +
       (result.reply || "") + " (" + num(result.elapsed_ms).toFixed(1) + " ms, frame " +
       (result.frame_sequence || 0) + ", " + num(result.regions_total) + " regions)" +
-      (result.why ? "\nwhy: " + result.why : "") +
+      (result.why ? "\nwhy: " + result.why : "") + unlikeNote(result) +
       (result.reply_frame ? "\nreply in " + ps.replyFrame(result.reply_frame).text : "");
     const frame = ps.replyFrame(result.reply_frame);
     $("result-frame").textContent = frame.text;
@@ -210,22 +236,52 @@
       if (!part.offered) row.className = "not-offered";
       if (!modelled) row.classList.add("no-model");
     }
-    for (const rej of result.rejections || []) {
+    // Near misses one a line; the regions unlike any part in one line that
+    // opens to list them.
+    const near = (result.rejections || []).filter((r) => !unlike(r));
+    const rest = (result.rejections || []).filter(unlike);
+    for (const rej of near) $("result-rejections").appendChild(rejectionItem(result, rej));
+    if (rest.length) {
       const li = document.createElement("li");
-      li.textContent = "region " + num(rej.region) + ": " + (rej.text || rej.test);
-      if (rej.remedy_key) {
-        const apply = document.createElement("button");
-        apply.type = "button";
-        apply.className = "remedy";
-        apply.dataset.region = String(num(rej.region));
-        apply.textContent = "apply " + rej.remedy_key + " " + rej.remedy_value;
-        apply.title = "TOLERANCE " + num(rej.nearest_type) + " " + rej.remedy_key + " " + rej.remedy_value +
-                      ", then " + (result.request_line || "LOCATE");
-        apply.addEventListener("click", () => applyRemedy(result, rej));
-        li.append(" ", apply);
-      }
+      li.className = "unlike";
+      const details = document.createElement("details");
+      // Open stays open as results arrive (the list is built anew each time).
+      details.open = unlikeOpen;
+      details.addEventListener("toggle", () => { unlikeOpen = details.open; });
+      const head = document.createElement("summary");
+      head.textContent = unlikeCount(rest.length) + " (far from every part in area or shape)";
+      const list = document.createElement("ul");
+      for (const rej of rest) list.appendChild(rejectionItem(result, rej));
+      details.append(head, list);
+      li.appendChild(details);
       $("result-rejections").appendChild(li);
     }
+  }
+
+  // The summary's line on the regions unlike any part: how many the
+  // overlay leaves unlabelled, or that "all reasons" labels them.
+  function unlikeNote(result) {
+    const n = (result.rejections || []).filter(unlike).length;
+    if (!n) return "";
+    return "\n" + unlikeCount(n) + ($("live-all-reasons").checked
+      ? ", labelled (all reasons)" : " left unlabelled, outlined faintly (all reasons labels them)");
+  }
+
+  function rejectionItem(result, rej) {
+    const li = document.createElement("li");
+    li.textContent = "region " + num(rej.region) + ": " + (rej.text || rej.test);
+    if (rej.remedy_key) {
+      const apply = document.createElement("button");
+      apply.type = "button";
+      apply.className = "remedy";
+      apply.dataset.region = String(num(rej.region));
+      apply.textContent = "apply " + rej.remedy_key + " " + rej.remedy_value;
+      apply.title = "TOLERANCE " + num(rej.nearest_type) + " " + rej.remedy_key + " " + rej.remedy_value +
+                    ", then " + (result.request_line || "LOCATE");
+      apply.addEventListener("click", () => applyRemedy(result, rej));
+      li.append(" ", apply);
+    }
+    return li;
   }
 
   function refresh() { draw(); summarize(); }
@@ -244,6 +300,8 @@
     ps.on("frame", draw);
     $("frame").addEventListener("load", draw);
     for (const id of ["live-overlay", "live-regions"]) $(id).addEventListener("change", draw);
+    // The summary says whether the regions unlike any part are labelled.
+    $("live-all-reasons").addEventListener("change", refresh);
     $("live-binary").addEventListener("change", (e) => { ps.binaryWanted = e.target.checked; ps.showFrame(); });
     $("live-locate").addEventListener("click", () => say("LOCATE " + ($("live-type").value.trim() || "ALL")));
     // WHY answers about the last LOCATE on the same connection: a LOCATE

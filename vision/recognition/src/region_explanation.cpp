@@ -63,6 +63,27 @@ RegionExplanation explainRegionAsAsked(const Region& region,
   return explainRegion(region, asked);
 }
 
+bool unlikeEveryModel(const Region& region, const std::vector<const PartModel*>& models) {
+  if (models.empty()) return false;
+  RegionCache cache(region, 0);
+  for (const PartModel* m : models) {
+    const BodyModel& body = m->body;
+    const double gap = region.area - body.area;
+    const double allowed =
+        kUnlikeTolerances * std::max(body.area_tolerance, kUnlikeMinAreaTolerance) * body.area;
+    if (region.touches_border) {
+      // The frame hides an unknown share of the region: area and holes
+      // beyond it, never more of either than the part has.
+      if (gap <= allowed && holesAtLeast(region, m->min_hole_area) <= body.holes) return false;
+      continue;
+    }
+    const bool far_shape = huDistance(body, cache.logHu()) >
+                           kUnlikeTolerances * std::max(body.hu_tolerance, kUnlikeMinHuTolerance);
+    if (std::abs(gap) <= allowed && !far_shape) return false;
+  }
+  return true;
+}
+
 namespace {
 // A tolerance written with this many decimals: the value TOLERANCE reads
 // back is the one checked here.

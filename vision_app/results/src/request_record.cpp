@@ -1,7 +1,8 @@
 // Rejections and the WHY line of a LOCATE: every region no offered part
 // came from, explained against the asked type's models (or as a part of
 // another type, or one with no free grasp), with the tolerance change that
-// would accept it where one test alone refuses it.
+// would accept it where one test alone refuses it, and whether it is
+// plainly unlike any part (which WHY counts rather than explains).
 #include "picksight/results/request_record.hpp"
 
 #include <algorithm>
@@ -70,7 +71,20 @@ std::vector<const vision::PartModel*> modelsOf(const ModelList& models, int type
   return list;
 }
 
+// WHY's clause counting the regions unlike any part it left unsaid
+// (`more`: after some that it said).
+std::string unlikeSummary(size_t count, bool more) {
+  return std::to_string(count) + (more ? " more" : "") + (count == 1 ? " region" : " regions") +
+         " unlike any part";
+}
+
 }  // namespace
+
+bool unlikeAnyPart(const RegionRejection& r, const vision::Region& region,
+                   const ModelList& models) {
+  if (r.test != "holes" && r.test != "area" && r.test != "hu" && r.test != "edge") return false;
+  return r.remedy_key.empty() && vision::unlikeEveryModel(region, modelsOf(models, -1));
+}
 
 namespace {
 const char* replyFrameName(store::CoordinateFrame frame) {
@@ -176,6 +190,7 @@ void RequestRecord::explain() const {
         if (m.type == r.nearest_type) r.nearest_name = m.name;
     }
     r.text = rejectionText(r) + remedyText(r);
+    r.unlike_any_part = unlikeAnyPart(r, scene.regions[i], models);
     rejections_.push_back(std::move(r));
   }
   why_ = "OK " + std::to_string(rejections_.size());
@@ -183,14 +198,43 @@ void RequestRecord::explain() const {
     why_ += scene.regions.empty() ? " no region in the frame" : " every region reported";
     return;
   }
+  // The near misses' sentences first, then those of the regions unlike any
+  // part, each while the line has room, in region order: on a textured belt
+  // a sentence per blotch pushed the few regions worth a look out of the
+  // line. What did not fit is counted at the end: "; ..." where near misses
+  // were left out, and the regions unlike any part left unsaid.
+  const size_t unlike = std::count_if(rejections_.begin(), rejections_.end(),
+                                      [](const RegionRejection& r) { return r.unlike_any_part; });
   const std::string more = "; ...";
-  for (size_t i = 0; i < rejections_.size(); ++i) {
-    const std::string item = (i == 0 ? " " : "; ") + rejections_[i].text;
-    if (why_.size() + item.size() + more.size() > kMaxWhyBytes) {
-      why_ += more;
-      break;
+  // Room kept for the count's clause ("; <k> more regions unlike any part").
+  const size_t tail = unlike ? 2 + unlikeSummary(unlike, true).size() : 0;
+  bool first = true;
+  size_t said_unlike = 0;
+  bool near_cut = false;
+  for (const bool unlike_pass : {false, true}) {
+    for (const auto& r : rejections_) {
+      if (r.unlike_any_part != unlike_pass) continue;
+      const std::string item = (first ? " " : "; ") + r.text;
+      // Room after it for what may follow: "; ..." and the count after a
+      // near miss, the count after a region unlike any part but the last.
+      const size_t keep =
+          !unlike_pass ? more.size() + tail : (said_unlike + 1 == unlike ? 0 : tail);
+      if (why_.size() + item.size() + keep > kMaxWhyBytes) {
+        if (!unlike_pass) {
+          why_ += more;
+          first = false;
+          near_cut = true;
+        }
+        break;
+      }
+      why_ += item;
+      first = false;
+      if (unlike_pass) ++said_unlike;
     }
-    why_ += item;
+    if (near_cut) break;
+  }
+  if (said_unlike < unlike) {
+    why_ += (first ? " " : "; ") + unlikeSummary(unlike - said_unlike, said_unlike > 0);
   }
 }
 

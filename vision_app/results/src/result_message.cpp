@@ -242,6 +242,7 @@ void buildVisionResult(const RequestRecord& record, const std::string& app, uint
       rejection->set_remedy_key(r.remedy_key);
       rejection->set_remedy_value(r.remedy_value);
       rejection->set_text(r.text);
+      rejection->set_unlike_any_part(r.unlike_any_part);
     }
   } else if (record.frame) {
     const cv::Mat grey = greyImage(*record.frame);

@@ -21,6 +21,7 @@
 #include "picksight/common/frame.hpp"
 #include "picksight/store/cell_calibration.hpp"
 #include "picksight/store/model_library.hpp"
+#include "picksight/vision/segmentation/regions.hpp"
 
 namespace picksight::results {
 
@@ -44,11 +45,23 @@ struct RegionRejection {
   std::string remedy_key;
   std::string remedy_value;  // as written, the text TOLERANCE reads
   std::string text;          // as WHY prints it, the remedy included
+  // Plainly unlike every trained part (unlikeAnyPart): belt texture, a
+  // shadow, dirt. WHY sums these up in one clause and the web HMI draws
+  // them without a label, so the near misses stand out.
+  bool unlike_any_part = false;
 };
+
+// Whether a rejected region is plainly unlike every part of `models`
+// (vision::unlikeEveryModel, frame pixels): it fails a test read before the
+// part's boundary ("holes", "area", "hu", or "edge"; a scaled copy or a
+// mirror image is the part's own shape), and no remedy accepts it.
+bool unlikeAnyPart(const RegionRejection& r, const vision::Region& region,
+                   const store::ModelList& models);
 
 // Regions published (and explained) per request, largest first.
 constexpr size_t kMaxResultRegions = 1024;
-// Longest WHY line: the first rejections that fit, then "; ...".
+// Longest WHY line: the first near misses that fit, then "; ...", then the
+// count of regions unlike any part.
 constexpr size_t kMaxWhyBytes = 1000;
 
 class RequestRecord {
@@ -82,8 +95,10 @@ class RequestRecord {
   // Every region of a LOCATE not reported as a part of the asked type, in
   // region order; empty for other requests.
   const std::vector<RegionRejection>& rejections() const;
-  // The WHY line: "OK <n> <text>; <text>..." (n rejections), at most
-  // kMaxWhyBytes; empty for requests other than LOCATE.
+  // The WHY line: "OK <n> <text>; <text>...; <k> regions unlike any part"
+  // (n rejections: the near misses' sentences in region order, then the
+  // count of the k unlike any part), at most kMaxWhyBytes; empty for
+  // requests other than LOCATE.
   const std::string& why() const;
 
  private:

@@ -47,6 +47,32 @@ RegionExplanation explainRegion(const Region& region, const std::vector<const Pa
 RegionExplanation explainRegionAsAsked(const Region& region,
                                        const std::vector<const PartModel*>& models, int asked_type);
 
+// How far off a model a region must lie to be plainly unlike that part, in
+// that model's own tolerances. A tolerance is what its integrator said a
+// real part varies by (lens, height, piece to piece, light); a region off
+// by twice that is no such part measured a little off, and nobody would
+// double a tolerance for it. One closer (a part a little beyond its
+// tolerance, one a shadow joined) stays a near miss worth a look.
+constexpr double kUnlikeTolerances = 2;
+// The tolerances "far" is measured from at the least: those LEARN sets
+// (its default area tolerance, its smallest Hu tolerance). A tolerance
+// tightened below them says the parts vary less, not that a region just
+// past it is unlike the part: the near misses a tightened tolerance
+// refuses keep their sentence.
+constexpr double kUnlikeMinAreaTolerance = 0.1;
+constexpr double kUnlikeMinHuTolerance = 0.5;
+
+// Whether `region` is plainly unlike every one of `models` (false with
+// none): for each model, its area lies further from the model's than
+// kUnlikeTolerances times the model's area tolerance, or its shape (the Hu
+// distance) further than kUnlikeTolerances times its hu_tolerance (each
+// tolerance at least kUnlikeMinAreaTolerance, kUnlikeMinHuTolerance). A region
+// the frame's border cuts is no whole part's shape, and the frame may hide
+// any share of its area and holes: it is unlike a model only when too
+// large by that margin or with more holes than the part (as the model
+// counts them). Frame pixels, as recognize().
+bool unlikeEveryModel(const Region& region, const std::vector<const PartModel*>& models);
+
 // One tolerance of one model changed (`TOLERANCE <type> <key> <value>`).
 struct RegionRemedy {
   int type = -1;
