@@ -209,7 +209,11 @@
       "#" + (result.request_id || 0) + " " + (result.request_line || result.request || "") + " -> " +
       (result.reply || "") + " (" + num(result.elapsed_ms).toFixed(1) + " ms, frame " +
       (result.frame_sequence || 0) + ", " + num(result.regions_total) + " regions)" +
-      (result.why ? "\nwhy: " + result.why : "") + unlikeNote(result) +
+      // WHY's line where no rejection is listed below (a failed LOCATE, or
+      // every region reported): the list says it region by region, near
+      // misses first, and WHY's line of a belt ran to its 1000 bytes.
+      (result.why && !(result.rejections || []).length ? "\nwhy: " + result.why : "") +
+      unlikeNote(result) +
       (result.reply_frame ? "\nreply in " + ps.replyFrame(result.reply_frame).text : "");
     const frame = ps.replyFrame(result.reply_frame);
     $("result-frame").textContent = frame.text;
@@ -269,7 +273,8 @@
 
   function rejectionItem(result, rej) {
     const li = document.createElement("li");
-    li.textContent = "region " + num(rej.region) + ": " + (rej.text || rej.test);
+    // WHY's sentence names its region; a bare test name does not.
+    li.textContent = rej.text || "region " + num(rej.region) + ": " + rej.test;
     if (rej.remedy_key) {
       const apply = document.createElement("button");
       apply.type = "button";

@@ -101,7 +101,7 @@ def test_near_misses_are_labelled_and_the_belt_is_not(cell, browser):
         return Array.from(document.querySelectorAll('#result-rejections > li')).map(li => ({
             cls: li.className, text: li.querySelector('summary') ? li.querySelector('summary').textContent
                                                                   : li.textContent}));""")
-    assert [i["text"].split(":")[0] for i in items[:2]] == [f"region {int(r.get('region', 0))}" for r in near]
+    assert [i["text"].split(" ")[1] for i in items[:2]] == [str(int(r.get("region", 0))) for r in near], items
     assert len(items) == 3 and items[2]["cls"] == "unlike" and items[2]["text"].startswith(counted), items
     assert not browser.js("return document.querySelector('#result-rejections li.unlike details').open")
     browser.screenshot("overlay-clutter")
