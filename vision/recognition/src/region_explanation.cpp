@@ -79,7 +79,9 @@ bool unlikeEveryModel(const Region& region, const std::vector<const PartModel*>&
     }
     const bool far_shape = huDistance(body, cache.logHu()) >
                            kUnlikeTolerances * std::max(body.hu_tolerance, kUnlikeMinHuTolerance);
-    if (std::abs(gap) <= allowed && !far_shape) return false;
+    const double ratio = region.area / body.area;
+    const bool copy_size = ratio >= kUnlikeMinCopyArea && ratio <= kUnlikeMaxCopyArea;
+    if (!far_shape && (std::abs(gap) <= allowed || copy_size)) return false;
   }
   return true;
 }
