@@ -80,7 +80,10 @@ bool unlikeEveryModel(const Region& region, const std::vector<const PartModel*>&
     const bool far_shape = huDistance(body, cache.logHu()) >
                            kUnlikeTolerances * std::max(body.hu_tolerance, kUnlikeMinHuTolerance);
     const double ratio = region.area / body.area;
-    const bool copy_size = ratio >= kUnlikeMinCopyArea && ratio <= kUnlikeMaxCopyArea;
+    // A copy has the part's holes, and at most a speckle's more (a belt's
+    // blotch the threshold took in, of a part's shape and size, had 16).
+    const bool copy_size = ratio >= kUnlikeMinCopyArea && ratio <= kUnlikeMaxCopyArea &&
+                           holesAtLeast(region, m->min_hole_area) <= body.holes + 1;
     if (!far_shape && (std::abs(gap) <= allowed || copy_size)) return false;
   }
   return true;
