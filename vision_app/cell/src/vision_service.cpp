@@ -680,7 +680,7 @@ double pieceDepth(const cv::Mat& piece, const cv::Mat& own, const cv::Mat& grey)
   cv::dilate(
       piece, near,
       cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * kNearPiecePx + 1, 2 * kNearPiecePx + 1}));
-  const auto median = [&](const cv::Mat& where, double* level) {
+  const auto middleMean = [&](const cv::Mat& where, double* level) {
     std::vector<uint8_t> values;
     for (int y = 0; y < where.rows; ++y) {
       const uint8_t* w = where.ptr<uint8_t>(y);
@@ -701,8 +701,8 @@ double pieceDepth(const cv::Mat& piece, const cv::Mat& own, const cv::Mat& grey)
   double level = 0;
   double body = 0;
   double surface = 0;
-  if (!median(piece, &level) || !median(near & own & ~piece, &body) ||
-      !median(near & ~own, &surface) || body == surface) {
+  if (!middleMean(piece, &level) || !middleMean(near & own & ~piece, &body) ||
+      !middleMean(near & ~own, &surface) || body == surface) {
     return 0;
   }
   return (surface - level) / (surface - body);
