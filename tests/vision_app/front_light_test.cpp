@@ -1586,7 +1586,8 @@ TEST_CASE("LEARN keeps a limb lying over a darker stretch of the surface, its ed
   const ps::SilhouetteSceneOptions look = lookOf("low-contrast");
   const ps::SilhouetteType dog = drawing("shapes/tari1000/obj27_3.png", 240);
   // The benchmark's spot, seed and turn for it there (the 12th of its types,
-  // teaching 3: teachSpot(11, 0), seed 7 + 11 + 3 x 100003, 30 degrees).
+  // the fourth teaching, numbered 3 from 0: teachSpot(11, 0), seed 7 + 11 +
+  // 3 x 100003, 30 degrees).
   const cv::Point2d spot(235.07962915799556, 640.71077688873959);
   constexpr uint64_t kSeed = 300027;
   cv::Point2d centre;

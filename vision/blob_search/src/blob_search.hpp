@@ -189,7 +189,8 @@ class BlobSearch {
   // when that is every edge (edges_); made when first asked.
   std::optional<EdgeDistance> outline_;
   // The wide map the searches about a point read (searchAbout): the same
-  // for each of them, made when first asked (a tenth of each search).
+  // for each of them, made when first asked (a sixth of each search's
+  // time went to making it).
   std::optional<EdgeDistance> about_map_;
   int blob_pixels_ = 0;
   size_t budget_ = 0;  // edge fits the blob may cost

@@ -2,7 +2,7 @@
 // came from, explained against the asked type's models (or as a part of
 // another type, or one with no free grasp), with the tolerance change that
 // would accept it where one test alone refuses it, and whether it is
-// plainly unlike any part (which WHY counts rather than explains).
+// plainly unlike any part (which WHY says after the near misses).
 #include "picksight/results/request_record.hpp"
 
 #include <algorithm>

@@ -46,8 +46,9 @@ struct RegionRejection {
   std::string remedy_value;  // as written, the text TOLERANCE reads
   std::string text;          // as WHY prints it, the remedy included
   // Plainly unlike every trained part (unlikeAnyPart): belt texture, a
-  // shadow, dirt. WHY sums these up in one clause and the web HMI draws
-  // them without a label, so the near misses stand out.
+  // shadow, dirt. WHY says these after the near misses, while its line has
+  // room, and the web HMI draws them without a label, so the near misses
+  // stand out.
   bool unlike_any_part = false;
 };
 
@@ -60,8 +61,8 @@ bool unlikeAnyPart(const RegionRejection& r, const vision::Region& region,
 
 // Regions published (and explained) per request, largest first.
 constexpr size_t kMaxResultRegions = 1024;
-// Longest WHY line: the first near misses that fit, then "; ...", then the
-// count of regions unlike any part.
+// Longest WHY line: the near misses that fit (then "; ..."), the regions
+// unlike any part that fit, then the count of those left unsaid.
 constexpr size_t kMaxWhyBytes = 1000;
 
 class RequestRecord {
@@ -95,10 +96,10 @@ class RequestRecord {
   // Every region of a LOCATE not reported as a part of the asked type, in
   // region order; empty for other requests.
   const std::vector<RegionRejection>& rejections() const;
-  // The WHY line: "OK <n> <text>; <text>...; <k> regions unlike any part"
-  // (n rejections: the near misses' sentences in region order, then the
-  // count of the k unlike any part), at most kMaxWhyBytes; empty for
-  // requests other than LOCATE.
+  // The WHY line: "OK <n> <text>; <text>...[; <k> more regions unlike any
+  // part]" (n rejections: the near misses' sentences in region order, then
+  // those of the regions unlike any part, then the count of those left
+  // unsaid), at most kMaxWhyBytes; empty for requests other than LOCATE.
   const std::string& why() const;
 
  private:

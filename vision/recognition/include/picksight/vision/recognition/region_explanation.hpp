@@ -63,11 +63,12 @@ constexpr double kUnlikeMinAreaTolerance = 0.1;
 constexpr double kUnlikeMinHuTolerance = 0.5;
 // A region of a model's shape (within kUnlikeTolerances of its Hu
 // tolerance), with the model's holes and at most one more, is never unlike
-// it while its area lies within these multiples of the model's: the part's shape at another size is a size confusion
-// worth a look (the front-light benchmark's copies are 0.8 and 1.25 times
-// a part's size), however far its area is from the tolerance, and a
-// pinhole in such a copy must not hide it (refused for its holes first, a
-// 0.8 copy read unlike the part by its area alone in clang's build).
+// it while its area lies within these multiples of the model's: the part's
+// shape at another size is a size confusion worth a look (the front-light
+// benchmark's copies are 0.8 and 1.25 times a part's size), however far
+// its area is from the tolerance, and a speckle's hole in such a copy must
+// not hide it (refused for its holes first, a 0.8 copy read unlike the
+// part by its area alone in clang's build).
 constexpr double kUnlikeMinCopyArea = 0.5;
 constexpr double kUnlikeMaxCopyArea = 2.0;
 
