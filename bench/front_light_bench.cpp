@@ -264,20 +264,294 @@ void score(const std::vector<ps::SilhouettePart>& truth, const pc::LocateOutcome
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// What the command line sets for every cell of the benchmark.
+struct Settings {
   int scenes = 2;
   int rounds = 5;
   int jpeg_quality = 0;
-  bool standard_types = false;
   bool list_errors = false;
   bool stages = false;
   std::string save_frames;
-  bool keep_shadows = false;
-  int window = 0;
   bool teach_on_plain = false;
   int teach_views = 1;
+};
+
+// One condition's light: its name, how its frames look and the vision
+// app's options under it.
+struct Light {
+  std::string condition;
+  ps::SilhouetteSceneOptions look;
+  pc::VisionOptions options;
+};
+
+// The part types, as named and as drawn.
+struct Types {
+  const std::vector<TypeSpec>& specs;
+  const std::vector<ps::SilhouetteType>& drawn;
+};
+
+// A cell taught under one light: its models and what each tells of its
+// type.
+struct Cell {
+  std::shared_ptr<pst::ModelList> models = std::make_shared<pst::ModelList>();
+  std::vector<int> type_of_model;  // a model's type -> the type's index
+  std::vector<bool> chiral;        // per type: its model is not mirror-symmetric
+  // Per type: where the model's reference point lies on the drawn part.
+  std::vector<cv::Point2d> reference;
+  Row taught;  // what LEARN, LEARN ... AT and LEARNVIEW answered
+};
+
+// Where type i lies in its teach frame for `view` (0: LEARN, then
+// LEARNVIEW's) of a teaching (`again`: its seeds' offset): anywhere a user
+// might lay it, its whole outline a margin inside the frame.
+cv::Point2d teachSpot(const Light& light, const TypeSpec& spec, size_t i, int view,
+                      uint64_t again) {
+  std::mt19937_64 rng(0x7465616368ULL + 131 * i + static_cast<uint64_t>(view) + again);
+  const double margin = 0.75 * spec.size_px + 20;
+  std::uniform_real_distribution<double> x(margin, light.look.width - 1 - margin);
+  std::uniform_real_distribution<double> y(margin, light.look.height - 1 - margin);
+  const double at_x = x(rng);
+  return cv::Point2d(at_x, y(rng));
+}
+
+// Where the model's reference point (the region's centroid) lies on a part
+// drawn with `seed` at `spot`, turned back to the part: measured on a
+// sharp, evenly back-lit image of it, so that the light of the condition
+// counts in the error, not in the truth.
+cv::Point2d referenceOnPart(const ps::SilhouetteType& type, const ps::SilhouetteSceneOptions& look,
+                            uint64_t seed, cv::Point2d spot) {
+  ps::SilhouetteSceneOptions sharp_look;
+  sharp_look.noise_sigma = 0;
+  sharp_look.uneven_light = false;
+  sharp_look.width = look.width;
+  sharp_look.height = look.height;
+  cv::Point2d sharp_drawn;
+  const cv::Mat sharp = ps::renderSilhouetteInFrame(type, sharp_look, seed, spot, &sharp_drawn,
+                                                    picksight::bench::kTrainAngleDeg);
+  pv::BinarizeOptions b;
+  b.adaptive_window = kTruthWindow;
+  const auto seen = pv::findRegions(pv::binarize(sharp, b), {}, sharp);
+  size_t largest = 0;
+  for (size_t k = 1; k < seen.size(); ++k) {
+    if (seen[k].area > seen[largest].area) largest = k;
+  }
+  const cv::Point2d offset = seen.empty() ? cv::Point2d() : seen[largest].centroid - sharp_drawn;
+  const double back = -picksight::bench::kTrainAngleDeg * M_PI / 180.0;
+  return {offset.x * std::cos(back) - offset.y * std::sin(back),
+          offset.x * std::sin(back) + offset.y * std::cos(back)};
+}
+
+// Writes a teach image (and what the vision pass takes for parts there,
+// before any model) to --save-frames, each teaching's apart (the first's
+// named as without --teachings).
+void saveTeachImage(const Settings& s, const Light& light, const std::string& type, int teaching,
+                    const cv::Mat& image) {
+  const std::string name =
+      light.condition + "-teach-" + type + (teaching > 0 ? "-" + std::to_string(teaching + 1) : "");
+  cv::imwrite(s.save_frames + "/" + name + ".png", image);
+  const auto seen =
+      pc::locateInFrame(frameOf(image), light.options, std::make_shared<pst::ModelList>(), -1);
+  if (!seen.scene.mask.empty())
+    cv::imwrite(s.save_frames + "/" + name + "-mask.png", seen.scene.mask);
+}
+
+// More views of type i (LEARNVIEW) added to its learned model: the part
+// alone again, turned and lying on another stretch of the surface, each
+// read with the model so far.
+void addViews(const Settings& s, const Light& light, const Types& types, size_t i,
+              const ps::SilhouetteSceneOptions& teach_look, uint64_t again, const Cell& cell,
+              pc::LearnOutcome* learned, Row* taught) {
+  for (int v = 1; v < s.teach_views; ++v) {
+    auto trial = std::make_shared<pst::ModelList>(*cell.models);
+    trial->push_back(learned->model);
+    cv::Point2d unused;
+    const cv::Mat view =
+        delivered(ps::renderSilhouetteInFrame(types.drawn[i], teach_look, 1000 * v + 7 + i + again,
+                                              teachSpot(light, types.specs[i], i, v, again),
+                                              &unused, picksight::bench::kTrainAngleDeg + 47.0 * v),
+                  s.jpeg_quality);
+    auto seen =
+        pc::viewInFrame(frameOf(view), light.options, trial, learned->model.type, std::nullopt);
+    if (!seen) {
+      taught->views_refused += 1;
+      if (s.list_errors) {
+        std::printf("  %s %s: view %d refused: %s\n", light.condition.c_str(),
+                    types.specs[i].name.c_str(), v, seen.error().message.c_str());
+      }
+      continue;
+    }
+    learned->model = std::move(seen->model);
+  }
+}
+
+// Teaches type i into `cell` as a user would: LEARN on an image of the part
+// alone under the same light (or, --teach-on-plain, on a plain surface);
+// when LEARN refuses, LEARN ... AT a box around it; then its further views.
+void teachType(const Settings& s, const Light& light, const Types& types, size_t i, int teaching,
+               Cell* cell) {
+  const uint64_t again = 100003ULL * static_cast<uint64_t>(teaching);
+  const TypeSpec& spec = types.specs[i];
+  ps::SilhouetteSceneOptions teach_look = light.look;
+  if (s.teach_on_plain) {
+    ps::FrontLight plain;
+    plain.colour = light.look.front.colour;
+    plain.part_bgr = light.look.front.part_bgr;
+    plain.background_bgr = light.look.front.background_bgr;
+    teach_look.front = plain;
+  }
+  const cv::Point2d spot = teachSpot(light, spec, i, 0, again);
+  cv::Point2d drawn;
+  const cv::Mat image =
+      delivered(ps::renderSilhouetteInFrame(types.drawn[i], teach_look, 7 + i + again, spot, &drawn,
+                                            picksight::bench::kTrainAngleDeg),
+                s.jpeg_quality);
+  if (!s.save_frames.empty()) saveTeachImage(s, light, spec.name, teaching, image);
+  const picksight::Frame frame = frameOf(image);
+  const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
+  Row& taught = cell->taught;
+  auto learned =
+      pc::learnInImage(grey, frame.mapping, light.options, cell->models,
+                       static_cast<int>(cell->models->size()) + 1, spec.name, std::nullopt);
+  if (learned) {
+    taught.learn_ok += 1;
+  } else {
+    if (taught.first_refusal.empty()) {
+      taught.first_refusal = spec.name + ": " + learned.error().message;
+    }
+    // The box a user drags: the part with a margin of a tenth of its size.
+    const double half = 0.6 * spec.size_px;
+    const cv::Rect at(static_cast<int>(drawn.x - half), static_cast<int>(drawn.y - half),
+                      static_cast<int>(2 * half), static_cast<int>(2 * half));
+    learned = pc::learnInImage(grey, frame.mapping, light.options, cell->models,
+                               static_cast<int>(cell->models->size()) + 1, spec.name, at);
+    if (learned) taught.learn_at_ok += 1;
+  }
+  if (!learned) {
+    taught.untaught += 1;
+    if (s.list_errors) {
+      std::printf("  %s %s: not taught: %s\n", light.condition.c_str(), spec.name.c_str(),
+                  learned.error().message.c_str());
+    }
+    return;
+  }
+  cell->reference[i] = referenceOnPart(types.drawn[i], light.look, 7 + i + again, spot);
+  cell->chiral[i] = !learned->model.body.mirror_symmetric;
+  if (s.list_errors) {
+    // The teach image's reading of the reference point, on the part.
+    const double back = -picksight::bench::kTrainAngleDeg * M_PI / 180.0;
+    const cv::Point2d d = learned->model.trained_centroid - drawn;
+    const cv::Point2d on(d.x * std::cos(back) - d.y * std::sin(back),
+                         d.x * std::sin(back) + d.y * std::cos(back));
+    std::printf("  %s %s: taught %+.3f %+.3f px off on the part\n", light.condition.c_str(),
+                spec.name.c_str(), on.x - cell->reference[i].x, on.y - cell->reference[i].y);
+  }
+  addViews(s, light, types, i, teach_look, again, *cell, &*learned, &taught);
+  if (s.list_errors && s.teach_views > 1) {
+    std::printf("  %s %s: %zu views, origin at %+.3f %+.3f\n", light.condition.c_str(),
+                spec.name.c_str(), learned->model.views.size() + 1, learned->model.origin_shift.x,
+                learned->model.origin_shift.y);
+  }
+  auto next = std::make_shared<pst::ModelList>(*cell->models);
+  next->push_back(std::move(learned->model));
+  cell->models = next;
+  cell->type_of_model.resize(static_cast<size_t>(cell->models->back().type) + 1, -1);
+  cell->type_of_model[static_cast<size_t>(cell->models->back().type)] = static_cast<int>(i);
+}
+
+// The cell taught under `light`, every type in turn. Teaching 0 is the
+// benchmark's own; each further one lays every part down again: its
+// spots, its surface and its noise from other seeds.
+Cell teachCell(const Settings& s, const Light& light, const Types& types, int teaching) {
+  Cell cell;
+  cell.chiral.assign(types.drawn.size(), true);
+  cell.reference.resize(types.drawn.size());
+  for (size_t i = 0; i < types.drawn.size(); ++i) teachType(s, light, types, i, teaching, &cell);
+  return cell;
+}
+
+// --stages: the vision pass's first two stages alone on `frame`, as
+// locateInFrame prepares them (the vision image, a colour frame projected
+// on the taught colours, and the frame's options).
+void timeStages(const picksight::Frame& frame, const Light& light, const pst::ModelList& models,
+                Row* row) {
+  const cv::Mat grey = pc::visionImage(frame, models);
+  const pc::VisionOptions o = pc::frameOptions(light.options, frame.mapping, grey.size(), models);
+  cv::Mat mask;
+  row->binarize_ms.push_back(
+      picksight::bench::elapsedMs([&] { mask = pv::binarize(grey, o.binarize); }));
+  // The regions LOCATE finds: from the speck area up when the smallest
+  // region follows the models.
+  const pv::RegionOptions located = pc::locateRegionOptions(o, models);
+  std::vector<pv::Region> regions;
+  row->regions_ms.push_back(
+      picksight::bench::elapsedMs([&] { regions = pv::findRegions(mask, located, grey); }));
+  pv::RegionOptions uncut = located;
+  uncut.cut_shadows = false;
+  row->uncut_ms.push_back(
+      picksight::bench::elapsedMs([&] { regions = pv::findRegions(mask, uncut, grey); }));
+}
+
+// The row of one arrangement of `cell`'s parts under `light`: every scene
+// and round located (LOCATE ALL) in turn with the plain OpenCV pass, and
+// scored.
+Row runArrangement(const Settings& s, const Light& light, const Types& types, const Cell& cell,
+                   const std::string& name) {
+  const ps::Arrangement arrangement = name == "separated"  ? ps::Arrangement::kSeparated
+                                      : name == "touching" ? ps::Arrangement::kTouching
+                                                           : ps::Arrangement::kOverlapping;
+  Row row = cell.taught;
+  row.condition = light.condition;
+  row.arrangement = name;
+  const std::string frames = s.save_frames + "/" + light.condition + "-" + name + "-";
+  size_t turn = 0;
+  for (int n = 0; n < s.scenes; ++n) {
+    ps::SilhouetteSceneOptions o = light.look;
+    o.arrangement = arrangement;
+    o.seed = 5000 * (static_cast<uint64_t>(arrangement) + 1) + static_cast<uint64_t>(n);
+    const ps::SilhouetteScene scene(types.drawn, cell.chiral, o);
+    for (int r = 0; r < s.rounds; ++r) {
+      const cv::Mat image = delivered(scene.render(static_cast<uint64_t>(r)), s.jpeg_quality);
+      const bool save = !s.save_frames.empty() && r == 0;
+      if (save) cv::imwrite(frames + std::to_string(n) + ".png", image);
+      const picksight::Frame frame = frameOf(image);
+      pc::LocateOutcome outcome;
+      double sink = 0;
+      picksight::bench::timeInTurn<2>(turn++,
+                                      {[&] {
+                                         if (cell.models->empty()) return;
+                                         outcome = pc::locateInFrame(frame, light.options,
+                                                                     cell.models, -1);
+                                       },
+                                       [&] {
+                                         cv::Mat grey = image;
+                                         if (image.channels() == 3)
+                                           cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+                                         sink += picksight::bench::competentOpenCvPass(grey);
+                                       }},
+                                      {&row.locate_ms, &row.plain_ms});
+      if (save && !outcome.scene.mask.empty()) {
+        // What the vision pass took for parts: to look at beside the frame.
+        cv::imwrite(frames + std::to_string(n) + "-mask.png", outcome.scene.mask);
+      }
+      if (s.stages && !cell.models->empty()) timeStages(frame, light, *cell.models, &row);
+      if (s.list_errors) {
+        std::printf("  %s %s scene %d round %d:\n", light.condition.c_str(), name.c_str(), n, r);
+      }
+      score(scene.truth(), outcome, cell.type_of_model, cell.reference, s.list_errors, types.specs,
+            row);
+      if (sink == 0) std::printf("!");
+    }
+  }
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Settings s;
+  bool standard_types = false;
+  bool keep_shadows = false;
+  int window = 0;
   int teachings = 1;
   double blur_sigma = ps::SilhouetteSceneOptions{}.blur_sigma;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
@@ -294,21 +568,21 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(condition_names));
   app.add_option("--arrangements", arrangements, "separated, touching, overlapping")
       ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
-  app.add_option("--scenes", scenes, "scenes per condition and arrangement")
+  app.add_option("--scenes", s.scenes, "scenes per condition and arrangement")
       ->check(CLI::Range(1, 50))
       ->capture_default_str();
-  app.add_option("--rounds", rounds, "frames (noise) per scene, each timed")
+  app.add_option("--rounds", s.rounds, "frames (noise) per scene, each timed")
       ->check(CLI::Range(1, 200))
       ->capture_default_str();
-  app.add_option("--jpeg-quality", jpeg_quality,
+  app.add_option("--jpeg-quality", s.jpeg_quality,
                  "deliver every image through JPEG at this quality (0: lossless)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
   app.add_flag("--standard-types", standard_types,
                "the 15 types of picksight-bench-silhouettes instead of unseen ones");
-  app.add_flag("--list-errors", list_errors,
+  app.add_flag("--list-errors", s.list_errors,
                "print each false report, each part missed and each placed over 0.2 px off");
-  app.add_flag("--stages", stages,
+  app.add_flag("--stages", s.stages,
                "also time binarization and the region pass alone (medians, ms): where the time "
                "goes");
   app.add_option("--blur", blur_sigma,
@@ -324,7 +598,7 @@ int main(int argc, char** argv) {
   app.add_flag("--keep-shadows", keep_shadows,
                "leave cast shadows joined to the parts (to measure what cutting them gains and "
                "costs)");
-  app.add_flag("--teach-on-plain", teach_on_plain,
+  app.add_flag("--teach-on-plain", s.teach_on_plain,
                "teach each type on a plain surface, evenly lit (a sheet of card under the cell), "
                "the part's and the surface's levels and colours kept; the scenes keep the "
                "condition's light");
@@ -334,29 +608,32 @@ int main(int argc, char** argv) {
                  "run every scene with each teaching's models: one teach image's texture and noise "
                  "move every part of its type alike, and one teaching shows one draw of that")
       ->check(CLI::Range(1, 20));
-  app.add_option("--teach-views", teach_views,
+  app.add_option("--teach-views", s.teach_views,
                  "teach each type from this many images of it (LEARN, then LEARNVIEW on the part "
                  "lying elsewhere, turned), each under the teach light")
       ->check(CLI::Range(1, 33))
       ->capture_default_str();
-  app.add_option("--save-frames", save_frames,
+  app.add_option("--save-frames", s.save_frames,
                  "write each scene's first frame, its binarization (-mask) and each teach image "
                  "here (PNG), to look at");
   app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
   if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
-  if (!save_frames.empty() && !std::filesystem::is_directory(save_frames)) {
-    std::fprintf(stderr, "--save-frames: %s is not a directory\n", save_frames.c_str());
+  if (!s.save_frames.empty() && !std::filesystem::is_directory(s.save_frames)) {
+    std::fprintf(stderr, "--save-frames: %s is not a directory\n", s.save_frames.c_str());
     return 2;
   }
 
   const std::vector<TypeSpec>& specs =
       standard_types ? picksight::bench::silhouetteTypeSpecs() : unseenTypeSpecs();
-  std::vector<ps::SilhouetteType> types;
-  if (!picksight::bench::loadSilhouetteTypes(specs, data_dir, &types)) return 1;
+  std::vector<ps::SilhouetteType> drawn;
+  if (!picksight::bench::loadSilhouetteTypes(specs, data_dir, &drawn)) return 1;
+  const Types types{specs, drawn};
 
   std::vector<Row> rows;
   for (const auto& condition : conditions) {
-    ps::SilhouetteSceneOptions look;
+    Light light;
+    light.condition = condition;
+    ps::SilhouetteSceneOptions& look = light.look;
     if (!ps::frontLightCondition(condition, &look.front, &look.part_level,
                                  &look.background_level)) {
       const std::string photo = data_dir + "/surfaces/" + condition + ".png";
@@ -369,235 +646,25 @@ int main(int argc, char** argv) {
     look.blur_sigma = blur_sigma;
     // The vision app's defaults (the window it picks from the image and the
     // models, unless --window sets one as a user's --window would).
-    pc::VisionOptions options;
-    options.binarize.adaptive_window = window;
-    options.regions.cut_shadows = !keep_shadows;
+    light.options.binarize.adaptive_window = window;
+    light.options.regions.cut_shadows = !keep_shadows;
     if (look.part_level > look.background_level) {
-      options.binarize.polarity = pv::Polarity::kLightOnDark;
+      light.options.binarize.polarity = pv::Polarity::kLightOnDark;
     }
     std::vector<Row> taught_rows;  // one per arrangement, over every teaching
     for (int teaching = 0; teaching < teachings; ++teaching) {
-      // Teaching 0 is the benchmark's own; each further one lays every part
-      // down again: its spots, its surface and its noise from other seeds.
-      const uint64_t again = 100003ULL * static_cast<uint64_t>(teaching);
-      // Teach every type as a user would: LEARN on an image of the part alone
-      // under the same light (or, --teach-on-plain, on a plain surface); when
-      // LEARN refuses, LEARN ... AT a box around it.
-      auto models = std::make_shared<pst::ModelList>();
-      std::vector<int> type_of_model;
-      std::vector<bool> chiral(types.size(), true);
-      std::vector<cv::Point2d> reference(types.size());
-      Row taught;
-      // Where a part lies in its teach frame: anywhere a user might lay it,
-      // its whole outline a margin inside the frame (view 0: LEARN, then
-      // LEARNVIEW's).
-      const auto teachSpot = [&](size_t i, int view) {
-        std::mt19937_64 rng(0x7465616368ULL + 131 * i + static_cast<uint64_t>(view) + again);
-        const double margin = 0.75 * specs[i].size_px + 20;
-        std::uniform_real_distribution<double> x(margin, look.width - 1 - margin);
-        std::uniform_real_distribution<double> y(margin, look.height - 1 - margin);
-        const double at_x = x(rng);
-        return cv::Point2d(at_x, y(rng));
-      };
-      for (size_t i = 0; i < types.size(); ++i) {
-        cv::Point2d drawn;
-        ps::SilhouetteSceneOptions teach_look = look;
-        if (teach_on_plain) {
-          ps::FrontLight plain;
-          plain.colour = look.front.colour;
-          plain.part_bgr = look.front.part_bgr;
-          plain.background_bgr = look.front.background_bgr;
-          teach_look.front = plain;
-        }
-        const cv::Mat image = delivered(
-            ps::renderSilhouetteInFrame(types[i], teach_look, 7 + i + again, teachSpot(i, 0),
-                                        &drawn, picksight::bench::kTrainAngleDeg),
-            jpeg_quality);
-        if (!save_frames.empty()) {
-          // Each teaching's own teach images (the first's named as without
-          // --teachings).
-          const std::string teach_name = condition + "-teach-" + specs[i].name +
-                                         (teaching > 0 ? "-" + std::to_string(teaching + 1) : "");
-          cv::imwrite(save_frames + "/" + teach_name + ".png", image);
-          // What the vision pass takes for parts there, before any model.
-          const auto seen =
-              pc::locateInFrame(frameOf(image), options, std::make_shared<pst::ModelList>(), -1);
-          if (!seen.scene.mask.empty()) {
-            cv::imwrite(save_frames + "/" + teach_name + "-mask.png", seen.scene.mask);
-          }
-        }
-        const picksight::Frame frame = frameOf(image);
-        const cv::Mat& grey = frame.image;  // LEARN reads a colour frame in colour
-        auto learned =
-            pc::learnInImage(grey, frame.mapping, options, models,
-                             static_cast<int>(models->size()) + 1, specs[i].name, std::nullopt);
-        if (learned) {
-          taught.learn_ok += 1;
-        } else {
-          if (taught.first_refusal.empty()) {
-            taught.first_refusal = specs[i].name + ": " + learned.error().message;
-          }
-          // The box a user drags: the part with a margin of a tenth of its size.
-          const double half = 0.6 * specs[i].size_px;
-          const cv::Rect at(static_cast<int>(drawn.x - half), static_cast<int>(drawn.y - half),
-                            static_cast<int>(2 * half), static_cast<int>(2 * half));
-          learned = pc::learnInImage(grey, frame.mapping, options, models,
-                                     static_cast<int>(models->size()) + 1, specs[i].name, at);
-          if (learned) taught.learn_at_ok += 1;
-        }
-        if (!learned) {
-          taught.untaught += 1;
-          if (list_errors) {
-            std::printf("  %s %s: not taught: %s\n", condition.c_str(), specs[i].name.c_str(),
-                        learned.error().message.c_str());
-          }
-          continue;
-        }
-        // Where the model's reference point lies on the drawn part: measured on
-        // a sharp, evenly back-lit image of it, so that the light of the
-        // condition counts in the error, not in the truth.
-        ps::SilhouetteSceneOptions sharp_look;
-        sharp_look.noise_sigma = 0;
-        sharp_look.uneven_light = false;
-        cv::Point2d sharp_drawn;
-        sharp_look.width = look.width;
-        sharp_look.height = look.height;
-        const cv::Mat sharp =
-            ps::renderSilhouetteInFrame(types[i], sharp_look, 7 + i + again, teachSpot(i, 0),
-                                        &sharp_drawn, picksight::bench::kTrainAngleDeg);
-        pv::BinarizeOptions b;
-        b.adaptive_window = kTruthWindow;
-        const auto seen = pv::findRegions(pv::binarize(sharp, b), {}, sharp);
-        size_t largest = 0;
-        for (size_t k = 1; k < seen.size(); ++k) {
-          if (seen[k].area > seen[largest].area) largest = k;
-        }
-        const cv::Point2d offset =
-            seen.empty() ? cv::Point2d() : seen[largest].centroid - sharp_drawn;
-        const double back = -picksight::bench::kTrainAngleDeg * M_PI / 180.0;
-        reference[i] = {offset.x * std::cos(back) - offset.y * std::sin(back),
-                        offset.x * std::sin(back) + offset.y * std::cos(back)};
-        chiral[i] = !learned->model.body.mirror_symmetric;
-        if (list_errors) {
-          // The teach image's reading of the reference point, on the part.
-          const cv::Point2d d = learned->model.trained_centroid - drawn;
-          const cv::Point2d on(d.x * std::cos(back) - d.y * std::sin(back),
-                               d.x * std::sin(back) + d.y * std::cos(back));
-          std::printf("  %s %s: taught %+.3f %+.3f px off on the part\n", condition.c_str(),
-                      specs[i].name.c_str(), on.x - reference[i].x, on.y - reference[i].y);
-        }
-        // More views (LEARNVIEW): the part alone again, turned and lying on
-        // another stretch of the surface, each read with the model so far.
-        for (int v = 1; v < teach_views; ++v) {
-          auto trial = std::make_shared<pst::ModelList>(*models);
-          trial->push_back(learned->model);
-          cv::Point2d unused;
-          const cv::Mat view =
-              delivered(ps::renderSilhouetteInFrame(types[i], teach_look, 1000 * v + 7 + i + again,
-                                                    teachSpot(i, v), &unused,
-                                                    picksight::bench::kTrainAngleDeg + 47.0 * v),
-                        jpeg_quality);
-          auto seen =
-              pc::viewInFrame(frameOf(view), options, trial, learned->model.type, std::nullopt);
-          if (!seen) {
-            taught.views_refused += 1;
-            if (list_errors) {
-              std::printf("  %s %s: view %d refused: %s\n", condition.c_str(),
-                          specs[i].name.c_str(), v, seen.error().message.c_str());
-            }
-            continue;
-          }
-          learned->model = std::move(seen->model);
-        }
-        if (list_errors && teach_views > 1) {
-          std::printf("  %s %s: %zu views, origin at %+.3f %+.3f\n", condition.c_str(),
-                      specs[i].name.c_str(), learned->model.views.size() + 1,
-                      learned->model.origin_shift.x, learned->model.origin_shift.y);
-        }
-        auto next = std::make_shared<pst::ModelList>(*models);
-        next->push_back(std::move(learned->model));
-        models = next;
-        type_of_model.resize(static_cast<size_t>(models->back().type) + 1, -1);
-        type_of_model[static_cast<size_t>(models->back().type)] = static_cast<int>(i);
-      }
+      const Cell cell = teachCell(s, light, types, teaching);
       for (size_t a = 0; a < arrangements.size(); ++a) {
-        const std::string& name = arrangements[a];
-        const ps::Arrangement arrangement = name == "separated"  ? ps::Arrangement::kSeparated
-                                            : name == "touching" ? ps::Arrangement::kTouching
-                                                                 : ps::Arrangement::kOverlapping;
-        Row row = taught;
-        row.condition = condition;
-        row.arrangement = name;
-        size_t turn = 0;
-        for (int n = 0; n < scenes; ++n) {
-          ps::SilhouetteSceneOptions o = look;
-          o.arrangement = arrangement;
-          o.seed = 5000 * (static_cast<uint64_t>(arrangement) + 1) + static_cast<uint64_t>(n);
-          const ps::SilhouetteScene scene(types, chiral, o);
-          for (int r = 0; r < rounds; ++r) {
-            const cv::Mat image = delivered(scene.render(static_cast<uint64_t>(r)), jpeg_quality);
-            if (!save_frames.empty() && r == 0) {
-              cv::imwrite(
-                  save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) + ".png",
-                  image);
-            }
-            const picksight::Frame frame = frameOf(image);
-            pc::LocateOutcome outcome;
-            double sink = 0;
-            picksight::bench::timeInTurn<2>(turn++,
-                                            {[&] {
-                                               if (models->empty()) return;
-                                               outcome =
-                                                   pc::locateInFrame(frame, options, models, -1);
-                                             },
-                                             [&] {
-                                               cv::Mat grey = image;
-                                               if (image.channels() == 3)
-                                                 cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-                                               sink += picksight::bench::competentOpenCvPass(grey);
-                                             }},
-                                            {&row.locate_ms, &row.plain_ms});
-            if (!save_frames.empty() && r == 0 && !outcome.scene.mask.empty()) {
-              // What the vision pass took for parts: to look at beside the frame.
-              cv::imwrite(save_frames + "/" + condition + "-" + name + "-" + std::to_string(n) +
-                              "-mask.png",
-                          outcome.scene.mask);
-            }
-            if (stages && !models->empty()) {
-              // As locateInFrame prepares them: the vision image (a colour
-              // frame projected on the taught colours) and the frame's options.
-              const cv::Mat grey = pc::visionImage(frame, *models);
-              const pc::VisionOptions o =
-                  pc::frameOptions(options, frame.mapping, grey.size(), *models);
-              cv::Mat mask;
-              row.binarize_ms.push_back(
-                  picksight::bench::elapsedMs([&] { mask = pv::binarize(grey, o.binarize); }));
-              // The regions LOCATE finds: from the speck area up when the
-              // smallest region follows the models.
-              const pv::RegionOptions located = pc::locateRegionOptions(o, *models);
-              std::vector<pv::Region> regions;
-              row.regions_ms.push_back(picksight::bench::elapsedMs(
-                  [&] { regions = pv::findRegions(mask, located, grey); }));
-              pv::RegionOptions uncut = located;
-              uncut.cut_shadows = false;
-              row.uncut_ms.push_back(picksight::bench::elapsedMs(
-                  [&] { regions = pv::findRegions(mask, uncut, grey); }));
-            }
-            if (list_errors)
-              std::printf("  %s %s scene %d round %d:\n", condition.c_str(), name.c_str(), n, r);
-            score(scene.truth(), outcome, type_of_model, reference, list_errors, specs, row);
-            if (sink == 0) std::printf("!");
-          }
-        }
+        Row row = runArrangement(s, light, types, cell, arrangements[a]);
         if (teaching == 0) {
           row.pos_by_teaching.push_back(positionRms(row));
           row.recall_by_teaching.push_back(recallOf(row));
           taught_rows.push_back(row);
         } else {
-          addTeaching(row, types.size(), static_cast<size_t>(teaching), &taught_rows[a]);
+          addTeaching(row, specs.size(), static_cast<size_t>(teaching), &taught_rows[a]);
         }
-        std::fprintf(stderr, "%s %s done (teaching %d)\n", condition.c_str(), name.c_str(),
-                     teaching + 1);
+        std::fprintf(stderr, "%s %s done (teaching %d)\n", condition.c_str(),
+                     arrangements[a].c_str(), teaching + 1);
       }
     }
     rows.insert(rows.end(), taught_rows.begin(), taught_rows.end());
@@ -605,9 +672,9 @@ int main(int argc, char** argv) {
 
   std::printf(
       "\n%zu types (%s), %d scenes x %d frames per row%s, 1920x1080, 20 parts, %s\n", specs.size(),
-      standard_types ? "the silhouette benchmark's" : "unseen", scenes, rounds,
+      standard_types ? "the silhouette benchmark's" : "unseen", s.scenes, s.rounds,
       teachings > 1 ? (" x " + std::to_string(teachings) + " teachings").c_str() : "",
-      jpeg_quality > 0 ? ("JPEG quality " + std::to_string(jpeg_quality)).c_str() : "lossless");
+      s.jpeg_quality > 0 ? ("JPEG quality " + std::to_string(s.jpeg_quality)).c_str() : "lossless");
   std::printf("%-13s %-10s %5s %5s %5s %7s %9s %6s %5s %5s %8s %8s %8s %8s %8s %8s\n", "condition",
               "arrange", "LEARN", "AT", "none", "recall", "precision", "mirror", "size", "other",
               "pos RMS", "scatter", "ang RMS", "median", "p99", "plain");
@@ -650,7 +717,7 @@ int main(int argc, char** argv) {
                   *std::min_element(r.recall_by_teaching.begin(), r.recall_by_teaching.end()));
     }
   }
-  if (stages) {
+  if (s.stages) {
     std::printf(
         "\nwhere the time goes (medians, ms): binarize, regions (shadows cut), of which "
         "cutting shadows (regions less the pass without), the rest of the vision pass "
@@ -667,9 +734,9 @@ int main(int argc, char** argv) {
     }
   }
   for (const auto& r : rows) {
-    if (teach_views > 1 && r.arrangement == rows.front().arrangement) {
+    if (s.teach_views > 1 && r.arrangement == rows.front().arrangement) {
       std::printf("  %s: %d views per type, %d LEARNVIEWs refused\n", r.condition.c_str(),
-                  teach_views, r.views_refused);
+                  s.teach_views, r.views_refused);
     }
     if (r.arrangement == rows.front().arrangement && !r.first_refusal.empty()) {
       std::printf("  %s: LEARN first refused with \"%s\"\n", r.condition.c_str(),
