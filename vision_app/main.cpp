@@ -27,7 +27,13 @@ int main(int argc, char** argv) {
   using namespace picksight;
   setLogPrefix("vision");
   const std::vector<std::string> args(argv + 1, argv + argc);
-  if (app::isOfflineCommand(args)) return app::runOfflineCommand(args, std::cout, std::cerr);
+  if (app::isOfflineCommand(args)) {
+    // Image after image in one process (test-run over a folder): each
+    // frame's buffers kept for the next, as the service keeps them. Without,
+    // `test-run` over 45 frames of 1920x1080 took 2.1 s instead of 1.1.
+    retainLargeBuffers();
+    return app::runOfflineCommand(args, std::cout, std::cerr);
+  }
   bool help = false;
   auto options = app::parseAppArgs(args, &help);
   if (help) {

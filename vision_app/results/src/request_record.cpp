@@ -82,7 +82,14 @@ std::string unlikeSummary(size_t count, bool more) {
 
 bool unlikeAnyPart(const RegionRejection& r, const vision::Region& region,
                    const ModelList& models) {
-  if (r.test != "holes" && r.test != "area" && r.test != "hu" && r.test != "edge") return false;
+  // The tests read before the part's boundary, by the names the rejection
+  // holds (vision::regionTestName's).
+  using vision::RegionTest;
+  const auto named = [&](RegionTest t) { return r.test == vision::regionTestName(t); };
+  if (!named(RegionTest::kHoles) && !named(RegionTest::kArea) && !named(RegionTest::kHu) &&
+      !named(RegionTest::kEdge)) {
+    return false;
+  }
   return r.remedy_key.empty() && vision::unlikeEveryModel(region, modelsOf(models, -1));
 }
 
