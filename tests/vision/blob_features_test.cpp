@@ -235,3 +235,46 @@ TEST_CASE("a shape's extent is that of every pair of its hull's points", "[visio
     CHECK(e.width == Approx(width).margin(1e-9));
   }
 }
+
+TEST_CASE("an outline's extent is its points' to the last digit", "[vision][blob]") {
+  // The outlines of random pixel sets (discs, bars, lines, specks, some
+  // cut by the box's edge; rows with one pixel, columns of one): read from
+  // the rows' ends, the figures those of every point's hull.
+  cv::RNG rng(41);
+  int outlines = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    cv::Mat mask(120, 160, CV_8UC1, cv::Scalar(0));
+    for (int k = 0; k < 6; ++k) {
+      const cv::Point p(rng.uniform(-10, 170), rng.uniform(-10, 130));
+      switch (rng.uniform(0, 4)) {
+        case 0:
+          cv::circle(mask, p, rng.uniform(1, 40), cv::Scalar(255), cv::FILLED);
+          break;
+        case 1:
+          cv::line(mask, p, {rng.uniform(-10, 170), rng.uniform(-10, 130)}, cv::Scalar(255),
+                   rng.uniform(1, 4));
+          break;
+        case 2:
+          cv::ellipse(mask, p, {rng.uniform(1, 50), rng.uniform(1, 10)}, rng.uniform(0.0, 180.0), 0,
+                      360, cv::Scalar(255), cv::FILLED);
+          break;
+        default:
+          mask.at<uint8_t>(std::clamp(p.y, 0, 119), std::clamp(p.x, 0, 159)) = 255;
+          break;
+      }
+    }
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(mask, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
+    for (const auto& outline : contours) {
+      CAPTURE(trial, outline.size());
+      const Extent rows = extentOfOutline(outline);
+      const Extent points = extentOf(std::vector<cv::Point2f>(outline.begin(), outline.end()));
+      CHECK(rows.diameter == points.diameter);
+      CHECK(rows.width == points.width);
+      ++outlines;
+    }
+  }
+  CHECK(outlines > 300);
+  CHECK(extentOfOutline({{3, 4}}).diameter == 0);
+  CHECK(extentOfOutline({{0, 0}, {30, 40}}).diameter == 50);
+}

@@ -539,8 +539,7 @@ BlobSearch::BlobSearch(const std::vector<Region>& regions, size_t index,
                     region_.touches_border ? kMinBorderSteppedShare : kMinOutlineSteppedShare)) {
     return;
   }
-  const Extent blob_extent =
-      extentOf(std::vector<cv::Point2f>(region_.outer.begin(), region_.outer.end()));
+  const Extent blob_extent = extentOfOutline(region_.outer);
   // Of a blob the frame's edge cuts, the largest piece its erosion leaves
   // (kSeamPx; see leastCore).
   double core = region_.area;
