@@ -9,7 +9,8 @@
 
 namespace picksight {
 
-// Call once at the start of a long-running service, before its threads:
+// Call once at the start of a long-running service, or of a command that
+// reads image after image, before its threads:
 // blocks up to 32 MiB come from the heap and freed memory is kept up to
 // 128 MiB. Costs that much resident memory at most; a service that handles
 // frames every second would map it again anyway.

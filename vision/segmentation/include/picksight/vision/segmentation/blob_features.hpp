@@ -66,7 +66,7 @@ struct Extent {
 };
 Extent extentOf(const std::vector<cv::Point2f>& points);
 // The same of a region's outline (pixels), the same figures to the last
-// digit, in a tenth of the time.
+// digit, in a seventh of the time.
 Extent extentOfOutline(const std::vector<cv::Point>& outline);
 
 // Eccentricity of the moments' equivalent ellipse.
