@@ -282,8 +282,9 @@ cv::Mat& SyntheticSource::freeBuffer() {
   constexpr size_t kPoolSize = 4;
   for (auto& b : pool_) {
     // Only the pool refers to it: every frame made from it was released. The
-    // count is read atomically, as other threads release their references.
-    if (b.u != nullptr && CV_XADD(&b.u->refcount, 0) == 1) return b;
+    // count is read atomically, as other threads release their references
+    // (OpenCV's own CV_XADD is C11's _Atomic under clang, which warns in C++).
+    if (b.u != nullptr && __atomic_load_n(&b.u->refcount, __ATOMIC_ACQUIRE) == 1) return b;
   }
   if (pool_.size() < kPoolSize) return pool_.emplace_back();
   spare_ = cv::Mat();

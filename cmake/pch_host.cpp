@@ -1,0 +1,2 @@
+// The translation unit of the precompiled headers' hosts
+// (cmake/PrecompiledHeaders.cmake): its headers are all they compile.
