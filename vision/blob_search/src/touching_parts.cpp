@@ -23,6 +23,7 @@
 
 #include "blob_search.hpp"
 #include "picksight/common/angles.hpp"
+#include "picksight/vision/segmentation/disc_morphology.hpp"
 #include "picksight/vision/segmentation/row_runs.hpp"
 #include "touching_parts_internal.hpp"
 
@@ -470,15 +471,12 @@ FaintPart::FaintPart(const Region& r, const cv::Mat& blob, cv::Rect blob_box) {
   if (both.empty()) return;
   cv::Mat mask(r.grey.size(), CV_8UC1, cv::Scalar(0));
   blob(both - blob_box.tl()).copyTo(mask(both - origin_));
-  const auto disc = [](int radius) {
-    return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
-  };
   cv::Mat inside;
   cv::Mat near;
   cv::Mat ring;
-  cv::erode(mask, inside, disc(kLevelInsetPx));
-  cv::dilate(mask, near, disc(kRingFromPx));
-  cv::dilate(mask, ring, disc(kRingToPx));
+  erodeDisc(mask, inside, kLevelInsetPx);
+  dilateDisc(mask, near, kRingFromPx);
+  dilateDisc(mask, ring, kRingToPx);
   ring.setTo(0, near);
   const double part = medianWhere(r.grey, inside);
   const double surface = medianWhere(r.grey, ring);

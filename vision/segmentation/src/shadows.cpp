@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fill_contour.hpp"
+#include "picksight/vision/segmentation/disc_morphology.hpp"
 #include "picksight/vision/segmentation/row_runs.hpp"
 
 namespace picksight::vision {
@@ -133,10 +134,6 @@ Reaches reachesFor(double blur_px) {
   r.ring_inner = std::max(kRingInner, clear + 1);
   r.outside_sigma = kOutsideSigma * r.far_out / kFarOut;
   return r;
-}
-
-cv::Mat disc(int radius) {
-  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
 }
 
 using Histogram = std::array<int, 256>;
@@ -314,7 +311,7 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
       cv::Rect(0, 0, own.cols, own.rows);
   cv::Mat shadow = cv::Mat::zeros(own.size(), CV_8UC1);
   cv::Mat layers = shadow(r);
-  cv::dilate(core(r), layers, disc(kCoreDepth + 1));
+  dilateDisc(core(r), layers, kCoreDepth + 1);
   cv::bitwise_and(layers, lighter(r), layers);
   // Only layers on the outline: a lighter patch inside the part (a mark, a
   // highlight) is the part's.
@@ -369,10 +366,10 @@ cv::Mat thickLayer(const cv::Mat& g, const cv::Mat& own, const cv::Mat& interior
   cv::Mat rest;
   cv::bitwise_and(own(r), ~layers, rest);
   cv::Mat near;
-  cv::dilate(rest, near, disc(kStepReadPx));
+  dilateDisc(rest, near, kStepReadPx);
   cv::Mat layer_side;
   cv::bitwise_and(near, layers, layer_side);
-  cv::dilate(layers, near, disc(kStepReadPx));
+  dilateDisc(layers, near, kStepReadPx);
   cv::Mat part_side;
   cv::bitwise_and(near, rest, part_side);
   if (cv::countNonZero(layer_side) < kMinCorePixels || cv::countNonZero(part_side) < kMinCorePixels)
@@ -525,17 +522,17 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
 
   Levels l;
   cv::Mat interior;
-  cv::erode(own, interior, disc(kCoreDepth));
+  erodeDisc(own, interior, kCoreDepth);
   if (!levelsOf(g, interior, kMinShadowPixels, &l.part, &l.part_spread)) return false;
   cv::Mat near;
   cv::Mat ring;
-  cv::dilate(own, near, disc(reach.ring_inner));
+  dilateDisc(own, near, reach.ring_inner);
   // The inner disc twice makes about the outer one (40 pixels of a 220 px
   // box differ, at the ring's rim), and costs one pass with a 7x7 kernel
   // beside `near`'s (about 45 us on such a box) instead of one with 13x13
   // (about 140 us).
   static_assert(kRingOuter == 2 * kRingInner, "the ring's outer disc is two inner ones");
-  cv::dilate(near, ring, disc(reach.ring_inner));
+  dilateDisc(near, ring, reach.ring_inner);
   cv::bitwise_xor(ring, near, ring);
   cv::Mat free;
   cv::compare(mask(box), 0, free, cv::CMP_EQ);
@@ -567,7 +564,7 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
     double level = 0;
     levelsOf(g, layer, 1, &level);
     cv::Mat reach;
-    cv::dilate(layer, reach, disc(kCutReach));
+    dilateDisc(layer, reach, kCutReach);
     cv::bitwise_and(reach, own, reach);
     cv::Mat beyond;
     cv::compare(g, 0.5 * (l.part + level), beyond, cv::CMP_GE);
@@ -589,7 +586,7 @@ bool cutRegion(const cv::Mat& mask, const cv::Mat& grey,
   // where it shows clearly (the ring a tenth darker along an edge that runs
   // with the light moved a part by half a pixel): with a shadow, every edge
   // of the part is read against the level beside it.
-  cv::dilate(own, zone, disc(reach.far_out + kZoneReach));
+  dilateDisc(own, zone, reach.far_out + kZoneReach);
   const cv::Mat outside = outsideLevels(g, own, free, zone, cut->blur_px);
   int thin = 0;
   for (int y = 0; y < own.rows; ++y) {
@@ -661,8 +658,8 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
   const Reaches reach = reachesFor(blur_px);
   cv::Mat inner;
   cv::Mat ring;
-  cv::dilate(own, inner, disc(reach.near_out));
-  cv::dilate(own, ring, disc(reach.far_out));
+  dilateDisc(own, inner, reach.near_out);
+  dilateDisc(own, ring, reach.far_out);
   ring.setTo(0, inner);
   cv::bitwise_and(ring, free, ring);
   cv::bitwise_and(ring, where, ring);

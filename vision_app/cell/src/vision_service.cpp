@@ -20,6 +20,7 @@
 #include "picksight/vision/recognition/recognizer.hpp"
 #include "picksight/vision/recognition/region_explanation.hpp"
 #include "picksight/vision/segmentation/colour_axis.hpp"
+#include "picksight/vision/segmentation/disc_morphology.hpp"
 #include "picksight/vision/training/part_training.hpp"
 
 namespace picksight::cell {
@@ -437,13 +438,10 @@ std::optional<Levels> levelsOf(const vision::Region& r, const cv::Mat& grey, con
   cv::Mat own = cv::Mat::zeros(box.size(), CV_8U);
   cv::drawContours(own, std::vector<std::vector<cv::Point>>{r.outer}, 0, cv::Scalar(255),
                    cv::FILLED, cv::LINE_8, cv::noArray(), INT_MAX, -box.tl());
-  const auto disc = [](int radius) {
-    return cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * radius + 1, 2 * radius + 1});
-  };
   cv::Mat core, near, far;
-  cv::erode(own, core, disc(1));
-  cv::dilate(own, near, disc(kRingInner));
-  cv::dilate(own, far, disc(kRingOuter));
+  vision::erodeDisc(own, core, 1);
+  vision::dilateDisc(own, near, kRingInner);
+  vision::dilateDisc(own, far, kRingOuter);
   const cv::Mat ring = far & ~near & (mask(box) == 0);
   if (cv::countNonZero(core) == 0 || cv::countNonZero(ring) == 0) return std::nullopt;
   const cv::Mat surface = grey(box);

@@ -1,0 +1,107 @@
+// Disc dilation and erosion against OpenCV's own, pixel for pixel: random
+// masks and grey images, every radius from 0 to 9, boxes smaller than the
+// disc, views into larger images (whose neighbours OpenCV reads) and
+// results written in place.
+#include <catch2/catch.hpp>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "picksight/vision/segmentation/disc_morphology.hpp"
+
+namespace pv = picksight::vision;
+
+namespace {
+// Discs, bars and speckle on a black image, some cut by its edges; or
+// random grey levels (a morphology of any levels, not only masks).
+cv::Mat randomImage(std::mt19937& rng, int width, int height, bool grey) {
+  cv::Mat image(height, width, CV_8UC1, cv::Scalar(0));
+  if (grey) {
+    cv::randu(image, 0, 256);
+    return image;
+  }
+  std::uniform_int_distribution<int> x(-8, width + 8);
+  std::uniform_int_distribution<int> y(-8, height + 8);
+  std::uniform_int_distribution<int> size(1, 30);
+  std::uniform_int_distribution<int> kind(0, 2);
+  for (int i = 0; i < 10; ++i) {
+    const cv::Point p(x(rng), y(rng));
+    const int s = size(rng);
+    switch (kind(rng)) {
+      case 0:
+        cv::circle(image, p, s, cv::Scalar(255), cv::FILLED);
+        break;
+      case 1:
+        cv::line(image, p, p + cv::Point(s, s / 2), cv::Scalar(255), 1 + s % 3);
+        break;
+      default: {
+        std::uniform_int_distribution<int> in_x(0, width - 1);
+        std::uniform_int_distribution<int> in_y(0, height - 1);
+        for (int k = 0; k < 3 * s; ++k) image.at<uint8_t>(in_y(rng), in_x(rng)) = 255;
+      }
+    }
+  }
+  return image;
+}
+
+int differing(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size() || a.type() != b.type()) return -1;
+  return cv::countNonZero(a != b);
+}
+}  // namespace
+
+TEST_CASE("a disc's dilation and erosion are OpenCV's to the last pixel",
+          "[vision][segmentation]") {
+  std::mt19937 rng(20261207);
+  std::uniform_int_distribution<int> side(1, 90);
+  int compared = 0;
+  for (int radius = 0; radius <= 9; ++radius) {
+    const cv::Mat element = pv::discElement(radius);
+    for (int trial = 0; trial < 24; ++trial) {
+      const bool grey = trial % 4 == 3;
+      const cv::Mat image = randomImage(rng, side(rng), side(rng), grey);
+      // The whole image, and a view into it (OpenCV reads the view's
+      // neighbours in the larger image, up to the disc's reach).
+      cv::Rect view(0, 0, image.cols, image.rows);
+      if (trial % 2 == 1 && image.cols > 2 && image.rows > 2) {
+        std::uniform_int_distribution<int> x0(0, image.cols - 2);
+        std::uniform_int_distribution<int> y0(0, image.rows - 2);
+        view.x = x0(rng);
+        view.y = y0(rng);
+        view.width = std::uniform_int_distribution<int>(1, image.cols - view.x)(rng);
+        view.height = std::uniform_int_distribution<int>(1, image.rows - view.y)(rng);
+      }
+      const cv::Mat src = image(view);
+      std::ostringstream what;
+      what << "radius " << radius << ", " << image.cols << "x" << image.rows << " view " << view
+           << (grey ? " grey" : " mask");
+      INFO(what.str());
+      cv::Mat expected;
+      cv::Mat got;
+      cv::dilate(src, expected, element);
+      pv::dilateDisc(src, got, radius);
+      CHECK(differing(got, expected) == 0);
+      cv::erode(src, expected, element);
+      pv::erodeDisc(src, got, radius);
+      CHECK(differing(got, expected) == 0);
+      // In place, as `cv::erode(rest, rest, ...)` is written.
+      cv::Mat in_place = src.clone();
+      cv::Mat whole_expected;
+      cv::dilate(in_place, whole_expected, element);
+      pv::dilateDisc(in_place, in_place, radius);
+      CHECK(differing(in_place, whole_expected) == 0);
+      // Into a view of a larger image of src's size: written there.
+      cv::Mat canvas(src.rows + 4, src.cols + 4, CV_8UC1, cv::Scalar(7));
+      cv::Mat into = canvas(cv::Rect(2, 2, src.cols, src.rows));
+      pv::erodeDisc(src, into, radius);
+      cv::erode(src, expected, element);
+      CHECK(differing(canvas(cv::Rect(2, 2, src.cols, src.rows)), expected) == 0);
+      CHECK(canvas.at<uint8_t>(0, 0) == 7);
+      CHECK(canvas.at<uint8_t>(canvas.rows - 1, canvas.cols - 1) == 7);
+      ++compared;
+    }
+  }
+  CHECK(compared == 240);
+}

@@ -1,0 +1,160 @@
+// Dilation by a disc as maxima of row runs (see disc_morphology.hpp).
+#include "picksight/vision/segmentation/disc_morphology.hpp"
+
+#include <algorithm>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace picksight::vision {
+
+cv::Mat discElement(int radius) {
+  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+}
+
+namespace {
+// Up to this radius OpenCV's own filter is as fast or faster: on a part's
+// box (286 x 300), one thread, buffers kept, OpenCV 28 / 50 / 87 / 140 /
+// 188 / 2310 us at radius 2 / 3 / 4 / 5 / 6 / 20, these runs 36 / 42 / 52 /
+// 58 / 68 / 190 us.
+constexpr int kOwnUpTo = 2;
+
+// The half-width of each of the element's runs, row by row (-1: a row with
+// none), read from OpenCV's own element so that the pixels are its.
+std::vector<int> runHalfWidths(int radius) {
+  const cv::Mat e = discElement(radius);
+  std::vector<int> half(static_cast<size_t>(e.rows), -1);
+  for (int y = 0; y < e.rows; ++y) {
+    const uint8_t* row = e.ptr<uint8_t>(y);
+    const uint8_t* end = row + e.cols;
+    const uint8_t* first = std::find_if(row, end, [](uint8_t v) { return v != 0; });
+    if (first == end) continue;
+    const auto begin = static_cast<int>(first - row);
+    // One run, centred: what the maxima below assume.
+    const int last = 2 * radius - begin;
+    CV_Assert(last < e.cols &&
+              std::all_of(row + begin, row + last + 1, [](uint8_t v) { return v != 0; }) &&
+              std::none_of(row + last + 1, end, [](uint8_t v) { return v != 0; }));
+    half[static_cast<size_t>(y)] = radius - begin;
+  }
+  return half;
+}
+
+// The dilation of `inner` (a rectangle of `image`) by the disc, into dst;
+// `image` holds inner's neighbours as far as they are to be read. Each step
+// is one cv::max over whole images (OpenCV's vector code): hand-written
+// 16-byte loops fusing the steps were slower (radius 3: 48 us against 42).
+void dilateInner(const cv::Mat& image, const cv::Rect& inner, int radius, cv::Mat& dst) {
+  const std::vector<int> half = runHalfWidths(radius);
+  const int reach = *std::max_element(half.begin(), half.end());
+  const int rows = image.rows;
+  // The image with `reach` columns of zeros either side: a run reaching
+  // past the image's edge reads zeros, which change no maximum (OpenCV's
+  // default border for a dilation).
+  const int width = image.cols + 2 * reach;
+  cv::Mat padded = cv::Mat::zeros(rows, width, CV_8UC1);
+  image.copyTo(padded(cv::Rect(reach, 0, image.cols, rows)));
+  // levels[k]: at column x the maximum of padded's columns x to x + 2^k - 1,
+  // for x up to width - 2^k (the columns past it are not written).
+  std::vector<cv::Mat> levels{padded};
+  // Per half-width w: at inner's column x the maximum of the image's
+  // columns x - w to x + w, in every row of the image.
+  std::vector<cv::Mat> runs(static_cast<size_t>(reach) + 1);
+  for (const int w : half) {
+    if (w < 0 || !runs[static_cast<size_t>(w)].empty()) continue;
+    const int from = reach + inner.x - w;  // padded's column of the run's start
+    if (w == 0) {
+      runs[0] = padded.colRange(from, from + inner.width);
+      continue;
+    }
+    const int n = 2 * w + 1;
+    size_t k = 0;
+    while ((size_t{2} << k) <= static_cast<size_t>(n)) ++k;
+    const int span = 1 << k;  // the largest power of two up to n
+    while (levels.size() <= k) {
+      const cv::Mat& prev = levels.back();
+      const int step = 1 << (levels.size() - 1);
+      const int valid = width - 2 * step + 1;
+      cv::Mat next(rows, width, CV_8UC1);
+      cv::Mat written = next.colRange(0, valid);
+      cv::max(prev.colRange(0, valid), prev.colRange(step, step + valid), written);
+      levels.push_back(next);
+    }
+    // Two windows of `span` cover the n columns, overlapping in the middle.
+    cv::Mat run(rows, inner.width, CV_8UC1);
+    cv::max(levels[k].colRange(from, from + inner.width),
+            levels[k].colRange(from + n - span, from + n - span + inner.width), run);
+    runs[static_cast<size_t>(w)] = run;
+  }
+  // Down the disc's rows: dst's row y is the maximum of the runs of image
+  // rows inner.y + y + dy that exist. The first row range that covers all
+  // of dst sets it; otherwise it starts from zeros.
+  dst.create(inner.height, inner.width, CV_8UC1);
+  bool set = false;
+  for (size_t i = 0; i < half.size(); ++i) {
+    if (half[i] < 0) continue;
+    const int dy = static_cast<int>(i) - radius;
+    const int y0 = std::max(0, -(inner.y + dy));
+    const int y1 = std::min(inner.height, rows - (inner.y + dy));
+    const cv::Mat& run = runs[static_cast<size_t>(half[i])];
+    if (!set && y0 == 0 && y1 == inner.height) {
+      run.rowRange(inner.y + dy, inner.y + dy + inner.height).copyTo(dst);
+      set = true;
+      continue;
+    }
+    if (!set) {
+      dst.setTo(0);
+      set = true;
+    }
+    if (y0 >= y1) continue;
+    cv::Mat out = dst.rowRange(y0, y1);
+    cv::max(out, run.rowRange(inner.y + dy + y0, inner.y + dy + y1), out);
+  }
+}
+
+// src with the neighbours a disc of `radius` reads beyond it when src is a
+// view into a larger image (as OpenCV's morphology reads them), and where
+// src lies within it.
+cv::Mat withNeighbours(const cv::Mat& src, int radius, cv::Rect* inner) {
+  cv::Size whole;
+  cv::Point offset;
+  src.locateROI(whole, offset);
+  const int top = std::min(radius, offset.y);
+  const int left = std::min(radius, offset.x);
+  const int bottom = std::min(radius, whole.height - offset.y - src.rows);
+  const int right = std::min(radius, whole.width - offset.x - src.cols);
+  cv::Mat image = src;
+  image.adjustROI(top, bottom, left, right);
+  *inner = cv::Rect(left, top, src.cols, src.rows);
+  return image;
+}
+}  // namespace
+
+void dilateDisc(const cv::Mat& src, cv::Mat& dst, int radius) {
+  CV_Assert(src.type() == CV_8UC1 && radius >= 0);
+  if (radius <= kOwnUpTo || src.empty()) {
+    cv::dilate(src, dst, discElement(radius));
+    return;
+  }
+  cv::Rect inner;
+  const cv::Mat image = withNeighbours(src, radius, &inner);
+  dilateInner(image, inner, radius, dst);
+}
+
+void erodeDisc(const cv::Mat& src, cv::Mat& dst, int radius) {
+  CV_Assert(src.type() == CV_8UC1 && radius >= 0);
+  if (radius <= kOwnUpTo || src.empty()) {
+    cv::erode(src, dst, discElement(radius));
+    return;
+  }
+  // The erosion is the complement's dilation, complemented: past the
+  // image's edge the complement's zeros are the erosion's border (pixels
+  // outside take no part in a minimum either).
+  cv::Rect inner;
+  cv::Mat inverse;
+  cv::bitwise_not(withNeighbours(src, radius, &inner), inverse);
+  dilateInner(inverse, inner, radius, dst);
+  cv::bitwise_not(dst, dst);
+}
+
+}  // namespace picksight::vision
