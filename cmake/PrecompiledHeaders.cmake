@@ -1,13 +1,13 @@
 # Precompiled headers for every C++ target (PICKSIGHT_PCH). Three sources in
 # four include OpenCV's core and imgproc and the same standard headers, and
 # every test source Catch2: parsed once per build instead of once per
-# source. Two hosts make them, one per set of
-# flags a precompiled header must share with its users (the optimization
-# level among them: __OPTIMIZE__ changes the standard library's inlines):
-# picksight_pch for the libraries, programs and benchmarks (the build
-# type's -O2), picksight_test_pch for the test sources (-O0,
-# tests/CMakeLists.txt). Every other target reuses one of the two
-# (the hosts' own sources are empty).
+# source. Hosts make them, one per set of flags a precompiled header must
+# share with its users (the optimization level among them: __OPTIMIZE__
+# changes the standard library's inlines): picksight_pch for the libraries,
+# programs and benchmarks (the build type's -O2), picksight_test_pch for the
+# test sources (-O0, tests/CMakeLists.txt) and, in a fuzzing build,
+# picksight_fuzz_pch for the libraries with the fuzzers' coverage. Every
+# other target reuses one of them (the hosts' own sources are empty).
 #
 # The headers are included ahead of each source, so a source that forgot
 # one of them still compiles here: a tree without them (the option's
