@@ -24,8 +24,8 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "opencv_baseline.hpp"
 #include "picksight/cell/vision_service.hpp"
@@ -151,8 +151,9 @@ void addTeaching(const Row& more, size_t types, size_t teaching, Row* into) {
 cv::Mat delivered(const cv::Mat& image, int jpeg_quality) {
   if (jpeg_quality <= 0) return image;
   std::vector<uchar> bytes;
-  cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
-  return cv::imdecode(bytes, image.channels() == 3 ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
+  picksight::codecs::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+  return picksight::codecs::imdecode(
+      bytes, image.channels() == 3 ? cv::IMREAD_COLOR : cv::IMREAD_GRAYSCALE);
 }
 
 picksight::Frame frameOf(const cv::Mat& image) {
@@ -348,11 +349,11 @@ void saveTeachImage(const Settings& s, const Light& light, const std::string& ty
                     const cv::Mat& image) {
   const std::string name =
       light.condition + "-teach-" + type + (teaching > 0 ? "-" + std::to_string(teaching + 1) : "");
-  cv::imwrite(s.save_frames + "/" + name + ".png", image);
+  picksight::codecs::imwrite(s.save_frames + "/" + name + ".png", image);
   const auto seen =
       pc::locateInFrame(frameOf(image), light.options, std::make_shared<pst::ModelList>(), -1);
   if (!seen.scene.mask.empty())
-    cv::imwrite(s.save_frames + "/" + name + "-mask.png", seen.scene.mask);
+    picksight::codecs::imwrite(s.save_frames + "/" + name + "-mask.png", seen.scene.mask);
 }
 
 // More views of type i (LEARNVIEW) added to its learned model: the part
@@ -512,7 +513,7 @@ Row runArrangement(const Settings& s, const Light& light, const Types& types, co
     for (int r = 0; r < s.rounds; ++r) {
       const cv::Mat image = delivered(scene.render(static_cast<uint64_t>(r)), s.jpeg_quality);
       const bool save = !s.save_frames.empty() && r == 0;
-      if (save) cv::imwrite(frames + std::to_string(n) + ".png", image);
+      if (save) picksight::codecs::imwrite(frames + std::to_string(n) + ".png", image);
       const picksight::Frame frame = frameOf(image);
       pc::LocateOutcome outcome;
       double sink = 0;
@@ -531,7 +532,7 @@ Row runArrangement(const Settings& s, const Light& light, const Types& types, co
                                       {&row.locate_ms, &row.plain_ms});
       if (save && !outcome.scene.mask.empty()) {
         // What the vision pass took for parts: to look at beside the frame.
-        cv::imwrite(frames + std::to_string(n) + "-mask.png", outcome.scene.mask);
+        picksight::codecs::imwrite(frames + std::to_string(n) + "-mask.png", outcome.scene.mask);
       }
       if (s.stages && !cell.models->empty()) timeStages(frame, light, *cell.models, &row);
       if (s.list_errors) {
@@ -637,7 +638,8 @@ int main(int argc, char** argv) {
     if (!ps::frontLightCondition(condition, &look.front, &look.part_level,
                                  &look.background_level)) {
       const std::string photo = data_dir + "/surfaces/" + condition + ".png";
-      if (!ps::photographedCondition(condition, cv::imread(photo, cv::IMREAD_GRAYSCALE),
+      if (!ps::photographedCondition(condition,
+                                     picksight::codecs::imread(photo, cv::IMREAD_GRAYSCALE),
                                      &look.front, &look.part_level, &look.background_level)) {
         std::fprintf(stderr, "%s: cannot read %s\n", condition.c_str(), photo.c_str());
         return 1;

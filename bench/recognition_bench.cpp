@@ -15,8 +15,8 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "opencv_baseline.hpp"
 #include "picksight/common/angles.hpp"
@@ -230,7 +230,7 @@ struct Silhouette {
 };
 
 Silhouette loadSilhouette(const std::string& path, const std::string& name) {
-  const cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  const cv::Mat img = picksight::codecs::imread(path, cv::IMREAD_GRAYSCALE);
   Silhouette s;
   s.name = name;
   if (img.empty()) return s;

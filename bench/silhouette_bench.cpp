@@ -21,7 +21,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "opencv_baseline.hpp"
 #include "picksight/common/angles.hpp"
@@ -370,8 +370,8 @@ int main(int argc, char** argv) {
   const auto delivered = [jpeg_quality](const cv::Mat& image) {
     if (jpeg_quality <= 0) return image;
     std::vector<uchar> bytes;
-    cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
-    return cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+    picksight::codecs::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+    return picksight::codecs::imdecode(bytes, cv::IMREAD_GRAYSCALE);
   };
   if (threads >= 0) cv::setNumThreads(threads);
 

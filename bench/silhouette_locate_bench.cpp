@@ -19,7 +19,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "bench_cell.hpp"
 #include "opencv_baseline.hpp"
@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
       frames.push_back(scene.render(0));
       char file[64];
       std::snprintf(file, sizeof file, "/%04d.pgm", n);
-      if (!cv::imwrite(frames_dir + file, frames.back())) {
+      if (!picksight::codecs::imwrite(frames_dir + file, frames.back())) {
         std::fprintf(stderr, "cannot write %s%s\n", frames_dir.c_str(), file);
         return 1;
       }

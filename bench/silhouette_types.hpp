@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/command_line.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
@@ -91,7 +91,8 @@ inline bool loadSilhouetteTypes(const std::vector<TypeSpec>& specs, const std::s
       types->push_back(synthetic::silhouetteFromPartType(spec.name, spec.size_px));
       continue;
     }
-    const cv::Mat drawing = cv::imread(data_dir + "/" + spec.file, cv::IMREAD_GRAYSCALE);
+    const cv::Mat drawing =
+        picksight::codecs::imread(data_dir + "/" + spec.file, cv::IMREAD_GRAYSCALE);
     if (drawing.empty()) {
       std::fprintf(stderr, "cannot read %s/%s (--data DIR)\n", data_dir.c_str(), spec.file.c_str());
       return false;

@@ -32,7 +32,13 @@ int main(int argc, char** argv) {
     // frame's buffers kept for the next, as the service keeps them. Without,
     // `test-run` over 45 frames of 1920x1080 took 2.1 s instead of 1.25.
     retainLargeBuffers();
-    return app::runOfflineCommand(args, std::cout, std::cerr);
+    try {
+      return app::runOfflineCommand(args, std::cout, std::cerr);
+    } catch (const std::exception& e) {
+      // An installation fault (the codecs module missing), not a bad image.
+      std::cerr << "picksight-vision: " << e.what() << "\n";
+      return 1;
+    }
   }
   bool help = false;
   auto options = app::parseAppArgs(args, &help);

@@ -3,8 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/calibration/camera_calibration.hpp"
 
@@ -47,7 +47,7 @@ TEST_CASE("the chessboard views give OpenCV's own calibration of them", "[calibr
   for (int i : {1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13, 14}) {
     char name[32];
     std::snprintf(name, sizeof(name), "left%02d.jpg", i);
-    views.push_back(cv::imread(kBoardDir + name, cv::IMREAD_GRAYSCALE));
+    views.push_back(picksight::codecs::imread(kBoardDir + name, cv::IMREAD_GRAYSCALE));
     REQUIRE_FALSE(views.back().empty());
   }
   cv::FileStorage stored(kBoardDir + "left_intrinsics.yml", cv::FileStorage::READ);

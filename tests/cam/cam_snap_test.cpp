@@ -27,7 +27,7 @@ TEST_CASE("snap saves the frame with its exact pixels, honouring the stride", "[
   CHECK(run.err.empty());
   CHECK(run.out == "saved " + std::to_string(c.width) + "x" + std::to_string(c.height) + " " +
                        c.format + " frame #77 to " + file + "\n");
-  const cv::Mat read = cv::imread(file, cv::IMREAD_UNCHANGED);
+  const cv::Mat read = picksight::codecs::imread(file, cv::IMREAD_UNCHANGED);
   const cv::Mat expected = expectedImage(c.width, c.height, c.channels);
   REQUIRE(read.type() == expected.type());
   REQUIRE(read.size() == expected.size());
@@ -52,7 +52,7 @@ TEST_CASE("snap as JSON describes the saved frame", "[cam]") {
                        R"("triggered":true,"device_timestamp_ns":0,)"
                        R"("host_timestamp_ns":1700000000123456789})"
                        "\n");
-  CHECK(cv::imread(file, cv::IMREAD_UNCHANGED).size() == cv::Size(4, 2));
+  CHECK(picksight::codecs::imread(file, cv::IMREAD_UNCHANGED).size() == cv::Size(4, 2));
 }
 
 TEST_CASE("snap refuses a frame whose payload does not match its header", "[cam]") {

@@ -18,8 +18,8 @@
 #include <catch2/catch.hpp>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "cam_cli.hpp"
 #include "picksight.pb.h"

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <optional>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "cell_fixture.hpp"
 #include "picksight/common/atomic_file.hpp"
@@ -217,7 +217,8 @@ TEST_CASE("a camera tilted 2 degrees, calibrated on a dot grid, places parts wit
 TEST_CASE("picksight-cam target refuses bad positions and cameras without a robot and sets parts",
           "[e2e][calibration]") {
   test::TempDir dir;
-  REQUIRE(cv::imwrite(dir.file("still.png"), cv::Mat(64, 64, CV_8UC1, cv::Scalar(200))));
+  REQUIRE(
+      picksight::codecs::imwrite(dir.file("still.png"), cv::Mat(64, 64, CV_8UC1, cv::Scalar(200))));
   VideoServerProcess server(
       {"--source", kCamera, "--source", "cam1=file:" + dir.file("still.png")});
   const std::string cam = binPath("picksight-cam");

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "cell_fixture.hpp"
 #include "picksight/common/angles.hpp"

@@ -4,7 +4,7 @@
 // instead of old positions.
 #include <catch2/catch.hpp>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include <chrono>
 #include <filesystem>
@@ -80,7 +80,7 @@ TEST_CASE("LOCATE on a file camera whose file is gone is an error until it retur
           "[e2e][security]") {
   test::TempDir dir;
   const std::string path = (dir.path() / "scene.png").string();
-  REQUIRE(cv::imwrite(path, cv::Mat(240, 320, CV_8UC1, cv::Scalar(255))));
+  REQUIRE(picksight::codecs::imwrite(path, cv::Mat(240, 320, CV_8UC1, cv::Scalar(255))));
   VideoServerProcess server({"--source", "cam0=file:" + path, "--mode", "trigger"});
   VisionProcess vision(server);
   auto robot = vision.connect();
@@ -93,6 +93,6 @@ TEST_CASE("LOCATE on a file camera whose file is gone is an error until it retur
   // Every LOCATE now says so, at once: none waits for a frame.
   CHECK(robot.request("LOCATE 1", 10s)->rfind("ERROR 22 ", 0) == 0);
 
-  REQUIRE(cv::imwrite(path, cv::Mat(240, 320, CV_8UC1, cv::Scalar(255))));
+  REQUIRE(picksight::codecs::imwrite(path, cv::Mat(240, 320, CV_8UC1, cv::Scalar(255))));
   CHECK(requestUntil(robot, "LOCATE 1", "OK ").rfind("OK ", 0) == 0);
 }

@@ -3,10 +3,10 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
+#include "picksight/codecs/codecs.hpp"
 
 #include "cell_fixture.hpp"
 #include "picksight/common/clock.hpp"
@@ -212,7 +212,7 @@ TEST_CASE("snap saves the next frame and close releases the camera until open re
   const auto published = sub.receive(5s);
   REQUIRE(published);
   REQUIRE(cam(server, {"snap", "cam0", file}).exit_code == 0);
-  const cv::Mat saved = cv::imread(file, cv::IMREAD_UNCHANGED);
+  const cv::Mat saved = picksight::codecs::imread(file, cv::IMREAD_UNCHANGED);
   REQUIRE_FALSE(saved.empty());
   REQUIRE(saved.size() == cv::Size(640, 480));
   REQUIRE(saved.type() == CV_8UC1);
@@ -246,20 +246,20 @@ TEST_CASE("snap saves the next frame and close releases the camera until open re
 TEST_CASE("a file camera follows its image replaced by one of another size", "[e2e][video]") {
   picksight::test::TempDir dir;
   const std::string path = dir.file("scene.png");
-  REQUIRE(cv::imwrite(path, cv::Mat(480, 640, CV_8UC1, cv::Scalar(90))));
+  REQUIRE(picksight::codecs::imwrite(path, cv::Mat(480, 640, CV_8UC1, cv::Scalar(90))));
   VideoServerProcess server({"--source", "cam0=file:" + path, "--mode", "trigger"});
   const std::string snap = dir.file("snap.png");
   REQUIRE(cam(server, {"snap", "cam0", snap}).exit_code == 0);
-  REQUIRE(cv::imread(snap, cv::IMREAD_UNCHANGED).size() == cv::Size(640, 480));
+  REQUIRE(picksight::codecs::imread(snap, cv::IMREAD_UNCHANGED).size() == cv::Size(640, 480));
   CHECK(infoValue(cam(server, {"info", "cam0"}).out, "sensor") == "640x480");
 
   // Replaced as a person saving another photograph would (renamed over it).
   for (const cv::Size size : {cv::Size(800, 600), cv::Size(320, 200)}) {
     const std::string next = dir.file("next.png");
-    REQUIRE(cv::imwrite(next, cv::Mat(size, CV_8UC1, cv::Scalar(120))));
+    REQUIRE(picksight::codecs::imwrite(next, cv::Mat(size, CV_8UC1, cv::Scalar(120))));
     std::filesystem::rename(next, path);
     REQUIRE(cam(server, {"snap", "cam0", snap}).exit_code == 0);
-    CHECK(cv::imread(snap, cv::IMREAD_UNCHANGED).size() == size);
+    CHECK(picksight::codecs::imread(snap, cv::IMREAD_UNCHANGED).size() == size);
     // What clients map ROIs and parts through: the new size, no restart.
     const std::string info = cam(server, {"info", "cam0"}).out;
     INFO(info);

@@ -80,6 +80,7 @@ for path in ./usr/bin/picksight-video-server ./usr/bin/picksight-vision ./usr/bi
   ./usr/lib/systemd/system/picksight-video-server.service \
   "./usr/lib/systemd/system/picksight-vision@.service" ./usr/lib/sysusers.d/picksight.conf \
   ./usr/lib/tmpfiles.d/picksight.conf ./usr/lib/udev/rules.d/99-picksight-u3v.rules \
+  ./usr/lib/picksight/libpicksight_codecs.so \
   ./etc/picksight/video-server.yaml ./usr/share/doc/picksight/CAMERAS.md \
   ./etc/picksight/vision/cam0.yaml ./usr/share/doc/picksight/README.md \
   ./usr/share/doc/picksight/copyright ./usr/lib/python3/dist-packages/picksight/__init__.py \
@@ -213,6 +214,15 @@ reply="$(/usr/bin/picksight-robot --port "$port" --timeout 30 'LOCATE 1')" ||
   fail "picksight-robot LOCATE 1 failed: '$reply'"
 echo "LOCATE 1 -> $reply"
 [[ "$reply" == "OK "* ]] || fail "LOCATE replied '$reply'"
+# Image files through the installed codecs module (/usr/lib/picksight, which
+# no program links: docs/ARCHITECTURE.md): a snapshot written as PNG by the
+# packaged camera tool, read back by an offline LOCATE.
+snap_out="$(/usr/bin/picksight-cam --control "$control" snap cam0 "$work/snap.png" 2>&1)" ||
+  fail "picksight-cam snap: $snap_out"
+offline="$(/usr/bin/picksight-vision locate --data-dir "$work/offline" "$work/snap.png" 2>&1)" ||
+  fail "picksight-vision locate on the snapshot: $offline"
+[[ "$offline" == "OK "* ]] || fail "the offline LOCATE of the snapshot replied '$offline'"
+echo "snapshot through /usr/lib/picksight/libpicksight_codecs.so, offline LOCATE -> ${offline%% *} ${offline#OK }" | cut -c1-100
 
 # The packaged Python client with Debian's python3, from no build tree: the
 # installed module, and a request through it (its bytecode, written as root,

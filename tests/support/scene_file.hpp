@@ -7,7 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -44,7 +44,7 @@ struct SceneFile {
   SceneFile& operator=(const SceneFile&) = delete;
   void show(const cv::Mat& img) const {
     const std::string next = dir + "/next.png";
-    REQUIRE(cv::imwrite(next, img));
+    REQUIRE(picksight::codecs::imwrite(next, img));
     REQUIRE(std::rename(next.c_str(), path.c_str()) == 0);
   }
 };

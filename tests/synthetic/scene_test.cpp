@@ -13,8 +13,8 @@
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 namespace ps = picksight::synthetic;
 
@@ -514,8 +514,8 @@ TEST_CASE("render adds reproducible per-frame noise", "[synthetic]") {
 
 TEST_CASE("a photographed surface keeps the photograph's pattern at the condition's strength",
           "[synthetic][front]") {
-  const cv::Mat photo = cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/brick.png",
-                                   cv::IMREAD_GRAYSCALE);
+  const cv::Mat photo = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/brick.png", cv::IMREAD_GRAYSCALE);
   REQUIRE(!photo.empty());
   ps::FrontLight light;
   double part = 0;

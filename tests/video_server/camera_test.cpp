@@ -23,8 +23,8 @@
 
 #include <catch2/catch.hpp>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 #include "temp_dir.hpp"
 
 #include "picksight/video_server/camera.hpp"
@@ -375,7 +375,7 @@ TEST_CASE("Camera retries a source that is missing and streams once it appears",
   CHECK_THAT(camera->status().last_error, Catch::Contains(path));
   CHECK(sink.count() == 0);
 
-  REQUIRE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
+  REQUIRE(picksight::codecs::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
   CHECK(sink.waitForCount(1));
   CHECK(camera->status().state == "streaming");
   camera->stop();
@@ -389,7 +389,7 @@ TEST_CASE("Camera of a file that goes away fails after the grace period until it
           "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");
-  REQUIRE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
+  REQUIRE(picksight::codecs::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
   CollectingSink sink;
   auto camera = makeCamera(config(AcquisitionMode::kFreeRun, 20, "file:" + path), sink);
   camera->start();
@@ -410,7 +410,7 @@ TEST_CASE("Camera of a file that goes away fails after the grace period until it
   // Back: streams the new image.
   const size_t before = sink.count();
   const std::string tmp = dir.file("scene.tmp.png");
-  REQUIRE(cv::imwrite(tmp, cv::Mat(30, 40, CV_8UC1, cv::Scalar(7))));
+  REQUIRE(picksight::codecs::imwrite(tmp, cv::Mat(30, 40, CV_8UC1, cv::Scalar(7))));
   fs::rename(tmp, path);
   REQUIRE(sink.waitForCount(before + 1));
   CHECK(waitForState(*camera, "streaming"));
@@ -432,7 +432,7 @@ TEST_CASE("Camera in an outage refuses triggers at once and never bursts afterwa
     CHECK(refused.error().code == picksight::video::SourceErrc::kUnavailable);
     CHECK_THAT(refused.error().message, Catch::Contains("cam1") && Catch::Contains(path));
   }
-  REQUIRE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
+  REQUIRE(picksight::codecs::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(99))));
   REQUIRE(waitForState(*camera, "streaming"));
   // Absence, not speed: the refused triggers would have been served by now.
   std::this_thread::sleep_for(300ms);

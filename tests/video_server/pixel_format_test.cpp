@@ -8,8 +8,8 @@
 
 #include <catch2/catch.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/video_server/mjpeg_frame.hpp"
 #include "picksight/video_server/pixel_format.hpp"
@@ -159,7 +159,7 @@ TEST_CASE("MJPEG decodes to the encoded image", "[video_server][formats]") {
   cv::Mat image(48, 64, CV_8UC3, cv::Scalar(30, 160, 220));
   cv::rectangle(image, cv::Rect(16, 16, 16, 16), cv::Scalar(200, 20, 40), cv::FILLED);
   std::vector<uint8_t> jpeg;
-  REQUIRE(cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 95}));
+  REQUIRE(picksight::codecs::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 95}));
   const cv::Mat raw(1, static_cast<int>(jpeg.size()), CV_8UC1, jpeg.data());
 
   const cv::Mat bgr = convertOk(raw, PixelLayout::kMJPEG, OutputFormat::kBgr8);
@@ -207,7 +207,7 @@ TEST_CASE("MJPEG frames without Huffman tables or with bytes after the end decod
   cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
   std::vector<uint8_t> jpeg;
   // Not optimized: the encoder's tables are the standard ones, as in MJPEG.
-  REQUIRE(cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80}));
+  REQUIRE(picksight::codecs::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80}));
   const cv::Mat whole(1, static_cast<int>(jpeg.size()), CV_8UC1, jpeg.data());
   const cv::Mat expected_bgr = convertOk(whole, PixelLayout::kMJPEG, OutputFormat::kBgr8);
   const cv::Mat expected_grey = convertOk(whole, PixelLayout::kMJPEG, OutputFormat::kMono8);
@@ -245,7 +245,7 @@ TEST_CASE("MJPEG frames without Huffman tables or with bytes after the end decod
 TEST_CASE("corrupt and truncated MJPEG frames are errors, not crashes", "[video_server][formats]") {
   cv::Mat image(64, 64, CV_8UC1, cv::Scalar(90));
   std::vector<uint8_t> jpeg;
-  REQUIRE(cv::imencode(".jpg", image, jpeg));
+  REQUIRE(picksight::codecs::imencode(".jpg", image, jpeg));
   std::vector<uint8_t> truncated(jpeg.begin(), jpeg.begin() + static_cast<long>(jpeg.size() / 2));
   std::vector<uint8_t> garbage(500, 0x5A);
   garbage[0] = 0xFF;

@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "blob_search.hpp"
 #include "drawn_parts.hpp"
@@ -851,8 +851,8 @@ namespace {
 // A public silhouette of the test data (tests/data/`file`), `size` px
 // across, as a polygon about its centroid.
 ps::Shape drawnShape(const std::string& file, double size) {
-  const cv::Mat drawing =
-      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+  const cv::Mat drawing = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
   REQUIRE(!drawing.empty());
   const ps::SilhouetteType type = ps::silhouetteFromDrawing(file, drawing, size);
   std::vector<std::vector<cv::Point>> outlines;

@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
@@ -38,8 +38,8 @@ pv::Region onlyPart(const cv::Mat& image, pv::RegionOptions r = {}) {
 // A public silhouette of this repository's test data (`file` under
 // tests/data), `size` px across.
 ps::SilhouetteType drawn(const char* file, double size) {
-  const cv::Mat drawing =
-      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+  const cv::Mat drawing = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
   REQUIRE(!drawing.empty());
   return ps::silhouetteFromDrawing(file, drawing, size);
 }
@@ -773,8 +773,8 @@ TEST_CASE("a hole over a paving's light joint is a hole, not a glint", "[vision]
   // glint (beyond the bricks' median by over half the contrast), the hole
   // was filled, and the part's model verified turned end for end in a blob
   // with a part touching it: 7.7 px and 180 degrees off.
-  const cv::Mat photo = cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/brick.png",
-                                   cv::IMREAD_GRAYSCALE);
+  const cv::Mat photo = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/brick.png", cv::IMREAD_GRAYSCALE);
   REQUIRE(!photo.empty());
   ps::SilhouetteSceneOptions look;
   REQUIRE(ps::photographedCondition("brick", photo, &look.front, &look.part_level,

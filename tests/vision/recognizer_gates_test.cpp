@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "drawn_parts.hpp"
 #include "picksight/vision/models/part_model.hpp"
@@ -334,8 +334,8 @@ TEST_CASE("lone sweets in a photograph pass the shape test of one of them", "[vi
   // lit from one side, none perfectly round. Their highlights are holes in
   // the binarized image, left out by a minimum hole area, as a cell set up
   // for glossy parts would.
-  const cv::Mat grey = cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/smarties.png",
-                                  cv::IMREAD_GRAYSCALE);
+  const cv::Mat grey = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/smarties.png", cv::IMREAD_GRAYSCALE);
   REQUIRE_FALSE(grey.empty());
   TrainOptions options;
   options.regions.min_hole_area = 120;

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/models/part_model.hpp"
@@ -63,7 +63,7 @@ inline SilhouetteModels trainSilhouettes(const std::vector<SilhouetteSpec>& spec
       out.types.push_back(synthetic::silhouetteFromPartType(spec.name, spec.size_px));
     } else {
       const std::string path = std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + spec.file;
-      const cv::Mat drawing = cv::imread(path, cv::IMREAD_GRAYSCALE);
+      const cv::Mat drawing = picksight::codecs::imread(path, cv::IMREAD_GRAYSCALE);
       INFO(path);
       REQUIRE_FALSE(drawing.empty());
       out.types.push_back(synthetic::silhouetteFromDrawing(spec.name, drawing, spec.size_px));

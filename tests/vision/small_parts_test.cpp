@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "silhouette_support.hpp"
@@ -91,8 +91,8 @@ TEST_CASE("a model's lines and arcs lie on the part it was trained from", "[visi
        {Case{"shapes/tari1000/obj1_1.png", 120, 30}, Case{"shapes/tari1000/obj5_1.png", 200, 0},
         Case{"shapes/tari1000/obj6_1.png", 120, 30}}) {
     INFO(c.file << " at " << c.size_px << " px, turned " << c.turn_deg);
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + c.file, cv::IMREAD_GRAYSCALE);
+    const cv::Mat drawing = picksight::codecs::imread(
+        std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + c.file, cv::IMREAD_GRAYSCALE);
     REQUIRE_FALSE(drawing.empty());
     const auto type = ps::silhouetteFromDrawing("part", drawing, c.size_px);
     const int side = static_cast<int>(c.size_px * 1.5) + 300;

@@ -7,7 +7,7 @@
 
 #include <map>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/angles.hpp"
 #include "picksight/synthetic/scene.hpp"
@@ -134,7 +134,7 @@ TEST_CASE("a part located from its edges lands on its drawn centroid", "[vision]
   std::vector<PartModel> models;
   for (size_t i = 0; i < std::size(specs); ++i) {
     const std::string path = std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + specs[i].file;
-    const cv::Mat drawing = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    const cv::Mat drawing = picksight::codecs::imread(path, cv::IMREAD_GRAYSCALE);
     INFO(path);
     REQUIRE_FALSE(drawing.empty());
     types.push_back(ps::silhouetteFromDrawing(specs[i].name, drawing, specs[i].size_px));

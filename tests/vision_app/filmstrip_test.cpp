@@ -9,7 +9,7 @@
 #include <future>
 #include <mutex>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/filmstrip/filmstrip.hpp"
@@ -278,7 +278,8 @@ TEST_CASE("a filmstrip export is a folder a dir: camera serves in order",
     names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   CHECK(names == std::vector<std::string>{".filmstrip", "000001.png", "000002.png"});
-  CHECK(cv::imread(dir.file("export/000002.png"), cv::IMREAD_UNCHANGED).at<uchar>(0, 0) == 30);
+  CHECK(picksight::codecs::imread(dir.file("export/000002.png"), cv::IMREAD_UNCHANGED)
+            .at<uchar>(0, 0) == 30);
   CHECK(fs::exists(dir.file("export/.filmstrip/000002.json")));
   auto again = strip->exportTo(dir.file("export"), {1});
   REQUIRE_FALSE(again);

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/app/offline_commands.hpp"
 #include "picksight/cell/vision_service.hpp"
@@ -100,8 +100,8 @@ ps::SilhouetteScene sixParts(const ps::SilhouetteType& type, ps::SilhouetteScene
 
 // A public silhouette of this repository's test data, `size` px across.
 ps::SilhouetteType drawing(const std::string& file, double size) {
-  const cv::Mat image =
-      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+  const cv::Mat image = picksight::codecs::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file,
+                                                  cv::IMREAD_GRAYSCALE);
   REQUIRE(!image.empty());
   return ps::silhouetteFromDrawing(file, image, size);
 }
@@ -339,13 +339,13 @@ TEST_CASE("a green part on a grey belt is taught from a colour image file withou
   std::filesystem::create_directories(dir);
   ps::SilhouetteSceneOptions o = lookOf("colour");
   const cv::Mat alone = ps::renderSilhouetteAlone(boneType(), 630, o, 13, nullptr, 30);
-  REQUIRE(cv::imwrite((dir / "part.png").string(), alone));
+  REQUIRE(picksight::codecs::imwrite((dir / "part.png").string(), alone));
   o.width = 1280;
   o.height = 960;
   o.parts = 8;
   o.distractor_share = 0;
   const ps::SilhouetteScene scene({boneType()}, {true}, o);
-  REQUIRE(cv::imwrite((dir / "scene.png").string(), scene.render(0)));
+  REQUIRE(picksight::codecs::imwrite((dir / "scene.png").string(), scene.render(0)));
   const auto run = [&](const std::string& command, const std::string& image) {
     std::vector<std::string> args{command, "--data-dir", (dir / "data").string(), "--window",
                                   "400"};
@@ -364,7 +364,8 @@ TEST_CASE("a green part on a grey belt is taught from a colour image file withou
   CHECK_THAT(located, Catch::StartsWith("OK " + std::to_string(scene.truth().size()) + " "));
   // The same image as a JPEG (a phone's, an IP camera's): taught in colour
   // still, with the warning that its colour came at half resolution.
-  REQUIRE(cv::imwrite((dir / "part.jpg").string(), alone, {cv::IMWRITE_JPEG_QUALITY, 90}));
+  REQUIRE(picksight::codecs::imwrite((dir / "part.jpg").string(), alone,
+                                     {cv::IMWRITE_JPEG_QUALITY, 90}));
   const std::string from_jpeg = run("learn", "part.jpg");
   CHECK_THAT(from_jpeg, Catch::StartsWith("OK 1 tee "));
   CHECK_THAT(from_jpeg, Catch::Contains("came compressed"));
@@ -455,8 +456,8 @@ TEST_CASE("a model's edge offsets survive its file and a resize, and damaged one
 
 TEST_CASE("the sweets photograph: a green sweet taught in colour is found",
           "[vision_app][photograph][colour][front]") {
-  const cv::Mat photo =
-      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/smarties.png", cv::IMREAD_COLOR);
+  const cv::Mat photo = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/smarties.png", cv::IMREAD_COLOR);
   REQUIRE(!photo.empty());
   VisionOptions options;
   // The green sweet alone in the upper middle, as a user drags the box.
@@ -559,8 +560,8 @@ TEST_CASE("the turn of a separated part under a front light is read on its edges
   std::vector<ps::SilhouetteType> shapes;
   for (const int k : {2, 4, 7, 9, 12, 14, 17, 19, 21, 24}) {
     const std::string file = "shapes/tari1000/obj" + std::to_string(k) + "_7.png";
-    const cv::Mat drawing =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
+    const cv::Mat drawing = picksight::codecs::imread(
+        std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + file, cv::IMREAD_GRAYSCALE);
     REQUIRE(!drawing.empty());
     shapes.push_back(ps::silhouetteFromDrawing(file, drawing, 220));
   }
@@ -648,9 +649,9 @@ TEST_CASE("parts in the corners of a vignetted frame at 30 levels of contrast ar
 
 // The look of a condition on a photographed surface (tests/data/surfaces).
 ps::SilhouetteSceneOptions photographedLook(const std::string& condition) {
-  const cv::Mat photo =
-      cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/" + condition + ".png",
-                 cv::IMREAD_GRAYSCALE);
+  const cv::Mat photo = picksight::codecs::imread(
+      std::string(PICKSIGHT_TEST_DATA_DIR) + "/surfaces/" + condition + ".png",
+      cv::IMREAD_GRAYSCALE);
   REQUIRE(!photo.empty());
   ps::SilhouetteSceneOptions look;
   REQUIRE(ps::photographedCondition(condition, photo, &look.front, &look.part_level,
@@ -700,7 +701,7 @@ TEST_CASE("LEARN AT takes a small part on paving bricks, not the darker bricks b
   // speckled, and ringed by light joints: read against the joints' mean
   // they stood off the surface half as deep as the part, and LEARN AT
   // around the part (Tari-1000 obj18 at 190 px) counted them as parts.
-  const cv::Mat drawing = cv::imread(
+  const cv::Mat drawing = picksight::codecs::imread(
       std::string(PICKSIGHT_TEST_DATA_DIR) + "/shapes/tari1000/obj18_3.png", cv::IMREAD_GRAYSCALE);
   REQUIRE(!drawing.empty());
   const ps::SilhouetteType type = ps::silhouetteFromDrawing("obj18", drawing, 190);
@@ -1626,7 +1627,8 @@ TEST_CASE("picksight-vision learnview reads a part again in each image file and 
   for (int v = 0; v < 3; ++v) {
     const cv::Mat image =
         ps::renderSilhouetteAlone(boneType(), 600, look, 60 + v, nullptr, 30 + 47 * v);
-    REQUIRE(cv::imwrite((dir / ("view" + std::to_string(v) + ".png")).string(), image));
+    REQUIRE(
+        picksight::codecs::imwrite((dir / ("view" + std::to_string(v) + ".png")).string(), image));
   }
   const auto run = [&](std::vector<std::string> args, int expected_status) {
     args.insert(args.begin() + 1, {"--data-dir", (dir / "data").string(), "--window", "400"});

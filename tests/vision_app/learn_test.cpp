@@ -11,8 +11,8 @@
 #include <tuple>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
@@ -453,7 +453,7 @@ TEST_CASE("offline learn --at learns the one part inside a rectangle as LEARN AT
           "[learn][learn_at][offline]") {
   StillCell cell(fullFrame());
   const std::string image = cell.dir + "/scene.png";
-  REQUIRE(cv::imwrite(image, fullFrame()));
+  REQUIRE(picksight::codecs::imwrite(image, fullFrame()));
   const auto run = [&](std::vector<std::string> extra, std::string* err_text = nullptr) {
     std::vector<std::string> args{"learn", "--data-dir", cell.dir + "/offline", "--type", "4"};
     args.insert(args.end(), extra.begin(), extra.end());
@@ -480,7 +480,8 @@ TEST_CASE("offline learn --at learns the one part inside a rectangle as LEARN AT
   CHECK(*parseDouble(fields[3]) == Approx(M_PI * 110 * 110).epsilon(0.01));
   CHECK(std::filesystem::exists(cell.dir + "/offline/models/type_4.yaml"));
   // Its teach image beside it, the 1280 x 960 image shrunk to fit 1024.
-  const cv::Mat taught = cv::imread(cell.dir + "/offline/models/type_4.png", cv::IMREAD_UNCHANGED);
+  const cv::Mat taught =
+      picksight::codecs::imread(cell.dir + "/offline/models/type_4.png", cv::IMREAD_UNCHANGED);
   CHECK(taught.cols == 1024);
   CHECK(taught.rows == 768);
   std::string err;

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "cell_fixture.hpp"
 #include "temp_dir.hpp"
@@ -177,11 +177,11 @@ TEST_CASE("photographs: a part taught on its colour from a JPEG frame is warned 
   // copies are named .png.
   const test::TempDir dir;
   const auto asJpeg = [&](const std::string& scene) {
-    const cv::Mat photo =
-        cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + scene, cv::IMREAD_COLOR);
+    const cv::Mat photo = picksight::codecs::imread(
+        std::string(PICKSIGHT_TEST_DATA_DIR) + "/scenes/" + scene, cv::IMREAD_COLOR);
     REQUIRE(!photo.empty());
     std::vector<uint8_t> bytes;
-    REQUIRE(cv::imencode(".jpg", photo, bytes, {cv::IMWRITE_JPEG_QUALITY, 90}));
+    REQUIRE(picksight::codecs::imencode(".jpg", photo, bytes, {cv::IMWRITE_JPEG_QUALITY, 90}));
     return dir.write(scene, std::string(bytes.begin(), bytes.end()));
   };
   const std::string warned = "this frame came compressed";

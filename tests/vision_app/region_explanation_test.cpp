@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "../vision/drawn_parts.hpp"
 #include "picksight/cell/vision_service.hpp"
@@ -90,8 +90,8 @@ TEST_CASE("explanations agree with recognition on every separated region",
     if (spec.file.empty()) {
       types.push_back(ps::silhouetteFromPartType(spec.name, spec.size_px));
     } else {
-      const cv::Mat drawing =
-          cv::imread(std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + spec.file, cv::IMREAD_GRAYSCALE);
+      const cv::Mat drawing = picksight::codecs::imread(
+          std::string(PICKSIGHT_TEST_DATA_DIR) + "/" + spec.file, cv::IMREAD_GRAYSCALE);
       REQUIRE_FALSE(drawing.empty());
       types.push_back(ps::silhouetteFromDrawing(spec.name, drawing, spec.size_px));
     }

@@ -3,8 +3,8 @@
 // size, hand and type.
 #include <catch2/catch.hpp>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include <algorithm>
 #include <cmath>

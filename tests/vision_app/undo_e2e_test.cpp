@@ -14,7 +14,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "../vision/drawn_parts.hpp"
 #include "cell_fixture.hpp"
@@ -149,8 +149,8 @@ TEST_CASE("UNDO restores a forgotten model with its grasps and takes back TOLERA
 
 // The teach image beside a model: what the camera showed when it was taught.
 cv::Mat teachImage(const UndoCell& cell, int type = 1) {
-  return cv::imread(cell.data_dir + "/models/type_" + std::to_string(type) + ".png",
-                    cv::IMREAD_UNCHANGED);
+  return picksight::codecs::imread(cell.data_dir + "/models/type_" + std::to_string(type) + ".png",
+                                   cv::IMREAD_UNCHANGED);
 }
 
 bool same(const cv::Mat& a, const cv::Mat& b) {

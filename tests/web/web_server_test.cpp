@@ -12,8 +12,8 @@
 #include <optional>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/angles.hpp"
 #include "picksight/transport/control_client.hpp"
@@ -76,9 +76,9 @@ std::vector<uint64_t> streamParts(const WebProcess& web, const std::string& came
              [&](const char* data, size_t size) {
                parser.add(data, size);
                while (auto part = parser.next()) {
-                 const cv::Mat image =
-                     cv::imdecode(std::vector<unsigned char>(part->jpeg.begin(), part->jpeg.end()),
-                                  cv::IMREAD_UNCHANGED);
+                 const cv::Mat image = picksight::codecs::imdecode(
+                     std::vector<unsigned char>(part->jpeg.begin(), part->jpeg.end()),
+                     cv::IMREAD_UNCHANGED);
                  CHECK(!image.empty());
                  sequences.push_back(part->sequence);
                }
@@ -173,7 +173,7 @@ TEST_CASE("a snapshot is the published frame pixel for pixel", "[web]") {
     CHECK(png->get_header_value("Content-Type") == "image/png");
     CHECK(png->get_header_value("X-Frame-Timestamp-Ns") ==
           std::to_string(frame->info.host_timestamp_ns));
-    const cv::Mat decoded = cv::imdecode(
+    const cv::Mat decoded = picksight::codecs::imdecode(
         std::vector<unsigned char>(png->body.begin(), png->body.end()), cv::IMREAD_UNCHANGED);
     REQUIRE(decoded.size() == frame->image.size());
     REQUIRE(decoded.type() == frame->image.type());
@@ -317,7 +317,7 @@ TEST_CASE("events carry results published on a vision app's results stream", "[w
   auto binary = web.client().Get("/binary/cell1.png");
   REQUIRE(binary);
   CHECK(binary->status == 200);
-  const cv::Mat mask = cv::imdecode(
+  const cv::Mat mask = picksight::codecs::imdecode(
       std::vector<unsigned char>(binary->body.begin(), binary->body.end()), cv::IMREAD_UNCHANGED);
   REQUIRE(mask.type() == CV_8UC1);
   CHECK(mask.size() == cv::Size(320, 240));

@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "cam_cli.hpp"
 #include "picksight/common/text.hpp"
@@ -192,7 +192,7 @@ Result<proto::ControlRequest> buildSnap(const ArgReader& a, const std::string& c
   if (!file) return file.error();
   // Checked before asking: a snap in trigger mode takes a frame that the
   // vision apps receive too, which should not happen for a file never written.
-  if (!cv::haveImageWriter(*file)) {
+  if (!picksight::codecs::haveImageWriter(*file)) {
     return usageError("snap: no image writer for '" + *file +
                       "'; the extension names the format (.png, .jpg, .tiff, .bmp)");
   }

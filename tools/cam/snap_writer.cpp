@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/transport/frame_message.hpp"
 #include "reply_printer.hpp"
@@ -33,9 +33,11 @@ Result<void> saveSnap(const std::string& camera, const proto::SnapReply& snap,
   bool written = false;
   std::string reason = "cannot write the file (does its directory exist, is it writable?)";
   try {
-    written = cv::imwrite(file, frame->image);
+    written = picksight::codecs::imwrite(file, frame->image);
   } catch (const cv::Exception& e) {
     reason = e.err;  // what() adds OpenCV's source path and line
+  } catch (const std::exception& e) {
+    reason = e.what();  // the codecs module missing from the installation
   }
   if (!written) return makeError(CliErrc::kSaveFailed, "could not save '" + file + "': " + reason);
 

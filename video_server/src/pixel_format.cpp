@@ -3,8 +3,8 @@
 
 #include "picksight/video_server/mjpeg_frame.hpp"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -153,7 +153,7 @@ Result<cv::Mat> decodeJpeg(const cv::Mat& raw, bool mono) {
   const Result<cv::Mat> jpeg = completeMjpegFrame(raw);
   if (!jpeg) return jpeg.error();
   // Decoding to grey skips the colour planes entirely (libjpeg reads Y only).
-  cv::Mat out = cv::imdecode(*jpeg, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+  cv::Mat out = picksight::codecs::imdecode(*jpeg, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
   if (out.empty()) {
     return makeError(SourceErrc::kBadValue, "corrupt MJPEG frame (" + std::to_string(raw.total()) +
                                                 " bytes): not decodable");

@@ -20,9 +20,9 @@
 #include <httplib.h>
 #include <sodium.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <zmq.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/common/log.hpp"
@@ -606,7 +606,8 @@ void WebServer::Impl::snapshot(const std::string& camera, httplib::Response& res
   // tens of milliseconds instead of hundreds.
   if (!onIdle(
           [&] {
-            encoded = cv::imencode(".png", frame->image, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+            encoded = picksight::codecs::imencode(".png", frame->image, png,
+                                                  {cv::IMWRITE_PNG_COMPRESSION, 1});
           },
           res))
     return;
@@ -758,7 +759,8 @@ void WebServer::Impl::binary(const std::string& name, const httplib::Request& re
             cv::Mat grey = frame->image;
             if (grey.channels() == 3) cv::cvtColor(frame->image, grey, cv::COLOR_BGR2GRAY);
             const cv::Mat mask = vision::binarize(grey, options);
-            encoded = cv::imencode(".png", mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
+            encoded =
+                picksight::codecs::imencode(".png", mask, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
           },
           res))
     return;

@@ -12,8 +12,8 @@
 
 #include <catch2/catch.hpp>
 
-#include <opencv2/imgcodecs.hpp>
 #include <zmq.hpp>
+#include "picksight/codecs/codecs.hpp"
 #include "temp_dir.hpp"
 
 #include "picksight/sources/source.hpp"
@@ -31,7 +31,7 @@ using picksight::test::TempDir;
 
 // A flat grey image whose level identifies it.
 void writeImage(const fs::path& file, int level, cv::Size size = {32, 24}) {
-  REQUIRE(cv::imwrite(file.string(), cv::Mat(size, CV_8UC1, cv::Scalar(level))));
+  REQUIRE(picksight::codecs::imwrite(file.string(), cv::Mat(size, CV_8UC1, cv::Scalar(level))));
 }
 
 int levelOf(Source& source) {
@@ -87,10 +87,10 @@ TEST_CASE("dir: the listing is re-read when files come and go", "[video_server][
 
 TEST_CASE("dir: 16-bit images are Mono16, colour images BGR8", "[video_server][dir]") {
   TempDir dir;
-  REQUIRE(
-      cv::imwrite((dir.path() / "0.png").string(), cv::Mat(8, 8, CV_16UC1, cv::Scalar(257 * 200))));
-  REQUIRE(
-      cv::imwrite((dir.path() / "1.png").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(10, 20, 30))));
+  REQUIRE(picksight::codecs::imwrite((dir.path() / "0.png").string(),
+                                     cv::Mat(8, 8, CV_16UC1, cv::Scalar(257 * 200))));
+  REQUIRE(picksight::codecs::imwrite((dir.path() / "1.png").string(),
+                                     cv::Mat(8, 8, CV_8UC3, cv::Scalar(10, 20, 30))));
   auto source = dirSource(dir.path());
   REQUIRE(source->open());
   auto deep = source->grab(1s);
@@ -108,8 +108,8 @@ TEST_CASE("dir: 16-bit images are Mono16, colour images BGR8", "[video_server][d
 TEST_CASE("dir: a JPEG's frame is marked compressed, a PNG's is not", "[video_server][dir]") {
   TempDir dir;
   const cv::Mat bgr(8, 8, CV_8UC3, cv::Scalar(10, 20, 30));
-  REQUIRE(cv::imwrite((dir.path() / "0.jpg").string(), bgr));
-  REQUIRE(cv::imwrite((dir.path() / "1.png").string(), bgr));
+  REQUIRE(picksight::codecs::imwrite((dir.path() / "0.jpg").string(), bgr));
+  REQUIRE(picksight::codecs::imwrite((dir.path() / "1.png").string(), bgr));
   auto source = dirSource(dir.path());
   REQUIRE(source->open());
   auto jpeg = source->grab(1s);

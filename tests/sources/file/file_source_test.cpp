@@ -16,7 +16,7 @@
 #include <catch2/catch.hpp>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 #include "temp_dir.hpp"
 
 #include "picksight/sources/source.hpp"
@@ -69,7 +69,7 @@ TEST_CASE("FileSource serves the image on every grab", "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");
   const cv::Mat a = sceneImage(1);
-  REQUIRE(cv::imwrite(path, a));
+  REQUIRE(picksight::codecs::imwrite(path, a));
   auto source = fileSource(path);
   REQUIRE(source->open());
   const auto info = source->info();
@@ -85,7 +85,7 @@ TEST_CASE("FileSource serves colour as BGR and 16-bit images as 8-bit", "[video_
   SECTION("colour") {
     cv::Mat bgr(10, 12, CV_8UC3, cv::Scalar(10, 20, 30));
     const std::string path = dir.file("colour.png");
-    REQUIRE(cv::imwrite(path, bgr));
+    REQUIRE(picksight::codecs::imwrite(path, bgr));
     auto source = fileSource(path);
     REQUIRE(source->open());
     const cv::Mat image = grabImage(*source);
@@ -95,7 +95,7 @@ TEST_CASE("FileSource serves colour as BGR and 16-bit images as 8-bit", "[video_
   SECTION("16-bit") {
     cv::Mat deep(10, 12, CV_16UC1, cv::Scalar(200 * 257));
     const std::string path = dir.file("deep.png");
-    REQUIRE(cv::imwrite(path, deep));
+    REQUIRE(picksight::codecs::imwrite(path, deep));
     auto source = fileSource(path);
     REQUIRE(source->open());
     const cv::Mat image = grabImage(*source);
@@ -109,7 +109,7 @@ TEST_CASE("FileSource marks a JPEG's frames compressed, by its content, not its 
   TempDir dir;
   const cv::Mat bgr(48, 64, CV_8UC3, cv::Scalar(40, 160, 70));
   std::vector<uint8_t> jpeg;
-  REQUIRE(cv::imencode(".jpg", bgr, jpeg));
+  REQUIRE(picksight::codecs::imencode(".jpg", bgr, jpeg));
   const std::string named_png = dir.file("photo.png");
   std::ofstream(named_png, std::ios::binary)
       .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
@@ -120,7 +120,7 @@ TEST_CASE("FileSource marks a JPEG's frames compressed, by its content, not its 
   CHECK(frame->compressed);
   // A lossless image, even named .jpg, is not.
   const std::string lossless = dir.file("photo.jpg.png");
-  REQUIRE(cv::imwrite(lossless, bgr));
+  REQUIRE(picksight::codecs::imwrite(lossless, bgr));
   const std::string named_jpg = dir.file("lossless.jpg");
   REQUIRE(std::rename(lossless.c_str(), named_jpg.c_str()) == 0);
   auto plain = fileSource(named_jpg);
@@ -133,13 +133,13 @@ TEST_CASE("FileSource marks a JPEG's frames compressed, by its content, not its 
 TEST_CASE("FileSource picks up a new image renamed over the path", "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");
-  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  REQUIRE(picksight::codecs::imwrite(path, sceneImage(1)));
   auto source = fileSource(path);
   REQUIRE(source->open());
   CHECK(sameImage(grabImage(*source), sceneImage(1)));
 
   const std::string tmp = dir.file("scene.tmp.png");
-  REQUIRE(cv::imwrite(tmp, sceneImage(2)));
+  REQUIRE(picksight::codecs::imwrite(tmp, sceneImage(2)));
   REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
   CHECK(sameImage(grabImage(*source), sceneImage(2)));
   CHECK(sameImage(grabImage(*source), sceneImage(2)));
@@ -150,14 +150,14 @@ TEST_CASE("FileSource picks up a renamed image of equal size and mtime (new inod
   TempDir dir;
   // PGM: the file size depends only on the image size.
   const std::string path = dir.file("scene.pgm");
-  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  REQUIRE(picksight::codecs::imwrite(path, sceneImage(1)));
   auto source = fileSource(path);
   REQUIRE(source->open());
   CHECK(sameImage(grabImage(*source), sceneImage(1)));
   const struct stat before = statOf(path);
 
   const std::string tmp = dir.file("scene.tmp.pgm");
-  REQUIRE(cv::imwrite(tmp, sceneImage(2)));
+  REQUIRE(picksight::codecs::imwrite(tmp, sceneImage(2)));
   const timespec times[2] = {before.st_atim, before.st_mtim};
   REQUIRE(::utimensat(AT_FDCWD, tmp.c_str(), times, 0) == 0);
   REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
@@ -199,7 +199,7 @@ TEST_CASE("FileSource keeps the last image while the file is missing or unreadab
           "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");
-  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  REQUIRE(picksight::codecs::imwrite(path, sceneImage(1)));
   auto source = fileSource(path);
   REQUIRE(source->open());
   CHECK(sameImage(grabImage(*source), sceneImage(1)));
@@ -211,7 +211,7 @@ TEST_CASE("FileSource keeps the last image while the file is missing or unreadab
   CHECK(sameImage(grabImage(*source), sceneImage(1)));
 
   const std::string tmp = dir.file("scene.tmp.png");
-  REQUIRE(cv::imwrite(tmp, sceneImage(3)));
+  REQUIRE(picksight::codecs::imwrite(tmp, sceneImage(3)));
   REQUIRE(std::rename(tmp.c_str(), path.c_str()) == 0);
   CHECK(sameImage(grabImage(*source), sceneImage(3)));
 }
@@ -220,7 +220,7 @@ TEST_CASE("FileSource fails once the file stays gone or unreadable past the grac
           "[video_server]") {
   TempDir dir;
   const std::string path = dir.file("scene.png");
-  REQUIRE(cv::imwrite(path, sceneImage(1)));
+  REQUIRE(picksight::codecs::imwrite(path, sceneImage(1)));
   auto source = fileSource(path);
   REQUIRE(source->open());
   CHECK(sameImage(grabImage(*source), sceneImage(1)));
@@ -244,7 +244,7 @@ TEST_CASE("FileSource fails once the file stays gone or unreadable past the grac
   // As the camera does: close, then open again until the file is back.
   source->close();
   CHECK_FALSE(source->open());
-  REQUIRE(cv::imwrite(path, sceneImage(2)));
+  REQUIRE(picksight::codecs::imwrite(path, sceneImage(2)));
   REQUIRE(source->open());
   CHECK(sameImage(grabImage(*source), sceneImage(2)));
 }

@@ -20,8 +20,8 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/clock.hpp"
 #include "picksight/sources/source.hpp"
@@ -105,7 +105,7 @@ class MjpegHttpServer {
       cv::Mat image(240, 320, CV_8UC3, cv::Scalar(50, 200, 50));
       image(cv::Rect(0, 0, 160, 240)).setTo(cv::Scalar(level_.load(), 100, 200));
       std::vector<uint8_t> jpeg;
-      cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
+      picksight::codecs::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
       const std::string part =
           "--frame\r\nContent-Type: image/jpeg\r\nContent-Length: " + std::to_string(jpeg.size()) +
           "\r\n\r\n";

@@ -13,7 +13,7 @@
 #include <thread>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 namespace picksight::video::testing {
 namespace {
@@ -221,10 +221,10 @@ void SimulatedV4l2Device::fill(uint32_t index) {
     used = size_t{pix_.bytesperline} * pix_.height;
   } else {
     std::vector<uint8_t> jpeg;
-    cv::imencode(".jpg",
-                 cv::Mat(static_cast<int>(pix_.height), static_cast<int>(pix_.width), CV_8UC3,
-                         cv::Scalar(y, y, y)),
-                 jpeg);
+    picksight::codecs::imencode(".jpg",
+                                cv::Mat(static_cast<int>(pix_.height), static_cast<int>(pix_.width),
+                                        CV_8UC3, cv::Scalar(y, y, y)),
+                                jpeg);
     std::copy(jpeg.begin(), jpeg.end(), b.bytes.begin());
     used = jpeg.size();
   }

@@ -7,8 +7,8 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <system_error>
+#include "picksight/codecs/codecs.hpp"
 
 #include "eight_bit_image.hpp"
 #include "picksight/common/frame.hpp"
@@ -118,7 +118,7 @@ Result<SourceFrame> DirSource::grab(std::chrono::milliseconds /*timeout*/) {
     const std::string file = path_ + "/" + name;
     cv::Mat image;
     try {
-      image = cv::imread(file, cv::IMREAD_UNCHANGED);
+      image = picksight::codecs::imread(file, cv::IMREAD_UNCHANGED);
     } catch (const cv::Exception&) {
       image.release();  // a decoder that throws on a corrupt file: skipped like any unreadable one
     }

@@ -5,7 +5,7 @@
 
 #include <cerrno>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "eight_bit_image.hpp"
 #include "picksight/common/frame.hpp"
@@ -43,7 +43,7 @@ Result<void> FileSource::refresh() {
     failing_since_.reset();  // back as it was (moved away and back)
     return {};
   }
-  cv::Mat loaded = cv::imread(path_, cv::IMREAD_UNCHANGED);
+  cv::Mat loaded = picksight::codecs::imread(path_, cv::IMREAD_UNCHANGED);
   if (loaded.empty()) return failing("not a readable image");
   failing_since_.reset();
   image_ = toEightBit(loaded);

@@ -1,14 +1,13 @@
 // Stream camera source.
 #include "stream_source.hpp"
 
-#include <opencv2/videoio.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
 #include <vector>
 
+#include "picksight/codecs/codecs.hpp"
 #include "picksight/common/clock.hpp"
 #include "picksight/common/text.hpp"
 
@@ -86,12 +85,14 @@ StreamSource::~StreamSource() { close(); }
 
 Result<void> StreamSource::open() {
   close();
-  auto capture = std::make_unique<cv::VideoCapture>();
+  std::unique_ptr<cv::VideoCapture> capture;
   const std::vector<int> params = {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, kOpenTimeoutMs,
                                    cv::CAP_PROP_READ_TIMEOUT_MSEC, kReadTimeoutMs};
   try {
+    capture = codecs::newVideoCapture();
     capture->open(url_, cv::CAP_FFMPEG, params);
-  } catch (const cv::Exception& e) {
+  } catch (const std::exception& e) {
+    // cv::Exception, or the codecs module missing from the installation.
     return makeError(SourceErrc::kUnavailable, "stream:" + url_ + ": " + e.what());
   }
   if (!capture->isOpened())

@@ -1,8 +1,8 @@
 // Offline subcommands over image files.
 #include "picksight/app/offline_commands.hpp"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -117,7 +117,7 @@ int runLens(const std::vector<std::string>& args, std::ostream& out, std::ostrea
       err << "picksight-vision lens: unknown option '" << a << "'\n";
       return 2;
     } else {
-      views.push_back(cv::imread(a, cv::IMREAD_GRAYSCALE));
+      views.push_back(picksight::codecs::imread(a, cv::IMREAD_GRAYSCALE));
       if (views.back().empty()) err << "picksight-vision lens: cannot read '" << a << "'\n";
     }
   }
@@ -154,7 +154,7 @@ namespace {
 // colour one (a colour camera's frame is read in colour where a model was
 // taught by its colour); empty when it cannot be read.
 cv::Mat readFrameImage(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_ANYCOLOR);
+  cv::Mat image = picksight::codecs::imread(path, cv::IMREAD_ANYCOLOR);
   if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
   return image;
 }

@@ -2,8 +2,8 @@
 // sensor pixels; training and blob features on the same frames.
 #include "picksight/cell/vision_service.hpp"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include <algorithm>
 #include <climits>
@@ -332,7 +332,7 @@ std::optional<std::string> teachImagePng(const cv::Mat& frame) {
     cv::resize(frame, image, size, 0, 0, cv::INTER_AREA);
   }
   std::vector<uchar> png;
-  if (!cv::imencode(".png", image, png)) return std::nullopt;
+  if (!picksight::codecs::imencode(".png", image, png)) return std::nullopt;
   return std::string(png.begin(), png.end());
 }
 

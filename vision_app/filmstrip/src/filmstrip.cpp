@@ -18,7 +18,7 @@
 #include <mutex>
 #include <thread>
 
-#include <opencv2/imgcodecs.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/common/log.hpp"
@@ -405,7 +405,7 @@ Result<std::pair<Entry, cv::Mat>> Filmstrip::frame(uint64_t id) const {
     return makeError(FilmstripErrc::kNoFrame, "filmstrip entry " + std::to_string(id) +
                                                   " has no frame (the request failed before one)");
   const std::string file = impl_->path(e->image);
-  cv::Mat image = cv::imread(file, cv::IMREAD_UNCHANGED);
+  cv::Mat image = picksight::codecs::imread(file, cv::IMREAD_UNCHANGED);
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
     return makeError(FilmstripErrc::kDamaged, file + ": not an 8-bit grey or colour PNG");
   return std::make_pair(std::move(*e), std::move(image));

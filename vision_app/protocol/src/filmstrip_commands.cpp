@@ -7,8 +7,8 @@
 #include <cctype>
 #include <limits>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 #include "picksight/cell/vision_settings.hpp"
 #include "picksight/common/text.hpp"
@@ -108,7 +108,7 @@ std::string image(const Request& r, const Filmstrip& strip) {
                0, 0, cv::INTER_AREA);
   }
   std::vector<uchar> png;
-  if (!cv::imencode(".png", picture, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
+  if (!picksight::codecs::imencode(".png", picture, png, {cv::IMWRITE_PNG_COMPRESSION, 1}))
     return errorReply(FilmstripErrc::kDamaged,
                       "the frame of entry " + std::to_string(*id) + " cannot be encoded");
   return "OK " + std::to_string(picture.cols) + " " + std::to_string(picture.rows) + " " +
