@@ -67,8 +67,8 @@ bool imencode(const std::string& ext, cv::InputArray image, std::vector<uchar>& 
 
 bool haveImageWriter(const std::string& path) { return table().haveImageWriter(path); }
 
-std::unique_ptr<cv::VideoCapture> newVideoCapture() {
-  return std::unique_ptr<cv::VideoCapture>(table().newVideoCapture());
+std::unique_ptr<VideoStream> newVideoStream() {
+  return std::unique_ptr<VideoStream>(table().newVideoStream());
 }
 
 }  // namespace picksight::codecs

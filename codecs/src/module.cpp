@@ -22,7 +22,22 @@ bool encodeImage(const std::string& ext, cv::InputArray image, std::vector<uchar
 
 bool haveWriter(const std::string& path) { return cv::haveImageWriter(path); }
 
-cv::VideoCapture* newCapture() { return new cv::VideoCapture(); }
+class CaptureStream final : public picksight::codecs::VideoStream {
+ public:
+  bool open(const std::string& url, int api, const std::vector<int>& params) override {
+    return capture_.open(url, api, params);
+  }
+  bool isOpened() const override { return capture_.isOpened(); }
+  bool grab() override { return capture_.grab(); }
+  bool retrieve(cv::Mat& image) override { return capture_.retrieve(image); }
+  double get(int property) const override { return capture_.get(property); }
+  bool set(int property, double value) override { return capture_.set(property, value); }
+
+ private:
+  cv::VideoCapture capture_;
+};
+
+picksight::codecs::VideoStream* newStream() { return new CaptureStream(); }
 
 const picksight::codecs::ModuleTable kTable{picksight::codecs::kModuleVersion,
                                             readImage,
@@ -30,7 +45,7 @@ const picksight::codecs::ModuleTable kTable{picksight::codecs::kModuleVersion,
                                             decodeImage,
                                             encodeImage,
                                             haveWriter,
-                                            newCapture};
+                                            newStream};
 
 }  // namespace
 

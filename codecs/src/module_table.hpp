@@ -7,7 +7,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/videoio.hpp>
+#include "picksight/codecs/codecs.hpp"
 
 namespace picksight::codecs {
 
@@ -21,10 +21,10 @@ struct ModuleTable {
   bool (*imencode)(const std::string& ext, cv::InputArray image, std::vector<uchar>& bytes,
                    const std::vector<int>& params);
   bool (*haveImageWriter)(const std::string& path);
-  cv::VideoCapture* (*newVideoCapture)();
+  VideoStream* (*newVideoStream)();
 };
 
-inline constexpr int kModuleVersion = 1;
+inline constexpr int kModuleVersion = 2;
 inline constexpr const char* kModuleEntry = "picksight_codecs_table";
 
 }  // namespace picksight::codecs

@@ -70,12 +70,12 @@ TEST_CASE("images go through the module as through OpenCV", "[codecs]") {
   CHECK_FALSE(picksight::codecs::haveImageWriter("a.unknown-format"));
 }
 
-TEST_CASE("a video capture from the module opens files and reports a missing one", "[codecs]") {
-  auto capture = picksight::codecs::newVideoCapture();
+TEST_CASE("a video stream from the module reports a file it cannot open", "[codecs]") {
+  auto capture = picksight::codecs::newVideoStream();
   REQUIRE(capture);
   CHECK_FALSE(capture->isOpened());
   TempDir dir;
-  CHECK_FALSE(capture->open(dir.file("missing.mp4"), cv::CAP_FFMPEG));
+  CHECK_FALSE(capture->open(dir.file("missing.mp4"), cv::CAP_FFMPEG, {}));
   CHECK_FALSE(capture->isOpened());
 }
 

@@ -85,11 +85,11 @@ StreamSource::~StreamSource() { close(); }
 
 Result<void> StreamSource::open() {
   close();
-  std::unique_ptr<cv::VideoCapture> capture;
+  std::unique_ptr<codecs::VideoStream> capture;
   const std::vector<int> params = {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, kOpenTimeoutMs,
                                    cv::CAP_PROP_READ_TIMEOUT_MSEC, kReadTimeoutMs};
   try {
-    capture = codecs::newVideoCapture();
+    capture = codecs::newVideoStream();
     capture->open(url_, cv::CAP_FFMPEG, params);
   } catch (const std::exception& e) {
     // cv::Exception, or the codecs module missing from the installation.
@@ -136,7 +136,7 @@ SourceInfo StreamSource::info() const {
 }
 
 void StreamSource::readLoop() {
-  cv::VideoCapture& capture = *capture_;
+  codecs::VideoStream& capture = *capture_;
   bool rewound = false;  // a file that fails right after a rewind is broken, not at its end
   for (;;) {
     {

@@ -13,8 +13,8 @@
 
 #include "picksight/sources/source.hpp"
 
-namespace cv {
-class VideoCapture;
+namespace picksight::codecs {
+class VideoStream;
 }
 
 namespace picksight::video {
@@ -53,7 +53,7 @@ class StreamDelay {
 };
 
 // Threading: the public methods are called from the camera's acquisition
-// thread only. While open, a reader thread owns the VideoCapture and reads
+// thread only. While open, a reader thread owns the VideoStream and reads
 // continuously, keeping only the newest frame: a network stream that is not
 // drained builds up latency (RTSP) or stalls the sender (HTTP), and a read
 // that blocks on a silent server must not hold up the camera's commands.
@@ -92,7 +92,7 @@ class StreamSource : public Source {
   const bool is_file_;  // no "scheme://": seekable, so it loops
   // Used by the reader thread only while it runs; created in open() and
   // destroyed in close() after the reader has stopped.
-  std::unique_ptr<cv::VideoCapture> capture_;
+  std::unique_ptr<codecs::VideoStream> capture_;
   std::thread reader_;
   int width_ = 0;
   int height_ = 0;

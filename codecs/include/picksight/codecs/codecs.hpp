@@ -24,7 +24,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
+#include <opencv2/videoio.hpp>  // the cv::CAP_* enums
 
 namespace picksight::codecs {
 
@@ -35,10 +35,24 @@ bool imencode(const std::string& ext, cv::InputArray image, std::vector<uchar>& 
               const std::vector<int>& params = {});
 bool haveImageWriter(const std::string& path);
 
-// A closed cv::VideoCapture made by the module. Every member of
-// cv::VideoCapture a caller uses is virtual (open, read, get, set, release,
-// the destructor), so calls reach videoio through the object's own table.
-std::unique_ptr<cv::VideoCapture> newVideoCapture();
+// A video stream read by OpenCV's cv::VideoCapture inside the module. The
+// interface is PickSight's own, not cv::VideoCapture's, so that a program
+// needs nothing of videoio to call it (UBSan's checks of a call through a
+// pointer need the class's type information, which videoio would define).
+// Each member does what cv::VideoCapture's member of the same name does.
+class VideoStream {
+ public:
+  virtual ~VideoStream() = default;
+  virtual bool open(const std::string& url, int api, const std::vector<int>& params) = 0;
+  virtual bool isOpened() const = 0;
+  virtual bool grab() = 0;
+  virtual bool retrieve(cv::Mat& image) = 0;
+  virtual double get(int property) const = 0;
+  virtual bool set(int property, double value) = 0;
+};
+
+// A stream not yet opened.
+std::unique_ptr<VideoStream> newVideoStream();
 
 // Where the module is looked for: <directory of this executable>/../lib/
 // picksight/libpicksight_codecs.so (build/bin and build/tests find build/lib;
