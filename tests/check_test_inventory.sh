@@ -84,7 +84,7 @@ fi
 # Per binary, the entry's own arguments must run the cases it stands for:
 # every case the binary lists (never a hidden one: any test spec, even one
 # that only leaves cases out, makes Catch 2 select hidden cases too), less
-# the [accuracy] ones where the build leaves them out
+# the [accuracy] and [sweep] ones where the build leaves them out
 # (PICKSIGHT_TEST_SKIP_ACCURACY).
 if [ "$mode" = per-binary ]; then
   (cd "$build" && ctest --show-only=json-v1) >"$work/ctest.json"
@@ -102,7 +102,7 @@ PY
     name="$(basename "$binary")"
     cp "$work/listed.$name" "$work/want"
     if [ "${#command[@]}" -gt 1 ]; then
-      "$binary" "[accuracy]" --list-test-names-only | sort >"$work/left_out" || true
+      "$binary" "[accuracy],[sweep]" --list-test-names-only | sort >"$work/left_out" || true
       comm -23 "$work/want" "$work/left_out" >"$work/want.kept"
       mv "$work/want.kept" "$work/want"
     fi

@@ -832,7 +832,7 @@ TEST_CASE("touching parts whose corners the light blurs are found from what thei
 }
 
 TEST_CASE("parts taught alone on gravel keep their own outline and are found touching",
-          "[vision_app][learn][locate][front]") {
+          "[vision_app][learn][locate][front][sweep]") {
   // A part alone in a whole frame of photographed gravel: the frame is
   // surface but for a hundredth of it, and its levels are no two
   // populations. Otsu split the stones' own shades, the contrast came out
@@ -913,7 +913,7 @@ cv::Mat onGravelAsTaught(const std::string& name, int size_px, uint64_t k,
 }  // namespace
 
 TEST_CASE("stones a part's teach outline took in do not keep it from being found touching",
-          "[vision_app][learn][locate][front]") {
+          "[vision_app][learn][locate][front][sweep]") {
   // On photographed gravel a dark stone against the part joins it in the
   // teach image's mask: a bump of a few pixels on the outline, a stretch
   // too short for its primitive's median contrast to see. In a scene the
@@ -1752,7 +1752,7 @@ TEST_CASE("a separated part beside a shadow that joins it is placed on its edges
 }
 
 TEST_CASE("a slender part on wood is taught with the app's own settings and found there",
-          "[vision_app][learn][front]") {
+          "[vision_app][learn][front][sweep]") {
   // A public tulip (Tari-1000) on a long thin stem, 260 px long, on wood in
   // a 1920 x 1080 frame, the vision app's default settings. LEARN read it
   // whole with the frame's own window (180 px), then again with one as wide
@@ -1826,7 +1826,7 @@ cv::Mat againstWall(const cv::Mat& image, const cv::Mat& dark, cv::Point part, i
 }  // namespace
 
 TEST_CASE("a part against a tray's wall at the frame's edge is found but not one the edge cuts",
-          "[vision_app][locate][front]") {
+          "[vision_app][locate][front][sweep]") {
   // A tray's wall along the left of the frame, as dark as the parts, and a
   // part lying against it: one region runs from the part off the frame.
   // LOCATE left every region the frame's edge cuts out (a part cut by it
@@ -1892,7 +1892,7 @@ TEST_CASE("a part against a tray's wall at the frame's edge is found but not one
 }
 
 TEST_CASE("the front-light benchmark's speckled corner at 30 levels holds no part",
-          "[vision_app][locate][front]") {
+          "[vision_app][locate][front][sweep]") {
   // picksight-bench-front-light --conditions low-contrast --arrangements
   // touching, scene 1, as the benchmark makes it: 14 public silhouettes
   // (Tari-1000, their third drawings) taught as the benchmark teaches them
@@ -1965,7 +1965,7 @@ TEST_CASE("the front-light benchmark's speckled corner at 30 levels holds no par
 }
 
 TEST_CASE("LEARN names a shadow only where one lies beside the part, an uneven surface otherwise",
-          "[vision_app][learn][front]") {
+          "[vision_app][learn][front][sweep]") {
   // At 30 grey levels of contrast a blotched belt, paving bricks and gravel
   // lie a quarter of the contrast off the surface's level along a tenth or
   // a fifth of a part's outline, as a cast shadow does: LEARN called each of
