@@ -16,8 +16,9 @@ namespace {
 
 const ModuleTable& table() {
   // Opened once per process (a function-local static is initialized by one
-  // thread while others wait) and never closed: frames decoded by it may
-  // outlive any caller.
+  // thread while others wait; one that threw is tried again at the next
+  // call) and never closed: a VideoStream it made runs its code for as long
+  // as the stream lives.
   static const ModuleTable* const loaded = [] {
     const std::string path = modulePath();
     void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);

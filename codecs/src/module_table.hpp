@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+
 #include "picksight/codecs/codecs.hpp"
 
 namespace picksight::codecs {

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <future>
+#include <stdexcept>
 #include <thread>
 
 #include <catch2/catch.hpp>
@@ -51,6 +52,17 @@ TEST_CASE("a starved image job runs on its caller and one caller at a time", "[w
   CHECK(second.get() == IdleWorker::Outcome::kCaller);
   release_worker.set_value();
   CHECK(first.get() == IdleWorker::Outcome::kIdle);
+  CHECK(worker.run([&] { ran = true; }) == IdleWorker::Outcome::kIdle);
+  CHECK(ran);
+}
+
+TEST_CASE("an image job that throws fails its own request, not the worker", "[web]") {
+  // Say a PNG encoder that throws, or the codecs module missing: on the
+  // worker's thread the exception would have ended the web server.
+  IdleWorker worker("test images");
+  CHECK_THROWS_WITH(worker.run([] { throw std::runtime_error("no codecs here"); }),
+                    "no codecs here");
+  bool ran = false;
   CHECK(worker.run([&] { ran = true; }) == IdleWorker::Outcome::kIdle);
   CHECK(ran);
 }

@@ -31,7 +31,13 @@ void IdleWorker::loop() {
     queue_.pop_front();
     job->started = true;
     lock.unlock();
-    job->fn();
+    try {
+      job->fn();
+    } catch (...) {
+      // Not this thread's to handle (it would end the web server): the
+      // caller's, whose request then fails alone.
+      job->error = std::current_exception();
+    }
     lock.lock();
     job->done = true;
     finished_.notify_all();
@@ -49,11 +55,15 @@ IdleWorker::Outcome IdleWorker::run(const std::function<void()>& job) {
   if (!stopping_) {
     queue_.push_back(entry);
     wake_.notify_one();
-    if (finished_.wait_for(lock, starved_, [&] { return entry->done || stopping_; }) && entry->done)
+    if (finished_.wait_for(lock, starved_, [&] { return entry->done || stopping_; }) &&
+        entry->done) {
+      if (entry->error) std::rethrow_exception(entry->error);
       return Outcome::kIdle;
+    }
     if (entry->started) {
       // Running on the worker: it finishes what it began.
       finished_.wait(lock, [&] { return entry->done; });
+      if (entry->error) std::rethrow_exception(entry->error);
       return Outcome::kIdle;
     }
     queue_.erase(std::remove(queue_.begin(), queue_.end(), entry), queue_.end());

@@ -9,11 +9,14 @@
 // A job that has waited kIdleStarved for the worker (every core busy) is
 // run by its caller instead, one such caller at a time in the whole
 // worker: a saturated machine serves an image now and then, never none.
+// A job that throws on the worker has its exception thrown again by run(),
+// in the caller's thread, as if the caller had run it.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -45,6 +48,7 @@ class IdleWorker {
     std::function<void()> fn;
     bool started = false;
     bool done = false;
+    std::exception_ptr error;  // what the job threw on the worker
   };
   void loop();
 
