@@ -13,8 +13,8 @@
 
 #include <zmq.hpp>
 
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/clock.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/transport/frame_message.hpp"
 
@@ -26,24 +26,22 @@ int main(int argc, char** argv) {
   std::string curve_server_key;
   std::string curve_key;
   std::string control;
-  CLI::App app("Receives frames for a while; prints what it got, lost and how late.",
-               "picksight-bench-subscriber");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--frames", endpoint, "the frame PUB endpoint")->type_name("E")->required();
-  app.add_option("--camera", camera, "camera to subscribe to")
-      ->type_name("C")
-      ->capture_default_str();
-  app.add_option("--seconds", seconds, "how long to receive")
-      ->type_name("S")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_flag("--bare", bare, "read the benchmark's plain ZeroMQ messages");
-  app.add_option("--curve-server-key", curve_server_key, "the server's public key: talk CURVE")
-      ->type_name("FILE");
-  app.add_option("--curve-key", curve_key, "this client's secret key file")->type_name("FILE");
-  app.add_option("--control", control, "the control endpoint (with CURVE: the frames' key)")
-      ->type_name("E");
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  picksight::cli::App app("Receives frames for a while; prints what it got, lost and how late.",
+                          "picksight-bench-subscriber");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--frames", endpoint, "the frame PUB endpoint")->typeName("E")->required();
+  app.addOption("--camera", camera, "camera to subscribe to")->typeName("C")->showDefault();
+  app.addOption("--seconds", seconds, "how long to receive")
+      ->typeName("S")
+      ->check(picksight::cli::positiveNumber())
+      ->showDefault();
+  app.addFlag("--bare", bare, "read the benchmark's plain ZeroMQ messages");
+  app.addOption("--curve-server-key", curve_server_key, "the server's public key: talk CURVE")
+      ->typeName("FILE");
+  app.addOption("--curve-key", curve_key, "this client's secret key file")->typeName("FILE");
+  app.addOption("--control", control, "the control endpoint (with CURVE: the frames' key)")
+      ->typeName("E");
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   std::optional<picksight::transport::CurveClientKeys> curve;
   if (!curve_server_key.empty()) {
     auto keys = picksight::transport::loadClientKeys(curve_key, curve_server_key);

@@ -20,9 +20,9 @@
 
 #include <zmq.hpp>
 
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/atomic_file.hpp"
 #include "picksight/common/clock.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/tool_support/subprocess.hpp"
 #include "picksight/transport/curve_server.hpp"
@@ -206,14 +206,14 @@ void row(const char* what, int n, const Summary& s) {
 
 int main(int argc, char** argv) {
   double seconds = 5;
-  CLI::App app("Frame distribution benchmark: PickSight against bare ZeroMQ.",
-               "picksight-bench-distribution");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--seconds", seconds, "length of each run")
-      ->type_name("S")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  picksight::cli::App app("Frame distribution benchmark: PickSight against bare ZeroMQ.",
+                          "picksight-bench-distribution");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--seconds", seconds, "length of each run")
+      ->typeName("S")
+      ->check(picksight::cli::positiveNumber())
+      ->showDefault();
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   const std::string dir = binDir();
   const BenchKeys keys = writeKeys();
   const std::vector<std::string> server_curve = {"--curve-secret-key", keys.server_secret};

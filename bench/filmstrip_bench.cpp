@@ -48,11 +48,11 @@ bool round(const picksight::bench::VideoServerRun& server, const std::vector<std
 
 int main(int argc, char** argv) {
   int rounds = 4;
-  const auto args =
-      picksight::bench::parseLocateArgs(argc, argv, {400, 1920, 1080, 20}, [&](CLI::App& app) {
-        app.add_option("--rounds", rounds, "alternating rounds of each (requests split among them)")
-            ->check(CLI::PositiveNumber)
-            ->capture_default_str();
+  const auto args = picksight::bench::parseLocateArgs(
+      argc, argv, {400, 1920, 1080, 20}, [&](picksight::cli::App& app) {
+        app.addOption("--rounds", rounds, "alternating rounds of each (requests split among them)")
+            ->check(picksight::cli::positiveNumber())
+            ->showDefault();
       });
   auto server = picksight::bench::startVideoServer(picksight::bench::syntheticCamera(args));
   if (!server) return 1;

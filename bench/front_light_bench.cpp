@@ -29,8 +29,8 @@
 
 #include "opencv_baseline.hpp"
 #include "picksight/cell/vision_service.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/angles.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/common/frame.hpp"
 #include "picksight/synthetic/front_light.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
@@ -559,66 +559,67 @@ int main(int argc, char** argv) {
   std::vector<std::string> conditions = {"clean",        "textured", "shadow", "glossy",
                                          "low-contrast", "colour",   "wood",   "metal"};
   std::vector<std::string> arrangements = {"separated", "touching"};
-  CLI::App app("Parts under a front-lit cell's light: teaching, recall, precision, accuracy.",
-               argc > 0 ? argv[0] : "picksight-bench-front-light");
-  app.set_help_flag("-h,--help", "print this help");
+  picksight::cli::App app(
+      "Parts under a front-lit cell's light: teaching, recall, precision, accuracy.",
+      argc > 0 ? argv[0] : "picksight-bench-front-light");
+  app.setHelpFlag("-h,--help", "print this help");
   std::vector<std::string> condition_names = ps::frontLightConditionNames();
   for (const auto& name : ps::photographedConditionNames()) condition_names.push_back(name);
-  app.add_option("--conditions", conditions,
-                 "light conditions (brick, gravel: photographed surfaces, not run by default)")
-      ->check(CLI::IsMember(condition_names));
-  app.add_option("--arrangements", arrangements, "separated, touching, overlapping")
-      ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
-  app.add_option("--scenes", s.scenes, "scenes per condition and arrangement")
-      ->check(CLI::Range(1, 50))
-      ->capture_default_str();
-  app.add_option("--rounds", s.rounds, "frames (noise) per scene, each timed")
-      ->check(CLI::Range(1, 200))
-      ->capture_default_str();
-  app.add_option("--jpeg-quality", s.jpeg_quality,
-                 "deliver every image through JPEG at this quality (0: lossless)")
-      ->check(CLI::Range(0, 100))
-      ->capture_default_str();
-  app.add_flag("--standard-types", standard_types,
-               "the 15 types of picksight-bench-silhouettes instead of unseen ones");
-  app.add_flag("--list-errors", s.list_errors,
-               "print each false report, each part missed and each placed over 0.2 px off");
-  app.add_flag("--stages", s.stages,
-               "also time binarization and the region pass alone (medians, ms): where the time "
-               "goes");
-  app.add_option("--blur", blur_sigma,
-                 "the lens's blur (Gaussian sigma, px) of scenes and teach images: a camera out "
-                 "of focus")
-      ->check(CLI::Range(0.0, 5.0))
-      ->capture_default_str();
-  app.add_option("--window", window,
-                 "the adaptive threshold's window, as the vision app's --window (0: the app's "
-                 "own, from the image and the taught parts)")
-      ->check(CLI::Range(0, 4000))
-      ->capture_default_str();
-  app.add_flag("--keep-shadows", keep_shadows,
-               "leave cast shadows joined to the parts (to measure what cutting them gains and "
-               "costs)");
-  app.add_flag("--teach-on-plain", s.teach_on_plain,
-               "teach each type on a plain surface, evenly lit (a sheet of card under the cell), "
-               "the part's and the surface's levels and colours kept; the scenes keep the "
-               "condition's light");
-  app.add_option("--teachings", teachings,
-                 "teach the cell this many times over, each type laid again for each teaching "
-                 "(another spot, another stretch of the surface, another draw of the noise), and "
-                 "run every scene with each teaching's models: one teach image's texture and noise "
-                 "move every part of its type alike, and one teaching shows one draw of that")
-      ->check(CLI::Range(1, 20));
-  app.add_option("--teach-views", s.teach_views,
-                 "teach each type from this many images of it (LEARN, then LEARNVIEW on the part "
-                 "lying elsewhere, turned), each under the teach light")
-      ->check(CLI::Range(1, 33))
-      ->capture_default_str();
-  app.add_option("--save-frames", s.save_frames,
-                 "write each scene's first frame, its binarization (-mask) and each teach image "
-                 "here (PNG), to look at");
-  app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  app.addOption("--conditions", conditions,
+                "light conditions (brick, gravel: photographed surfaces, not run by default)")
+      ->check(picksight::cli::isMember(condition_names));
+  app.addOption("--arrangements", arrangements, "separated, touching, overlapping")
+      ->check(picksight::cli::isMember({"separated", "touching", "overlapping"}));
+  app.addOption("--scenes", s.scenes, "scenes per condition and arrangement")
+      ->check(picksight::cli::range(1, 50))
+      ->showDefault();
+  app.addOption("--rounds", s.rounds, "frames (noise) per scene, each timed")
+      ->check(picksight::cli::range(1, 200))
+      ->showDefault();
+  app.addOption("--jpeg-quality", s.jpeg_quality,
+                "deliver every image through JPEG at this quality (0: lossless)")
+      ->check(picksight::cli::range(0, 100))
+      ->showDefault();
+  app.addFlag("--standard-types", standard_types,
+              "the 15 types of picksight-bench-silhouettes instead of unseen ones");
+  app.addFlag("--list-errors", s.list_errors,
+              "print each false report, each part missed and each placed over 0.2 px off");
+  app.addFlag("--stages", s.stages,
+              "also time binarization and the region pass alone (medians, ms): where the time "
+              "goes");
+  app.addOption("--blur", blur_sigma,
+                "the lens's blur (Gaussian sigma, px) of scenes and teach images: a camera out "
+                "of focus")
+      ->check(picksight::cli::range(0.0, 5.0))
+      ->showDefault();
+  app.addOption("--window", window,
+                "the adaptive threshold's window, as the vision app's --window (0: the app's "
+                "own, from the image and the taught parts)")
+      ->check(picksight::cli::range(0, 4000))
+      ->showDefault();
+  app.addFlag("--keep-shadows", keep_shadows,
+              "leave cast shadows joined to the parts (to measure what cutting them gains and "
+              "costs)");
+  app.addFlag("--teach-on-plain", s.teach_on_plain,
+              "teach each type on a plain surface, evenly lit (a sheet of card under the cell), "
+              "the part's and the surface's levels and colours kept; the scenes keep the "
+              "condition's light");
+  app.addOption("--teachings", teachings,
+                "teach the cell this many times over, each type laid again for each teaching "
+                "(another spot, another stretch of the surface, another draw of the noise), and "
+                "run every scene with each teaching's models: one teach image's texture and noise "
+                "move every part of its type alike, and one teaching shows one draw of that")
+      ->check(picksight::cli::range(1, 20));
+  app.addOption("--teach-views", s.teach_views,
+                "teach each type from this many images of it (LEARN, then LEARNVIEW on the part "
+                "lying elsewhere, turned), each under the teach light")
+      ->check(picksight::cli::range(1, 33))
+      ->showDefault();
+  app.addOption("--save-frames", s.save_frames,
+                "write each scene's first frame, its binarization (-mask) and each teach image "
+                "here (PNG), to look at");
+  app.addOption("--data", data_dir, "test data directory (shapes/...)")->showDefault();
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   if (!s.save_frames.empty() && !std::filesystem::is_directory(s.save_frames)) {
     std::fprintf(stderr, "--save-frames: %s is not a directory\n", s.save_frames.c_str());
     return 2;

@@ -7,7 +7,7 @@
 #include <functional>
 #include <string>
 
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::bench {
@@ -24,23 +24,19 @@ struct LocateArgs {
 // bad option, prints the help and exits: the callers are benchmark mains
 // with nothing to clean up yet.
 inline LocateArgs parseLocateArgs(int argc, char** argv, LocateArgs a,
-                                  const std::function<void(CLI::App&)>& more = {}) {
-  CLI::App app("LOCATE benchmark against the real processes.", argc > 0 ? argv[0] : "bench");
+                                  const std::function<void(cli::App&)>& more = {}) {
+  cli::App app("LOCATE benchmark against the real processes.", argc > 0 ? argv[0] : "bench");
   if (more) more(app);
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--requests", a.requests, "LOCATE requests to time")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--width", a.width, "image width")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--height", a.height, "image height")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--parts", a.parts, "parts in the scene")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  if (auto exit_code = parseMainArgs(app, argc, argv)) std::exit(*exit_code);
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--requests", a.requests, "LOCATE requests to time")
+      ->check(cli::positiveNumber())
+      ->showDefault();
+  app.addOption("--width", a.width, "image width")->check(cli::positiveNumber())->showDefault();
+  app.addOption("--height", a.height, "image height")->check(cli::positiveNumber())->showDefault();
+  app.addOption("--parts", a.parts, "parts in the scene")
+      ->check(cli::positiveNumber())
+      ->showDefault();
+  if (auto exit_code = cli::parseMainArgs(app, argc, argv)) std::exit(*exit_code);
   return a;
 }
 

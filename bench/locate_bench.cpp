@@ -137,17 +137,17 @@ int main(int argc, char** argv) {
   double scale = 1;
   bool learn = false;
   std::string results_bind;
-  const auto args =
-      picksight::bench::parseLocateArgs(argc, argv, {300, 1920, 1080, 20}, [&](CLI::App& app) {
-        app.add_option("--scale", scale,
-                       "camera resize (frame px per sensor px) after learning one part at full "
-                       "size; 1: no resize")
-            ->check(CLI::Range(0.05, 1.0))
-            ->capture_default_str();
-        app.add_flag("--learn", learn, "learn one part before timing (implied by --scale)");
-        app.add_option("--results-bind", results_bind,
-                       "the vision app's results stream endpoint, 'none' for no stream (default: "
-                       "the app's)");
+  const auto args = picksight::bench::parseLocateArgs(
+      argc, argv, {300, 1920, 1080, 20}, [&](picksight::cli::App& app) {
+        app.addOption("--scale", scale,
+                      "camera resize (frame px per sensor px) after learning one part at full "
+                      "size; 1: no resize")
+            ->check(picksight::cli::range(0.05, 1.0))
+            ->showDefault();
+        app.addFlag("--learn", learn, "learn one part before timing (implied by --scale)");
+        app.addOption("--results-bind", results_bind,
+                      "the vision app's results stream endpoint, 'none' for no stream (default: "
+                      "the app's)");
       });
   const int requests = args.requests, width = args.width, height = args.height, parts = args.parts;
   auto server = picksight::bench::startVideoServer(picksight::bench::syntheticCamera(args));

@@ -24,8 +24,8 @@
 #include "picksight/codecs/codecs.hpp"
 
 #include "opencv_baseline.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/angles.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/blob_search/touching_parts.hpp"
 #include "picksight/vision/models/part_model.hpp"
@@ -305,67 +305,68 @@ int main(int argc, char** argv) {
   bool per_type = true;
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> which = {"separated", "touching", "overlapping"};
-  CLI::App app("Recognition on everyday-object silhouettes: speed, precision, recall, accuracy.",
-               argc > 0 ? argv[0] : "picksight-bench-silhouettes");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--scenes", scenes, "scenes per arrangement")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--rounds", rounds, "frames (noise) per scene, each timed")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  app.add_option("--threads", threads, "OpenCV worker threads (-1: OpenCV's default)")
-      ->capture_default_str();
-  app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
-  app.add_option("--arrangements", which, "separated, touching, overlapping")
-      ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
-  app.add_flag("!--no-per-type", per_type, "families only");
+  picksight::cli::App app(
+      "Recognition on everyday-object silhouettes: speed, precision, recall, accuracy.",
+      argc > 0 ? argv[0] : "picksight-bench-silhouettes");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--scenes", scenes, "scenes per arrangement")
+      ->check(picksight::cli::positiveNumber())
+      ->showDefault();
+  app.addOption("--rounds", rounds, "frames (noise) per scene, each timed")
+      ->check(picksight::cli::positiveNumber())
+      ->showDefault();
+  app.addOption("--threads", threads, "OpenCV worker threads (-1: OpenCV's default)")
+      ->showDefault();
+  app.addOption("--data", data_dir, "test data directory (shapes/...)")->showDefault();
+  app.addOption("--arrangements", which, "separated, touching, overlapping")
+      ->check(picksight::cli::isMember({"separated", "touching", "overlapping"}));
+  app.addFlag("!--no-per-type", per_type, "families only");
   // The camera's look, for conditions the defaults do not show: a defocused
   // lens, a noisier sensor, less contrast, light parts on a dark table.
   ps::SilhouetteSceneOptions look;
   picksight::bench::addSceneSizeOptions(app, look);
-  app.add_option("--blur", look.blur_sigma, "edge blur, sigma in pixels")
-      ->check(CLI::Range(0.0, 5.0))
-      ->capture_default_str();
-  app.add_option("--noise", look.noise_sigma, "sensor noise, sigma in grey levels")
-      ->check(CLI::Range(0.0, 40.0))
-      ->capture_default_str();
-  app.add_option("--part-level", look.part_level, "grey level of the parts")
-      ->check(CLI::Range(0.0, 255.0))
-      ->capture_default_str();
-  app.add_option("--background-level", look.background_level, "grey level of the background")
-      ->check(CLI::Range(0.0, 255.0))
-      ->capture_default_str();
+  app.addOption("--blur", look.blur_sigma, "edge blur, sigma in pixels")
+      ->check(picksight::cli::range(0.0, 5.0))
+      ->showDefault();
+  app.addOption("--noise", look.noise_sigma, "sensor noise, sigma in grey levels")
+      ->check(picksight::cli::range(0.0, 40.0))
+      ->showDefault();
+  app.addOption("--part-level", look.part_level, "grey level of the parts")
+      ->check(picksight::cli::range(0.0, 255.0))
+      ->showDefault();
+  app.addOption("--background-level", look.background_level, "grey level of the background")
+      ->check(picksight::cli::range(0.0, 255.0))
+      ->showDefault();
   int jpeg_quality = 0;
-  app.add_option("--jpeg-quality", jpeg_quality,
-                 "deliver every image (training and scenes) through JPEG at this quality, as an "
-                 "IP camera or a phone's stream does (0: lossless)")
-      ->check(CLI::Range(0, 100))
-      ->capture_default_str();
+  app.addOption("--jpeg-quality", jpeg_quality,
+                "deliver every image (training and scenes) through JPEG at this quality, as an "
+                "IP camera or a phone's stream does (0: lossless)")
+      ->check(picksight::cli::range(0, 100))
+      ->showDefault();
   bool from_edges = false;
-  app.add_flag("--from-edges", from_edges,
-               "locate every blob's parts the way touching parts are (hypotheses and the edge "
-               "fit), to measure that path on separated parts");
+  app.addFlag("--from-edges", from_edges,
+              "locate every blob's parts the way touching parts are (hypotheses and the edge "
+              "fit), to measure that path on separated parts");
   bool scaling = false;
-  app.add_flag("--scaling", scaling,
-               "also time each region's recognition alone (first frame of each scene) and "
-               "print the time on 1 to 16 cores it gives, simulated");
+  app.addFlag("--scaling", scaling,
+              "also time each region's recognition alone (first frame of each scene) and "
+              "print the time on 1 to 16 cores it gives, simulated");
   bool list_false = false;
-  app.add_flag("--list-errors", list_false,
-               "print each false report (the type reported, where, and what is drawn there) and "
-               "each part missed");
+  app.addFlag("--list-errors", list_false,
+              "print each false report (the type reported, where, and what is drawn there) and "
+              "each part missed");
   std::vector<std::string> custom;
-  app.add_option("--types", custom,
-                 "train these drawings instead of the default 15 (family \"other\"): "
-                 "FILE[:SIZE_PX] under the data directory, e.g. "
-                 "shapes/tari1000/obj3_1.png:220 (size default 220)");
+  app.addOption("--types", custom,
+                "train these drawings instead of the default 15 (family \"other\"): "
+                "FILE[:SIZE_PX] under the data directory, e.g. "
+                "shapes/tari1000/obj3_1.png:220 (size default 220)");
   int model_count = 0;
-  app.add_option("--models", model_count,
-                 "train this many types (0: the scene's): fewer, the first of the scene's; more, "
-                 "the scene's and drawings never put in a scene (false reports if found)")
-      ->check(CLI::Range(0, 100))
-      ->capture_default_str();
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  app.addOption("--models", model_count,
+                "train this many types (0: the scene's): fewer, the first of the scene's; more, "
+                "the scene's and drawings never put in a scene (false reports if found)")
+      ->check(picksight::cli::range(0, 100))
+      ->showDefault();
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   // What the camera delivers of a rendered image.
   const auto delivered = [jpeg_quality](const cv::Mat& image) {
     if (jpeg_quality <= 0) return image;

@@ -23,7 +23,7 @@
 
 #include "bench_cell.hpp"
 #include "opencv_baseline.hpp"
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/store/model_library.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
 #include "picksight/vision/models/part_model.hpp"
@@ -55,26 +55,27 @@ int main(int argc, char** argv) {
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
   std::vector<std::string> which = {"separated", "touching", "overlapping"};
   ps::SilhouetteSceneOptions look;
-  CLI::App app("LOCATE ALL over the robot protocol on silhouette scenes, beside plain OpenCV.",
-               argc > 0 ? argv[0] : "picksight-bench-silhouette-locate");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--scenes", scenes, "scenes per arrangement (frames the camera cycles through)")
-      ->check(CLI::Range(1, 50))
-      ->capture_default_str();
-  app.add_option("--requests", requests, "LOCATE ALL requests timed per arrangement")
-      ->check(CLI::Range(10, 100000))
-      ->capture_default_str();
-  app.add_option("--data", data_dir, "test data directory (shapes/...)")->capture_default_str();
-  app.add_option("--arrangements", which, "separated, touching, overlapping")
-      ->check(CLI::IsMember({"separated", "touching", "overlapping"}));
+  picksight::cli::App app(
+      "LOCATE ALL over the robot protocol on silhouette scenes, beside plain OpenCV.",
+      argc > 0 ? argv[0] : "picksight-bench-silhouette-locate");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--scenes", scenes, "scenes per arrangement (frames the camera cycles through)")
+      ->check(picksight::cli::range(1, 50))
+      ->showDefault();
+  app.addOption("--requests", requests, "LOCATE ALL requests timed per arrangement")
+      ->check(picksight::cli::range(10, 100000))
+      ->showDefault();
+  app.addOption("--data", data_dir, "test data directory (shapes/...)")->showDefault();
+  app.addOption("--arrangements", which, "separated, touching, overlapping")
+      ->check(picksight::cli::isMember({"separated", "touching", "overlapping"}));
   std::vector<int> type_counts = {15};
-  app.add_option("--types", type_counts,
-                 "trained types the cell knows, one run each (the scenes' 15 first, then types "
-                 "never shown: 1-100)")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
+  app.addOption("--types", type_counts,
+                "trained types the cell knows, one run each (the scenes' 15 first, then types "
+                "never shown: 1-100)")
+      ->check(picksight::cli::range(1, 100))
+      ->showDefault();
   picksight::bench::addSceneSizeOptions(app, look);
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
 
   const auto& specs = picksight::bench::silhouetteTypeSpecs();
   const std::string cell_dir = picksight::bench::makeDataDir();

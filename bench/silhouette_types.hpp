@@ -9,7 +9,7 @@
 
 #include "picksight/codecs/codecs.hpp"
 
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/synthetic/silhouette_scene.hpp"
 
 namespace picksight::bench {
@@ -104,16 +104,16 @@ inline bool loadSilhouetteTypes(const std::vector<TypeSpec>& specs, const std::s
 
 // The scenes' frame size and part count as options (--width --height
 // --parts): 4000 x 3000 with 80 parts is a 12 MP camera's.
-inline void addSceneSizeOptions(CLI::App& app, synthetic::SilhouetteSceneOptions& look) {
-  app.add_option("--width", look.width,
-                 "frame width, px (4000 with --height 3000 --parts 80: 12 MP)")
-      ->check(CLI::Range(640, 8192))
-      ->capture_default_str();
-  app.add_option("--height", look.height, "frame height, px")
-      ->check(CLI::Range(480, 8192))
-      ->capture_default_str();
-  app.add_option("--parts", look.parts, "parts a scene (distractors included)")
-      ->check(CLI::Range(1, 400))
-      ->capture_default_str();
+inline void addSceneSizeOptions(cli::App& app, synthetic::SilhouetteSceneOptions& look) {
+  app.addOption("--width", look.width,
+                "frame width, px (4000 with --height 3000 --parts 80: 12 MP)")
+      ->check(cli::range(640, 8192))
+      ->showDefault();
+  app.addOption("--height", look.height, "frame height, px")
+      ->check(cli::range(480, 8192))
+      ->showDefault();
+  app.addOption("--parts", look.parts, "parts a scene (distractors included)")
+      ->check(cli::range(1, 400))
+      ->showDefault();
 }
 }  // namespace picksight::bench

@@ -34,7 +34,7 @@
 #include <openssl/ssl.h>
 
 #include "locate_args.hpp"
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/tool_support/subprocess.hpp"
 
 namespace {
@@ -251,24 +251,24 @@ void printRow(const char* what, const char* path, const std::vector<double>& ms)
 
 int main(int argc, char** argv) {
   Args args;
-  CLI::App app("picksight-web beside slow clients: page and API latency.", argv[0]);
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--slow", args.slow, "slow sockets")
-      ->check(CLI::Range(0, 2000))
-      ->capture_default_str();
-  app.add_option("--per-source", args.per_source, "slow sockets per source address 127.0.0.x")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
-  app.add_option("--byte-every", args.byte_every_s, "seconds between a slow socket's bytes")
-      ->check(CLI::Range(0.05, 60.0))
-      ->capture_default_str();
-  app.add_option("--seconds", args.seconds, "seconds per row")
-      ->check(CLI::Range(1.0, 3600.0))
-      ->capture_default_str();
-  app.add_flag("--tls", args.tls,
-               "HTTPS with a self-signed certificate (as the Debian package serves it); the slow "
-               "sockets complete their handshake first");
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  picksight::cli::App app("picksight-web beside slow clients: page and API latency.", argv[0]);
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--slow", args.slow, "slow sockets")
+      ->check(picksight::cli::range(0, 2000))
+      ->showDefault();
+  app.addOption("--per-source", args.per_source, "slow sockets per source address 127.0.0.x")
+      ->check(picksight::cli::range(1, 1000))
+      ->showDefault();
+  app.addOption("--byte-every", args.byte_every_s, "seconds between a slow socket's bytes")
+      ->check(picksight::cli::range(0.05, 60.0))
+      ->showDefault();
+  app.addOption("--seconds", args.seconds, "seconds per row")
+      ->check(picksight::cli::range(1.0, 3600.0))
+      ->showDefault();
+  app.addFlag("--tls", args.tls,
+              "HTTPS with a self-signed certificate (as the Debian package serves it); the slow "
+              "sockets complete their handshake first");
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   if ((args.slow + args.per_source - 1) / args.per_source > 250) {
     std::fprintf(stderr, "--slow / --per-source: more than 250 source addresses\n");
     return 2;

@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "picksight/app/app_options.hpp"
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "temp_dir.hpp"
 
 using namespace picksight;
@@ -22,7 +22,7 @@ std::string configError(const std::string& yaml) {
   const std::string path = dir.write("cell.yaml", yaml);
   auto parsed = parse({"--config", path});
   REQUIRE_FALSE(parsed);
-  CHECK(parsed.error().code == CommandLineErrc::kBadOption);
+  CHECK(parsed.error().code == cli::CommandLineErrc::kBadOption);
   // Every message names the file, so a service log points at it.
   CHECK(parsed.error().message.find(path) != std::string::npos);
   return parsed.error().message;

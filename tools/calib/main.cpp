@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "picksight/calibration/robot_camera.hpp"
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/text.hpp"
 
 using namespace picksight;
@@ -17,11 +17,11 @@ using namespace picksight;
 int main(int argc, char** argv) {
   std::string path;
   std::string method_name = "best";
-  CLI::App app("Robot-camera calibration from a CSV of point pairs.", "picksight-calib");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--csv", path,
-                 "a header line, then robot_x,robot_y,vision_x,vision_y per point (mm)")
-      ->type_name("FILE")
+  cli::App app("Robot-camera calibration from a CSV of point pairs.", "picksight-calib");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--csv", path,
+                "a header line, then robot_x,robot_y,vision_x,vision_y per point (mm)")
+      ->typeName("FILE")
       ->required();
   const std::vector<calibration::Method> all{
       calibration::Method::kBest,         calibration::Method::kGeometric,
@@ -29,11 +29,11 @@ int main(int argc, char** argv) {
       calibration::Method::kTilt,         calibration::Method::kHomography};
   std::vector<std::string> names;
   for (auto m : all) names.push_back(calibration::methodName(m));
-  app.add_option("--method", method_name, "how to fit the transform")
-      ->type_name("best|geometric|lsq|similarity|tilt|homography")
-      ->check(CLI::IsMember(names))
-      ->capture_default_str();
-  if (auto exit_code = parseMainArgs(app, argc, argv)) return *exit_code;
+  app.addOption("--method", method_name, "how to fit the transform")
+      ->typeName("best|geometric|lsq|similarity|tilt|homography")
+      ->check(cli::isMember(names))
+      ->showDefault();
+  if (auto exit_code = cli::parseMainArgs(app, argc, argv)) return *exit_code;
   calibration::Method method = calibration::Method::kBest;
   for (auto m : all) {
     if (method_name == calibration::methodName(m)) method = m;

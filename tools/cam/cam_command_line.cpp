@@ -12,7 +12,6 @@
 #include <CLI/CLI.hpp>
 
 #include "cam_cli.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::cam {
@@ -127,6 +126,14 @@ class CamHelpFormatter : public CLI::Formatter {
     return text + "\n" + app->get_footer() + "\n";
   }
 };
+
+// A CLI11 check whose message is what `check` returns for a bad value (empty
+// when the value is good). This tool declares its commands with CLI11 itself
+// (subcommands, its own help layout), which picksight::cli does not wrap.
+CLI::Validator checkValue(std::function<std::string(const std::string&)> check) {
+  return CLI::Validator([check = std::move(check)](std::string& value) { return check(value); },
+                        "");
+}
 
 // Whether `word` is meant as an option rather than a value: "-5" is a word,
 // so that roi can say why a negative X is wrong.

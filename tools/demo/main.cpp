@@ -19,8 +19,8 @@
 #include <opencv2/core.hpp>
 #include <zmq.hpp>
 
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/angles.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/common/stop_signals.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/tool_support/line_client.hpp"
@@ -292,41 +292,41 @@ int main(int argc, char** argv) {
   int height = 960;
   long long seed = 1;
   int web_port = -1;
-  CLI::App app(
+  picksight::cli::App app(
       "Quick-start demo: a whole cell on the synthetic camera and its simulated robot:\n"
       "CALCAM, STORE, COMPUTE, LEARN, GRASP and LOCATE in robot millimetres, beside the truth.",
       "picksight-demo");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--requests", requests, "LOCATE requests to send")
-      ->type_name("N")
-      ->check(CLI::Range(0, 100))
-      ->capture_default_str();
-  app.add_option("--parts", parts, "parts on the table when picking")
-      ->type_name("N")
-      ->check(CLI::Range(1, 40))
-      ->capture_default_str();
-  app.add_option("--points", points, "calibration points to STORE")
-      ->type_name("N")
-      ->check(CLI::Range(3, 64))
-      ->capture_default_str();
-  app.add_option("--width", width, "image width")
-      ->type_name("W")
-      ->check(CLI::Range(320, 4096))
-      ->capture_default_str();
-  app.add_option("--height", height, "image height")
-      ->type_name("H")
-      ->check(CLI::Range(240, 4096))
-      ->capture_default_str();
-  app.add_option("--seed", seed, "scene seed")
-      ->type_name("S")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--web", web_port,
-                 "after the script, keep the cell running with its web HMI on this port "
-                 "(127.0.0.1; 0: any free port) until interrupted")
-      ->type_name("PORT")
-      ->check(CLI::Range(0, 65535));
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--requests", requests, "LOCATE requests to send")
+      ->typeName("N")
+      ->check(picksight::cli::range(0, 100))
+      ->showDefault();
+  app.addOption("--parts", parts, "parts on the table when picking")
+      ->typeName("N")
+      ->check(picksight::cli::range(1, 40))
+      ->showDefault();
+  app.addOption("--points", points, "calibration points to STORE")
+      ->typeName("N")
+      ->check(picksight::cli::range(3, 64))
+      ->showDefault();
+  app.addOption("--width", width, "image width")
+      ->typeName("W")
+      ->check(picksight::cli::range(320, 4096))
+      ->showDefault();
+  app.addOption("--height", height, "image height")
+      ->typeName("H")
+      ->check(picksight::cli::range(240, 4096))
+      ->showDefault();
+  app.addOption("--seed", seed, "scene seed")
+      ->typeName("S")
+      ->check(picksight::cli::nonNegativeNumber())
+      ->showDefault();
+  app.addOption("--web", web_port,
+                "after the script, keep the cell running with its web HMI on this port "
+                "(127.0.0.1; 0: any free port) until interrupted")
+      ->typeName("PORT")
+      ->check(picksight::cli::range(0, 65535));
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   // Blocked before any thread or child starts: Ctrl-C reaches the demo's
   // wait (and the children's own), never a ZeroMQ thread.
   std::optional<picksight::StopSignals> stop_signals;

@@ -8,8 +8,8 @@
 #include <iostream>
 #include <string>
 
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/atomic_file.hpp"
-#include "picksight/common/command_line.hpp"
 #include "picksight/transport/curve_keys.hpp"
 
 namespace {
@@ -31,22 +31,22 @@ int main(int argc, char** argv) {
   std::string name;
   std::string dir = ".";
   bool force = false;
-  CLI::App app(
+  picksight::cli::App app(
       "Generates a ZeroMQ CURVE key pair: NAME.key holds the public key (give it to the\n"
       "peers), NAME.key_secret both keys (keep it on this host, mode 0600).",
       "picksight-keygen");
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("NAME", name, "base name of the two files (e.g. server, or a client's name)")
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("NAME", name, "base name of the two files (e.g. server, or a client's name)")
       ->required()
-      ->check(picksight::checkValue([](const std::string& v) {
+      ->check(picksight::cli::checkValue([](const std::string& v) {
         return v.empty() || v.find('/') != std::string::npos
                    ? "NAME must be a plain file name, got '" + v + "'"
                    : std::string();
       }));
-  app.add_option("--dir", dir, "where to write them")->type_name("DIR")->capture_default_str();
-  app.add_flag("--force", force, "replace existing files of that name");
+  app.addOption("--dir", dir, "where to write them")->typeName("DIR")->showDefault();
+  app.addFlag("--force", force, "replace existing files of that name");
   app.footer("Prints the public key on stdout.");
-  if (auto exit_code = picksight::parseMainArgs(app, argc, argv)) return *exit_code;
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
 
   const std::string public_path = dir + "/" + name + ".key";
   const std::string secret_path = dir + "/" + name + ".key_secret";

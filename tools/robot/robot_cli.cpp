@@ -1,10 +1,9 @@
 // picksight-robot's command line, connection and batch modes.
 #include "robot_cli.hpp"
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 
 namespace picksight::robot {
 
@@ -19,41 +18,41 @@ bool isOkReply(const std::string& reply) { return reply == "OK" || reply.rfind("
 Result<RobotOptions> parseCommandLine(const std::vector<std::string>& args) {
   RobotOptions o;
   double timeout_s = static_cast<double>(o.timeout.count()) / 1000.0;
-  CLI::App app(
+  cli::App app(
       "Sends robot-protocol requests to a PickSight vision app and prints the replies.\n"
       "With no REQUEST: reads requests from stdin, one per line, or, on a terminal,\n"
       "prompts with line editing and history (~/.picksight_robot_history).\n"
       "Exit code: 0 every reply OK, 1 an ERROR reply, 2 bad usage or no connection.",
       kProgram);
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--host", o.host, "vision app host name or address")
-      ->type_name("HOST")
-      ->capture_default_str();
-  app.add_option("--port", o.port, "robot port")
-      ->type_name("PORT")
-      ->check(CLI::Range(1, 65535))
-      ->capture_default_str();
-  app.add_option("--timeout", timeout_s, "seconds to wait for a connection or a reply")
-      ->type_name("S")
-      ->check(checkValue([](const std::string& v) {
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--host", o.host, "vision app host name or address")
+      ->typeName("HOST")
+      ->showDefault();
+  app.addOption("--port", o.port, "robot port")
+      ->typeName("PORT")
+      ->check(cli::range(1, 65535))
+      ->showDefault();
+  app.addOption("--timeout", timeout_s, "seconds to wait for a connection or a reply")
+      ->typeName("S")
+      ->check(cli::checkValue([](const std::string& v) {
         char* end = nullptr;
         const double d = std::strtod(v.c_str(), &end);
         return (end && *end == '\0' && std::isfinite(d) && d > 0 && d <= 3600)
                    ? std::string()
                    : std::string("a number of seconds in (0, 3600]");
       }))
-      ->capture_default_str();
-  app.add_option("request", o.commands, "request lines, e.g. 'LOCATE 1' (one per argument)")
-      ->type_name("REQUEST");
+      ->showDefault();
+  app.addOption("request", o.commands, "request lines, e.g. 'LOCATE 1' (one per argument)")
+      ->typeName("REQUEST");
   bool help = false;
-  if (auto ok = parseArgs(app, args, &help); !ok) return ok.error();
+  if (auto ok = cli::parseArgs(app, args, &help); !ok) return ok.error();
   if (help) {
     o.help_text = app.help();
     return o;
   }
   for (const auto& c : o.commands) {
     if (c.find_first_of("\r\n") != std::string::npos) {
-      return makeError(CommandLineErrc::kBadOption,
+      return makeError(cli::CommandLineErrc::kBadOption,
                        "a request may not hold a line break: give each one as its own argument");
     }
   }

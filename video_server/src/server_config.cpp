@@ -8,7 +8,7 @@
 #include <optional>
 #include <set>
 
-#include "picksight/common/command_line.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/video_server/video_errors.hpp"
 
@@ -258,48 +258,48 @@ struct ServerArgs {
 
 // Declares the options on `app`, bound to `a`; both parseServerArgs and
 // serverUsage use it, so the help lists exactly what is parsed.
-void defineServerOptions(CLI::App& app, ServerArgs& a) {
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--config", a.config_file,
-                 "YAML file with frames, control and cameras (see deploy/examples)")
-      ->type_name("FILE");
-  app.add_option("--source", a.sources, "a camera (default: cam0=synthetic:), repeatable")
-      ->type_name("NAME=URI")
-      ->check(checkValue([](const std::string& v) {
+void defineServerOptions(cli::App& app, ServerArgs& a) {
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--config", a.config_file,
+                "YAML file with frames, control and cameras (see deploy/examples)")
+      ->typeName("FILE");
+  app.addOption("--source", a.sources, "a camera (default: cam0=synthetic:), repeatable")
+      ->typeName("NAME=URI")
+      ->check(cli::checkValue([](const std::string& v) {
         const size_t eq = v.find('=');
         if (eq == std::string::npos || eq == 0 || eq + 1 == v.size()) {
           return "expected NAME=URI, got '" + v + "'";
         }
         return std::string();
       }));
-  app.add_option("--frames", a.frames, "frame PUB endpoint (default tcp://*:5555)")
-      ->type_name("ENDPOINT");
-  app.add_option("--control", a.control, "control REP endpoint (default tcp://*:5556)")
-      ->type_name("ENDPOINT");
-  app.add_option("--mode", a.mode, "acquisition mode of the --source cameras (default freerun)")
-      ->type_name("freerun|trigger|hardware")
-      ->check(checkValue([](const std::string& v) {
+  app.addOption("--frames", a.frames, "frame PUB endpoint (default tcp://*:5555)")
+      ->typeName("ENDPOINT");
+  app.addOption("--control", a.control, "control REP endpoint (default tcp://*:5556)")
+      ->typeName("ENDPOINT");
+  app.addOption("--mode", a.mode, "acquisition mode of the --source cameras (default freerun)")
+      ->typeName("freerun|trigger|hardware")
+      ->check(cli::checkValue([](const std::string& v) {
         auto m = parseMode(v);
         return m ? std::string() : m.error().message;
       }));
-  app.add_option("--fps", a.fps,
-                 "free-run frame rate of the --source cameras (default: a camera's own, 10 for "
-                 "the others)")
-      ->type_name("F")
-      ->check(checkValue([](const std::string& v) {
+  app.addOption("--fps", a.fps,
+                "free-run frame rate of the --source cameras (default: a camera's own, 10 for "
+                "the others)")
+      ->typeName("F")
+      ->check(cli::checkValue([](const std::string& v) {
         auto f = parseFps(v);
         return f ? std::string() : f.error().message;
       }));
-  app.add_option("--curve-secret-key", a.curve_secret_key,
-                 "CURVE: encrypt control and seal frames (once each, for every subscriber); "
-                 "the server's NAME.key_secret "
-                 "(picksight-keygen; see docs/SECURITY.md)")
-      ->type_name("FILE");
-  app.add_option("--curve-clients", a.curve_allow_list,
-                 "admit only these CURVE clients: a directory of their NAME.key files, or one "
-                 "file of public-key lines (without it any client knowing the server's public "
-                 "key gets in)")
-      ->type_name("DIR|FILE");
+  app.addOption("--curve-secret-key", a.curve_secret_key,
+                "CURVE: encrypt control and seal frames (once each, for every subscriber); "
+                "the server's NAME.key_secret "
+                "(picksight-keygen; see docs/SECURITY.md)")
+      ->typeName("FILE");
+  app.addOption("--curve-clients", a.curve_allow_list,
+                "admit only these CURVE clients: a directory of their NAME.key files, or one "
+                "file of public-key lines (without it any client knowing the server's public "
+                "key gets in)")
+      ->typeName("DIR|FILE");
   app.footer(
       "Sources (URI):\n"
       "  aravis:<device-id>        GigE Vision / USB3 Vision (empty id: first found)\n"
@@ -315,26 +315,27 @@ void defineServerOptions(CLI::App& app, ServerArgs& a) {
       "On start it prints 'frames <endpoint>' and 'control <endpoint>' on stdout.");
 }
 
-CLI::App serverApp() {
-  return CLI::App("Publishes camera frames over ZeroMQ and serves camera configuration.",
+cli::App serverApp() {
+  return cli::App("Publishes camera frames over ZeroMQ and serves camera configuration.",
                   "picksight-video-server");
 }
 
 }  // namespace
 
 std::string serverUsage() {
-  CLI::App app = serverApp();
+  cli::App app = serverApp();
   ServerArgs unused;
   defineServerOptions(app, unused);
   return app.help();
 }
 
 Result<ServerConfig> parseServerArgs(const std::vector<std::string>& args, bool* help) {
-  CLI::App app = serverApp();
+  cli::App app = serverApp();
   ServerArgs a;
   defineServerOptions(app, a);
   bool wants_help = false;
-  if (auto ok = parseArgs(app, args, &wants_help, VideoErrc::kBadConfig); !ok) return ok.error();
+  if (auto ok = cli::parseArgs(app, args, &wants_help, VideoErrc::kBadConfig); !ok)
+    return ok.error();
   if (help) *help = wants_help;
   ServerConfig config;
   if (wants_help) return config;

@@ -9,9 +9,9 @@
 #include <filesystem>
 #include <set>
 
+#include "picksight/cli/command_line.hpp"
+#include "picksight/cli/config_file.hpp"
 #include "picksight/common/atomic_file.hpp"
-#include "picksight/common/command_line.hpp"
-#include "picksight/common/config_file.hpp"
 #include "picksight/common/text.hpp"
 #include "picksight/web/web_errors.hpp"
 
@@ -58,111 +58,110 @@ Result<VisionAppEndpoint> parseVisionApp(const std::string& text) {
 }
 
 template <typename F>
-CLI::Validator checkEach(F parse) {
-  return checkValue([parse](const std::string& value) {
+cli::Validator checkEach(F parse) {
+  return cli::checkValue([parse](const std::string& value) {
     auto parsed = parse(value);
     return parsed ? std::string() : parsed.error().message;
   });
 }
 
-CLI::Validator checkAllowList() {
-  return checkValue([](const std::string& v) {
+cli::Validator checkAllowList() {
+  return cli::checkValue([](const std::string& v) {
     auto list = AllowList::parse(v);
     return list ? std::string() : list.error().message;
   });
 }
 
-void defineOptions(CLI::App& app, WebOptions& o, RawOptions& raw) {
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--listen", raw.listen,
-                 "HOST:PORT to serve HTTP on (port 0: any free port; prints 'web http://...')")
-      ->check(checkValue(checkHostPort))
-      ->capture_default_str();
-  app.add_option("--video-server", raw.video_servers,
-                 "FRAMES_ENDPOINT,CONTROL_ENDPOINT of a video server (repeatable)")
+void defineOptions(cli::App& app, WebOptions& o, RawOptions& raw) {
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--listen", raw.listen,
+                "HOST:PORT to serve HTTP on (port 0: any free port; prints 'web http://...')")
+      ->check(cli::checkValue(checkHostPort))
+      ->showDefault();
+  app.addOption("--video-server", raw.video_servers,
+                "FRAMES_ENDPOINT,CONTROL_ENDPOINT of a video server (repeatable)")
       ->check(checkEach(parseVideoServer))
-      ->take_all();
-  app.add_option("--vision-app", raw.vision_apps,
-                 "NAME,RESULTS_ENDPOINT,HOST:PORT of a vision app: its results stream "
-                 "('none': no results) and its robot or setup port (repeatable)")
+      ->takeAll();
+  app.addOption("--vision-app", raw.vision_apps,
+                "NAME,RESULTS_ENDPOINT,HOST:PORT of a vision app: its results stream "
+                "('none': no results) and its robot or setup port (repeatable)")
       ->check(checkEach(parseVisionApp))
-      ->take_all();
-  app.add_option("--assets", o.assets_dir, "directory of the page's files (index.html, ...)")
-      ->capture_default_str();
-  app.add_option("--allow", raw.allow,
-                 "peers allowed to connect: addresses or CIDR networks (default: everyone "
-                 "that reaches the listen address)")
+      ->takeAll();
+  app.addOption("--assets", o.assets_dir, "directory of the page's files (index.html, ...)")
+      ->showDefault();
+  app.addOption("--allow", raw.allow,
+                "peers allowed to connect: addresses or CIDR networks (default: everyone "
+                "that reaches the listen address)")
       ->check(checkAllowList());
-  app.add_option("--allow-host", raw.allow_hosts,
-                 "names and addresses this server answers to, as a request's Host and a "
-                 "browser's Origin give them (repeatable, or comma-separated; '*': any; default: "
-                 "localhost, loopback, this machine's names and addresses)")
-      ->take_all();
-  app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality of the streams")
-      ->check(CLI::Range(10, 100))
-      ->capture_default_str();
-  app.add_option("--max-streams", o.max_streams, "concurrent MJPEG and event streams")
-      ->check(CLI::Range(1, 200))
-      ->capture_default_str();
-  app.add_option("--header-timeout", raw.header_timeout_s,
-                 "seconds a connection has to deliver its whole request (header and body); "
-                 "no byte restarts it")
-      ->check(CLI::Range(1, 300))
-      ->capture_default_str();
-  app.add_option("--per-address", o.per_address,
-                 "connections open at once from one address (streams included)")
-      ->check(CLI::Range(1, 1024))
-      ->capture_default_str();
-  app.add_option(
-      "--users", o.users_file,
-      "the users file (argon2id hashes, written through the page's Users tab); with no "
-      "users, an 'admin' with a random password printed once (default: in memory)");
-  app.add_option("--session-timeout", raw.session_timeout_s,
-                 "seconds without a request after which a login ends")
-      ->check(CLI::Range(1, 86400))
-      ->capture_default_str();
-  app.add_option("--audit-file", o.audit_file,
-                 "the audit trail: every change made and every login through the page, one JSON "
-                 "record a line (default: audit.jsonl beside the --users file; without one, the "
-                 "newest 1000 records in memory)");
-  app.add_option("--audit-max-kib", raw.audit_max_kib,
-                 "KiB one audit file may hold before the next is started (x --audit-files: "
-                 "65536 at most)")
-      ->check(CLI::Range(16, 65536))
-      ->capture_default_str();
-  app.add_option("--audit-files", o.audit_files,
-                 "audit files kept, the current one included (the oldest beyond is deleted)")
-      ->check(CLI::Range(2, 100))
-      ->capture_default_str();
-  app.add_option("--metrics-token", raw.metrics_token_file,
-                 "FILE holding a bearer token (16..256 printable characters; the file not "
-                 "readable by others) with which GET /metrics needs no login: "
-                 "'Authorization: Bearer TOKEN'");
-  app.add_option("--metrics-allow", raw.metrics_allow,
-                 "peers (addresses or CIDR networks) that may GET /metrics without a login")
+  app.addOption("--allow-host", raw.allow_hosts,
+                "names and addresses this server answers to, as a request's Host and a "
+                "browser's Origin give them (repeatable, or comma-separated; '*': any; default: "
+                "localhost, loopback, this machine's names and addresses)")
+      ->takeAll();
+  app.addOption("--jpeg-quality", o.jpeg_quality, "JPEG quality of the streams")
+      ->check(cli::range(10, 100))
+      ->showDefault();
+  app.addOption("--max-streams", o.max_streams, "concurrent MJPEG and event streams")
+      ->check(cli::range(1, 200))
+      ->showDefault();
+  app.addOption("--header-timeout", raw.header_timeout_s,
+                "seconds a connection has to deliver its whole request (header and body); "
+                "no byte restarts it")
+      ->check(cli::range(1, 300))
+      ->showDefault();
+  app.addOption("--per-address", o.per_address,
+                "connections open at once from one address (streams included)")
+      ->check(cli::range(1, 1024))
+      ->showDefault();
+  app.addOption("--users", o.users_file,
+                "the users file (argon2id hashes, written through the page's Users tab); with no "
+                "users, an 'admin' with a random password printed once (default: in memory)");
+  app.addOption("--session-timeout", raw.session_timeout_s,
+                "seconds without a request after which a login ends")
+      ->check(cli::range(1, 86400))
+      ->showDefault();
+  app.addOption("--audit-file", o.audit_file,
+                "the audit trail: every change made and every login through the page, one JSON "
+                "record a line (default: audit.jsonl beside the --users file; without one, the "
+                "newest 1000 records in memory)");
+  app.addOption("--audit-max-kib", raw.audit_max_kib,
+                "KiB one audit file may hold before the next is started (x --audit-files: "
+                "65536 at most)")
+      ->check(cli::range(16, 65536))
+      ->showDefault();
+  app.addOption("--audit-files", o.audit_files,
+                "audit files kept, the current one included (the oldest beyond is deleted)")
+      ->check(cli::range(2, 100))
+      ->showDefault();
+  app.addOption("--metrics-token", raw.metrics_token_file,
+                "FILE holding a bearer token (16..256 printable characters; the file not "
+                "readable by others) with which GET /metrics needs no login: "
+                "'Authorization: Bearer TOKEN'");
+  app.addOption("--metrics-allow", raw.metrics_allow,
+                "peers (addresses or CIDR networks) that may GET /metrics without a login")
       ->check(checkAllowList());
-  app.add_option("--tls-cert", o.tls_cert,
-                 "PEM certificate (its chain after it): serve HTTPS instead of HTTP; with "
-                 "--tls-key")
-      ->check(CLI::ExistingFile);
-  app.add_option("--tls-key", o.tls_key,
-                 "PEM private key of --tls-cert (a file others may not read)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--http-redirect", raw.http_redirect,
-                 "HOST:PORT of a plain-HTTP port that only redirects to the HTTPS one (with "
-                 "--tls-cert; port 0: any free port, printed as 'redirect http://...')")
-      ->check(checkValue(checkHostPort));
-  app.add_option("--first-admin", o.first_admin_file,
-                 "with --users: when the users file holds no user, make 'admin' with a random "
-                 "password, write the password to FILE (created 0600, never overwritten) and "
-                 "exit; with users already, exit and change nothing (for installers)");
-  app.add_option("--config", raw.config_file,
-                 "YAML file of options, each named as its flag without dashes "
-                 "(lists for the repeatable ones); the command line overrides it");
+  app.addOption("--tls-cert", o.tls_cert,
+                "PEM certificate (its chain after it): serve HTTPS instead of HTTP; with "
+                "--tls-key")
+      ->check(cli::existingFile());
+  app.addOption("--tls-key", o.tls_key,
+                "PEM private key of --tls-cert (a file others may not read)")
+      ->check(cli::existingFile());
+  app.addOption("--http-redirect", raw.http_redirect,
+                "HOST:PORT of a plain-HTTP port that only redirects to the HTTPS one (with "
+                "--tls-cert; port 0: any free port, printed as 'redirect http://...')")
+      ->check(cli::checkValue(checkHostPort));
+  app.addOption("--first-admin", o.first_admin_file,
+                "with --users: when the users file holds no user, make 'admin' with a random "
+                "password, write the password to FILE (created 0600, never overwritten) and "
+                "exit; with users already, exit and change nothing (for installers)");
+  app.addOption("--config", raw.config_file,
+                "YAML file of options, each named as its flag without dashes "
+                "(lists for the repeatable ones); the command line overrides it");
 }
 
-CLI::App webApp() {
-  return CLI::App(
+cli::App webApp() {
+  return cli::App(
       "Web HMI of a PickSight cell: live cameras, vision results, camera settings, "
       "teaching and calibration from a browser.",
       "picksight-web");
@@ -259,7 +258,7 @@ std::string defaultAssetsDir() {
   return PICKSIGHT_WEB_INSTALLED_ASSETS;
 }
 
-std::string webUsage() { return toolUsage(webApp, defineOptions); }
+std::string webUsage() { return cli::toolUsage(webApp, defineOptions); }
 
 namespace {
 
@@ -289,8 +288,8 @@ Result<void> checkCombinations(const WebOptions& o) {
 }  // namespace
 
 Result<WebOptions> parseWebArgs(const std::vector<std::string>& args, bool* help) {
-  auto o =
-      parseToolOptions<WebOptions, RawOptions>(args, help, webApp, defineOptions, finishOptions);
+  auto o = cli::parseToolOptions<WebOptions, RawOptions>(args, help, webApp, defineOptions,
+                                                         finishOptions);
   if (!o || (help && *help)) return o;
   if (auto checked = checkCombinations(*o); !checked) return checked.error();
   return o;

@@ -1,12 +1,11 @@
 // picksight-vision option parsing, with CLI11.
 #include "picksight/app/app_options.hpp"
 
-#include <CLI/CLI.hpp>
 #include <set>
 
+#include "picksight/cli/command_line.hpp"
+#include "picksight/cli/config_file.hpp"
 #include "picksight/common/allow_list.hpp"
-#include "picksight/common/command_line.hpp"
-#include "picksight/common/config_file.hpp"
 #include "picksight/common/text.hpp"
 
 namespace picksight::app {
@@ -67,168 +66,166 @@ std::string checkThreshold(const std::string& v) {
 }
 
 // The filmstrip's directory and bounds (filmstrip.hpp).
-void defineFilmstripOptions(CLI::App& app, RawOptions& raw) {
+void defineFilmstripOptions(cli::App& app, RawOptions& raw) {
   const filmstrip::FilmstripOptions defaults;
   const auto count = [](long long high) {
-    return checkValue([high](const std::string& v) { return checkRange(v, 1, high); });
+    return cli::checkValue([high](const std::string& v) { return checkRange(v, 1, high); });
   };
-  app.add_option("--filmstrip-dir", raw.filmstrip_dir,
-                 "where the frames of recent LOCATE, WHY and PLC requests are kept "
-                 "(default DATA_DIR/filmstrip; 'none': no filmstrip)")
-      ->type_name("DIR");
-  app.add_option("--filmstrip-entries", raw.filmstrip_entries,
-                 "successful requests kept (default " + std::to_string(defaults.max_entries) + ")")
-      ->type_name("N")
+  app.addOption("--filmstrip-dir", raw.filmstrip_dir,
+                "where the frames of recent LOCATE, WHY and PLC requests are kept "
+                "(default DATA_DIR/filmstrip; 'none': no filmstrip)")
+      ->typeName("DIR");
+  app.addOption("--filmstrip-entries", raw.filmstrip_entries,
+                "successful requests kept (default " + std::to_string(defaults.max_entries) + ")")
+      ->typeName("N")
       ->check(count(1000000));
-  app.add_option("--filmstrip-mb", raw.filmstrip_mb,
-                 "their megabytes on disk at most (default " +
-                     std::to_string(defaults.max_bytes >> 20) + ")")
-      ->type_name("MB")
+  app.addOption("--filmstrip-mb", raw.filmstrip_mb,
+                "their megabytes on disk at most (default " +
+                    std::to_string(defaults.max_bytes >> 20) + ")")
+      ->typeName("MB")
       ->check(count(1000000));
-  app.add_option("--filmstrip-failures", raw.filmstrip_failures,
-                 "failed requests (nothing found, an error) and WHYs kept (default " +
-                     std::to_string(defaults.max_failures) + ")")
-      ->type_name("N")
+  app.addOption("--filmstrip-failures", raw.filmstrip_failures,
+                "failed requests (nothing found, an error) and WHYs kept (default " +
+                    std::to_string(defaults.max_failures) + ")")
+      ->typeName("N")
       ->check(count(1000000));
-  app.add_option("--filmstrip-failure-mb", raw.filmstrip_failure_mb,
-                 "their megabytes on disk at most (default " +
-                     std::to_string(defaults.max_failure_bytes >> 20) + ")")
-      ->type_name("MB")
+  app.addOption("--filmstrip-failure-mb", raw.filmstrip_failure_mb,
+                "their megabytes on disk at most (default " +
+                    std::to_string(defaults.max_failure_bytes >> 20) + ")")
+      ->typeName("MB")
       ->check(count(1000000));
-  app.add_option("--filmstrip-queue", raw.filmstrip_queue,
-                 "requests waiting to be written; beyond, successes are dropped first and "
-                 "counted (default " +
-                     std::to_string(defaults.queue) + ")")
-      ->type_name("N")
+  app.addOption("--filmstrip-queue", raw.filmstrip_queue,
+                "requests waiting to be written; beyond, successes are dropped first and "
+                "counted (default " +
+                    std::to_string(defaults.queue) + ")")
+      ->typeName("N")
       ->check(count(4096));
-  app.add_option("--filmstrip-success-ms", raw.filmstrip_interval,
-                 "a success is recorded only this long after the last one recorded (0: every "
-                 "one; failures always; default " +
-                     std::to_string(defaults.success_interval.count()) + ")")
-      ->type_name("MS")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 86400000); }));
+  app.addOption("--filmstrip-success-ms", raw.filmstrip_interval,
+                "a success is recorded only this long after the last one recorded (0: every "
+                "one; failures always; default " +
+                    std::to_string(defaults.success_interval.count()) + ")")
+      ->typeName("MS")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 0, 86400000); }));
 }
 
 // Declares the options on `app`, bound to `o` and `raw`; parseAppArgs and
 // appUsage share it, so the help lists exactly what is parsed. Long because
 // it is one declaration per option, in the order --help lists them; it
 // decides nothing.
-void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
-  app.set_help_flag("-h,--help", "print this help");
-  app.add_option("--config", raw.config_file,
-                 "YAML file of options, each named as its flag without dashes "
-                 "(robot-port: 5600); options given here override it")
-      ->type_name("FILE");
-  app.add_option("--frames", o.frames_endpoint, "video server frame endpoint")
-      ->type_name("ENDPOINT")
-      ->capture_default_str();
-  app.add_option("--control", o.control_endpoint, "video server control endpoint")
-      ->type_name("ENDPOINT")
-      ->capture_default_str();
-  app.add_option("--camera", o.camera, "camera to watch")->type_name("NAME")->capture_default_str();
-  app.add_option("--name", o.name,
-                 "this vision app's name, the results topic (default: the camera)")
-      ->type_name("NAME")
-      ->check(checkValue([](const std::string& v) {
+void defineAppOptions(cli::App& app, AppOptions& o, RawOptions& raw) {
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--config", raw.config_file,
+                "YAML file of options, each named as its flag without dashes "
+                "(robot-port: 5600); options given here override it")
+      ->typeName("FILE");
+  app.addOption("--frames", o.frames_endpoint, "video server frame endpoint")
+      ->typeName("ENDPOINT")
+      ->showDefault();
+  app.addOption("--control", o.control_endpoint, "video server control endpoint")
+      ->typeName("ENDPOINT")
+      ->showDefault();
+  app.addOption("--camera", o.camera, "camera to watch")->typeName("NAME")->showDefault();
+  app.addOption("--name", o.name, "this vision app's name, the results topic (default: the camera)")
+      ->typeName("NAME")
+      ->check(cli::checkValue([](const std::string& v) {
         return !v.empty() && v.size() <= 64 ? std::string() : "must be 1 to 64 characters";
       }));
-  app.add_option("--results-bind", o.results_bind,
-                 "ZeroMQ endpoint the results stream is published on ('none': off)")
-      ->type_name("ENDPOINT")
-      ->capture_default_str();
-  app.add_option("--robot-port", raw.robot_port,
-                 "TCP port for robot controllers (default 5600, 0 = any free)")
-      ->type_name("PORT")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
-  app.add_option("--bind", o.robot.listen.bind_address,
-                 "address the robot port listens on (robots are other hosts: all interfaces)")
-      ->type_name("ADDRESS")
-      ->capture_default_str();
-  app.add_option("--robot-allow", raw.robot_allow,
-                 "addresses or networks allowed to connect, e.g. '10.0.0.0/8 192.168.1.7' "
-                 "(default: any)")
-      ->type_name("LIST")
-      ->check(checkValue(checkAllowList));
-  app.add_flag("--robot-read-only", o.robot_read_only,
-               "the robot port refuses requests that change models, calibration or camera");
-  app.add_option("--robot-idle-timeout", raw.robot_idle_timeout,
-                 "seconds without a request before a connection is closed (default 60, 0 = never)")
-      ->type_name("SECONDS")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 86400); }));
-  app.add_option("--robot-per-address", raw.robot_per_address,
-                 "connections allowed from one address (default 32 of 64, 0 = no own limit)")
-      ->type_name("N")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 64); }));
-  app.add_option("--setup-port", raw.setup_port,
-                 "a second, full-access port for set-up (0 = any free; default: none)")
-      ->type_name("PORT")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
-  app.add_option("--setup-bind", raw.setup_bind, "address the set-up port listens on")
-      ->type_name("ADDRESS")
-      ->capture_default_str();
-  app.add_option("--data-dir", o.data_dir, "models and calibrations")
-      ->type_name("DIR")
-      ->capture_default_str();
-  app.add_option("--threshold", raw.threshold, "binarization (default adaptive)")
-      ->type_name("adaptive|otsu|fixed:LEVEL")
-      ->check(checkValue(checkThreshold));
-  app.add_option("--polarity", raw.polarity,
-                 "dark parts on light background (default) or light on dark")
-      ->type_name("dark|light")
-      ->check(checkValue([](const std::string& v) {
+  app.addOption("--results-bind", o.results_bind,
+                "ZeroMQ endpoint the results stream is published on ('none': off)")
+      ->typeName("ENDPOINT")
+      ->showDefault();
+  app.addOption("--robot-port", raw.robot_port,
+                "TCP port for robot controllers (default 5600, 0 = any free)")
+      ->typeName("PORT")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
+  app.addOption("--bind", o.robot.listen.bind_address,
+                "address the robot port listens on (robots are other hosts: all interfaces)")
+      ->typeName("ADDRESS")
+      ->showDefault();
+  app.addOption("--robot-allow", raw.robot_allow,
+                "addresses or networks allowed to connect, e.g. '10.0.0.0/8 192.168.1.7' "
+                "(default: any)")
+      ->typeName("LIST")
+      ->check(cli::checkValue(checkAllowList));
+  app.addFlag("--robot-read-only", o.robot_read_only,
+              "the robot port refuses requests that change models, calibration or camera");
+  app.addOption("--robot-idle-timeout", raw.robot_idle_timeout,
+                "seconds without a request before a connection is closed (default 60, 0 = never)")
+      ->typeName("SECONDS")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 0, 86400); }));
+  app.addOption("--robot-per-address", raw.robot_per_address,
+                "connections allowed from one address (default 32 of 64, 0 = no own limit)")
+      ->typeName("N")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 0, 64); }));
+  app.addOption("--setup-port", raw.setup_port,
+                "a second, full-access port for set-up (0 = any free; default: none)")
+      ->typeName("PORT")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
+  app.addOption("--setup-bind", raw.setup_bind, "address the set-up port listens on")
+      ->typeName("ADDRESS")
+      ->showDefault();
+  app.addOption("--data-dir", o.data_dir, "models and calibrations")
+      ->typeName("DIR")
+      ->showDefault();
+  app.addOption("--threshold", raw.threshold, "binarization (default adaptive)")
+      ->typeName("adaptive|otsu|fixed:LEVEL")
+      ->check(cli::checkValue(checkThreshold));
+  app.addOption("--polarity", raw.polarity,
+                "dark parts on light background (default) or light on dark")
+      ->typeName("dark|light")
+      ->check(cli::checkValue([](const std::string& v) {
         return v == "dark" || v == "light" ? std::string()
                                            : "must be dark or light, got '" + v + "'";
       }));
-  app.add_option("--window", raw.window,
-                 "adaptive illumination window, wider than the largest part")
-      ->type_name("PIXELS")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 8, 16384); }));
-  app.add_option("--min-area", raw.min_area,
-                 "smallest region that counts as a part (default: 50, or a twentieth of the "
-                 "smallest trained part when that is more)")
-      ->type_name("PIXELS")
-      ->check(checkValue([](const std::string& v) {
+  app.addOption("--window", raw.window, "adaptive illumination window, wider than the largest part")
+      ->typeName("PIXELS")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 8, 16384); }));
+  app.addOption("--min-area", raw.min_area,
+                "smallest region that counts as a part (default: 50, or a twentieth of the "
+                "smallest trained part when that is more)")
+      ->typeName("PIXELS")
+      ->check(cli::checkValue([](const std::string& v) {
         auto m = parseDouble(v);
         return m && *m >= 1 ? std::string() : "must be a number >= 1, got '" + v + "'";
       }));
-  app.add_option("--min-hole-area", raw.min_hole_area,
-                 "smallest hole (sensor pixels) counted in a part (default 0: every hole)")
-      ->type_name("PIXELS")
-      ->check(checkValue([](const std::string& v) {
+  app.addOption("--min-hole-area", raw.min_hole_area,
+                "smallest hole (sensor pixels) counted in a part (default 0: every hole)")
+      ->typeName("PIXELS")
+      ->check(cli::checkValue([](const std::string& v) {
         auto m = parseDouble(v);
         return m && *m >= 0 && *m <= 1e9 ? std::string()
                                          : "must be a number in [0, 1e9], got '" + v + "'";
       }));
-  app.add_option("--modbus-port", raw.modbus_port,
-                 "TCP port of the PLC (Modbus TCP) server; absent = no PLC port, 0 = any free")
-      ->type_name("PORT")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
-  app.add_option("--modbus-bind", o.plc.server.listen.bind_address,
-                 "address the Modbus port listens on")
-      ->type_name("ADDRESS")
-      ->capture_default_str();
-  app.add_option("--modbus-unit", raw.modbus_unit, "Modbus unit id answered (default 1)")
-      ->type_name("1-247")
-      ->check(checkValue([](const std::string& v) { return checkRange(v, 1, 247); }));
-  app.add_option("--modbus-allow", raw.modbus_allow,
-                 "PLCs that may connect: addresses or networks (default any)")
-      ->type_name("LIST")
-      ->check(checkValue(checkAllowList));
-  app.add_option("--modbus-word-order", raw.modbus_word_order,
-                 "32-bit values: high word first (ABCD, default) or low word first (CDAB)")
-      ->type_name("ABCD|CDAB")
-      ->check(checkValue([](const std::string& v) {
+  app.addOption("--modbus-port", raw.modbus_port,
+                "TCP port of the PLC (Modbus TCP) server; absent = no PLC port, 0 = any free")
+      ->typeName("PORT")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 0, 65535); }));
+  app.addOption("--modbus-bind", o.plc.server.listen.bind_address,
+                "address the Modbus port listens on")
+      ->typeName("ADDRESS")
+      ->showDefault();
+  app.addOption("--modbus-unit", raw.modbus_unit, "Modbus unit id answered (default 1)")
+      ->typeName("1-247")
+      ->check(cli::checkValue([](const std::string& v) { return checkRange(v, 1, 247); }));
+  app.addOption("--modbus-allow", raw.modbus_allow,
+                "PLCs that may connect: addresses or networks (default any)")
+      ->typeName("LIST")
+      ->check(cli::checkValue(checkAllowList));
+  app.addOption("--modbus-word-order", raw.modbus_word_order,
+                "32-bit values: high word first (ABCD, default) or low word first (CDAB)")
+      ->typeName("ABCD|CDAB")
+      ->check(cli::checkValue([](const std::string& v) {
         return plc::parseWordOrder(v) ? std::string() : "must be ABCD or CDAB, got '" + v + "'";
       }));
   defineFilmstripOptions(app, raw);
-  CLI::Option* server_key =
-      app.add_option("--curve-server-key", raw.curve_server_key,
-                     "talk CURVE to the video server: its public NAME.key (docs/SECURITY.md)")
-          ->type_name("FILE");
-  app.add_option("--curve-key", raw.curve_key,
-                 "this client's NAME.key_secret, for a server with an allow-list "
-                 "(default: a fresh key pair)")
-      ->type_name("FILE")
+  cli::Option* server_key =
+      app.addOption("--curve-server-key", raw.curve_server_key,
+                    "talk CURVE to the video server: its public NAME.key (docs/SECURITY.md)")
+          ->typeName("FILE");
+  app.addOption("--curve-key", raw.curve_key,
+                "this client's NAME.key_secret, for a server with an allow-list "
+                "(default: a fresh key pair)")
+      ->typeName("FILE")
       ->needs(server_key);
   app.footer(
       "On start it prints 'robot <port>', 'setup <port>' (with --setup-port), 'modbus <port>' "
@@ -236,14 +233,14 @@ void defineAppOptions(CLI::App& app, AppOptions& o, RawOptions& raw) {
       "stdout.");
 }
 
-CLI::App visionApp() {
-  return CLI::App("Subscribes to one camera of a video server and answers robot controllers.",
+cli::App visionApp() {
+  return cli::App("Subscribes to one camera of a video server and answers robot controllers.",
                   "picksight-vision");
 }
 
 }  // namespace
 
-std::string appUsage() { return toolUsage(visionApp, defineAppOptions); }
+std::string appUsage() { return cli::toolUsage(visionApp, defineAppOptions); }
 
 namespace {
 
@@ -321,8 +318,8 @@ Result<AppOptions> finishOptions(AppOptions o, RawOptions& raw) {
 }  // namespace
 
 Result<AppOptions> parseAppArgs(const std::vector<std::string>& args, bool* help) {
-  return parseToolOptions<AppOptions, RawOptions>(args, help, visionApp, defineAppOptions,
-                                                  finishOptions);
+  return cli::parseToolOptions<AppOptions, RawOptions>(args, help, visionApp, defineAppOptions,
+                                                       finishOptions);
 }
 
 }  // namespace picksight::app
