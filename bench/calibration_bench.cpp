@@ -15,6 +15,7 @@
 #include "picksight/calibration/dot_grid_model.hpp"
 #include "picksight/calibration/robot_camera.hpp"
 #include "picksight/calibration/vision_frame.hpp"
+#include "picksight/cli/command_line.hpp"
 #include "picksight/common/angles.hpp"
 
 using namespace picksight;
@@ -196,7 +197,11 @@ void timing() {
 }
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  picksight::cli::App app("Robot-camera calibration on random synthetic cells: errors per method.",
+                          "picksight-bench-calibration");
+  app.setHelpFlag("-h,--help", "print this help");
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   std::printf(
       "Robot-camera calibration on random synthetic cells (360 x 170 mm field,\n"
       "points spread over it; errors against the exact vision-to-robot map).\n"

@@ -5,7 +5,6 @@
 // included: on tmpfs they cost nothing, so the file system is printed).
 // The first load of each job reads and checks its file; later ones find
 // it parsed (JobSwitch keeps the last few), so both are printed.
-// Usage: picksight-bench-job-switch [<parent of the data dir> [<loads>]]
 #include <sys/vfs.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "picksight/app/vision_cell.hpp"
+#include "picksight/cli/command_line.hpp"
 
 namespace {
 using namespace picksight;
@@ -73,8 +73,21 @@ bool ok(const std::string& reply, const std::string& request) {
 int main(int argc, char** argv) {
   // Where the data directory goes: the working directory by default (a
   // real disk, unlike /tmp on many machines).
-  const std::string parent = argc > 1 ? argv[1] : ".";
-  const int rounds = argc > 2 ? std::atoi(argv[2]) : 40;
+  std::string parent = ".";
+  int rounds = 40;
+  picksight::cli::App app("JOB LOAD of two jobs of 16 trained types, alternately, in one cell.",
+                          "picksight-bench-job-switch");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--dir", parent,
+                "where the benchmark's data directory is made (and removed): the disk measured")
+      ->typeName("DIR")
+      ->check(picksight::cli::existingDirectory())
+      ->showDefault();
+  app.addOption("--loads", rounds, "timed loads after the first of each job")
+      ->typeName("N")
+      ->check(picksight::cli::range(1, 100000))
+      ->showDefault();
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
   const std::string dir = parent + "/picksight-job-bench-" + std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   int status = 0;

@@ -16,6 +16,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include "picksight/cli/command_line.hpp"
 #include "picksight/codecs/codecs.hpp"
 
 #include "opencv_baseline.hpp"
@@ -496,17 +497,26 @@ int main(int argc, char** argv) {
   int rounds = 10;
   bool accuracy = true;  // --accuracy 0: the speed figures alone (profiling)
   std::string data_dir = PICKSIGHT_TEST_DATA_DIR;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    const auto v = picksight::parseInt(argv[i + 1]);
-    if (a == "--scenes" && v && *v > 0) scenes = static_cast<int>(*v);
-    if (a == "--rounds" && v && *v > 0) rounds = static_cast<int>(*v);
-    if (a == "--data") data_dir = argv[i + 1];
-    if (a == "--accuracy" && v) accuracy = *v != 0;
-    // --threads 1: every instruction on the calling thread, where a profiler
-    // charges it to the step that asked for it.
-    if (a == "--threads" && v) cv::setNumThreads(static_cast<int>(*v));
-  }
+  int threads = -1;
+  picksight::cli::App app(
+      "Recognition on synthetic parts and silhouettes: precision, recall, "
+      "accuracy and speed.",
+      "picksight-bench-recognition");
+  app.setHelpFlag("-h,--help", "print this help");
+  app.addOption("--scenes", scenes, "scenes per accuracy figure")
+      ->check(picksight::cli::range(1, 1000))
+      ->showDefault();
+  app.addOption("--rounds", rounds, "timed passes per speed figure")
+      ->check(picksight::cli::range(1, 1000))
+      ->showDefault();
+  app.addOption("--accuracy", accuracy, "0: the speed figures alone (profiling)")->showDefault();
+  app.addOption("--data", data_dir, "test data directory (shapes/...)")->showDefault();
+  // 1: every instruction on the calling thread, where a profiler charges it
+  // to the step that asked for it.
+  app.addOption("--threads", threads, "OpenCV's threads (default: every core)")
+      ->check(picksight::cli::range(1, 256));
+  if (auto exit_code = picksight::cli::parseMainArgs(app, argc, argv)) return *exit_code;
+  if (threads > 0) cv::setNumThreads(threads);
   const auto& types = ps::allPartTypes();
   std::printf(
       "training on one synthetic part of each of %zu types (120 px, noise 3, blur 0.7, uneven "

@@ -31,6 +31,10 @@ Validator nonNegativeNumber() {
 
 Validator existingFile() { return Validator(std::make_shared<CLI::Validator>(CLI::ExistingFile)); }
 
+Validator existingDirectory() {
+  return Validator(std::make_shared<CLI::Validator>(CLI::ExistingDirectory));
+}
+
 Validator isMember(std::vector<std::string> names) {
   return Validator(std::make_shared<CLI::IsMember>(std::move(names)));
 }
@@ -89,6 +93,7 @@ template Option* App::addOption(const std::string&, long&, const std::string&);
 template Option* App::addOption(const std::string&, long long&, const std::string&);
 template Option* App::addOption(const std::string&, unsigned long&, const std::string&);
 template Option* App::addOption(const std::string&, double&, const std::string&);
+template Option* App::addOption(const std::string&, bool&, const std::string&);
 template Option* App::addOption(const std::string&, std::vector<std::string>&, const std::string&);
 template Option* App::addOption(const std::string&, std::vector<int>&, const std::string&);
 template Option* App::addOption(const std::string&, std::vector<double>&, const std::string&);

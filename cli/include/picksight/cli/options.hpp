@@ -37,6 +37,7 @@ class Validator {
   friend Validator positiveNumber();
   friend Validator nonNegativeNumber();
   friend Validator existingFile();
+  friend Validator existingDirectory();
   friend Validator isMember(std::vector<std::string> names);
 
   std::shared_ptr<const CLI::Validator> validator_;
@@ -48,6 +49,7 @@ Validator range(double lo, double hi);
 Validator positiveNumber();
 Validator nonNegativeNumber();
 Validator existingFile();
+Validator existingDirectory();
 // One of `names`; the help lists them.
 Validator isMember(std::vector<std::string> names);
 
