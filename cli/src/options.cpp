@@ -69,8 +69,6 @@ Option* Option::takeAll() {
   return this;
 }
 
-std::size_t Option::count() const { return option_->count(); }
-
 App::App(const std::string& description, const std::string& name)
     : app_(std::make_unique<CLI::App>(description, name)) {}
 

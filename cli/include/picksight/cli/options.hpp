@@ -6,7 +6,6 @@
 // that declare options include only this header.
 #pragma once
 
-#include <cstddef>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -28,18 +27,11 @@ namespace picksight::cli {
 class Validator {
  public:
   explicit Validator(std::function<std::string(std::string&)> check, std::string description = "");
+  // One of CLI11's own (options.cpp: the functions below).
+  explicit Validator(std::shared_ptr<const CLI::Validator> validator);
 
  private:
   friend class Option;
-  explicit Validator(std::shared_ptr<const CLI::Validator> validator);
-  friend Validator range(int lo, int hi);
-  friend Validator range(double lo, double hi);
-  friend Validator positiveNumber();
-  friend Validator nonNegativeNumber();
-  friend Validator existingFile();
-  friend Validator existingDirectory();
-  friend Validator isMember(std::vector<std::string> names);
-
   std::shared_ptr<const CLI::Validator> validator_;
 };
 
@@ -69,8 +61,6 @@ class Option {
   Option* needs(Option* other);
   // A repeated option adds to the list rather than replacing it.
   Option* takeAll();
-  // How many times the last parse saw it.
-  std::size_t count() const;
 
  private:
   CLI::Option* option_;
