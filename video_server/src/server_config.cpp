@@ -1,4 +1,4 @@
-// Command-line (CLI11) and YAML configuration of the video server.
+// Command-line (picksight::cli) and YAML configuration of the video server.
 #include "picksight/video_server/server_config.hpp"
 
 #include <yaml-cpp/yaml.h>

@@ -1,4 +1,4 @@
-// picksight-web's options (CLI11) and its YAML file.
+// picksight-web's options (picksight::cli) and its YAML file.
 #include "picksight/web/web_options.hpp"
 
 #include <sys/stat.h>

@@ -1,4 +1,4 @@
-// picksight-vision option parsing, with CLI11.
+// picksight-vision option parsing, with picksight::cli.
 #include "picksight/app/app_options.hpp"
 
 #include <set>
