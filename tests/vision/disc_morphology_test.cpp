@@ -46,6 +46,24 @@ cv::Mat randomImage(std::mt19937& rng, int width, int height, bool grey) {
   return image;
 }
 
+// A random rectangle of the image (the whole of an image too small for
+// one).
+cv::Rect randomView(std::mt19937& rng, const cv::Mat& image) {
+  if (image.cols <= 2 || image.rows <= 2) return {0, 0, image.cols, image.rows};
+  cv::Rect view;
+  view.x = std::uniform_int_distribution<int>(0, image.cols - 2)(rng);
+  view.y = std::uniform_int_distribution<int>(0, image.rows - 2)(rng);
+  view.width = std::uniform_int_distribution<int>(1, image.cols - view.x)(rng);
+  view.height = std::uniform_int_distribution<int>(1, image.rows - view.y)(rng);
+  return view;
+}
+
+// The canvas's pixels outside its centre (src's size, 2 px in) are 7 still:
+// a result written into a view stays in it.
+bool borderUntouched(const cv::Mat& canvas) {
+  return canvas.at<uint8_t>(0, 0) == 7 && canvas.at<uint8_t>(canvas.rows - 1, canvas.cols - 1) == 7;
+}
+
 int differing(const cv::Mat& a, const cv::Mat& b) {
   if (a.size() != b.size() || a.type() != b.type()) return -1;
   return cv::countNonZero(a != b);
@@ -64,15 +82,8 @@ TEST_CASE("a disc's dilation and erosion are OpenCV's to the last pixel",
       const cv::Mat image = randomImage(rng, side(rng), side(rng), grey);
       // The whole image, and a view into it (OpenCV reads the view's
       // neighbours in the larger image, up to the disc's reach).
-      cv::Rect view(0, 0, image.cols, image.rows);
-      if (trial % 2 == 1 && image.cols > 2 && image.rows > 2) {
-        std::uniform_int_distribution<int> x0(0, image.cols - 2);
-        std::uniform_int_distribution<int> y0(0, image.rows - 2);
-        view.x = x0(rng);
-        view.y = y0(rng);
-        view.width = std::uniform_int_distribution<int>(1, image.cols - view.x)(rng);
-        view.height = std::uniform_int_distribution<int>(1, image.rows - view.y)(rng);
-      }
+      const cv::Rect view =
+          trial % 2 == 1 ? randomView(rng, image) : cv::Rect(0, 0, image.cols, image.rows);
       const cv::Mat src = image(view);
       std::ostringstream what;
       what << "radius " << radius << ", " << image.cols << "x" << image.rows << " view " << view
@@ -98,8 +109,59 @@ TEST_CASE("a disc's dilation and erosion are OpenCV's to the last pixel",
       pv::erodeDisc(src, into, radius);
       cv::erode(src, expected, element);
       CHECK(differing(canvas(cv::Rect(2, 2, src.cols, src.rows)), expected) == 0);
-      CHECK(canvas.at<uint8_t>(0, 0) == 7);
-      CHECK(canvas.at<uint8_t>(canvas.rows - 1, canvas.cols - 1) == 7);
+      CHECK(borderUntouched(canvas));
+      ++compared;
+    }
+  }
+  CHECK(compared == 240);
+}
+
+TEST_CASE("a mask's dilation and erosion on rows of bits are OpenCV's to the last pixel",
+          "[vision][segmentation]") {
+  std::mt19937 rng(20261208);
+  // Up to 200 columns: rows of one to four 64-pixel words, runs crossing
+  // from one word into the next.
+  std::uniform_int_distribution<int> side(1, 200);
+  int compared = 0;
+  for (int radius = 0; radius <= 9; ++radius) {
+    const cv::Mat element = pv::discElement(radius);
+    for (int trial = 0; trial < 24; ++trial) {
+      cv::Mat image = randomImage(rng, side(rng), side(rng), false);
+      // Any non-zero value is set; OpenCV's answer is read as such.
+      if (trial % 3 == 2) image.setTo(cv::Scalar(1), image);
+      const cv::Rect view =
+          trial % 2 == 1 ? randomView(rng, image) : cv::Rect(0, 0, image.cols, image.rows);
+      const cv::Mat src = image(view);
+      // OpenCV's answer on the same view of the image as 0 and 255 (a view:
+      // its neighbours read as they are).
+      const cv::Mat binary = image != 0;
+      const cv::Mat set = binary(view);
+      std::ostringstream what;
+      what << "radius " << radius << ", " << image.cols << "x" << image.rows << " view " << view;
+      INFO(what.str());
+      cv::Mat expected;
+      cv::Mat got;
+      cv::dilate(set, expected, element);
+      pv::dilateMask(src, got, radius);
+      CHECK(differing(got, expected) == 0);
+      cv::erode(set, expected, element);
+      pv::erodeMask(src, got, radius);
+      CHECK(differing(got, expected) == 0);
+      // In place, and into a view of a larger image.
+      cv::Mat in_place = src.clone();
+      cv::dilate(set.clone(), expected, element);
+      pv::dilateMask(in_place, in_place, radius);
+      CHECK(differing(in_place, expected) == 0);
+      in_place = src.clone();
+      cv::erode(set.clone(), expected, element);
+      pv::erodeMask(in_place, in_place, radius);
+      CHECK(differing(in_place, expected) == 0);
+      cv::Mat canvas(src.rows + 4, src.cols + 4, CV_8UC1, cv::Scalar(7));
+      cv::Mat into = canvas(cv::Rect(2, 2, src.cols, src.rows));
+      pv::dilateMask(src, into, radius);
+      cv::dilate(set, expected, element);
+      CHECK(differing(canvas(cv::Rect(2, 2, src.cols, src.rows)), expected) == 0);
+      CHECK(borderUntouched(canvas));
       ++compared;
     }
   }

@@ -2,8 +2,12 @@
 #include "picksight/vision/segmentation/disc_morphology.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace picksight::vision {
@@ -129,6 +133,162 @@ cv::Mat withNeighbours(const cv::Mat& src, int radius, cv::Rect* inner) {
   return image;
 }
 }  // namespace
+
+namespace {
+// A mask's rows as bits, 64 pixels a word (pixel x in bit x % 64 of word
+// x / 64), `words` a row; the bits past the last column are clear.
+struct PackedRows {
+  int rows = 0;
+  int words = 0;
+  std::vector<uint64_t> bits;
+  uint64_t* row(int y) { return bits.data() + static_cast<size_t>(y) * static_cast<size_t>(words); }
+  const uint64_t* row(int y) const {
+    return bits.data() + static_cast<size_t>(y) * static_cast<size_t>(words);
+  }
+};
+
+// The pixels of `image` that are set (`set` true: non-zero; false: zero),
+// packed.
+PackedRows pack(const cv::Mat& image, bool set) {
+  PackedRows p;
+  p.rows = image.rows;
+  p.words = (image.cols + 63) / 64;
+  p.bits.assign(static_cast<size_t>(p.rows) * static_cast<size_t>(p.words), 0);
+  for (int y = 0; y < image.rows; ++y) {
+    const uint8_t* in = image.ptr<uint8_t>(y);
+    uint64_t* out = p.row(y);
+    int x = 0;
+#if CV_SIMD128
+    // Sixteen pixels' tests a step, as the sign bits of their bytes.
+    for (; x + 16 <= image.cols; x += 16) {
+      const cv::v_uint8x16 zero = cv::v_load(in + x) == cv::v_setzero_u8();
+      const auto lanes = static_cast<uint64_t>(
+          static_cast<unsigned>(cv::v_signmask(cv::v_reinterpret_as_s8(zero))) & 0xFFFFu);
+      out[x / 64] |= (set ? ~lanes & 0xFFFFu : lanes) << (x % 64);
+    }
+#endif
+    for (; x < image.cols; ++x) {
+      const bool on = (in[x] != 0) == set;
+      out[x / 64] |= static_cast<uint64_t>(on) << (x % 64);
+    }
+  }
+  return p;
+}
+
+// dst = src | src shifted by `d` pixels (d > 0: each bit to d columns
+// further right; d < 0: left), over a row of `words` words.
+void orShifted(const uint64_t* src, uint64_t* dst, int words, int d) {
+  const int whole = std::abs(d) / 64;
+  const int part = std::abs(d) % 64;
+  for (int i = 0; i < words; ++i) {
+    uint64_t v = 0;
+    if (d > 0) {
+      const int from = i - whole;  // the word whose bits move into word i
+      if (from >= 0) v = src[from] << part;
+      if (part != 0 && from - 1 >= 0) v |= src[from - 1] >> (64 - part);
+    } else {
+      const int from = i + whole;
+      if (from < words) v = src[from] >> part;
+      if (part != 0 && from + 1 < words) v |= src[from + 1] << (64 - part);
+    }
+    dst[i] |= v;
+  }
+}
+
+// 0xFF in byte k of entry b where bit k of b is set: eight pixels a look-up.
+const std::array<uint64_t, 256>& byteSpread() {
+  static const std::array<uint64_t, 256> table = [] {
+    std::array<uint64_t, 256> t{};
+    for (size_t b = 0; b < t.size(); ++b) {
+      for (int k = 0; k < 8; ++k) {
+        if ((b >> k) & 1u) t[b] |= uint64_t{0xFF} << (8 * k);
+      }
+    }
+    return t;
+  }();
+  return table;
+}
+
+// The dilation of the pixels of `image` set as `set` says by the disc, over
+// `inner` (a rectangle of `image`, which holds inner's neighbours as far as
+// they are to be read), into dst as 255 where the dilation is set and 0
+// elsewhere (`invert`: the other way round). Rows of bits: each of the
+// disc's run widths is the row ORed with itself shifted, and the disc's rows
+// are ORed down, a word (64 pixels) at a time.
+void dilateBits(const cv::Mat& image, const cv::Rect& inner, int radius, bool set, bool invert,
+                cv::Mat& dst) {
+  const std::vector<int> half = runHalfWidths(radius);
+  const int reach = *std::max_element(half.begin(), half.end());
+  const PackedRows packed = pack(image, set);
+  const int words = packed.words;
+  // widened[w]: the rows dilated along themselves by w either way.
+  std::vector<PackedRows> widened(static_cast<size_t>(reach) + 1);
+  widened[0] = packed;
+  for (int w = 1; w <= reach; ++w) {
+    PackedRows& next = widened[static_cast<size_t>(w)];
+    next = widened[static_cast<size_t>(w) - 1];
+    for (int y = 0; y < packed.rows; ++y) {
+      orShifted(packed.row(y), next.row(y), words, w);
+      orShifted(packed.row(y), next.row(y), words, -w);
+    }
+  }
+  // Columns past the image's last are clear in the packed rows; shifts
+  // left may have carried none in (they read beyond the row as zeros).
+  std::vector<uint64_t> out(static_cast<size_t>(words) + 1);
+  std::vector<uint8_t> bytes(static_cast<size_t>(words) * 64 + 8);
+  const std::array<uint64_t, 256>& spread = byteSpread();
+  dst.create(inner.height, inner.width, CV_8UC1);
+  for (int y = 0; y < inner.height; ++y) {
+    std::fill(out.begin(), out.end(), 0);
+    const int at = inner.y + y;
+    for (size_t i = 0; i < half.size(); ++i) {
+      const int w = half[i];
+      const int from = at + static_cast<int>(i) - radius;
+      if (w < 0 || from < 0 || from >= packed.rows) continue;
+      const uint64_t* row = widened[static_cast<size_t>(w)].row(from);
+      for (int k = 0; k < words; ++k) out[static_cast<size_t>(k)] |= row[k];
+    }
+    // Bits to bytes for the whole row, then inner's columns copied out.
+    for (int k = 0; k < words; ++k) {
+      uint64_t v = out[static_cast<size_t>(k)];
+      if (invert) v = ~v;
+      for (int b = 0; b < 8; ++b) {
+        const uint64_t eight = spread[(v >> (8 * b)) & 0xFFu];
+        std::memcpy(bytes.data() + 64 * k + 8 * b, &eight, sizeof eight);
+      }
+    }
+    std::memcpy(dst.ptr<uint8_t>(y), bytes.data() + inner.x, static_cast<size_t>(inner.width));
+  }
+}
+}  // namespace
+
+namespace {
+// dilateMask (`dilate`) or erodeMask: the erosion is the dilation of the
+// unset pixels, complemented (past the image's edge nothing is unset:
+// pixels outside take no part).
+void morphMask(const cv::Mat& src, cv::Mat& dst, int radius, bool dilate) {
+  CV_Assert(src.type() == CV_8UC1 && radius >= 0);
+  if (src.empty()) {
+    dst.create(src.size(), CV_8UC1);
+    return;
+  }
+  cv::Rect inner;
+  const cv::Mat image = withNeighbours(src, radius, &inner);
+  if (dst.data == src.data) {
+    // Written in place: the result is made aside first (the rows read
+    // overlap those written).
+    cv::Mat made;
+    dilateBits(image, inner, radius, dilate, !dilate, made);
+    made.copyTo(dst);
+    return;
+  }
+  dilateBits(image, inner, radius, dilate, !dilate, dst);
+}
+}  // namespace
+
+void dilateMask(const cv::Mat& src, cv::Mat& dst, int radius) { morphMask(src, dst, radius, true); }
+
+void erodeMask(const cv::Mat& src, cv::Mat& dst, int radius) { morphMask(src, dst, radius, false); }
 
 void dilateDisc(const cv::Mat& src, cv::Mat& dst, int radius) {
   CV_Assert(src.type() == CV_8UC1 && radius >= 0);

@@ -24,4 +24,14 @@ cv::Mat discElement(int radius);
 void dilateDisc(const cv::Mat& src, cv::Mat& dst, int radius);
 void erodeDisc(const cv::Mat& src, cv::Mat& dst, int radius);
 
+// The same for masks (non-zero: set), into 0 and 255: equal to dilateDisc
+// and erodeDisc of a mask of 0 and 255 to the last pixel, on rows of bits (a
+// word of 64 pixels ORed with itself shifted, then down the disc's rows),
+// with buffers an eighth of the image's size. On a part's box (236 x 236,
+// one thread) 19 / 26 / 33 us at radius 3 / 6 / 9 against dilateDisc's 25
+// / 41 / 58; below radius 3 slower than OpenCV's own (14 against 8 us at
+// radius 1): use dilateDisc there. `dst` may be `src` or a view, as above.
+void dilateMask(const cv::Mat& src, cv::Mat& dst, int radius);
+void erodeMask(const cv::Mat& src, cv::Mat& dst, int radius);
+
 }  // namespace picksight::vision
