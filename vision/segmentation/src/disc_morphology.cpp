@@ -232,8 +232,9 @@ void dilateBits(const cv::Mat& image, const cv::Rect& inner, int radius, bool se
       orShifted(packed.row(y), next.row(y), words, -w);
     }
   }
-  // Columns past the image's last are clear in the packed rows; shifts
-  // left may have carried none in (they read beyond the row as zeros).
+  // Bits past the image's last column are clear in `packed`, so no shift
+  // left brings one in; shifts right may set some in the widened rows,
+  // which are never copied out (only inner's columns are).
   std::vector<uint64_t> out(static_cast<size_t>(words) + 1);
   std::vector<uint8_t> bytes(static_cast<size_t>(words) * 64 + 8);
   const std::array<uint64_t, 256>& spread = byteSpread();
