@@ -777,8 +777,12 @@ cv::Mat outsideLevels(const cv::Mat& g, const cv::Mat& own, const cv::Mat& free,
     // never kept.
     const cv::v_float32x4 least = cv::v_setall_f32(kMinOutsideWeight);
     const cv::v_float32x4 unread = cv::v_setall_f32(-1.0f);
-    // Sixteen pixels a step.
+    // Sixteen pixels a step; none of them asked for, none read.
     for (; x + 16 <= out.cols; x += 16) {
+      if (!cv::v_check_any(cv::v_load(in + x) != cv::v_setzero_u8())) {
+        for (int at = x; at < x + 16; at += 4) cv::v_store(o + at, unread);
+        continue;
+      }
       const std::array<cv::v_uint32x4, 4> lanes = widened(in + x);
       for (size_t q = 0; q < lanes.size(); ++q) {
         const int at = x + 4 * static_cast<int>(q);
