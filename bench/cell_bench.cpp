@@ -131,11 +131,7 @@ Breakdown breakdown(const std::string& data_dir, int width, int height, int part
 }  // namespace
 
 int main(int argc, char** argv) {
-  // As the services do (vision_app/main.cpp): frames and the vision pass's
-  // buffers stay in the process instead of being mapped and faulted in
-  // afresh each time, which no service pays (picksight-bench-front-light,
-  // one condition: 335 K page faults and 2.0 s of system time without, 43 K
-  // and 0.4 s with).
+  // The vision pass's buffers kept, as the services keep them.
   picksight::retainLargeBuffers();
   const auto args = picksight::bench::parseLocateArgs(argc, argv, {500, 1920, 1080, 20});
   const int requests = args.requests, width = args.width, height = args.height, parts = args.parts;

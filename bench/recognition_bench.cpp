@@ -494,11 +494,7 @@ __attribute__((noinline)) void speed(const std::map<std::string, Trained>& all, 
 }  // namespace
 
 int main(int argc, char** argv) {
-  // As the services do (vision_app/main.cpp): frames and the vision pass's
-  // buffers stay in the process instead of being mapped and faulted in
-  // afresh each time, which no service pays (picksight-bench-front-light,
-  // one condition: 335 K page faults and 2.0 s of system time without, 43 K
-  // and 0.4 s with).
+  // The vision pass's buffers kept, as the services keep them.
   picksight::retainLargeBuffers();
   int scenes = 10;
   int rounds = 10;

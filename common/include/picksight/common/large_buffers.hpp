@@ -10,7 +10,10 @@
 namespace picksight {
 
 // Call once at the start of a long-running service, or of a command that
-// reads image after image, before its threads:
+// reads image after image (the offline commands, the test main, the
+// benchmarks that run the vision pass in their own process:
+// picksight-bench-front-light on one condition made 335 K page faults and
+// 2.0 s of system time without, 43 K and 0.4 s with), before its threads:
 // blocks up to 32 MiB come from the heap and freed memory is kept up to
 // 128 MiB. Costs that much resident memory at most; a service that handles
 // frames every second would map it again anyway.
