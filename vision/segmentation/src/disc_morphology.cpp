@@ -25,7 +25,7 @@ constexpr int kOwnUpTo = 2;
 
 // The half-width of each of the element's runs, row by row (-1: a row with
 // none), read from OpenCV's own element so that the pixels are its.
-std::vector<int> runHalfWidths(int radius) {
+std::vector<int> halfWidthsOf(int radius) {
   const cv::Mat e = discElement(radius);
   std::vector<int> half(static_cast<size_t>(e.rows), -1);
   for (int y = 0; y < e.rows; ++y) {
@@ -42,6 +42,20 @@ std::vector<int> runHalfWidths(int radius) {
     half[static_cast<size_t>(y)] = radius - begin;
   }
   return half;
+}
+
+// Radii whose half-widths are made once, on first use, rather than from a
+// new element at every call: the shadow cut dilates seven times a shadowed
+// part, by radii of 3 to 8 (the lens's blur widens them).
+constexpr int kKeptRadii = 16;
+
+std::vector<int> runHalfWidths(int radius) {
+  static const std::vector<std::vector<int>> kept = [] {
+    std::vector<std::vector<int>> all;
+    for (int r = 0; r <= kKeptRadii; ++r) all.push_back(halfWidthsOf(r));
+    return all;
+  }();
+  return radius <= kKeptRadii ? kept[static_cast<size_t>(radius)] : halfWidthsOf(radius);
 }
 
 // The dilation of `inner` (a rectangle of `image`) by the disc, into dst;
@@ -132,9 +146,7 @@ cv::Mat withNeighbours(const cv::Mat& src, int radius, cv::Rect* inner) {
   *inner = cv::Rect(left, top, src.cols, src.rows);
   return image;
 }
-}  // namespace
 
-namespace {
 // A mask's rows as bits, 64 pixels a word (pixel x in bit x % 64 of word
 // x / 64), `words` a row; the bits past the last column are clear.
 struct PackedRows {
@@ -267,9 +279,7 @@ void dilateBits(const cv::Mat& image, const cv::Rect& inner, int radius, bool se
     std::memcpy(dst.ptr<uint8_t>(y), bytes.data() + inner.x, static_cast<size_t>(inner.width));
   }
 }
-}  // namespace
 
-namespace {
 // dilateMask (`dilate`) or erodeMask: the erosion is the dilation of the
 // unset pixels, complemented (past the image's edge nothing is unset:
 // pixels outside take no part).

@@ -784,6 +784,16 @@ void localLevels(const cv::Mat& grey, const RowRuns& ring, Keep&& keep, const Ro
                 cv::BORDER_CONSTANT);
   cv::boxFilter(sum, sum, -1, cv::Size(kCells, kCells), cv::Point(-1, -1), false,
                 cv::BORDER_CONSTANT);
+  // Each column's cell to the left of it and its weight towards the next
+  // one, worked out once for the box rather than for each band pixel.
+  std::vector<int> left(static_cast<size_t>(grey.cols));
+  std::vector<float> towards_right(static_cast<size_t>(grey.cols));
+  for (int x = 0; x < grey.cols; ++x) {
+    const float fx = std::clamp((x + 0.5f) / kLocalCellPx - 0.5f, 0.0f, columns - 1.0f);
+    const int x0 = static_cast<int>(fx);
+    left[static_cast<size_t>(x)] = x0;
+    towards_right[static_cast<size_t>(x)] = fx - x0;
+  }
   const bool made = levels->empty();
   if (made) levels->create(grey.size(), CV_32F);
   band.forEachRun([&](int y, int a, int b) {
@@ -800,10 +810,9 @@ void localLevels(const cv::Mat& grey, const RowRuns& ring, Keep&& keep, const Ro
     for (int x = a; x < b; ++x) {
       if (!made && o[x] >= 0) continue;
       o[x] = -1;
-      const float fx = std::clamp((x + 0.5f) / kLocalCellPx - 0.5f, 0.0f, columns - 1.0f);
-      const int x0 = static_cast<int>(fx);
+      const int x0 = left[static_cast<size_t>(x)];
       const int x1 = std::min(x0 + 1, columns - 1);
-      const float wx = fx - x0;
+      const float wx = towards_right[static_cast<size_t>(x)];
       const auto at = [&](const float* top, const float* bottom) {
         return (1 - wy) * ((1 - wx) * top[x0] + wx * top[x1]) +
                wy * ((1 - wx) * bottom[x0] + wx * bottom[x1]);
