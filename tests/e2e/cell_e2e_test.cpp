@@ -179,3 +179,17 @@ TEST_CASE("camera settings pass through to the video server", "[e2e][cell]") {
   CHECK(ask(robot, "ROI") == "OK 0 0 640 480");
   CHECK(ask(robot, "PING") == "OK");
 }
+
+TEST_CASE("a camera not open yet answers a ROI read with ERROR 20 and not zeros", "[e2e][cell]") {
+  // A folder that is not there: the video server keeps retrying the camera,
+  // which never opens, so its sensor's size is never known.
+  VideoServerProcess server(
+      {"--source", "cam0=dir:/nonexistent-picksight-frames", "--mode", "trigger"});
+  VisionProcess vision(server);
+  auto robot = vision.connect();
+  const std::string roi = ask(robot, "ROI");
+  INFO(roi);
+  CHECK(roi.rfind("ERROR 20 ", 0) == 0);
+  CHECK(roi.find("cam0 has not opened yet") != std::string::npos);
+  CHECK(ask(robot, "PING") == "OK");
+}

@@ -121,6 +121,7 @@ TEST_CASE("cell commands check their arguments before the camera or a file",
   CHECK(f.protocol.handle("GRIPPER 1 LIST").rfind("ERROR 32 ", 0) == 0);
   CHECK(f.protocol.handle("EXPOSURE 1000").rfind("ERROR 21 ", 0) == 0);
   CHECK(f.protocol.handle("ROI FULL").rfind("ERROR 21 ", 0) == 0);
+  CHECK(f.protocol.handle("ROI").rfind("ERROR 21 ", 0) == 0);
   const std::string status = f.protocol.handle("STATUS");
   CHECK(status.rfind("OK frame=vision-px scale=none ", 0) == 0);
   CHECK(status.find(" skipped=0 ") != std::string::npos);

@@ -55,14 +55,10 @@ IdleWorker::Outcome IdleWorker::run(const std::function<void()>& job) {
   if (!stopping_) {
     queue_.push_back(entry);
     wake_.notify_one();
-    if (finished_.wait_for(lock, starved_, [&] { return entry->done || stopping_; }) &&
-        entry->done) {
-      if (entry->error) std::rethrow_exception(entry->error);
-      return Outcome::kIdle;
-    }
-    if (entry->started) {
-      // Running on the worker: it finishes what it began.
-      finished_.wait(lock, [&] { return entry->done; });
+    finished_.wait_for(lock, starved_, [&] { return entry->done || stopping_; });
+    // Begun on the worker by now: it finishes what it began.
+    if (entry->started) finished_.wait(lock, [&] { return entry->done; });
+    if (entry->done) {
       if (entry->error) std::rethrow_exception(entry->error);
       return Outcome::kIdle;
     }

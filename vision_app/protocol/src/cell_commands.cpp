@@ -203,9 +203,24 @@ std::string roi(const Request& r, CellContext& cell) {
   const std::string usage = "usage: ROI <x> <y> <width> <height> | ROI FULL | ROI";
   if (r.args.empty()) {
     auto answer = cell.vision.withCamera([](link::CameraLink& camera) { return camera.roi(); });
-    if (!answer)
-      return errorReply(link::CameraErrc::kCameraRefused,
-                        "ROI: " + printable(answer.error().message, 120));
+    if (!answer) {
+      // No video server: ERROR 21, as when a frame is asked for; anything
+      // else the camera's refusal.
+      Error error = answer.error();
+      if (error.code != link::CameraErrc::kNoVideoServer)
+        error.code = link::CameraErrc::kCameraRefused;
+      error.message = "ROI: " + printable(error.message, 120);
+      return errorReply(error);
+    }
+    // Until a camera first opens, the video server knows neither its
+    // sensor's size nor its output's and describes both as 0 x 0: told as
+    // the region, a robot took a size the camera does not have (all zeros,
+    // in the first moments after a start). It is told to ask again, as for
+    // a frame not yet there.
+    if (answer->width <= 0 || answer->height <= 0)
+      return errorReply(link::CameraErrc::kNoFrame,
+                        "ROI: camera " + printable(cell.vision.camera(), 64) +
+                            " has not opened yet: its size is not known until it has");
     return "OK " + std::to_string(answer->x) + " " + std::to_string(answer->y) + " " +
            std::to_string(answer->width) + " " + std::to_string(answer->height);
   }
