@@ -457,7 +457,10 @@ class RobotClient:
         return Exposure(w[0], float(w[1]))
 
     def roi(self, x=None, y=None, width=None, height=None):
-        """Reads the camera's region, or crops it (all four given)."""
+        """Reads the camera's region, or crops it (all four given).
+
+        Right after a start, before the camera has first opened, its size is
+        not known: the read raises RobotError with code 20; ask again."""
         given = [v is not None for v in (x, y, width, height)]
         if any(given):
             if not all(given):
